@@ -1,0 +1,31 @@
+#pragma once
+#include <cmath>
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+namespace accretion {
+
+using Vec2 = glm::vec2;
+using Vec3 = glm::vec3;
+using DVec3 = glm::dvec3;
+
+inline constexpr float kPi = 3.14159265358979323846f;
+inline constexpr float kInvPi = 1.0f / kPi;
+inline constexpr float kInv4Pi = 1.0f / (4.0f * kPi);
+
+/// Rec.709 / sRGB luminance of a linear RGB triple.
+inline float luminance(const Vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+inline bool isFinite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+/// Orthonormal basis around a unit vector n (Duff et al. 2017, branchless).
+inline void orthonormalBasis(const Vec3& n, Vec3& t, Vec3& b) {
+    const float sign = std::copysign(1.0f, n.z);
+    const float a = -1.0f / (sign + n.z);
+    const float c = n.x * n.y * a;
+    t = Vec3(1.0f + sign * n.x * n.x * a, sign * c, -sign * n.x);
+    b = Vec3(c, sign + n.y * n.y * a, -n.y);
+}
+
+}  // namespace accretion

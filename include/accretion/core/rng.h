@@ -1,0 +1,46 @@
+#pragma once
+#include <cstdint>
+
+#include <pcg_random.hpp>
+
+namespace accretion {
+
+/// Fixed pass ids for random streams: a new pass never shifts another's numbers.
+enum class RngPass : std::uint32_t {
+    particles = 1,      ///< particle generator
+    lightSampling = 2,  ///< uniform / power light selection
+};
+
+/// 64-bit finaliser (SplitMix64), a bijection with good avalanche.
+constexpr std::uint64_t mix64(std::uint64_t x) {
+    x += 0x9e3779b97f4a7c15ull;
+    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+    x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+    return x ^ (x >> 31);
+}
+
+/// Hash of (item, frame, pass, seed) selecting one independent stream.
+constexpr std::uint64_t streamKey(std::uint64_t item, std::uint32_t frame, RngPass pass, std::uint64_t seed) {
+    std::uint64_t h = mix64(seed);
+    h = mix64(h ^ static_cast<std::uint64_t>(pass));
+    h = mix64(h ^ frame);
+    return mix64(h ^ item);
+}
+
+/// PCG32 stream of one pixel (or particle) in one pass of one frame.
+class Rng {
+public:
+    Rng(std::uint64_t item, std::uint32_t frame, RngPass pass, std::uint64_t seed)
+        : pcg_(streamKey(item, frame, pass, seed), mix64(item ^ (std::uint64_t(frame) << 32))) {}
+
+    /// Uniform float in [0, 1).
+    float uniform() { return static_cast<float>(pcg_() >> 8) * 0x1p-24f; }
+    /// Uniform integer in [0, n).
+    std::uint32_t uniformInt(std::uint32_t n) { return pcg_(n); }
+    std::uint32_t next() { return pcg_(); }
+
+private:
+    pcg32 pcg_;
+};
+
+}  // namespace accretion

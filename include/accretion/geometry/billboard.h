@@ -1,0 +1,44 @@
+#pragma once
+#include "accretion/core/math.h"
+#include "accretion/scene/settings.h"
+
+namespace accretion {
+
+struct Camera;
+
+/// Orientation of one billboard quad: corners p +- r right +- r up, uv (0,0)
+/// at p - r right - r up; normal = right x up faces the camera.
+struct BillboardFrame {
+    Vec3 right;
+    Vec3 up;
+    Vec3 normal() const { return glm::cross(right, up); }
+};
+
+/// The frame of a billboard at p moving with v (MODEL.md section 2):
+/// view_plane: the image plane; view_point: facing the eye; velocity: facing
+/// the eye with `right` along the projected velocity (view_point if v is 0).
+BillboardFrame billboardFrame(Orientation mode, const Camera& camera, const Vec3& p, const Vec3& v);
+
+/// Quad uv in [0,1]^2 from the barycentrics (u, v) of triangle `primID`
+/// (0,1,2) or (0,2,3) with uv corners (0,0), (1,0), (1,1), (0,1).
+inline Vec2 quadUv(unsigned primID, float u, float v) {
+    return (primID & 1u) ? Vec2(u, u + v) : Vec2(u + v, v);
+}
+
+/// Inside the inscribed disc of the quad (the `disc` alpha test).
+inline bool insideDisc(Vec2 uv) {
+    const Vec2 c = uv - Vec2(0.5f);
+    return glm::dot(c, c) <= 0.25f;
+}
+
+/// Normal of the sphere impostor at quad uv: (x, y, sqrt(1-x^2-y^2)) in the
+/// billboard frame, x, y = 2 uv - 1, clamped to the rim outside the disc.
+inline Vec3 impostorNormal(const BillboardFrame& f, Vec2 uv) {
+    Vec2 q = 2.0f * uv - Vec2(1.0f);
+    const float q2 = glm::dot(q, q);
+    if (q2 > 1.0f) q /= std::sqrt(q2);
+    const float z = std::sqrt(std::max(0.0f, 1.0f - glm::dot(q, q)));
+    return glm::normalize(q.x * f.right + q.y * f.up + z * f.normal());
+}
+
+}  // namespace accretion

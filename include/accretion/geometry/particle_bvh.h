@@ -1,0 +1,76 @@
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <embree3/rtcore.h>
+
+#include "accretion/geometry/billboard.h"
+#include "accretion/geometry/clustering.h"
+#include "accretion/geometry/embree_device.h"
+#include "accretion/particles/particles.h"
+#include "accretion/scene/settings.h"
+
+namespace accretion {
+
+struct Camera;
+
+/// What one build of the acceleration structure did and holds.
+struct BvhStats {
+    std::size_t clusters = 0;       ///< BLAS count (= TLAS instances)
+    std::size_t primitives = 0;     ///< triangles (billboards) or spheres
+    bool reclustered = false;       ///< clusters recomputed this frame
+    bool refitted = false;          ///< BLAS refitted instead of rebuilt
+    double clusterSeconds = 0.0;    ///< spatial clustering time
+    double blasSeconds = 0.0;       ///< all bottom-level builds (parallel)
+    double tlasSeconds = 0.0;       ///< top-level build
+    std::int64_t embreeBytes = 0;   ///< Embree's memory after the build (memory monitor)
+};
+
+/// A primary-ray hit, decoded to the particle.
+struct SurfaceHit {
+    std::uint32_t particle;  ///< global particle index
+    std::uint32_t cluster;   ///< cluster (TLAS instance) id
+    float t;                 ///< ray distance
+    Vec2 uv;                 ///< quad uv (billboards)
+};
+
+/// The GPU's acceleration structure on Embree (MODEL.md section 2): one BLAS
+/// per particle cluster, instanced in a TLAS; billboards as two triangles
+/// (optionally with the disc alpha test as a filter function) or spheres.
+class ParticleBvh {
+public:
+    ParticleBvh(const EmbreeDevice& device, const GeometrySettings& settings);
+    ~ParticleBvh();
+    ParticleBvh(const ParticleBvh&) = delete;
+    ParticleBvh& operator=(const ParticleBvh&) = delete;
+
+    /// Build (rebuild / refit / fast_trace, per the settings) for a frame.
+    void build(const Particles& particles, const Camera& camera);
+
+    /// Closest hit along o + t d, t in [0, tfar). d need not be unit.
+    bool intersect(const Vec3& o, const Vec3& d, float tfar, SurfaceHit& hit) const;
+    /// Any hit along o + t d, t in [0, tfar): the search stops at the first.
+    bool occluded(const Vec3& o, const Vec3& d, float tfar) const;
+
+    /// The billboard frame of a particle in the current build.
+    const BillboardFrame& frame(std::uint32_t particle) const { return frames_[particle]; }
+    const Clusters& clusters() const { return clusters_; }
+    const BvhStats& stats() const { return stats_; }
+    const GeometrySettings& settings() const { return settings_; }
+
+private:
+    void releaseBlas();
+    void buildBlas(std::size_t c, const Particles& particles, bool create);
+    void buildTlas();
+
+    const EmbreeDevice& device_;
+    GeometrySettings settings_;
+    Clusters clusters_;
+    std::vector<BillboardFrame> frames_;
+    std::vector<RTCScene> blas_;
+    std::vector<RTCGeometry> geometry_;  // one per BLAS, owned by its scene
+    RTCScene tlas_ = nullptr;
+    BvhStats stats_;
+};
+
+}  // namespace accretion

@@ -1,0 +1,25 @@
+#pragma once
+#include <filesystem>
+#include <map>
+#include <string>
+
+#include "accretion/render/frame_renderer.h"
+
+namespace accretion {
+
+/// Metadata stored in every output (string attributes `accretion:<key>`).
+using OutputMetadata = std::map<std::string, std::string>;
+
+/// Write a frame as a multi-layer float32 EXR (zip): R,G,B, Le.*, Lr.*,
+/// depth.Z, N.X/Y/Z, particle.id (uint32, 0xffffffff on a miss), and when
+/// `withErrors` Lr_stderr.* and spp. Atomic: temp file + rename.
+void writeFrameExr(const std::filesystem::path& file, const FrameImage& image, bool withErrors,
+                   const OutputMetadata& metadata);
+
+/// Tonemapped 8-bit sRGB preview of an RGB buffer: scale so that the 99.5th
+/// luminance percentile of non-black pixels maps to 1 (when autoExposure),
+/// times 2^exposure, clip. Atomic.
+void writePreviewPng(const std::filesystem::path& file, const std::vector<Vec3>& rgb, std::uint32_t width,
+                     std::uint32_t height, bool autoExposure, double exposure);
+
+}  // namespace accretion

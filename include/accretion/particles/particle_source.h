@@ -1,0 +1,31 @@
+#pragma once
+#include <cstdint>
+#include <optional>
+
+#include "accretion/particles/particles.h"
+#include "accretion/scene/settings.h"
+
+namespace accretion {
+
+/// Where a frame's particles come from: the disk generator, per-frame files
+/// (velocity from consecutive frames), or a fixed in-memory set (tests).
+class ParticleSource {
+public:
+    /// From the scene: particles.file if set, else the generator.
+    explicit ParticleSource(const Settings& settings);
+    /// A fixed particle set, the same every frame (albedo/type as given).
+    static ParticleSource fixed(Particles particles);
+
+    /// The particles of a frame, albedo filled from the scene.
+    Particles frame(std::uint32_t frame) const;
+    /// True if every frame holds the same particles.
+    bool isStatic() const;
+
+private:
+    ParticleSource() = default;
+    ParticleSettings particles_;
+    Vec3 albedo_{0.8f};
+    std::optional<Particles> fixed_;
+};
+
+}  // namespace accretion

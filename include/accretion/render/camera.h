@@ -1,0 +1,32 @@
+#pragma once
+#include <cstdint>
+
+#include "accretion/core/math.h"
+#include "accretion/scene/settings.h"
+
+namespace accretion {
+
+/// A pinhole camera pose of one frame.
+struct Camera {
+    Vec3 position;       ///< eye
+    Vec3 forward;        ///< unit view direction
+    Vec3 right;          ///< unit, image +x
+    Vec3 up;             ///< unit, image +y
+    float tanHalfFov;    ///< tan(vertical fov / 2)
+    std::uint32_t width, height;
+
+    /// The camera of a frame along the scene's path.
+    static Camera atFrame(const CameraSettings& s, std::uint32_t frame);
+    static Camera lookAt(const Vec3& eye, const Vec3& target, const Vec3& up, double fovDegrees,
+                         std::uint32_t width, std::uint32_t height);
+
+    /// Unit direction of the ray through the centre of pixel (x, y); y = 0 is the top row.
+    Vec3 pixelDirection(std::uint32_t x, std::uint32_t y) const {
+        const float aspect = float(width) / float(height);
+        const float sx = ((float(x) + 0.5f) / float(width) * 2.0f - 1.0f) * tanHalfFov * aspect;
+        const float sy = (1.0f - (float(y) + 0.5f) / float(height) * 2.0f) * tanHalfFov;
+        return glm::normalize(forward + sx * right + sy * up);
+    }
+};
+
+}  // namespace accretion

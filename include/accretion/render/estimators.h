@@ -1,0 +1,54 @@
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "accretion/core/math.h"
+#include "accretion/core/progress.h"
+#include "accretion/geometry/particle_bvh.h"
+#include "accretion/render/alias_table.h"
+#include "accretion/render/gbuffer.h"
+#include "accretion/scene/settings.h"
+
+namespace accretion {
+
+/// Per-pixel estimate of the reflected light Lr.
+struct LightingImage {
+    std::vector<Vec3> Lr;        ///< estimate
+    std::vector<Vec3> Lr_stderr; ///< standard error of the estimate (0 for exact)
+    std::vector<float> spp;      ///< light samples per pixel (N-1 terms for exact: 0 is written)
+};
+
+/// Counts of the lighting pass, summed over threads (integers: deterministic).
+struct LightingCounters {
+    std::uint64_t lightTerms = 0;     ///< unshadowed terms evaluated
+    std::uint64_t shadowRays = 0;     ///< occlusion queries
+    std::uint64_t shadowOccluded = 0; ///< queries that found a blocker
+    LightingCounters& operator+=(const LightingCounters& o) {
+        lightTerms += o.lightTerms;
+        shadowRays += o.shadowRays;
+        shadowOccluded += o.shadowOccluded;
+        return *this;
+    }
+};
+
+/// Everything the lighting estimators read.
+struct LightingInputs {
+    const ParticleBvh& bvh;
+    const Particles& particles;
+    const GBuffer& gbuffer;
+    const ShadingSettings& shading;
+    const RenderSettings& render;
+    std::uint32_t frame = 0;
+    const AliasTable* powerTable = nullptr;  ///< required by `power`
+};
+
+/// Light selection pmf over luminance(I_i), for the `power` estimator.
+AliasTable buildPowerTable(const Particles& particles);
+
+/// estimateLighting (MODEL.md sections 3-4): `exact` sums every light i != j
+/// with one shadow ray each; `uniform` / `power` average S one-sample
+/// estimates f I G V / p(i), with their standard error. Per-pixel PCG streams
+/// make the result independent of the thread count.
+LightingCounters estimateLighting(const LightingInputs& in, LightingImage& out, Progress* progress = nullptr);
+
+}  // namespace accretion

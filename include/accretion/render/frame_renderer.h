@@ -1,0 +1,65 @@
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "accretion/core/pass_timer.h"
+#include "accretion/geometry/embree_device.h"
+#include "accretion/geometry/particle_bvh.h"
+#include "accretion/particles/particle_source.h"
+#include "accretion/render/camera.h"
+#include "accretion/render/estimators.h"
+#include "accretion/render/gbuffer.h"
+#include "accretion/scene/settings.h"
+
+namespace accretion {
+
+/// Every per-pixel output of one frame (the EXR layers).
+struct FrameImage {
+    std::uint32_t width = 0, height = 0;
+    std::vector<Vec3> L;              ///< pixel value: Le + Lr, or the background
+    std::vector<Vec3> Le;             ///< self-emission s_e I_j
+    LightingImage lighting;           ///< Lr, its standard error, spp
+    std::vector<float> depth;         ///< camera-space z, +inf on a miss
+    std::vector<Vec3> normal;         ///< shading normal
+    std::vector<std::uint32_t> particle; ///< hit particle id, kNoParticle on a miss
+};
+
+/// Counts and times of one frame, for stats.json.
+struct FrameStats {
+    std::uint32_t frame = 0;
+    std::size_t particles = 0;
+    BvhStats bvh;
+    std::uint64_t primaryRays = 0;
+    LightingCounters lighting;
+    std::size_t hitPixels = 0;
+    PassTimer timer;                  ///< wall time per pass name
+    double seconds = 0.0;             ///< whole frame
+};
+
+struct RenderOptions {
+    bool quiet = false;  ///< no progress on stderr
+};
+
+/// Renders frames of a scene: loadParticles, buildClusters,
+/// buildLightSampler, traceGBuffer, estimateLighting, composeImage.
+/// Keeps the Embree device and BVH across frames (refit needs them).
+class FrameRenderer {
+public:
+    FrameRenderer(const Settings& settings, ParticleSource source, RenderOptions options = {});
+    ~FrameRenderer();
+
+    /// Render one frame; the passes' times go to stats.timer.
+    FrameImage render(std::uint32_t frame, FrameStats& stats);
+
+    const Settings& settings() const { return settings_; }
+
+private:
+    Settings settings_;
+    ParticleSource source_;
+    RenderOptions options_;
+    std::unique_ptr<EmbreeDevice> device_;
+    std::unique_ptr<ParticleBvh> bvh_;
+};
+
+}  // namespace accretion

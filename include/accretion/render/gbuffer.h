@@ -1,0 +1,36 @@
+#pragma once
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "accretion/core/math.h"
+#include "accretion/geometry/particle_bvh.h"
+#include "accretion/render/camera.h"
+
+namespace accretion {
+
+inline constexpr std::uint32_t kNoParticle = std::numeric_limits<std::uint32_t>::max();
+
+/// One G-buffer texel: what the primary ray through the pixel centre hit.
+struct GBufferTexel {
+    std::uint32_t particle = kNoParticle; ///< hit particle, kNoParticle on a miss
+    Vec3 position{0.0f};                  ///< x on the particle's surface
+    Vec3 normal{0.0f};                    ///< shading normal n
+    Vec3 geomNormal{0.0f};                ///< geometric normal (origin offsets)
+    float depth = 0.0f;                   ///< camera-space z (along the view direction)
+    Vec2 uv{0.0f};                        ///< quad uv
+    bool hit() const { return particle != kNoParticle; }
+};
+
+struct GBuffer {
+    std::uint32_t width = 0, height = 0;
+    std::vector<GBufferTexel> texels;
+    const GBufferTexel& at(std::uint32_t x, std::uint32_t y) const { return texels[std::size_t(y) * width + x]; }
+};
+
+/// traceGBuffer: one primary ray per pixel through its centre (MODEL.md
+/// section 3). Returns the number of rays traced.
+std::uint64_t traceGBuffer(const ParticleBvh& bvh, const Particles& particles, const Camera& camera,
+                           ShadingModel model, GBuffer& gbuffer);
+
+}  // namespace accretion

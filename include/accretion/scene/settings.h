@@ -1,0 +1,204 @@
+#pragma once
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "accretion/core/math.h"
+
+namespace accretion {
+
+/// Closed/open numeric bounds of a setting, checked at load.
+struct Range {
+    double lo = -std::numeric_limits<double>::infinity();
+    double hi = std::numeric_limits<double>::infinity();
+    bool loOpen = false;  ///< lo itself is excluded
+};
+inline constexpr Range kAny{};
+inline constexpr Range kPositive{0.0, std::numeric_limits<double>::infinity(), true};
+inline constexpr Range kNonNegative{0.0, std::numeric_limits<double>::infinity(), false};
+inline constexpr Range kUnit{0.0, 1.0, false};
+
+/// Names of an enum's values, index = underlying value.
+template <class E> struct EnumNames;
+
+#define ACC_ENUM_NAMES(E, ...)                                                  \
+    template <> struct EnumNames<E> {                                           \
+        static constexpr auto names = std::to_array<std::string_view>({__VA_ARGS__}); \
+    }
+
+enum class CameraPath { static_pose, orbit, linear };
+enum class Primitive { billboard, sphere };
+enum class Orientation { view_plane, view_point, velocity };
+enum class AlphaMode { opaque, disc };
+enum class BuildPolicy { rebuild, refit, fast_trace };
+enum class ShadingModel { lambert, sphere, isotropic };
+enum class EstimatorKind { exact, uniform, power };
+
+ACC_ENUM_NAMES(CameraPath, "static", "orbit", "linear");
+ACC_ENUM_NAMES(Primitive, "billboard", "sphere");
+ACC_ENUM_NAMES(Orientation, "view_plane", "view_point", "velocity");
+ACC_ENUM_NAMES(AlphaMode, "opaque", "disc");
+ACC_ENUM_NAMES(BuildPolicy, "rebuild", "refit", "fast_trace");
+ACC_ENUM_NAMES(ShadingModel, "lambert", "sphere", "isotropic");
+ACC_ENUM_NAMES(EstimatorKind, "exact", "uniform", "power");
+
+template <class E> constexpr std::string_view enumName(E e) {
+    return EnumNames<E>::names[static_cast<std::size_t>(e)];
+}
+
+// Each settings struct lists its fields once, in visit(): the same table
+// drives parsing (with validation), writing the effective settings, and help.
+// v.field(key, member, doc, range).
+
+/// [particles]: the accretion-disk generator (MODEL.md section 1) or a file.
+struct ParticleSettings {
+    std::string file;                  ///< particle file(s), `{frame}` pattern; empty = generator
+    std::uint32_t count = 10000;       ///< number of generated particles
+    std::uint64_t seed = 1;            ///< generator seed
+    double inner_radius = 1.0;         ///< disk inner radius
+    double outer_radius = 10.0;        ///< disk outer radius
+    double thickness = 0.25;           ///< height standard deviation at the outer radius (flared)
+    double radius = 0.04;              ///< particle radius
+    double radius_jitter = 0.5;        ///< relative uniform jitter of the radius, in [0,1)
+    double gm = 20.0;                  ///< gravitational parameter G*M of the central mass
+    double time_step = 0.02;           ///< simulated time between frames
+    double inner_temperature = 12000;  ///< temperature at the inner radius, kelvin
+    double temperature_exponent = 0.75;///< T(r) = T_in (r / r_in)^(-exponent)
+    double luminosity = 1.0;           ///< intensity (luminance) of a particle at T_in
+    std::vector<double> type_bands = {4500.0, 7500.0}; ///< temperature thresholds between particle types
+    double opacity = 1.0;              ///< opacity written to the GPU buffer
+
+    template <class V> void visit(V& v) {
+        v.field("file", file, "particle file path (raw .bin or .ply), {frame} pattern; empty: use the generator");
+        v.field("count", count, "number of generated particles", Range{1, 5e7});
+        v.field("seed", seed, "generator seed");
+        v.field("inner_radius", inner_radius, "disk inner radius", kPositive);
+        v.field("outer_radius", outer_radius, "disk outer radius (> inner_radius)", kPositive);
+        v.field("thickness", thickness, "height standard deviation at the outer radius", kNonNegative);
+        v.field("radius", radius, "particle radius", kPositive);
+        v.field("radius_jitter", radius_jitter, "relative radius jitter in [0,1)", Range{0.0, 0.999});
+        v.field("gm", gm, "gravitational parameter GM (Keplerian angular speed sqrt(GM/r^3))", kNonNegative);
+        v.field("time_step", time_step, "simulated time between frames", kNonNegative);
+        v.field("inner_temperature", inner_temperature, "temperature at the inner radius (K)", Range{100.0, 1e6});
+        v.field("temperature_exponent", temperature_exponent, "T(r) = T_in (r/r_in)^-exponent", Range{0.0, 4.0});
+        v.field("luminosity", luminosity, "luminance of a particle at the inner temperature", kNonNegative);
+        v.field("type_bands", type_bands, "increasing temperature thresholds (K) between particle types", Range{0.0, 1e7});
+        v.field("opacity", opacity, "particle opacity", kUnit);
+    }
+};
+
+/// [camera]: pinhole camera and its path over frames.
+struct CameraSettings {
+    Vec3 position{0.0f, 7.0f, 17.0f};  ///< eye position at frame 0
+    Vec3 look_at{0.0f, 0.0f, 0.0f};    ///< target point at frame 0
+    Vec3 up{0.0f, 1.0f, 0.0f};         ///< up direction
+    double fov = 45.0;                 ///< vertical field of view, degrees
+    std::uint32_t width = 640;         ///< image width, pixels
+    std::uint32_t height = 360;        ///< image height, pixels
+    CameraPath path = CameraPath::static_pose; ///< pose over frames
+    double orbit_speed = 1.0;          ///< orbit: degrees per frame around the y axis through look_at
+    Vec3 end_position{0.0f, 7.0f, 17.0f}; ///< linear: eye position at frame path_frames
+    Vec3 end_look_at{0.0f, 0.0f, 0.0f};   ///< linear: target at frame path_frames
+    std::uint32_t path_frames = 100;   ///< linear: frames from start to end pose
+
+    template <class V> void visit(V& v) {
+        v.field("position", position, "eye position at frame 0");
+        v.field("look_at", look_at, "target point at frame 0");
+        v.field("up", up, "up direction");
+        v.field("fov", fov, "vertical field of view in degrees", Range{0.0, 179.0, true});
+        v.field("width", width, "image width in pixels", Range{1, 16384});
+        v.field("height", height, "image height in pixels", Range{1, 16384});
+        v.field("path", path, "camera path over frames");
+        v.field("orbit_speed", orbit_speed, "orbit: degrees per frame around the y axis", Range{-360.0, 360.0});
+        v.field("end_position", end_position, "linear: eye position at frame path_frames");
+        v.field("end_look_at", end_look_at, "linear: target at frame path_frames");
+        v.field("path_frames", path_frames, "linear: frames from start to end pose", Range{1, 1e9});
+    }
+};
+
+/// [geometry]: what the GPU's BLAS/TLAS hold (MODEL.md section 2).
+struct GeometrySettings {
+    Primitive primitive = Primitive::billboard;      ///< billboard quads or procedural spheres
+    Orientation orientation = Orientation::view_plane; ///< billboard facing
+    AlphaMode alpha = AlphaMode::opaque;             ///< billboard alpha test
+    std::uint32_t cluster_size = 100;                ///< target particles per cluster (one BLAS each)
+    BuildPolicy build = BuildPolicy::rebuild;        ///< per-frame BLAS policy
+
+    template <class V> void visit(V& v) {
+        v.field("primitive", primitive, "particle geometry");
+        v.field("orientation", orientation, "billboard orientation");
+        v.field("alpha", alpha, "billboard alpha: opaque quad or alpha-tested disc");
+        v.field("cluster_size", cluster_size, "target particles per cluster (one BLAS each)", Range{1, 1e7});
+        v.field("build", build, "per-frame BLAS policy");
+    }
+};
+
+/// [shading]: the shading equation (MODEL.md section 3).
+struct ShadingSettings {
+    ShadingModel model = ShadingModel::lambert; ///< BRDF and cosine
+    Vec3 albedo{0.8f, 0.8f, 0.8f};              ///< particle albedo rho
+    double self_emission = 1.0;                 ///< s_e in Le = s_e I
+    double dmin = 0.0;                          ///< global distance clamp; dmin_i = max(r_i, dmin)
+    Vec3 background{0.0f, 0.0f, 0.0f};          ///< radiance of a miss
+
+    template <class V> void visit(V& v) {
+        v.field("model", model, "shading model");
+        v.field("albedo", albedo, "particle albedo rho (RGB)", kUnit);
+        v.field("self_emission", self_emission, "self-emission scale s_e", kNonNegative);
+        v.field("dmin", dmin, "global distance clamp (dmin_i = max(r_i, dmin))", kNonNegative);
+        v.field("background", background, "background radiance (RGB)", kNonNegative);
+    }
+};
+
+/// [render]: frames, estimator and outputs.
+struct RenderSettings {
+    std::uint32_t frame_start = 0;               ///< first frame rendered
+    std::uint32_t frames = 1;                    ///< number of frames rendered
+    EstimatorKind estimator = EstimatorKind::exact; ///< estimator of Lr
+    std::uint32_t samples = 16;                  ///< light samples per pixel (Monte Carlo estimators)
+    std::uint64_t seed = 0;                      ///< render seed
+    std::string output = "out/{scene}.{frame}.exr"; ///< EXR path, {scene} and {frame} patterns
+    double shadow_epsilon = 1e-4;                ///< relative far-end margin of shadow rays
+    double exposure = 0.0;                       ///< preview exposure in stops, added to auto exposure
+    bool auto_exposure = true;                   ///< preview: map the 99th luminance percentile to 1
+
+    template <class V> void visit(V& v) {
+        v.field("frame_start", frame_start, "first frame", Range{0, 1e9});
+        v.field("frames", frames, "number of frames", Range{1, 1e6});
+        v.field("estimator", estimator, "estimator of the reflected light Lr");
+        v.field("samples", samples, "light samples per pixel (uniform, power)", Range{1, 1e7});
+        v.field("seed", seed, "render seed");
+        v.field("output", output, "EXR output path; {scene} and {frame} are replaced");
+        v.field("shadow_epsilon", shadow_epsilon, "shadow ray far end: t < d (1 - eps)", Range{1e-7, 0.1});
+        v.field("exposure", exposure, "preview exposure (stops)", Range{-64.0, 64.0});
+        v.field("auto_exposure", auto_exposure, "preview: scale the 99th luminance percentile to 1");
+    }
+};
+
+/// Every setting of a run, parsed and validated in one place (scene_parser).
+struct Settings {
+    ParticleSettings particles;
+    CameraSettings camera;
+    GeometrySettings geometry;
+    ShadingSettings shading;
+    RenderSettings render;
+
+    std::string sceneName = "scene"; ///< stem of the scene file
+    std::string scenePath;           ///< scene file as given
+
+    template <class V> void visit(V& v) {
+        v.section("particles", particles);
+        v.section("camera", camera);
+        v.section("geometry", geometry);
+        v.section("shading", shading);
+        v.section("render", render);
+    }
+};
+
+/// Output path of a frame: {scene} and {frame} (zero-padded to 4) replaced.
+std::string expandPattern(std::string_view pattern, std::string_view scene, std::uint32_t frame);
+
+}  // namespace accretion

@@ -1,0 +1,168 @@
+// accretion render: frames of a scene to EXR + PNG preview + stats.json.
+#include <chrono>
+#include <filesystem>
+#include <memory>
+#include <optional>
+
+#include <fmt/core.h>
+#include <tbb/global_control.h>
+#include <tbb/info.h>
+
+#include "accretion/core/error.h"
+#include "accretion/core/version.h"
+#include "accretion/io/atomic_file.h"
+#include "accretion/io/exr_output.h"
+#include "accretion/io/stats_writer.h"
+#include "accretion/render/frame_renderer.h"
+#include "accretion/scene/scene_parser.h"
+#include "commands.h"
+
+namespace accretion::cmd {
+
+void appendFrameOverrides(const std::string& frames, std::vector<std::string>& overrides) {
+    if (frames.empty()) return;
+    const auto colon = frames.find(':');
+    auto number = [&](const std::string& s) -> unsigned long long {
+        std::size_t used = 0;
+        unsigned long long v = 0;
+        try {
+            v = std::stoull(s, &used);
+        } catch (...) {
+            used = 0;
+        }
+        if (s.empty() || used != s.size() || s[0] == '-')
+            throw InputError(fmt::format("command line --frames {}: expected A:B with 0 <= A < B", frames));
+        return v;
+    };
+    const unsigned long long a = number(frames.substr(0, colon));
+    const unsigned long long b = colon == std::string::npos ? a + 1 : number(frames.substr(colon + 1));
+    if (b <= a) throw InputError(fmt::format("command line --frames {}: end must be greater than start (half-open A:B)", frames));
+    overrides.push_back(fmt::format("render.frame_start={}", a));
+    overrides.push_back(fmt::format("render.frames={}", b - a));
+}
+
+namespace {
+
+struct RenderArgs : SceneArgs {
+    std::string output, estimator;
+    std::optional<std::uint32_t> spp;
+    std::optional<std::uint64_t> seed;
+};
+
+/// "out/{scene}.{frame}.exr" -> "out/<scene>" (the {frame} part and extension dropped).
+std::string runStem(const Settings& s) {
+    std::string pattern = s.render.output;
+    const auto f = pattern.find("{frame}");
+    if (f != std::string::npos) {
+        std::size_t begin = f;
+        if (begin > 0 && (pattern[begin - 1] == '.' || pattern[begin - 1] == '_' || pattern[begin - 1] == '-')) --begin;
+        pattern.erase(begin, f + 7 - begin);
+    }
+    std::filesystem::path p = expandPattern(pattern, s.sceneName, 0);
+    return (p.parent_path() / p.stem()).string();
+}
+
+void runRender(const RenderArgs& args) {
+    std::vector<std::string> overrides = args.defines;
+    if (!args.output.empty()) overrides.push_back("render.output=" + args.output);
+    if (!args.estimator.empty()) overrides.push_back("render.estimator=" + args.estimator);
+    if (args.spp) overrides.push_back(fmt::format("render.samples={}", *args.spp));
+    if (args.seed) overrides.push_back(fmt::format("render.seed={}", *args.seed));
+    appendFrameOverrides(args.frames, overrides);
+    const Settings settings = loadScene(args.scene, overrides);
+
+    std::optional<tbb::global_control> threads;
+    if (args.threads > 0) threads.emplace(tbb::global_control::max_allowed_parallelism, std::size_t(args.threads));
+    const int threadCount = args.threads > 0 ? args.threads : tbb::info::default_concurrency();
+
+    const std::string stem = runStem(settings);
+    const std::string settingsToml = settingsToToml(settings);
+    const bool withErrors = settings.render.estimator != EstimatorKind::exact;
+    writeFileAtomic(stem + ".settings.toml", settingsToml);
+
+    nlohmann::json stats = {
+        {"version", std::string(version())},
+        {"scene", settings.scenePath},
+        {"estimator", std::string(enumName(settings.render.estimator))},
+        {"seed", settings.render.seed},
+        {"samples", settings.render.samples},
+        {"threads", threadCount},
+        {"settings", settingsToml},
+        {"frames", nlohmann::json::array()},
+    };
+
+    const auto start = std::chrono::steady_clock::now();
+    FrameRenderer renderer(settings, ParticleSource(settings), RenderOptions{args.quiet});
+    std::uint64_t shadowRays = 0;
+    double lightingSeconds = 0.0;
+    for (std::uint32_t k = 0; k < settings.render.frames; ++k) {
+        const std::uint32_t frame = settings.render.frame_start + k;
+        if (!args.quiet)
+            fmt::print(stderr, "accretion: frame {} ({}/{})\n", frame, k + 1, settings.render.frames);
+        FrameStats fs;
+        const FrameImage image = renderer.render(frame, fs);
+
+        const std::string exr = expandPattern(settings.render.output, settings.sceneName, frame);
+        const std::filesystem::path base = std::filesystem::path(exr).replace_extension();
+        OutputMetadata meta = {
+            {"version", std::string(version())},
+            {"scene", settings.scenePath},
+            {"frame", std::to_string(frame)},
+            {"estimator", std::string(enumName(settings.render.estimator))},
+            {"samples", std::to_string(settings.render.samples)},
+            {"seed", std::to_string(settings.render.seed)},
+            {"render_time_s", fmt::format("{:.6f}", fs.seconds)},
+            {"settings", settingsToml},
+        };
+        {
+            auto t = fs.timer.scope(pass::writeOutputs);
+            writeFrameExr(exr, image, withErrors, meta);
+            writePreviewPng(base.string() + ".png", image.L, image.width, image.height, settings.render.auto_exposure,
+                            settings.render.exposure);
+            writePreviewPng(base.string() + ".Lr.png", image.lighting.Lr, image.width, image.height,
+                            settings.render.auto_exposure, settings.render.exposure);
+        }
+        nlohmann::json fj = frameStatsJson(fs);
+        fj["outputs"] = {{"exr", exr}, {"png", base.string() + ".png"}, {"lr_png", base.string() + ".Lr.png"}};
+        stats["frames"].push_back(fj);
+        shadowRays += fs.lighting.shadowRays;
+        lightingSeconds += fs.timer.seconds(pass::estimateLighting);
+        fmt::print("frame {}: {} ({:.2f} s, {} particles, {} clusters, build {:.1f} ms, {:.2f} M shadow rays/s)\n",
+                   frame, exr, fs.seconds, fs.particles, fs.bvh.clusters,
+                   1e3 * (fs.bvh.clusterSeconds + fs.bvh.blasSeconds + fs.bvh.tlasSeconds),
+                   fs.timer.seconds(pass::estimateLighting) > 0
+                       ? 1e-6 * double(fs.lighting.shadowRays) / fs.timer.seconds(pass::estimateLighting) : 0.0);
+        fmt::print("  preview: {}.png, lighting only: {}.Lr.png\n", base.string(), base.string());
+    }
+    const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    stats["total_seconds"] = total;
+    stats["shadow_rays_per_second"] = lightingSeconds > 0 ? double(shadowRays) / lightingSeconds : 0.0;
+    writeJson(stem + ".stats.json", stats);
+    fmt::print("stats: {}.stats.json\nsettings: {}.settings.toml\ntotal: {:.2f} s\n", stem, stem, total);
+}
+
+}  // namespace
+
+void addRenderCommand(CLI::App& app) {
+    auto args = std::make_shared<RenderArgs>();
+    CLI::App* cmd = app.add_subcommand("render", "Render frames of a scene to EXR (+ PNG preview, stats.json)");
+    cmd->add_option("scene", args->scene, "Scene file (TOML)")->required();
+    cmd->add_option("-o,--output", args->output, "EXR output path ({scene}, {frame} patterns) = render.output");
+    cmd->add_option("--estimator", args->estimator, "exact | uniform | power  (= render.estimator)");
+    cmd->add_option("--spp", args->spp, "Light samples per pixel (= render.samples)");
+    cmd->add_option("--seed", args->seed, "Render seed (= render.seed)");
+    cmd->add_option("--frames", args->frames, "Frames A:B, half-open (= render.frame_start, render.frames)");
+    cmd->add_option("--threads", args->threads, "Worker threads (default: all cores); never changes the image")
+        ->check(CLI::Range(0, 4096));
+    cmd->add_flag("-q,--quiet", args->quiet, "No progress on stderr");
+    cmd->add_option("-D,--define", args->defines, "Override a setting: -D section.key=value (TOML value)")
+        ->allow_extra_args(false);
+    cmd->add_flag_callback("--help-settings", [] {
+        fmt::print("Scene settings (section.key = default  # meaning):\n{}", settingsReference());
+        throw CLI::Success();
+    }, "List every scene setting with its default and meaning");
+    cmd->footer("Every -D key is a scene setting; see --help-settings. Exit codes: 0 ok, 1 bad input, 3 internal error.");
+    cmd->callback([args] { runRender(*args); });
+}
+
+}  // namespace accretion::cmd

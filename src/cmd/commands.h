@@ -1,0 +1,24 @@
+#pragma once
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+namespace accretion::cmd {
+
+/// Options shared by the commands that load a scene.
+struct SceneArgs {
+    std::string scene;                   ///< scene file
+    std::vector<std::string> defines;    ///< -D section.key=value
+    std::string frames;                  ///< --frames A:B (half-open)
+    int threads = 0;                     ///< --threads N (0: all cores)
+    bool quiet = false;                  ///< --quiet: no progress on stderr
+};
+
+/// Turn `--frames A:B` into overrides of render.frame_start / render.frames.
+void appendFrameOverrides(const std::string& frames, std::vector<std::string>& overrides);
+
+void addRenderCommand(CLI::App& app);
+void addParticlesCommand(CLI::App& app);
+
+}  // namespace accretion::cmd

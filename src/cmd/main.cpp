@@ -1,0 +1,30 @@
+// accretion: CPU reference renderer and GPU-cost simulator for ray-traced
+// particle lighting. Subcommands: render, particles.
+#include <cstdio>
+
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+
+#include "accretion/core/error.h"
+#include "accretion/core/version.h"
+#include "commands.h"
+
+int main(int argc, char** argv) {
+    CLI::App app{"accretion: reference renderer and GPU-cost simulator for ray-traced particle lighting"};
+    app.set_version_flag("--version", std::string(accretion::version()));
+    app.require_subcommand(1);
+    accretion::cmd::addRenderCommand(app);
+    accretion::cmd::addParticlesCommand(app);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e);
+    } catch (const accretion::InputError& e) {
+        fmt::print(stderr, "accretion: error: {}\n", e.what());
+        return 1;
+    } catch (const std::exception& e) {
+        fmt::print(stderr, "accretion: internal error: {}\n", e.what());
+        return 3;
+    }
+    return 0;
+}

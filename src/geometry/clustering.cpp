@@ -1,0 +1,81 @@
+#include "accretion/geometry/clustering.h"
+
+#include <algorithm>
+#include <limits>
+
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
+namespace accretion {
+namespace {
+
+constexpr int kBits = 10;  // Morton grid 1024^3
+
+std::uint32_t spreadBits(std::uint32_t x) {
+    x &= 0x3ff;
+    x = (x | (x << 16)) & 0x030000ff;
+    x = (x | (x << 8)) & 0x0300f00f;
+    x = (x | (x << 4)) & 0x030c30c3;
+    x = (x | (x << 2)) & 0x09249249;
+    return x;
+}
+
+}  // namespace
+
+Clusters clusterParticles(std::span<const Vec3> positions, std::uint32_t target) {
+    Clusters out;
+    const std::size_t n = positions.size();
+    out.offset.push_back(0);
+    if (n == 0) return out;
+    target = std::max<std::uint32_t>(target, 1);
+
+    Vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+    for (const Vec3& p : positions) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+    }
+    const Vec3 ext = hi - lo;
+    const float size = std::max({ext.x, ext.y, ext.z, 1e-30f});
+    const float scale = float((1 << kBits) - 1) / size;
+
+    // (Morton code << 32 | index): sorted, ties broken by index: deterministic.
+    std::vector<std::uint64_t> keys(n);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 8192), [&](const auto& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const Vec3 q = (positions[i] - lo) * scale;
+            const std::uint32_t code = spreadBits(std::uint32_t(q.x)) | (spreadBits(std::uint32_t(q.y)) << 1) |
+                                       (spreadBits(std::uint32_t(q.z)) << 2);
+            keys[i] = (std::uint64_t(code) << 32) | i;
+        }
+    });
+    tbb::parallel_sort(keys.begin(), keys.end());
+
+    // Finest level whose non-empty cells average >= target particles.
+    int level = kBits;  // cell = 2^level Morton units per axis; kBits = one cell
+    for (int l = 0; l <= kBits; ++l) {
+        const int shift = 32 + 3 * l;
+        std::size_t cells = 1;
+        for (std::size_t i = 1; i < n; ++i) cells += (keys[i] >> shift) != (keys[i - 1] >> shift);
+        if (double(n) / double(cells) >= double(target)) {
+            level = l;
+            break;
+        }
+    }
+    const int shift = 32 + 3 * level;
+
+    out.particle.resize(n);
+    for (std::size_t i = 0; i < n; ++i) out.particle[i] = std::uint32_t(keys[i] & 0xffffffffu);
+    out.offset.clear();
+    out.offset.push_back(0);
+    std::size_t begin = 0;
+    for (std::size_t i = 1; i <= n; ++i) {
+        if (i < n && (keys[i] >> shift) == (keys[i - 1] >> shift)) continue;
+        const std::size_t cellSize = i - begin;
+        const std::size_t parts = (cellSize + target - 1) / target;
+        for (std::size_t k = 1; k <= parts; ++k) out.offset.push_back(std::uint32_t(begin + cellSize * k / parts));
+        begin = i;
+    }
+    return out;
+}
+
+}  // namespace accretion

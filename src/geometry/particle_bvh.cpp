@@ -1,0 +1,213 @@
+#include "accretion/geometry/particle_bvh.h"
+
+#include <chrono>
+
+#include <tbb/parallel_for.h>
+
+#include "accretion/core/error.h"
+#include "accretion/render/camera.h"
+
+namespace accretion {
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// Any-hit of the disc alpha test: reject candidate hits outside the inscribed circle.
+void discAlphaFilter(const RTCFilterFunctionNArguments* args) {
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] != -1) continue;
+        const Vec2 uv = quadUv(RTCHitN_primID(args->hit, args->N, i), RTCHitN_u(args->hit, args->N, i),
+                               RTCHitN_v(args->hit, args->N, i));
+        if (!insideDisc(uv)) args->valid[i] = 0;
+    }
+}
+
+RTCBuildQuality sceneQuality(BuildPolicy p) {
+    return p == BuildPolicy::fast_trace ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_LOW;
+}
+
+}  // namespace
+
+ParticleBvh::ParticleBvh(const EmbreeDevice& device, const GeometrySettings& settings)
+    : device_(device), settings_(settings) {}
+
+ParticleBvh::~ParticleBvh() {
+    releaseBlas();
+    if (tlas_) rtcReleaseScene(tlas_);
+}
+
+void ParticleBvh::releaseBlas() {
+    for (RTCScene s : blas_) rtcReleaseScene(s);
+    blas_.clear();
+    geometry_.clear();
+}
+
+void ParticleBvh::buildBlas(std::size_t c, const Particles& particles, bool create) {
+    const auto members = clusters_.members(c);
+    const std::size_t n = members.size();
+    const bool billboards = settings_.primitive == Primitive::billboard;
+    RTCGeometry geom;
+    if (create) {
+        RTCScene scene = rtcNewScene(device_.get());
+        rtcSetSceneBuildQuality(scene, sceneQuality(settings_.build));
+        if (settings_.build == BuildPolicy::refit) rtcSetSceneFlags(scene, RTC_SCENE_FLAG_DYNAMIC);
+        geom = rtcNewGeometry(device_.get(), billboards ? RTC_GEOMETRY_TYPE_TRIANGLE : RTC_GEOMETRY_TYPE_SPHERE_POINT);
+        if (settings_.build == BuildPolicy::refit) rtcSetGeometryBuildQuality(geom, RTC_BUILD_QUALITY_REFIT);
+        if (billboards) {
+            rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, sizeof(float) * 3, 4 * n);
+            auto* idx = static_cast<std::uint32_t*>(
+                rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, sizeof(std::uint32_t) * 3, 2 * n));
+            for (std::uint32_t k = 0; k < n; ++k) {
+                const std::uint32_t v = 4 * k;
+                const std::uint32_t tri[6] = {v, v + 1, v + 2, v, v + 2, v + 3};
+                std::copy(tri, tri + 6, idx + 6 * k);
+            }
+            if (settings_.alpha == AlphaMode::disc) {
+                rtcSetGeometryIntersectFilterFunction(geom, &discAlphaFilter);
+                rtcSetGeometryOccludedFilterFunction(geom, &discAlphaFilter);
+            }
+        } else {
+            rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, sizeof(float) * 4, n);
+        }
+        rtcAttachGeometryByID(scene, geom, 0);
+        rtcReleaseGeometry(geom);  // the scene keeps it
+        blas_[c] = scene;
+        geometry_[c] = geom;
+    }
+    geom = geometry_[c];
+    auto* vtx = static_cast<float*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, 0));
+    for (std::size_t k = 0; k < n; ++k) {
+        const std::uint32_t i = members[k];
+        const Vec3 p = particles.position[i];
+        const float r = particles.radius[i];
+        if (billboards) {
+            const BillboardFrame& f = frames_[i];
+            const Vec3 a = r * f.right, b = r * f.up;
+            const Vec3 corners[4] = {p - a - b, p + a - b, p + a + b, p - a + b};
+            for (int j = 0; j < 4; ++j)
+                for (int d = 0; d < 3; ++d) vtx[12 * k + 3 * j + d] = corners[j][d];
+        } else {
+            vtx[4 * k + 0] = p.x;
+            vtx[4 * k + 1] = p.y;
+            vtx[4 * k + 2] = p.z;
+            vtx[4 * k + 3] = r;
+        }
+    }
+    if (!create) rtcUpdateGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0);
+    rtcCommitGeometry(geom);
+    rtcCommitScene(blas_[c]);
+}
+
+void ParticleBvh::buildTlas() {
+    if (tlas_) rtcReleaseScene(tlas_);
+    tlas_ = rtcNewScene(device_.get());
+    rtcSetSceneBuildQuality(tlas_, sceneQuality(settings_.build));
+    const float identity[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    for (std::size_t c = 0; c < blas_.size(); ++c) {
+        RTCGeometry inst = rtcNewGeometry(device_.get(), RTC_GEOMETRY_TYPE_INSTANCE);
+        rtcSetGeometryInstancedScene(inst, blas_[c]);
+        rtcSetGeometryTransform(inst, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, identity);
+        rtcCommitGeometry(inst);
+        rtcAttachGeometryByID(tlas_, inst, static_cast<unsigned>(c));
+        rtcReleaseGeometry(inst);
+    }
+    rtcCommitScene(tlas_);
+}
+
+void ParticleBvh::build(const Particles& particles, const Camera& camera) {
+    stats_ = BvhStats{};
+    const std::size_t n = particles.size();
+    const bool refit = settings_.build == BuildPolicy::refit && !blas_.empty() && clusters_.particle.size() == n;
+
+    auto t0 = std::chrono::steady_clock::now();
+    if (!refit) {
+        clusters_ = clusterParticles(particles.position, settings_.cluster_size);
+        stats_.reclustered = true;
+    }
+    stats_.clusterSeconds = secondsSince(t0);
+
+    t0 = std::chrono::steady_clock::now();
+    frames_.resize(n);
+    if (settings_.primitive == Primitive::billboard) {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const auto& r) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i)
+                frames_[i] = billboardFrame(settings_.orientation, camera, particles.position[i], particles.velocity[i]);
+        });
+    } else {
+        std::fill(frames_.begin(), frames_.end(), BillboardFrame{camera.right, camera.up});
+    }
+    if (!refit) {
+        releaseBlas();
+        blas_.assign(clusters_.count(), nullptr);
+        geometry_.assign(clusters_.count(), nullptr);
+    }
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, clusters_.count(), 1), [&](const auto& r) {
+        for (std::size_t c = r.begin(); c != r.end(); ++c) buildBlas(c, particles, !refit);
+    });
+    device_.check("buildClusters (BLAS)");
+    stats_.blasSeconds = secondsSince(t0);
+
+    t0 = std::chrono::steady_clock::now();
+    buildTlas();
+    device_.check("buildClusters (TLAS)");
+    stats_.tlasSeconds = secondsSince(t0);
+
+    stats_.refitted = refit;
+    stats_.clusters = clusters_.count();
+    stats_.primitives = settings_.primitive == Primitive::billboard ? 2 * n : n;
+    stats_.embreeBytes = device_.bytesInUse();
+}
+
+bool ParticleBvh::intersect(const Vec3& o, const Vec3& d, float tfar, SurfaceHit& hit) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    RTCRayHit rh;
+    rh.ray.org_x = o.x;
+    rh.ray.org_y = o.y;
+    rh.ray.org_z = o.z;
+    rh.ray.dir_x = d.x;
+    rh.ray.dir_y = d.y;
+    rh.ray.dir_z = d.z;
+    rh.ray.tnear = 0.0f;
+    rh.ray.tfar = tfar;
+    rh.ray.time = 0.0f;
+    rh.ray.mask = ~0u;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(tlas_, &context, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+    const std::uint32_t c = rh.hit.instID[0];
+    const bool billboards = settings_.primitive == Primitive::billboard;
+    const std::uint32_t local = billboards ? rh.hit.primID >> 1 : rh.hit.primID;
+    hit.cluster = c;
+    hit.particle = clusters_.particle[clusters_.offset[c] + local];
+    hit.t = rh.ray.tfar;
+    hit.uv = billboards ? quadUv(rh.hit.primID, rh.hit.u, rh.hit.v) : Vec2(rh.hit.u, rh.hit.v);
+    return true;
+}
+
+bool ParticleBvh::occluded(const Vec3& o, const Vec3& d, float tfar) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    RTCRay ray;
+    ray.org_x = o.x;
+    ray.org_y = o.y;
+    ray.org_z = o.z;
+    ray.dir_x = d.x;
+    ray.dir_y = d.y;
+    ray.dir_z = d.z;
+    ray.tnear = 0.0f;
+    ray.tfar = tfar;
+    ray.time = 0.0f;
+    ray.mask = ~0u;
+    ray.id = 0;
+    ray.flags = 0;
+    rtcOccluded1(tlas_, &context, &ray);
+    return ray.tfar < 0.0f;
+}
+
+}  // namespace accretion

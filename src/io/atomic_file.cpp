@@ -1,0 +1,68 @@
+#include "accretion/io/atomic_file.h"
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <fmt/format.h>
+
+#include "accretion/core/error.h"
+
+namespace accretion {
+namespace {
+
+std::filesystem::path tempPathFor(const std::filesystem::path& file) {
+    const auto dir = file.parent_path();
+    const std::string name = fmt::format(".{}.tmp{}{}", file.stem().string(), ::getpid(), file.extension().string());
+    return dir.empty() ? std::filesystem::path(name) : dir / name;
+}
+
+void ensureParent(const std::filesystem::path& file) {
+    const auto dir = file.parent_path();
+    if (dir.empty()) return;
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec) throw InputError(fmt::format("{}: cannot create output directory: {}", dir.string(), ec.message()));
+}
+
+void syncFile(const std::filesystem::path& p) {
+    const int fd = ::open(p.c_str(), O_RDONLY);
+    if (fd >= 0) {
+        ::fsync(fd);
+        ::close(fd);
+    }
+}
+
+}  // namespace
+
+void writeAtomicWith(const std::filesystem::path& file, const std::function<void(const std::filesystem::path&)>& write) {
+    ensureParent(file);
+    const auto tmp = tempPathFor(file);
+    try {
+        write(tmp);
+        syncFile(tmp);
+        std::error_code ec;
+        std::filesystem::rename(tmp, file, ec);
+        if (ec) throw InputError(fmt::format("{}: cannot rename output into place: {}", file.string(), ec.message()));
+    } catch (...) {
+        std::error_code ignored;
+        std::filesystem::remove(tmp, ignored);
+        throw;
+    }
+}
+
+void writeFileAtomic(const std::filesystem::path& file, std::string_view bytes) {
+    writeAtomicWith(file, [&](const std::filesystem::path& tmp) {
+        std::FILE* f = std::fopen(tmp.c_str(), "wb");
+        if (!f) throw InputError(fmt::format("{}: cannot write: {}", file.string(), std::strerror(errno)));
+        const bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+        const int err = errno;
+        const bool closed = std::fclose(f) == 0;
+        if (!ok || !closed)
+            throw InputError(fmt::format("{}: write failed: {}", file.string(), std::strerror(ok ? errno : err)));
+    });
+}
+
+}  // namespace accretion

@@ -1,0 +1,40 @@
+#include "accretion/io/stats_writer.h"
+
+#include "accretion/io/atomic_file.h"
+
+namespace accretion {
+
+nlohmann::json frameStatsJson(const FrameStats& s) {
+    nlohmann::json passes = nlohmann::json::object();
+    for (const auto& [name, seconds] : s.timer.all()) passes[name] = seconds;
+    const double lightingSeconds = s.timer.seconds(pass::estimateLighting);
+    return {
+        {"frame", s.frame},
+        {"seconds", s.seconds},
+        {"passes", passes},
+        {"counts",
+         {{"particles", s.particles},
+          {"clusters", s.bvh.clusters},
+          {"primitives", s.bvh.primitives},
+          {"hit_pixels", s.hitPixels},
+          {"light_terms", s.lighting.lightTerms}}},
+        {"rays",
+         {{"primary", s.primaryRays},
+          {"shadow", s.lighting.shadowRays},
+          {"shadow_occluded", s.lighting.shadowOccluded},
+          {"shadow_per_second", lightingSeconds > 0 ? double(s.lighting.shadowRays) / lightingSeconds : 0.0}}},
+        {"bvh",
+         {{"reclustered", s.bvh.reclustered},
+          {"refitted", s.bvh.refitted},
+          {"cluster_seconds", s.bvh.clusterSeconds},
+          {"blas_seconds", s.bvh.blasSeconds},
+          {"tlas_seconds", s.bvh.tlasSeconds},
+          {"embree_bytes", s.bvh.embreeBytes}}},
+    };
+}
+
+void writeJson(const std::filesystem::path& file, const nlohmann::json& doc) {
+    writeFileAtomic(file, doc.dump(2) + "\n");
+}
+
+}  // namespace accretion

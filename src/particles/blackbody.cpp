@@ -1,0 +1,55 @@
+#include "accretion/particles/blackbody.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace accretion {
+namespace {
+
+// Piecewise Gaussian lobe of the CIE fit.
+double lobe(double x, double mu, double s1, double s2) {
+    const double t = (x - mu) / (x < mu ? s1 : s2);
+    return std::exp(-0.5 * t * t);
+}
+
+DVec3 cieXYZ(double nm) {
+    return {1.056 * lobe(nm, 599.8, 37.9, 31.0) + 0.362 * lobe(nm, 442.0, 16.0, 26.7) - 0.065 * lobe(nm, 501.1, 20.4, 26.2),
+            0.821 * lobe(nm, 568.8, 46.9, 40.5) + 0.286 * lobe(nm, 530.9, 16.3, 31.1),
+            1.217 * lobe(nm, 437.0, 11.8, 36.0) + 0.681 * lobe(nm, 459.0, 26.0, 13.8)};
+}
+
+// Relative spectral radiance (Planck), wavelength in nm.
+double planck(double nm, double kelvin) {
+    constexpr double c2 = 1.4387769e7;  // second radiation constant, nm K
+    return std::pow(nm, -5.0) / std::expm1(c2 / (nm * kelvin));
+}
+
+}  // namespace
+
+Vec3 blackbodyColor(double kelvin) {
+    DVec3 xyz(0.0);
+    for (double nm = 360.0; nm <= 830.0; nm += 1.0) xyz += planck(nm, kelvin) * cieXYZ(nm);
+    // XYZ -> linear Rec.709 (D65).
+    DVec3 rgb(3.2404542 * xyz.x - 1.5371385 * xyz.y - 0.4985314 * xyz.z,
+              -0.9692660 * xyz.x + 1.8760108 * xyz.y + 0.0415560 * xyz.z,
+              0.0556434 * xyz.x - 0.2040259 * xyz.y + 1.0572252 * xyz.z);
+    rgb = glm::max(rgb, DVec3(0.0));
+    const double y = 0.2126 * rgb.x + 0.7152 * rgb.y + 0.0722 * rgb.z;
+    return y > 0.0 ? Vec3(rgb / y) : Vec3(0.0f);
+}
+
+BlackbodyTable::BlackbodyTable(double minKelvin, double maxKelvin, int entries)
+    : logMin_(std::log(minKelvin)), logMax_(std::log(maxKelvin)), table_(entries) {
+    for (int i = 0; i < entries; ++i)
+        table_[i] = blackbodyColor(std::exp(logMin_ + (logMax_ - logMin_) * i / (entries - 1)));
+}
+
+Vec3 BlackbodyTable::operator()(double kelvin) const {
+    const double u = (std::log(kelvin) - logMin_) / (logMax_ - logMin_) * double(table_.size() - 1);
+    const double c = std::clamp(u, 0.0, double(table_.size() - 1));
+    const std::size_t i = std::min(static_cast<std::size_t>(c), table_.size() - 2);
+    const float f = static_cast<float>(c - double(i));
+    return table_[i] * (1.0f - f) + table_[i + 1] * f;
+}
+
+}  // namespace accretion

@@ -1,0 +1,55 @@
+#include "accretion/particles/particle_source.h"
+
+#include <filesystem>
+
+#include "accretion/particles/disk_generator.h"
+#include "accretion/particles/particle_file.h"
+
+namespace accretion {
+
+ParticleSource::ParticleSource(const Settings& settings)
+    : particles_(settings.particles), albedo_(settings.shading.albedo) {}
+
+ParticleSource ParticleSource::fixed(Particles particles) {
+    ParticleSource s;
+    s.fixed_ = std::move(particles);
+    return s;
+}
+
+bool ParticleSource::isStatic() const {
+    if (fixed_) return true;
+    if (!particles_.file.empty()) return particles_.file.find("{frame}") == std::string::npos;
+    return particles_.time_step == 0.0 || particles_.gm == 0.0;
+}
+
+Particles ParticleSource::frame(std::uint32_t frame) const {
+    if (fixed_) return *fixed_;
+    Particles p;
+    if (particles_.file.empty()) {
+        p = generateDisk(particles_, frame);
+    } else {
+        const std::string path = expandPattern(particles_.file, "", frame);
+        p = readParticles(path);
+        // Velocity from consecutive frames (forward difference, else backward).
+        if (particles_.file.find("{frame}") != std::string::npos) {
+            const float dt = particles_.time_step > 0.0 ? float(particles_.time_step) : 1.0f;
+            auto neighbour = [&](std::uint32_t f) -> std::optional<Particles> {
+                const std::string q = expandPattern(particles_.file, "", f);
+                if (!std::filesystem::exists(q)) return std::nullopt;
+                Particles n = readParticles(q);
+                if (n.size() != p.size()) return std::nullopt;
+                return n;
+            };
+            if (auto next = neighbour(frame + 1)) {
+                for (std::size_t i = 0; i < p.size(); ++i) p.velocity[i] = (next->position[i] - p.position[i]) / dt;
+            } else if (frame > 0) {
+                if (auto prev = neighbour(frame - 1))
+                    for (std::size_t i = 0; i < p.size(); ++i) p.velocity[i] = (p.position[i] - prev->position[i]) / dt;
+            }
+        }
+    }
+    std::fill(p.albedo.begin(), p.albedo.end(), albedo_);
+    return p;
+}
+
+}  // namespace accretion

@@ -1,0 +1,41 @@
+#include "accretion/render/camera.h"
+
+#include <cmath>
+
+namespace accretion {
+
+Camera Camera::lookAt(const Vec3& eye, const Vec3& target, const Vec3& upHint, double fovDegrees,
+                      std::uint32_t width, std::uint32_t height) {
+    Camera c;
+    c.position = eye;
+    c.forward = glm::normalize(target - eye);
+    c.right = glm::normalize(glm::cross(c.forward, upHint));
+    c.up = glm::cross(c.right, c.forward);
+    c.tanHalfFov = float(std::tan(0.5 * fovDegrees * M_PI / 180.0));
+    c.width = width;
+    c.height = height;
+    return c;
+}
+
+Camera Camera::atFrame(const CameraSettings& s, std::uint32_t frame) {
+    Vec3 eye = s.position, target = s.look_at;
+    switch (s.path) {
+    case CameraPath::static_pose: break;
+    case CameraPath::orbit: {
+        const double a = double(frame) * s.orbit_speed * M_PI / 180.0;
+        const Vec3 d = eye - target;
+        const float c = float(std::cos(a)), sn = float(std::sin(a));
+        eye = target + Vec3(c * d.x + sn * d.z, d.y, -sn * d.x + c * d.z);
+        break;
+    }
+    case CameraPath::linear: {
+        const float t = float(frame) / float(s.path_frames);
+        eye = s.position + t * (s.end_position - s.position);
+        target = s.look_at + t * (s.end_look_at - s.look_at);
+        break;
+    }
+    }
+    return lookAt(eye, target, s.up, s.fov, s.width, s.height);
+}
+
+}  // namespace accretion

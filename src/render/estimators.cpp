@@ -1,0 +1,157 @@
+#include "accretion/render/estimators.h"
+
+#include <tbb/blocked_range2d.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include "accretion/core/error.h"
+#include "accretion/core/rng.h"
+#include "accretion/render/shading.h"
+#include "accretion/render/visibility.h"
+
+namespace accretion {
+namespace {
+
+/// The lights of a frame, as the hot loops read them.
+struct LightArrays {
+    const Vec3* position;
+    const Vec3* emission;
+    const float* radius;
+    std::vector<float> dmin2;  ///< max(r_i, dmin)^2
+    std::uint32_t count;
+};
+
+ShadingPoint shadingPoint(const GBufferTexel& g, const Particles& particles) {
+    return {g.position, g.normal, g.geomNormal, particles.albedo[g.particle], g.particle};
+}
+
+/// exact: sum over every light i != j of f I G V, in double.
+template <ShadingModel M, Primitive P>
+Vec3 exactPixel(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint& sp, float eps, LightingCounters& c) {
+    DVec3 sum(0.0);
+    for (std::uint32_t i = 0; i < L.count; ++i) {
+        if (i == sp.self) continue;
+        LightTerm t;
+        ++c.lightTerms;
+        if (!evalLight<M>(sp, L.position[i], L.emission[i], L.dmin2[i], t)) continue;
+        ++c.shadowRays;
+        if (visible<P>(bvh, sp, t, L.radius[i], eps)) sum += DVec3(t.value);
+        else ++c.shadowOccluded;
+    }
+    return Vec3(sum);
+}
+
+/// uniform / power: S one-sample estimates f I G V / p(i) (0 when i = j).
+template <ShadingModel M, Primitive P, bool Power>
+void sampledPixel(const ParticleBvh& bvh, const LightArrays& L, const AliasTable* table, const ShadingPoint& sp,
+                  std::uint32_t S, float eps, Rng& rng, Vec3& mean, Vec3& stderr, LightingCounters& c) {
+    DVec3 s1(0.0), s2(0.0);
+    const float uniformPdf = 1.0f / float(L.count);
+    for (std::uint32_t k = 0; k < S; ++k) {
+        std::uint32_t i;
+        float pdf;
+        if constexpr (Power) {
+            const std::uint32_t bucket = rng.uniformInt(L.count);
+            i = table->sample(bucket, rng.uniform());
+            pdf = table->pmf(i);
+        } else {
+            i = rng.uniformInt(L.count);
+            pdf = uniformPdf;
+        }
+        if (i == sp.self) continue;
+        LightTerm t;
+        ++c.lightTerms;
+        if (!evalLight<M>(sp, L.position[i], L.emission[i], L.dmin2[i], t)) continue;
+        ++c.shadowRays;
+        if (!visible<P>(bvh, sp, t, L.radius[i], eps)) {
+            ++c.shadowOccluded;
+            continue;
+        }
+        const DVec3 est = DVec3(t.value) / double(pdf);
+        s1 += est;
+        s2 += est * est;
+    }
+    const DVec3 m = s1 / double(S);
+    mean = Vec3(m);
+    if (S > 1) {
+        const DVec3 var = glm::max((s2 - double(S) * m * m) / double(S - 1), DVec3(0.0));
+        stderr = Vec3(glm::sqrt(var / double(S)));
+    } else {
+        stderr = Vec3(0.0f);
+    }
+}
+
+template <ShadingModel M, Primitive P>
+LightingCounters run(const LightingInputs& in, const LightArrays& L, LightingImage& out, Progress* progress) {
+    const GBuffer& gb = in.gbuffer;
+    const float eps = static_cast<float>(in.render.shadow_epsilon);
+    const EstimatorKind kind = in.render.estimator;
+    const std::uint32_t S = in.render.samples;
+    tbb::enumerable_thread_specific<LightingCounters> counters;
+
+    tbb::parallel_for(tbb::blocked_range2d<std::uint32_t>(0, gb.height, 8, 0, gb.width, 8), [&](const auto& r) {
+        LightingCounters& c = counters.local();
+        for (std::uint32_t y = r.rows().begin(); y != r.rows().end(); ++y) {
+            for (std::uint32_t x = r.cols().begin(); x != r.cols().end(); ++x) {
+                const std::size_t px = std::size_t(y) * gb.width + x;
+                const GBufferTexel& g = gb.texels[px];
+                if (!g.hit()) continue;
+                const ShadingPoint sp = shadingPoint(g, in.particles);
+                if (kind == EstimatorKind::exact) {
+                    out.Lr[px] = exactPixel<M, P>(in.bvh, L, sp, eps, c);
+                    continue;
+                }
+                Rng rng(px, in.frame, RngPass::lightSampling, in.render.seed);
+                if (kind == EstimatorKind::power)
+                    sampledPixel<M, P, true>(in.bvh, L, in.powerTable, sp, S, eps, rng, out.Lr[px], out.Lr_stderr[px], c);
+                else
+                    sampledPixel<M, P, false>(in.bvh, L, nullptr, sp, S, eps, rng, out.Lr[px], out.Lr_stderr[px], c);
+                out.spp[px] = float(S);
+            }
+        }
+        if (progress) progress->advance(std::uint64_t(r.rows().size()) * r.cols().size());
+    });
+    LightingCounters total;
+    for (const auto& c : counters) total += c;
+    return total;
+}
+
+template <ShadingModel M>
+LightingCounters dispatchPrimitive(const LightingInputs& in, const LightArrays& L, LightingImage& out, Progress* p) {
+    return in.bvh.settings().primitive == Primitive::sphere ? run<M, Primitive::sphere>(in, L, out, p)
+                                                            : run<M, Primitive::billboard>(in, L, out, p);
+}
+
+}  // namespace
+
+AliasTable buildPowerTable(const Particles& particles) {
+    std::vector<float> w(particles.size());
+    for (std::size_t i = 0; i < w.size(); ++i) w[i] = luminance(particles.emission[i]);
+    return AliasTable(w);
+}
+
+LightingCounters estimateLighting(const LightingInputs& in, LightingImage& out, Progress* progress) {
+    const std::size_t pixels = std::size_t(in.gbuffer.width) * in.gbuffer.height;
+    out.Lr.assign(pixels, Vec3(0.0f));
+    out.Lr_stderr.assign(pixels, Vec3(0.0f));
+    out.spp.assign(pixels, 0.0f);
+    if (in.particles.empty()) return {};
+    ACC_CHECK(in.render.estimator != EstimatorKind::power || in.powerTable);
+
+    LightArrays L{in.particles.position.data(), in.particles.emission.data(), in.particles.radius.data(), {},
+                  static_cast<std::uint32_t>(in.particles.size())};
+    L.dmin2.resize(L.count);
+    const float dmin = static_cast<float>(in.shading.dmin);
+    for (std::uint32_t i = 0; i < L.count; ++i) {
+        const float d = std::max(in.particles.radius[i], dmin);
+        L.dmin2[i] = d * d;
+    }
+    switch (in.shading.model) {
+    case ShadingModel::lambert: return dispatchPrimitive<ShadingModel::lambert>(in, L, out, progress);
+    case ShadingModel::sphere: return dispatchPrimitive<ShadingModel::sphere>(in, L, out, progress);
+    case ShadingModel::isotropic: return dispatchPrimitive<ShadingModel::isotropic>(in, L, out, progress);
+    }
+    return {};
+}
+
+}  // namespace accretion

@@ -1,0 +1,363 @@
+#include "accretion/scene/scene_parser.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include "accretion/core/error.h"
+
+namespace accretion {
+namespace {
+
+std::string where(const toml::source_region& src) {
+    const std::string path = src.path ? *src.path : std::string("<scene>");
+    if (path.rfind("-D ", 0) == 0) return "command line " + path;
+    return fmt::format("{}:{}", path, src.begin.line);
+}
+
+std::string typeName(const toml::node& n) {
+    std::ostringstream s;
+    s << n.type();
+    return s.str();
+}
+
+/// A TOML basic string literal holding s.
+std::string tomlQuote(std::string_view s) {
+    std::string q = "\"";
+    for (char c : s) {
+        if (static_cast<unsigned char>(c) < 0x20) { q += fmt::format("\\u{:04x}", int(c)); continue; }
+        if (c == '\\' || c == '"') q += '\\';
+        q += c;
+    }
+    return q + "\"";
+}
+
+/// Overrides from the command line, each parsed as its own TOML document so
+/// that its nodes carry "-D key=value" as their source.
+struct Overrides {
+    std::map<std::string, toml::table, std::less<>> docs;  // "section.key" -> { v = value }
+    std::set<std::string, std::less<>> used;
+
+    const toml::node* find(std::string_view dotted) const {
+        auto it = docs.find(dotted);
+        return it == docs.end() ? nullptr : it->second.get("v");
+    }
+};
+
+Overrides parseOverrides(const std::vector<std::string>& items) {
+    Overrides o;
+    for (const std::string& item : items) {
+        const std::string flag = "-D " + item;
+        const auto eq = item.find('=');
+        if (eq == std::string::npos || eq == 0)
+            throw InputError(fmt::format("command line {}: expected section.key=value", flag));
+        const std::string key = item.substr(0, eq);
+        const std::string value = item.substr(eq + 1);
+        if (std::count(key.begin(), key.end(), '.') != 1)
+            throw InputError(fmt::format("command line {}: key must be section.key (e.g. render.frames)", flag));
+        toml::table doc;
+        try {
+            doc = toml::parse("v = " + value, flag);
+        } catch (const toml::parse_error&) {
+            // A bare word (power, out/x.exr) is a string.
+            doc = toml::parse("v = " + tomlQuote(value), flag);
+        }
+        o.docs.insert_or_assign(key, std::move(doc));
+    }
+    return o;
+}
+
+
+/// Reads one section's fields from its table (and the overrides), checking
+/// types and ranges; remembers which keys it consumed.
+class SectionReader {
+public:
+    SectionReader(std::string_view section, const toml::table* table, Overrides& overrides)
+        : section_(section), table_(table), overrides_(overrides) {}
+
+    template <class T>
+    void field(std::string_view key, T& value, std::string_view /*doc*/, Range range = kAny) {
+        const std::string dotted = fmt::format("{}.{}", section_, key);
+        const toml::node* node = overrides_.find(dotted);
+        if (node) overrides_.used.insert(dotted);
+        else if (table_) node = table_->get(key);
+        if (table_ && table_->get(key)) seen_.insert(std::string(key));
+        if (!node) return;
+        read(*node, dotted, value, range);
+        locations_[std::string(key)] = where(node->source());
+    }
+
+    const std::set<std::string>& seen() const { return seen_; }
+    const std::map<std::string, std::string>& locations() const { return locations_; }
+
+private:
+    [[noreturn]] void fail(const toml::node& n, const std::string& dotted, const std::string& msg) const {
+        throw InputError(fmt::format("{}: {}: {}", where(n.source()), dotted, msg));
+    }
+
+    double number(const toml::node& n, const std::string& dotted, Range range) const {
+        double x;
+        if (auto* f = n.as_floating_point()) x = f->get();
+        else if (auto* i = n.as_integer()) x = static_cast<double>(i->get());
+        else fail(n, dotted, fmt::format("expected a number, got {}", typeName(n)));
+        checkRange(n, dotted, x, range);
+        return x;
+    }
+
+    void checkRange(const toml::node& n, const std::string& dotted, double x, Range range) const {
+        if (!std::isfinite(x)) fail(n, dotted, fmt::format("must be finite (got {})", x));
+        const bool below = range.loOpen ? !(x > range.lo) : !(x >= range.lo);
+        if (below || x > range.hi) {
+            std::string lo = range.loOpen ? fmt::format("> {}", range.lo) : fmt::format(">= {}", range.lo);
+            std::string msg = std::isinf(range.hi) ? fmt::format("must be {} (got {})", lo, x)
+                                                   : fmt::format("must be {} and <= {} (got {})", lo, range.hi, x);
+            fail(n, dotted, msg);
+        }
+    }
+
+    void read(const toml::node& n, const std::string& dotted, bool& v, Range) const {
+        auto* b = n.as_boolean();
+        if (!b) fail(n, dotted, fmt::format("expected a boolean, got {}", typeName(n)));
+        v = b->get();
+    }
+    template <class Int>
+        requires std::is_integral_v<Int>
+    void read(const toml::node& n, const std::string& dotted, Int& v, Range range) const {
+        auto* i = n.as_integer();
+        if (!i) fail(n, dotted, fmt::format("expected an integer, got {}", typeName(n)));
+        const std::int64_t x = i->get();
+        if (std::is_unsigned_v<Int> && x < 0) fail(n, dotted, fmt::format("must be >= 0 (got {})", x));
+        if (static_cast<std::uint64_t>(x) > static_cast<std::uint64_t>(std::numeric_limits<Int>::max()))
+            fail(n, dotted, fmt::format("too large (got {})", x));
+        checkRange(n, dotted, static_cast<double>(x), range);
+        v = static_cast<Int>(x);
+    }
+    void read(const toml::node& n, const std::string& dotted, double& v, Range range) const {
+        v = number(n, dotted, range);
+    }
+    void read(const toml::node& n, const std::string& dotted, std::string& v, Range) const {
+        auto* s = n.as_string();
+        if (!s) fail(n, dotted, fmt::format("expected a string, got {}", typeName(n)));
+        v = s->get();
+    }
+    void read(const toml::node& n, const std::string& dotted, Vec3& v, Range range) const {
+        auto* a = n.as_array();
+        if (!a || a->size() != 3) fail(n, dotted, "expected an array of 3 numbers");
+        for (int k = 0; k < 3; ++k) v[k] = static_cast<float>(number(*a->get(k), dotted, range));
+    }
+    void read(const toml::node& n, const std::string& dotted, std::vector<double>& v, Range range) const {
+        auto* a = n.as_array();
+        if (!a) fail(n, dotted, fmt::format("expected an array of numbers, got {}", typeName(n)));
+        v.clear();
+        for (const toml::node& e : *a) v.push_back(number(e, dotted, range));
+    }
+    template <class E>
+        requires std::is_enum_v<E>
+    void read(const toml::node& n, const std::string& dotted, E& v, Range) const {
+        constexpr auto& names = EnumNames<E>::names;
+        std::string choices;
+        for (auto nm : names) choices += (choices.empty() ? "" : " | ") + std::string(nm);
+        auto* s = n.as_string();
+        if (!s) fail(n, dotted, fmt::format("expected one of {}, got {}", choices, typeName(n)));
+        for (std::size_t k = 0; k < names.size(); ++k)
+            if (names[k] == s->get()) { v = static_cast<E>(k); return; }
+        fail(n, dotted, fmt::format("unknown value \"{}\" (expected {})", s->get(), choices));
+    }
+
+    std::string section_;
+    const toml::table* table_;
+    Overrides& overrides_;
+    std::set<std::string> seen_;
+    std::map<std::string, std::string> locations_;
+};
+
+/// Visits every section of Settings, reading it from the document.
+class SceneReader {
+public:
+    SceneReader(const toml::table& root, Overrides& overrides) : root_(root), overrides_(overrides) {}
+
+    template <class S> void section(std::string_view name, S& s) {
+        const toml::node* node = root_.get(name);
+        const toml::table* table = nullptr;
+        if (node) {
+            table = node->as_table();
+            if (!table) throw InputError(fmt::format("{}: [{}] must be a table, got {}", where(node->source()), name, typeName(*node)));
+        }
+        SectionReader reader(name, table, overrides_);
+        s.visit(reader);
+        if (table)
+            for (auto&& [key, value] : *table)
+                if (!reader.seen().count(std::string(key.str())))
+                    throw InputError(fmt::format("{}: {}.{}: unknown setting", where(value.source()), name, key.str()));
+        for (const auto& [k, loc] : reader.locations()) locations[fmt::format("{}.{}", name, k)] = loc;
+        sections_.insert(std::string(name));
+    }
+
+    void checkUnknownSections() const {
+        for (auto&& [key, value] : root_)
+            if (!sections_.count(std::string(key.str())))
+                throw InputError(fmt::format("{}: unknown section or key \"{}\" (sections: particles, camera, geometry, shading, render)",
+                                             where(value.source()), key.str()));
+    }
+
+    std::map<std::string, std::string> locations;  ///< "section.key" -> where it was set
+
+private:
+    const toml::table& root_;
+    Overrides& overrides_;
+    std::set<std::string> sections_;
+};
+
+/// Cross-field rules, reported at the location of the offending key.
+void validate(const Settings& s, const std::map<std::string, std::string>& loc, std::string_view sourceName) {
+    auto fail = [&](const std::string& key, const std::string& msg) {
+        auto it = loc.find(key);
+        const std::string at = it != loc.end() ? it->second : std::string(sourceName);
+        throw InputError(fmt::format("{}: {}: {}", at, key, msg));
+    };
+    if (!(s.particles.outer_radius > s.particles.inner_radius))
+        fail("particles.outer_radius", fmt::format("must be greater than inner_radius ({})", s.particles.inner_radius));
+    for (std::size_t k = 1; k < s.particles.type_bands.size(); ++k)
+        if (!(s.particles.type_bands[k] > s.particles.type_bands[k - 1]))
+            fail("particles.type_bands", "thresholds must increase");
+    if (s.particles.type_bands.size() > 254) fail("particles.type_bands", "at most 254 thresholds");
+    const Vec3 view = s.camera.look_at - s.camera.position;
+    if (glm::length(view) <= 0.0f) fail("camera.look_at", "must differ from camera.position");
+    if (glm::length(s.camera.up) <= 0.0f || glm::length(glm::cross(glm::normalize(view), glm::normalize(s.camera.up))) < 1e-4f)
+        fail("camera.up", "must be non-zero and not parallel to the view direction");
+    if (s.camera.path == CameraPath::linear && glm::length(s.camera.end_look_at - s.camera.end_position) <= 0.0f)
+        fail("camera.end_look_at", "must differ from camera.end_position");
+    if (static_cast<std::uint64_t>(s.render.frame_start) + s.render.frames > 0xffffffffull)
+        fail("render.frames", "frame_start + frames overflows");
+    if (s.render.output.empty()) fail("render.output", "must not be empty");
+    if (s.render.frames > 1 && s.render.output.find("{frame}") == std::string::npos)
+        fail("render.output", "a multi-frame render needs a {frame} pattern in the output path");
+    if (s.geometry.primitive == Primitive::sphere && s.geometry.alpha == AlphaMode::disc)
+        fail("geometry.alpha", "disc alpha applies to billboards only (primitive = \"sphere\")");
+}
+
+/// Builds a TOML table of the effective settings.
+class TomlWriter {
+public:
+    template <class S> void section(std::string_view name, S& s) {
+        current_ = toml::table{};
+        s.visit(*this);
+        root.insert(name, std::move(current_));
+    }
+    template <class T> void field(std::string_view key, const T& value, std::string_view, Range = kAny) {
+        current_.insert(key, toNode(value));
+    }
+    toml::table root;
+
+private:
+    static auto toNode(bool v) { return toml::value<bool>(v); }
+    static auto toNode(const std::string& v) { return toml::value<std::string>(v); }
+    static auto toNode(double v) { return toml::value<double>(v); }
+    template <class Int>
+        requires std::is_integral_v<Int>
+    static auto toNode(Int v) { return toml::value<std::int64_t>(static_cast<std::int64_t>(v)); }
+    static auto toNode(const Vec3& v) { return toml::array{double(v.x), double(v.y), double(v.z)}; }
+    static auto toNode(const std::vector<double>& v) {
+        toml::array a;
+        for (double x : v) a.push_back(x);
+        return a;
+    }
+    template <class E>
+        requires std::is_enum_v<E>
+    static auto toNode(E e) { return toml::value<std::string>(std::string(enumName(e))); }
+
+    toml::table current_;
+};
+
+/// Lists every setting with its default and doc line.
+class ReferenceWriter {
+public:
+    template <class S> void section(std::string_view name, S& s) {
+        out += fmt::format("[{}]\n", name);
+        s.visit(*this);
+    }
+    template <class T> void field(std::string_view key, const T& value, std::string_view doc, Range = kAny) {
+        std::ostringstream s;
+        s << toml::table{{key, toValue(value)}};
+        std::string line = s.str();
+        while (!line.empty() && line.back() == '\n') line.pop_back();
+        out += fmt::format("  {:<44} # {}{}\n", line, doc, choices<T>());
+    }
+    std::string out;
+
+private:
+    template <class T> static std::string choices() {
+        if constexpr (std::is_enum_v<T>) {
+            std::string c;
+            for (auto nm : EnumNames<T>::names) c += (c.empty() ? "" : " | ") + std::string(nm);
+            return " (" + c + ")";
+        }
+        return "";
+    }
+    template <class T> static auto toValue(const T& v) {
+        if constexpr (std::is_same_v<T, Vec3>) return toml::array{double(v.x), double(v.y), double(v.z)};
+        else if constexpr (std::is_same_v<T, std::vector<double>>) {
+            toml::array a;
+            for (double x : v) a.push_back(x);
+            return a;
+        } else if constexpr (std::is_enum_v<T>) return std::string(enumName(v));
+        else if constexpr (std::is_same_v<T, bool> || std::is_same_v<T, double> || std::is_same_v<T, std::string>) return v;
+        else return static_cast<std::int64_t>(v);
+    }
+};
+
+}  // namespace
+
+Settings parseScene(std::string_view text, std::string_view sourceName, const std::vector<std::string>& overrideItems) {
+    toml::table root;
+    try {
+        root = toml::parse(text, sourceName);
+    } catch (const toml::parse_error& e) {
+        throw InputError(fmt::format("{}: {}", where(e.source()), e.description()));
+    }
+    Overrides overrides = parseOverrides(overrideItems);
+    Settings settings;
+    SceneReader reader(root, overrides);
+    settings.visit(reader);
+    reader.checkUnknownSections();
+    for (const auto& [key, doc] : overrides.docs)
+        if (!overrides.used.count(key))
+            throw InputError(fmt::format("command line -D {}: unknown setting (see accretion render --help-settings)", key));
+    validate(settings, reader.locations, sourceName);
+    return settings;
+}
+
+Settings loadScene(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw InputError(fmt::format("{}: cannot open scene file", file.string()));
+    std::ostringstream text;
+    text << in.rdbuf();
+    if (in.bad()) throw InputError(fmt::format("{}: cannot read scene file", file.string()));
+    Settings s = parseScene(text.str(), file.string(), overrides);
+    s.scenePath = file.string();
+    s.sceneName = file.stem().string();
+    return s;
+}
+
+std::string settingsToToml(const Settings& settings) {
+    TomlWriter w;
+    const_cast<Settings&>(settings).visit(w);
+    std::ostringstream s;
+    s << w.root << "\n";
+    return s.str();
+}
+
+std::string settingsReference() {
+    Settings defaults;
+    ReferenceWriter w;
+    defaults.visit(w);
+    return w.out;
+}
+
+}  // namespace accretion
