@@ -1,0 +1,45 @@
+#include "support/test_scenes.h"
+
+#include <array>
+#include <cstdio>
+#include <sys/wait.h>
+
+#include "accretion/particles/particle_source.h"
+
+namespace accretion::test {
+
+Settings axisCameraSettings(float dist, std::uint32_t size, double fov) {
+    Settings s;
+    s.camera.position = Vec3(0.0f, 0.0f, dist);
+    s.camera.look_at = Vec3(0.0f);
+    s.camera.up = Vec3(0.0f, 1.0f, 0.0f);
+    s.camera.fov = fov;
+    s.camera.width = s.camera.height = size;
+    s.render.estimator = EstimatorKind::exact;
+    return s;
+}
+
+FrameImage renderParticles(const Settings& settings, const Particles& particles, std::uint32_t frame) {
+    FrameRenderer renderer(settings, ParticleSource::fixed(particles), RenderOptions{true});
+    FrameStats stats;
+    return renderer.render(frame, stats);
+}
+
+std::filesystem::path scratchDir(const std::string& name) {
+    const auto dir = std::filesystem::current_path() / "scratch" / name;
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    return dir;
+}
+
+int runCommand(const std::string& command, std::string& output) {
+    output.clear();
+    FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+    if (!pipe) return -1;
+    std::array<char, 4096> buf;
+    while (std::size_t n = std::fread(buf.data(), 1, buf.size(), pipe)) output.append(buf.data(), n);
+    const int status = pclose(pipe);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+}  // namespace accretion::test

@@ -1,0 +1,23 @@
+#pragma once
+#include <filesystem>
+#include <string>
+
+#include "accretion/render/frame_renderer.h"
+#include "accretion/scene/settings.h"
+
+namespace accretion::test {
+
+/// Settings of a static camera looking down -z from (0,0,dist) at the origin,
+/// odd square resolution so that the centre pixel's ray is exactly the axis.
+Settings axisCameraSettings(float dist = 10.0f, std::uint32_t size = 33, double fov = 10.0);
+
+/// Render one frame of a fixed particle set.
+FrameImage renderParticles(const Settings& settings, const Particles& particles, std::uint32_t frame = 0);
+
+/// A fresh empty directory under the build tree for a test's files.
+std::filesystem::path scratchDir(const std::string& name);
+
+/// Run a shell command; returns its exit status, stdout+stderr in `output`.
+int runCommand(const std::string& command, std::string& output);
+
+}  // namespace accretion::test
