@@ -16,6 +16,7 @@ nlohmann::json frameStatsJson(const FrameStats& s) {
          {{"particles", s.particles},
           {"clusters", s.bvh.clusters},
           {"primitives", s.bvh.primitives},
+          {"triangles", s.bvh.triangles},
           {"hit_pixels", s.hitPixels},
           {"light_terms", s.lighting.lightTerms}}},
         {"rays",

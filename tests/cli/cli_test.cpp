@@ -74,6 +74,7 @@ TEST_CASE("render writes EXR, PNG previews, stats and settings", "[cli]") {
     REQUIRE(stats["frames"].size() == 2);
     const auto& f0 = stats["frames"][0];
     REQUIRE(f0["counts"]["particles"] == 800);
+    REQUIRE(f0["counts"]["triangles"] == 1600);
     REQUIRE(f0["rays"]["primary"] == 80 * 45);
     REQUIRE(f0["rays"]["shadow"].get<std::uint64_t>() > 0);
     REQUIRE(f0["bvh"]["embree_bytes"].get<std::int64_t>() > 0);

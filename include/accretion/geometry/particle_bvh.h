@@ -18,6 +18,7 @@ struct Camera;
 struct BvhStats {
     std::size_t clusters = 0;       ///< BLAS count (= TLAS instances)
     std::size_t primitives = 0;     ///< triangles (billboards) or spheres
+    std::size_t triangles = 0;      ///< 2 per billboard, 0 for spheres
     bool reclustered = false;       ///< clusters recomputed this frame
     bool refitted = false;          ///< BLAS refitted instead of rebuilt
     double clusterSeconds = 0.0;    ///< spatial clustering time

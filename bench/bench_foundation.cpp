@@ -1,0 +1,92 @@
+// Micro-benchmarks of the foundation's hot paths, on the 100K-particle disk:
+//   BM_BuildClusters/<policy>  clustering + all BLAS + TLAS of one frame
+//   BM_ShadowRays/<estimator>  estimateLighting at 1280x720 (rays/s counter)
+// Run: ./build/bench/accretion_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+#include <benchmark/benchmark.h>
+
+#include "accretion/geometry/particle_bvh.h"
+#include "accretion/particles/disk_generator.h"
+#include "accretion/render/camera.h"
+#include "accretion/render/estimators.h"
+#include "accretion/render/gbuffer.h"
+
+using namespace accretion;
+
+namespace {
+
+Settings diskSettings(std::uint32_t count) {
+    Settings s;
+    s.particles.count = count;
+    s.particles.radius = 0.02;  // smaller particles for the denser disk
+    s.camera.width = 1280;
+    s.camera.height = 720;
+    return s;
+}
+
+Particles disk(const Settings& s, std::uint32_t frame) {
+    Particles p = generateDisk(s.particles, frame);
+    std::fill(p.albedo.begin(), p.albedo.end(), s.shading.albedo);
+    return p;
+}
+
+void BM_BuildClusters(benchmark::State& state) {
+    Settings s = diskSettings(std::uint32_t(state.range(0)));
+    s.geometry.build = static_cast<BuildPolicy>(state.range(1));
+    const Particles p0 = disk(s, 0), p1 = disk(s, 1);
+    const Camera cam = Camera::atFrame(s.camera, 0);
+    EmbreeDevice device;
+    ParticleBvh bvh(device, s.geometry);
+    bvh.build(p0, cam);
+    int frame = 0;
+    for (auto _ : state) bvh.build(++frame % 2 ? p1 : p0, cam);
+    state.counters["clusters"] = double(bvh.stats().clusters);
+    state.counters["embree_MB"] = double(bvh.stats().embreeBytes) / 1e6;
+    state.SetLabel(std::string(enumName(s.geometry.build)));
+}
+BENCHMARK(BM_BuildClusters)
+    ->ArgsProduct({{100'000}, {int(BuildPolicy::rebuild), int(BuildPolicy::refit), int(BuildPolicy::fast_trace)}})
+    ->Args({1'000'000, int(BuildPolicy::rebuild)})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+void BM_ShadowRays(benchmark::State& state) {
+    Settings s = diskSettings(100'000);
+    s.render.estimator = static_cast<EstimatorKind>(state.range(0));
+    s.render.samples = 8;
+    const Particles p = disk(s, 0);
+    const Camera cam = Camera::atFrame(s.camera, 0);
+    EmbreeDevice device;
+    ParticleBvh bvh(device, s.geometry);
+    bvh.build(p, cam);
+    GBuffer gb;
+    traceGBuffer(bvh, p, cam, s.shading.model, gb);
+    const AliasTable table = buildPowerTable(p);
+    LightingImage out;
+    std::uint64_t rays = 0;
+    for (auto _ : state) {
+        LightingInputs in{bvh, p, gb, s.shading, s.render, 0, &table};
+        rays += estimateLighting(in, out).shadowRays;
+    }
+    state.counters["shadow_rays_per_s"] = benchmark::Counter(double(rays), benchmark::Counter::kIsRate);
+    state.SetLabel(std::string(enumName(s.render.estimator)));
+}
+BENCHMARK(BM_ShadowRays)->Arg(int(EstimatorKind::uniform))->Arg(int(EstimatorKind::power))
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_TraceGBuffer(benchmark::State& state) {
+    const Settings s = diskSettings(100'000);
+    const Particles p = disk(s, 0);
+    const Camera cam = Camera::atFrame(s.camera, 0);
+    EmbreeDevice device;
+    ParticleBvh bvh(device, s.geometry);
+    bvh.build(p, cam);
+    GBuffer gb;
+    std::uint64_t rays = 0;
+    for (auto _ : state) rays += traceGBuffer(bvh, p, cam, s.shading.model, gb);
+    state.counters["primary_rays_per_s"] = benchmark::Counter(double(rays), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_TraceGBuffer)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+
+BENCHMARK_MAIN();
