@@ -29,6 +29,21 @@ Particles disk(const Settings& s, std::uint32_t frame) {
     return p;
 }
 
+/// Frame 0 of the disk, built, with its G-buffer traced.
+struct BuiltFrame {
+    explicit BuiltFrame(const Settings& settings)
+        : s(settings), p(disk(s, 0)), cam(Camera::atFrame(s.camera, 0)), bvh(device, s.geometry) {
+        bvh.build(p, cam);
+        traceGBuffer(bvh, p, cam, s.shading.model, gb);
+    }
+    Settings s;
+    Particles p;
+    Camera cam;
+    EmbreeDevice device;
+    ParticleBvh bvh;
+    GBuffer gb;
+};
+
 void BM_BuildClusters(benchmark::State& state) {
     Settings s = diskSettings(std::uint32_t(state.range(0)));
     s.geometry.build = static_cast<BuildPolicy>(state.range(1));
@@ -53,18 +68,12 @@ void BM_ShadowRays(benchmark::State& state) {
     Settings s = diskSettings(100'000);
     s.render.estimator = static_cast<EstimatorKind>(state.range(0));
     s.render.samples = 8;
-    const Particles p = disk(s, 0);
-    const Camera cam = Camera::atFrame(s.camera, 0);
-    EmbreeDevice device;
-    ParticleBvh bvh(device, s.geometry);
-    bvh.build(p, cam);
-    GBuffer gb;
-    traceGBuffer(bvh, p, cam, s.shading.model, gb);
-    const AliasTable table = buildPowerTable(p);
+    const BuiltFrame f(s);
+    const AliasTable table = buildPowerTable(f.p);
     LightingImage out;
     std::uint64_t rays = 0;
     for (auto _ : state) {
-        LightingInputs in{bvh, p, gb, s.shading, s.render, 0, &table};
+        LightingInputs in{f.bvh, f.p, f.gb, s.shading, s.render, 0, &table};
         rays += estimateLighting(in, out).shadowRays;
     }
     state.counters["shadow_rays_per_s"] = benchmark::Counter(double(rays), benchmark::Counter::kIsRate);
@@ -74,15 +83,9 @@ BENCHMARK(BM_ShadowRays)->Arg(int(EstimatorKind::uniform))->Arg(int(EstimatorKin
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_TraceGBuffer(benchmark::State& state) {
-    const Settings s = diskSettings(100'000);
-    const Particles p = disk(s, 0);
-    const Camera cam = Camera::atFrame(s.camera, 0);
-    EmbreeDevice device;
-    ParticleBvh bvh(device, s.geometry);
-    bvh.build(p, cam);
-    GBuffer gb;
+    BuiltFrame f(diskSettings(100'000));
     std::uint64_t rays = 0;
-    for (auto _ : state) rays += traceGBuffer(bvh, p, cam, s.shading.model, gb);
+    for (auto _ : state) rays += traceGBuffer(f.bvh, f.p, f.cam, f.s.shading.model, f.gb);
     state.counters["primary_rays_per_s"] = benchmark::Counter(double(rays), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_TraceGBuffer)->Unit(benchmark::kMillisecond)->UseRealTime();

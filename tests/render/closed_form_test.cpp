@@ -18,6 +18,15 @@ constexpr std::size_t kCentre = (kSize / 2) * kSize + kSize / 2;
 const Vec3 kRho(0.5f, 0.6f, 0.7f);
 const Vec3 kI(1.0f, 2.0f, 3.0f);
 
+/// Receiver j at the origin (normal +z) and a small emitter at distance d,
+/// angle theta from the normal, in the xz plane.
+Particles receiverAndEmitter(float d, float theta, float emitterRadius = 0.01f) {
+    Particles p;
+    p.push(Vec3(0.0f), 0.5f, Vec3(0.0f), kRho);
+    p.push(Vec3(d * std::sin(theta), 0.0f, d * std::cos(theta)), emitterRadius, kI, kRho);
+    return p;
+}
+
 void requireClose(const Vec3& got, const Vec3& want, double rel = 1e-4) {
     for (int c = 0; c < 3; ++c) REQUIRE(got[c] == Approx(want[c]).epsilon(rel).margin(1e-12));
 }
@@ -40,11 +49,8 @@ TEST_CASE("one emitter over a Lambertian billboard gives rho/pi I cos/d^2", "[cl
 
 TEST_CASE("an occluder between receiver and emitter gives exactly 0", "[closed_form]") {
     Settings s = axisCameraSettings();
-    const float d = 2.0f, theta = 1.0f;
-    const Vec3 light(d * std::sin(theta), 0.0f, d * std::cos(theta));
-    Particles p;
-    p.push(Vec3(0.0f), 0.5f, Vec3(0.0f), kRho);
-    p.push(light, 0.01f, kI, kRho);
+    Particles p = receiverAndEmitter(2.0f, 1.0f);
+    const Vec3 light = p.position[1];
     p.push(0.5f * light, 0.1f, Vec3(0.0f), kRho);  // blocker at the midpoint
     SECTION("opaque billboard") {}
     SECTION("disc alpha (centre of the disc blocks)") { s.geometry.alpha = AlphaMode::disc; }
@@ -56,10 +62,8 @@ TEST_CASE("an occluder between receiver and emitter gives exactly 0", "[closed_f
 TEST_CASE("disc alpha lets light through the transparent corner", "[closed_form]") {
     Settings s = axisCameraSettings();
     const float d = 2.0f, theta = 1.0f;
-    const Vec3 light(d * std::sin(theta), 0.0f, d * std::cos(theta));
-    Particles p;
-    p.push(Vec3(0.0f), 0.5f, Vec3(0.0f), kRho);
-    p.push(light, 0.01f, kI, kRho);
+    Particles p = receiverAndEmitter(d, theta);
+    const Vec3 light = p.position[1];
     // Blocker whose quad corner (uv ~ (0.05, 0.05), outside the disc) covers the segment.
     const float r = 0.1f;
     p.push(0.5f * light + Vec3(0.9f * r, 0.9f * r, 0.0f), r, Vec3(0.0f), kRho);
