@@ -1,6 +1,7 @@
 #include "accretion/scene/scene_parser.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -242,52 +243,45 @@ void validate(const Settings& s, const std::map<std::string, std::string>& loc, 
         fail("geometry.alpha", "disc alpha applies to billboards only (primitive = \"sphere\")");
 }
 
-/// Builds a TOML table of the effective settings.
+/// A setting's value as TOML text; floats in their shortest round-trip form.
+std::string tomlValue(bool v) { return v ? "true" : "false"; }
+std::string tomlValue(const std::string& v) { return tomlQuote(v); }
+template <class F>
+    requires std::is_floating_point_v<F>
+std::string tomlValue(F v) {
+    char buf[64];
+    const auto end = std::to_chars(buf, buf + sizeof buf, v).ptr;
+    std::string text(buf, end);
+    if (text.find_first_of(".e") == std::string::npos) text += ".0";  // keep it a TOML float
+    return text;
+}
+template <class Int>
+    requires(std::is_integral_v<Int> && !std::is_same_v<Int, bool>)
+std::string tomlValue(Int v) { return std::to_string(v); }
+std::string tomlValue(const Vec3& v) {
+    return fmt::format("[{}, {}, {}]", tomlValue(v.x), tomlValue(v.y), tomlValue(v.z));
+}
+std::string tomlValue(const std::vector<double>& v) {
+    std::string out = "[";
+    for (std::size_t i = 0; i < v.size(); ++i) out += (i ? ", " : "") + tomlValue(v[i]);
+    return out + "]";
+}
+template <class E>
+    requires std::is_enum_v<E>
+std::string tomlValue(E e) { return tomlQuote(enumName(e)); }
+
+/// Writes the effective settings as TOML, or (with docs) the reference list.
 class TomlWriter {
 public:
+    explicit TomlWriter(bool withDocs) : withDocs_(withDocs) {}
     template <class S> void section(std::string_view name, S& s) {
-        current_ = toml::table{};
-        s.visit(*this);
-        root.insert(name, std::move(current_));
-    }
-    template <class T> void field(std::string_view key, const T& value, std::string_view, Range = kAny) {
-        current_.insert(key, toNode(value));
-    }
-    toml::table root;
-
-private:
-    static auto toNode(bool v) { return toml::value<bool>(v); }
-    static auto toNode(const std::string& v) { return toml::value<std::string>(v); }
-    static auto toNode(double v) { return toml::value<double>(v); }
-    template <class Int>
-        requires std::is_integral_v<Int>
-    static auto toNode(Int v) { return toml::value<std::int64_t>(static_cast<std::int64_t>(v)); }
-    static auto toNode(const Vec3& v) { return toml::array{double(v.x), double(v.y), double(v.z)}; }
-    static auto toNode(const std::vector<double>& v) {
-        toml::array a;
-        for (double x : v) a.push_back(x);
-        return a;
-    }
-    template <class E>
-        requires std::is_enum_v<E>
-    static auto toNode(E e) { return toml::value<std::string>(std::string(enumName(e))); }
-
-    toml::table current_;
-};
-
-/// Lists every setting with its default and doc line.
-class ReferenceWriter {
-public:
-    template <class S> void section(std::string_view name, S& s) {
-        out += fmt::format("[{}]\n", name);
+        out += fmt::format("{}[{}]\n", out.empty() ? "" : "\n", name);
         s.visit(*this);
     }
     template <class T> void field(std::string_view key, const T& value, std::string_view doc, Range = kAny) {
-        std::ostringstream s;
-        s << toml::table{{key, toValue(value)}};
-        std::string line = s.str();
-        while (!line.empty() && line.back() == '\n') line.pop_back();
-        out += fmt::format("  {:<44} # {}{}\n", line, doc, choices<T>());
+        const std::string line = fmt::format("{} = {}", key, tomlValue(value));
+        if (!withDocs_) out += line + "\n";
+        else out += fmt::format("{:<44} # {}{}\n", line, doc, choices<T>());
     }
     std::string out;
 
@@ -300,16 +294,7 @@ private:
         }
         return "";
     }
-    template <class T> static auto toValue(const T& v) {
-        if constexpr (std::is_same_v<T, Vec3>) return toml::array{double(v.x), double(v.y), double(v.z)};
-        else if constexpr (std::is_same_v<T, std::vector<double>>) {
-            toml::array a;
-            for (double x : v) a.push_back(x);
-            return a;
-        } else if constexpr (std::is_enum_v<T>) return std::string(enumName(v));
-        else if constexpr (std::is_same_v<T, bool> || std::is_same_v<T, double> || std::is_same_v<T, std::string>) return v;
-        else return static_cast<std::int64_t>(v);
-    }
+    bool withDocs_;
 };
 
 }  // namespace
@@ -346,16 +331,15 @@ Settings loadScene(const std::filesystem::path& file, const std::vector<std::str
 }
 
 std::string settingsToToml(const Settings& settings) {
-    TomlWriter w;
-    const_cast<Settings&>(settings).visit(w);
-    std::ostringstream s;
-    s << w.root << "\n";
-    return s.str();
+    TomlWriter w(false);
+    Settings copy = settings;  // visit() is non-const: it also drives the reader
+    copy.visit(w);
+    return w.out;
 }
 
 std::string settingsReference() {
     Settings defaults;
-    ReferenceWriter w;
+    TomlWriter w(true);
     defaults.visit(w);
     return w.out;
 }
