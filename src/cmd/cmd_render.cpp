@@ -148,7 +148,7 @@ void addRenderCommand(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("render", "Render frames of a scene to EXR (+ PNG preview, stats.json)");
     cmd->add_option("scene", args->scene, "Scene file (TOML)")->required();
     cmd->add_option("-o,--output", args->output, "EXR output path ({scene}, {frame} patterns) = render.output");
-    cmd->add_option("--estimator", args->estimator, "exact | uniform | power  (= render.estimator)");
+    cmd->add_option("--estimator", args->estimator, "exact | uniform | power | ris  (= render.estimator)");
     cmd->add_option("--spp", args->spp, "Light samples per pixel (= render.samples)");
     cmd->add_option("--seed", args->seed, "Render seed (= render.seed)");
     cmd->add_option("--frames", args->frames, "Frames A:B, half-open (= render.frame_start, render.frames)");

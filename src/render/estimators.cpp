@@ -6,6 +6,7 @@
 
 #include "accretion/core/error.h"
 #include "accretion/core/rng.h"
+#include "accretion/lighting/reservoir.h"
 #include "accretion/render/shading.h"
 #include "accretion/render/visibility.h"
 
@@ -81,6 +82,54 @@ void sampledPixel(const ParticleBvh& bvh, const LightArrays& L, const AliasTable
     }
 }
 
+/// ris (MODEL.md section 4): per sample, one reservoir streams M candidates
+/// from the source pdf with w = p_hat / p_src, p_hat = luminance(f I G)
+/// without visibility; the kept y gets one shadow ray, weighted by W.
+template <ShadingModel M, Primitive P>
+void risPixel(const ParticleBvh& bvh, const LightArrays& L, const AliasTable* table, const ShadingPoint& sp,
+              const RenderSettings& rs, float eps, Rng& rng, Vec3& mean, Vec3& stderr, LightingCounters& c) {
+    DVec3 s1(0.0), s2(0.0);
+    const bool power = rs.source == LightSource::power;
+    const float uniformPdf = 1.0f / float(L.count);
+    for (std::uint32_t k = 0; k < rs.samples; ++k) {
+        Reservoir r;
+        Vec3 f_y(0.0f);
+        LightTerm t_y{};
+        for (std::uint32_t m = 0; m < rs.candidates; ++m) {
+            std::uint32_t i;
+            float p_src;
+            if (power) {
+                i = table->sample(rng.uniformInt(L.count), rng.uniform());
+                p_src = table->pmf(i);
+            } else {
+                i = rng.uniformInt(L.count);
+                p_src = uniformPdf;
+            }
+            LightTerm t;
+            float p_hat = 0.0f;
+            ++c.lightTerms;
+            if (i != sp.self && evalLight<M>(sp, L.position[i], L.emission[i], L.dmin2[i], t)) p_hat = luminance(t.value);
+            if (r.update(i, p_hat / p_src, p_hat, rng.uniform())) t_y = t;
+        }
+        r.finalize();
+        if (r.W <= 0.0f) {
+            continue;
+        }
+        ++c.shadowRays;
+        if (!visible<P>(bvh, sp, t_y, L.radius[r.y], eps)) {
+            ++c.shadowOccluded;
+            continue;
+        }
+        const DVec3 est = DVec3(t_y.value) * double(r.W);
+        s1 += est;
+        s2 += est * est;
+    }
+    const std::uint32_t S = rs.samples;
+    const DVec3 m = s1 / double(S);
+    mean = Vec3(m);
+    stderr = S > 1 ? Vec3(glm::sqrt(glm::max((s2 - double(S) * m * m) / double(S - 1), DVec3(0.0)) / double(S))) : Vec3(0.0f);
+}
+
 template <ShadingModel M, Primitive P>
 LightingCounters run(const LightingInputs& in, const LightArrays& L, LightingImage& out, Progress* progress) {
     const GBuffer& gb = in.gbuffer;
@@ -102,7 +151,9 @@ LightingCounters run(const LightingInputs& in, const LightArrays& L, LightingIma
                     continue;
                 }
                 Rng rng(px, in.frame, RngPass::lightSampling, in.render.seed);
-                if (kind == EstimatorKind::power)
+                if (kind == EstimatorKind::ris)
+                    risPixel<M, P>(in.bvh, L, in.powerTable, sp, in.render, eps, rng, out.Lr[px], out.Lr_stderr[px], c);
+                else if (kind == EstimatorKind::power)
                     sampledPixel<M, P, true>(in.bvh, L, in.powerTable, sp, S, eps, rng, out.Lr[px], out.Lr_stderr[px], c);
                 else
                     sampledPixel<M, P, false>(in.bvh, L, nullptr, sp, S, eps, rng, out.Lr[px], out.Lr_stderr[px], c);
@@ -124,6 +175,10 @@ LightingCounters dispatchPrimitive(const LightingInputs& in, const LightArrays& 
 
 }  // namespace
 
+bool needsPowerTable(const RenderSettings& r) {
+    return r.estimator == EstimatorKind::power || (r.estimator == EstimatorKind::ris && r.source == LightSource::power);
+}
+
 AliasTable buildPowerTable(const Particles& particles) {
     std::vector<float> w(particles.size());
     for (std::size_t i = 0; i < w.size(); ++i) w[i] = luminance(particles.emission[i]);
@@ -136,7 +191,7 @@ LightingCounters estimateLighting(const LightingInputs& in, LightingImage& out, 
     out.Lr_stderr.assign(pixels, Vec3(0.0f));
     out.spp.assign(pixels, 0.0f);
     if (in.particles.empty()) return {};
-    ACC_CHECK(in.render.estimator != EstimatorKind::power || in.powerTable);
+    ACC_CHECK(!needsPowerTable(in.render) || in.powerTable);
 
     LightArrays L{in.particles.position.data(), in.particles.emission.data(), in.particles.radius.data(), {},
                   static_cast<std::uint32_t>(in.particles.size())};

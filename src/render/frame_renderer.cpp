@@ -37,7 +37,7 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats) {
     double totalLuminance = 0.0;
     for (const Vec3& I : particles.emission) totalLuminance += luminance(I);
     const bool lit = totalLuminance > 0.0 && glm::length(settings_.shading.albedo) > 0.0f;
-    if (lit && settings_.render.estimator == EstimatorKind::power) {
+    if (lit && needsPowerTable(settings_.render)) {
         auto t = timer.scope(pass::buildLightSampler);
         powerTable = buildPowerTable(particles);
     }
@@ -57,7 +57,7 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats) {
         if (lit) {
             Progress progress(fmt::format("frame {} {}", frame, pass::estimateLighting), pixels, options_.quiet);
             LightingInputs in{*bvh_, particles, gbuffer, settings_.shading, settings_.render, frame,
-                              settings_.render.estimator == EstimatorKind::power ? &powerTable : nullptr};
+                              needsPowerTable(settings_.render) ? &powerTable : nullptr};
             stats.lighting = estimateLighting(in, img.lighting, &progress);
         } else {
             img.lighting.Lr.assign(pixels, Vec3(0.0f));

@@ -44,7 +44,7 @@ bool bitIdentical(const std::vector<float>& a, const std::vector<float>& b) {
 
 TEST_CASE("bit-identical EXR for 1 and 2 threads", "[cli][determinism]") {
     const auto dir = accretion::test::scratchDir("threads");
-    const std::string estimator = GENERATE("exact", "power", "uniform");
+    const std::string estimator = GENERATE("exact", "power", "uniform", "ris");
     std::string out;
     for (int t : {1, 2}) {
         const std::string cmd = smallQuickstart() + " --estimator " + estimator + " --spp 8 --threads " +

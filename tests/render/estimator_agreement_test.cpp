@@ -63,7 +63,7 @@ Agreement compare(const FrameImage& mc, const FrameImage& exact, float scale = 1
 
 }  // namespace
 
-TEST_CASE("uniform and power agree with exact, and a 1% bias is caught", "[estimators][statistical]") {
+TEST_CASE("uniform, power and ris agree with exact, and a 1% bias is caught", "[estimators][statistical]") {
     struct Config {
         const char* name;
         Primitive primitive;
@@ -73,8 +73,16 @@ TEST_CASE("uniform and power agree with exact, and a 1% bias is caught", "[estim
     const Config config = GENERATE(Config{"billboard lambert", Primitive::billboard, AlphaMode::opaque, ShadingModel::lambert},
                                    Config{"disc sphere-shaded", Primitive::billboard, AlphaMode::disc, ShadingModel::sphere},
                                    Config{"spheres isotropic", Primitive::sphere, AlphaMode::opaque, ShadingModel::isotropic});
-    const EstimatorKind kind = GENERATE(EstimatorKind::uniform, EstimatorKind::power);
-    INFO(config.name << ", " << enumName(kind));
+    struct Estimator {
+        EstimatorKind kind;
+        LightSource source;
+        std::uint32_t samples, candidates;
+    };
+    const Estimator est = GENERATE(Estimator{EstimatorKind::uniform, LightSource::uniform, 16384, 1},
+                                   Estimator{EstimatorKind::power, LightSource::uniform, 16384, 1},
+                                   Estimator{EstimatorKind::ris, LightSource::uniform, 4096, 8},
+                                   Estimator{EstimatorKind::ris, LightSource::power, 4096, 8});
+    INFO(config.name << ", " << enumName(est.kind) << " (source " << enumName(est.source) << ")");
 
     Settings s = smallDisk();
     s.geometry.primitive = config.primitive;
@@ -87,10 +95,19 @@ TEST_CASE("uniform and power agree with exact, and a 1% bias is caught", "[estim
     }();
 
     const FrameImage exact = renderParticles(s, particles);
-    s.render.estimator = kind;
-    s.render.samples = 16384;
+    s.render.estimator = est.kind;
+    s.render.source = est.source;
+    s.render.samples = est.samples;
+    s.render.candidates = est.candidates;
     s.render.seed = 11;
-    const FrameImage mc = renderParticles(s, particles);
+    FrameRenderer renderer(s, ParticleSource::fixed(particles), RenderOptions{true});
+    FrameStats stats;
+    const FrameImage mc = renderer.render(0, stats);
+    if (est.kind == EstimatorKind::ris) {  // M target evaluations and at most one shadow ray per reservoir
+        const std::uint64_t reservoirs = std::uint64_t(est.samples) * stats.hitPixels;
+        REQUIRE(stats.lighting.lightTerms == reservoirs * est.candidates);
+        REQUIRE(stats.lighting.shadowRays <= reservoirs);
+    }
 
     // Confidence: per-pixel tests at a family-wise level of 1e-4 (Bonferroni
     // over 3 channels x pixels); the global sum at |z| < 4.4 (p ~ 1e-5).

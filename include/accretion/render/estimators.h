@@ -39,15 +39,19 @@ struct LightingInputs {
     const ShadingSettings& shading;
     const RenderSettings& render;
     std::uint32_t frame = 0;
-    const AliasTable* powerTable = nullptr;  ///< required by `power`
+    const AliasTable* powerTable = nullptr;  ///< required when needsPowerTable()
 };
+
+/// True if the estimator samples lights in proportion to their power.
+bool needsPowerTable(const RenderSettings& render);
 
 /// Light selection pmf over luminance(I_i), for the `power` estimator.
 AliasTable buildPowerTable(const Particles& particles);
 
 /// estimateLighting (MODEL.md sections 3-4): `exact` sums every light i != j
 /// with one shadow ray each; `uniform` / `power` average S one-sample
-/// estimates f I G V / p(i), with their standard error. Per-pixel PCG streams
+/// estimates f I G V / p(i); `ris` averages S one-reservoir RIS estimates of
+/// M candidates each; Monte Carlo estimators also give their standard error. Per-pixel PCG streams
 /// make the result independent of the thread count.
 LightingCounters estimateLighting(const LightingInputs& in, LightingImage& out, Progress* progress = nullptr);
 

@@ -35,7 +35,8 @@ enum class Orientation { view_plane, view_point, velocity };
 enum class AlphaMode { opaque, disc };
 enum class BuildPolicy { rebuild, refit, fast_trace };
 enum class ShadingModel { lambert, sphere, isotropic };
-enum class EstimatorKind { exact, uniform, power };
+enum class EstimatorKind { exact, uniform, power, ris };
+enum class LightSource { uniform, power };
 
 ACC_ENUM_NAMES(CameraPath, "static", "orbit", "linear");
 ACC_ENUM_NAMES(Primitive, "billboard", "sphere");
@@ -43,7 +44,8 @@ ACC_ENUM_NAMES(Orientation, "view_plane", "view_point", "velocity");
 ACC_ENUM_NAMES(AlphaMode, "opaque", "disc");
 ACC_ENUM_NAMES(BuildPolicy, "rebuild", "refit", "fast_trace");
 ACC_ENUM_NAMES(ShadingModel, "lambert", "sphere", "isotropic");
-ACC_ENUM_NAMES(EstimatorKind, "exact", "uniform", "power");
+ACC_ENUM_NAMES(EstimatorKind, "exact", "uniform", "power", "ris");
+ACC_ENUM_NAMES(LightSource, "uniform", "power");
 
 template <class E> constexpr std::string_view enumName(E e) {
     return EnumNames<E>::names[static_cast<std::size_t>(e)];
@@ -159,6 +161,8 @@ struct RenderSettings {
     std::uint32_t frames = 1;                    ///< number of frames rendered
     EstimatorKind estimator = EstimatorKind::exact; ///< estimator of Lr
     std::uint32_t samples = 16;                  ///< light samples per pixel (Monte Carlo estimators)
+    std::uint32_t candidates = 32;               ///< ris: candidates M per reservoir
+    LightSource source = LightSource::uniform;   ///< ris: source pdf of the candidates
     std::uint64_t seed = 0;                      ///< render seed
     std::string output = "out/{scene}.{frame}.exr"; ///< EXR path, {scene} and {frame} patterns
     double shadow_epsilon = 1e-4;                ///< relative far-end margin of shadow rays
@@ -169,7 +173,9 @@ struct RenderSettings {
         v.field("frame_start", frame_start, "first frame", Range{0, 1e9});
         v.field("frames", frames, "number of frames", Range{1, 1e6});
         v.field("estimator", estimator, "estimator of the reflected light Lr");
-        v.field("samples", samples, "light samples per pixel (uniform, power)", Range{1, 1e7});
+        v.field("samples", samples, "light samples per pixel (uniform, power; ris: reservoirs)", Range{1, 1e7});
+        v.field("candidates", candidates, "ris: candidates M per reservoir", Range{1, 1e6});
+        v.field("source", source, "ris: source pdf of the candidates");
         v.field("seed", seed, "render seed");
         v.field("output", output, "EXR output path; {scene} and {frame} are replaced");
         v.field("shadow_epsilon", shadow_epsilon, "shadow ray far end: t < d (1 - eps)", Range{1e-7, 0.1});

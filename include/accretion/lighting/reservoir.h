@@ -1,0 +1,36 @@
+#pragma once
+#include <cstdint>
+#include <limits>
+
+namespace accretion {
+
+inline constexpr std::uint32_t kNoLight = std::numeric_limits<std::uint32_t>::max();
+
+/// Weighted reservoir of one light sample (Bitterli et al. 2020, Alg. 2):
+/// streams candidates, keeps y with probability w_y / w_sum.
+/// W = w_sum / (M p_hat(y)) is the contribution weight (MODEL.md section 4;
+/// not seed 004's w_sum / M).
+struct Reservoir {
+    std::uint32_t y = kNoLight;  ///< selected light
+    float w_sum = 0.0f;          ///< sum of resampling weights
+    float p_hat = 0.0f;          ///< target function of y at this pixel
+    std::uint32_t M = 0;         ///< candidates seen
+    float W = 0.0f;              ///< contribution weight (after finalize)
+
+    /// Stream candidate x with resampling weight w and target p_hat_x; u uniform in [0,1).
+    bool update(std::uint32_t x, float w, float p_hat_x, float u) {
+        w_sum += w;
+        ++M;
+        if (w > 0.0f && u * w_sum < w) {
+            y = x;
+            p_hat = p_hat_x;
+            return true;
+        }
+        return false;
+    }
+
+    /// W = w_sum / (M p_hat(y)), 0 when nothing was selected.
+    void finalize() { W = (y != kNoLight && p_hat > 0.0f && M > 0) ? w_sum / (float(M) * p_hat) : 0.0f; }
+};
+
+}  // namespace accretion

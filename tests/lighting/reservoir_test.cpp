@@ -1,0 +1,43 @@
+#include <catch2/catch.hpp>
+
+#include "accretion/core/rng.h"
+#include "accretion/lighting/reservoir.h"
+#include "support/statistics.h"
+
+using namespace accretion;
+
+TEST_CASE("streaming reservoir keeps candidate i with probability w_i / sum w (chi-square)", "[reservoir][statistical]") {
+    const std::vector<float> w = {0.5f, 0.0f, 3.0f, 1.0f, 0.25f, 6.0f, 2.0f, 0.0f, 1.5f, 4.0f};
+    double total = 0.0;
+    for (float x : w) total += x;
+    const int trials = 400'000;
+    std::vector<double> observed(w.size(), 0.0), expected(w.size());
+    Rng rng(0, 0, RngPass::lightSampling, 77);
+    for (int t = 0; t < trials; ++t) {
+        Reservoir r;
+        for (std::uint32_t i = 0; i < w.size(); ++i) r.update(i, w[i], 2.0f * w[i], rng.uniform());
+        r.finalize();
+        REQUIRE(r.M == w.size());
+        REQUIRE(r.w_sum == Approx(total));
+        REQUIRE(r.p_hat == 2.0f * w[r.y]);
+        // W = w_sum / (M p_hat(y)): the seed's w_sum / M would not divide by p_hat.
+        REQUIRE(r.W == Approx(total / (double(w.size()) * 2.0 * w[r.y])));
+        ++observed[r.y];
+    }
+    for (std::size_t i = 0; i < w.size(); ++i) expected[i] = trials * w[i] / total;
+    REQUIRE(observed[1] == 0.0);
+    REQUIRE(observed[7] == 0.0);
+    // Confidence 1e-4 (fixed seed).
+    CHECK(accretion::test::chiSquarePValue(observed, expected) > 1e-4);
+}
+
+TEST_CASE("an empty or all-zero reservoir has W = 0", "[reservoir]") {
+    Reservoir r;
+    r.finalize();
+    REQUIRE(r.W == 0.0f);
+    r.update(3, 0.0f, 0.0f, 0.5f);
+    r.finalize();
+    REQUIRE(r.y == kNoLight);
+    REQUIRE(r.W == 0.0f);
+    REQUIRE(r.M == 1);
+}
