@@ -5,7 +5,7 @@
 #include <benchmark/benchmark.h>
 
 #include "accretion/geometry/particle_bvh.h"
-#include "accretion/particles/disk_generator.h"
+#include "accretion/particles/particle_source.h"
 #include "accretion/render/camera.h"
 #include "accretion/render/estimators.h"
 #include "accretion/render/gbuffer.h"
@@ -23,11 +23,7 @@ Settings diskSettings(std::uint32_t count) {
     return s;
 }
 
-Particles disk(const Settings& s, std::uint32_t frame) {
-    Particles p = generateDisk(s.particles, frame);
-    std::fill(p.albedo.begin(), p.albedo.end(), s.shading.albedo);
-    return p;
-}
+Particles disk(const Settings& s, std::uint32_t frame) { return ParticleSource(s).frame(frame); }
 
 /// Frame 0 of the disk, built, with its G-buffer traced.
 struct BuiltFrame {

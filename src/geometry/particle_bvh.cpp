@@ -157,7 +157,7 @@ void ParticleBvh::build(const Particles& particles, const Camera& camera) {
     stats_.refitted = refit;
     stats_.clusters = clusters_.count();
     stats_.primitives = settings_.primitive == Primitive::billboard ? 2 * n : n;
-    stats_.triangles = settings_.primitive == Primitive::billboard ? 2 * n : 0;
+    stats_.triangles = settings_.primitive == Primitive::billboard ? stats_.primitives : 0;
     stats_.embreeBytes = device_.bytesInUse();
 }
 

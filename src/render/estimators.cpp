@@ -20,6 +20,7 @@ struct LightArrays {
     const float* radius;
     std::vector<float> dmin2;  ///< max(r_i, dmin)^2
     std::uint32_t count;
+    float uniformPdf;          ///< 1 / count
 };
 
 ShadingPoint shadingPoint(const GBufferTexel& g, const Particles& particles) {
@@ -42,92 +43,91 @@ Vec3 exactPixel(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint
     return Vec3(sum);
 }
 
+/// One light drawn from the source pmf: uniform, or power (alias table).
+struct LightSample {
+    std::uint32_t i;
+    float pdf;
+};
+
+template <bool Power>
+LightSample sampleLight(const LightArrays& L, const AliasTable* table, Rng& rng) {
+    if constexpr (Power) {
+        const std::uint32_t bucket = rng.uniformInt(L.count);  // sequenced: bucket, then coin
+        const std::uint32_t i = table->sample(bucket, rng.uniform());
+        return {i, table->pmf(i)};
+    } else {
+        return {rng.uniformInt(L.count), L.uniformPdf};
+    }
+}
+
+/// Mean and standard error of the mean of S per-sample estimates (0 counts).
+class SampleMean {
+public:
+    void add(const DVec3& x) {
+        s1_ += x;
+        s2_ += x * x;
+    }
+    void finish(std::uint32_t S, Vec3& mean, Vec3& stderr) const {
+        const DVec3 m = s1_ / double(S);
+        mean = Vec3(m);
+        const DVec3 var = S > 1 ? glm::max((s2_ - double(S) * m * m) / double(S - 1), DVec3(0.0)) : DVec3(0.0);
+        stderr = Vec3(glm::sqrt(var / double(S)));
+    }
+
+private:
+    DVec3 s1_{0.0}, s2_{0.0};
+};
+
 /// uniform / power: S one-sample estimates f I G V / p(i) (0 when i = j).
 template <ShadingModel M, Primitive P, bool Power>
 void sampledPixel(const ParticleBvh& bvh, const LightArrays& L, const AliasTable* table, const ShadingPoint& sp,
                   std::uint32_t S, float eps, Rng& rng, Vec3& mean, Vec3& stderr, LightingCounters& c) {
-    DVec3 s1(0.0), s2(0.0);
-    const float uniformPdf = 1.0f / float(L.count);
+    SampleMean acc;
     for (std::uint32_t k = 0; k < S; ++k) {
-        std::uint32_t i;
-        float pdf;
-        if constexpr (Power) {
-            const std::uint32_t bucket = rng.uniformInt(L.count);
-            i = table->sample(bucket, rng.uniform());
-            pdf = table->pmf(i);
-        } else {
-            i = rng.uniformInt(L.count);
-            pdf = uniformPdf;
-        }
-        if (i == sp.self) continue;
+        const LightSample x = sampleLight<Power>(L, table, rng);
+        if (x.i == sp.self) continue;
         LightTerm t;
         ++c.lightTerms;
-        if (!evalLight<M>(sp, L.position[i], L.emission[i], L.dmin2[i], t)) continue;
+        if (!evalLight<M>(sp, L.position[x.i], L.emission[x.i], L.dmin2[x.i], t)) continue;
         ++c.shadowRays;
-        if (!visible<P>(bvh, sp, t, L.radius[i], eps)) {
+        if (!visible<P>(bvh, sp, t, L.radius[x.i], eps)) {
             ++c.shadowOccluded;
             continue;
         }
-        const DVec3 est = DVec3(t.value) / double(pdf);
-        s1 += est;
-        s2 += est * est;
+        acc.add(DVec3(t.value) / double(x.pdf));
     }
-    const DVec3 m = s1 / double(S);
-    mean = Vec3(m);
-    if (S > 1) {
-        const DVec3 var = glm::max((s2 - double(S) * m * m) / double(S - 1), DVec3(0.0));
-        stderr = Vec3(glm::sqrt(var / double(S)));
-    } else {
-        stderr = Vec3(0.0f);
-    }
+    acc.finish(S, mean, stderr);
 }
 
 /// ris (MODEL.md section 4): per sample, one reservoir streams M candidates
-/// from the source pdf with w = p_hat / p_src, p_hat = luminance(f I G)
+/// from the source pmf with w = p_hat / p_src, p_hat = luminance(f I G)
 /// without visibility; the kept y gets one shadow ray, weighted by W.
-template <ShadingModel M, Primitive P>
+template <ShadingModel M, Primitive P, bool Power>
 void risPixel(const ParticleBvh& bvh, const LightArrays& L, const AliasTable* table, const ShadingPoint& sp,
               const RenderSettings& rs, float eps, Rng& rng, Vec3& mean, Vec3& stderr, LightingCounters& c) {
-    DVec3 s1(0.0), s2(0.0);
-    const bool power = rs.source == LightSource::power;
-    const float uniformPdf = 1.0f / float(L.count);
+    SampleMean acc;
     for (std::uint32_t k = 0; k < rs.samples; ++k) {
         Reservoir r;
-        Vec3 f_y(0.0f);
         LightTerm t_y{};
         for (std::uint32_t m = 0; m < rs.candidates; ++m) {
-            std::uint32_t i;
-            float p_src;
-            if (power) {
-                i = table->sample(rng.uniformInt(L.count), rng.uniform());
-                p_src = table->pmf(i);
-            } else {
-                i = rng.uniformInt(L.count);
-                p_src = uniformPdf;
-            }
+            const LightSample x = sampleLight<Power>(L, table, rng);
             LightTerm t;
             float p_hat = 0.0f;
             ++c.lightTerms;
-            if (i != sp.self && evalLight<M>(sp, L.position[i], L.emission[i], L.dmin2[i], t)) p_hat = luminance(t.value);
-            if (r.update(i, p_hat / p_src, p_hat, rng.uniform())) t_y = t;
+            if (x.i != sp.self && evalLight<M>(sp, L.position[x.i], L.emission[x.i], L.dmin2[x.i], t))
+                p_hat = luminance(t.value);
+            if (r.update(x.i, p_hat / x.pdf, p_hat, rng.uniform())) t_y = t;
         }
         r.finalize();
-        if (r.W <= 0.0f) {
-            continue;
-        }
+        if (r.W <= 0.0f) continue;
         ++c.shadowRays;
         if (!visible<P>(bvh, sp, t_y, L.radius[r.y], eps)) {
             ++c.shadowOccluded;
             continue;
         }
-        const DVec3 est = DVec3(t_y.value) * double(r.W);
-        s1 += est;
-        s2 += est * est;
+        acc.add(DVec3(t_y.value) * double(r.W));
     }
-    const std::uint32_t S = rs.samples;
-    const DVec3 m = s1 / double(S);
-    mean = Vec3(m);
-    stderr = S > 1 ? Vec3(glm::sqrt(glm::max((s2 - double(S) * m * m) / double(S - 1), DVec3(0.0)) / double(S))) : Vec3(0.0f);
+    acc.finish(rs.samples, mean, stderr);
 }
 
 template <ShadingModel M, Primitive P>
@@ -151,8 +151,10 @@ LightingCounters run(const LightingInputs& in, const LightArrays& L, LightingIma
                     continue;
                 }
                 Rng rng(px, in.frame, RngPass::lightSampling, in.render.seed);
-                if (kind == EstimatorKind::ris)
-                    risPixel<M, P>(in.bvh, L, in.powerTable, sp, in.render, eps, rng, out.Lr[px], out.Lr_stderr[px], c);
+                if (kind == EstimatorKind::ris && in.render.source == LightSource::power)
+                    risPixel<M, P, true>(in.bvh, L, in.powerTable, sp, in.render, eps, rng, out.Lr[px], out.Lr_stderr[px], c);
+                else if (kind == EstimatorKind::ris)
+                    risPixel<M, P, false>(in.bvh, L, nullptr, sp, in.render, eps, rng, out.Lr[px], out.Lr_stderr[px], c);
                 else if (kind == EstimatorKind::power)
                     sampledPixel<M, P, true>(in.bvh, L, in.powerTable, sp, S, eps, rng, out.Lr[px], out.Lr_stderr[px], c);
                 else
@@ -194,7 +196,7 @@ LightingCounters estimateLighting(const LightingInputs& in, LightingImage& out, 
     ACC_CHECK(!needsPowerTable(in.render) || in.powerTable);
 
     LightArrays L{in.particles.position.data(), in.particles.emission.data(), in.particles.radius.data(), {},
-                  static_cast<std::uint32_t>(in.particles.size())};
+                  static_cast<std::uint32_t>(in.particles.size()), 1.0f / float(in.particles.size())};
     L.dmin2.resize(L.count);
     const float dmin = static_cast<float>(in.shading.dmin);
     for (std::uint32_t i = 0; i < L.count; ++i) {

@@ -37,7 +37,8 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats) {
     double totalLuminance = 0.0;
     for (const Vec3& I : particles.emission) totalLuminance += luminance(I);
     const bool lit = totalLuminance > 0.0 && glm::length(settings_.shading.albedo) > 0.0f;
-    if (lit && needsPowerTable(settings_.render)) {
+    const bool power = lit && needsPowerTable(settings_.render);
+    if (power) {
         auto t = timer.scope(pass::buildLightSampler);
         powerTable = buildPowerTable(particles);
     }
@@ -57,7 +58,7 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats) {
         if (lit) {
             Progress progress(fmt::format("frame {} {}", frame, pass::estimateLighting), pixels, options_.quiet);
             LightingInputs in{*bvh_, particles, gbuffer, settings_.shading, settings_.render, frame,
-                              needsPowerTable(settings_.render) ? &powerTable : nullptr};
+                              power ? &powerTable : nullptr};
             stats.lighting = estimateLighting(in, img.lighting, &progress);
         } else {
             img.lighting.Lr.assign(pixels, Vec3(0.0f));

@@ -26,13 +26,12 @@ std::string smallQuickstart() {
 }
 
 /// All channels of an EXR as floats (particle.id converts exactly).
-std::vector<float> readPixels(const std::filesystem::path& file, std::vector<std::string>* names = nullptr) {
+std::vector<float> readPixels(const std::filesystem::path& file) {
     auto in = OIIO::ImageInput::open(file.string());
     REQUIRE(in);
     const auto& spec = in->spec();
     std::vector<float> px(std::size_t(spec.width) * spec.height * spec.nchannels);
     REQUIRE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, px.data()));
-    if (names) *names = spec.channelnames;
     return px;
 }
 

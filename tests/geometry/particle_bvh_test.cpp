@@ -4,7 +4,6 @@
 
 #include <limits>
 
-#include "accretion/core/rng.h"
 #include "accretion/geometry/particle_bvh.h"
 #include "accretion/particles/disk_generator.h"
 #include "accretion/render/camera.h"
@@ -75,6 +74,24 @@ TEST_CASE("Embree hits match brute force for every geometry and build policy", "
         REQUIRE(bvh.stats().refitted == (g.build == BuildPolicy::refit && frame > 0));
         std::vector<BillboardFrame> frames(p.size());
         for (std::uint32_t i = 0; i < p.size(); ++i) frames[i] = bvh.frame(i);
+        // The frames the brute force reuses are checked on their own: orthonormal,
+        // facing the camera as MODEL.md section 2 defines for each mode.
+        if (g.primitive == Primitive::billboard)
+            for (std::uint32_t i = 0; i < p.size(); ++i) {
+                const BillboardFrame& f = frames[i];
+                REQUIRE(glm::length(f.right) == Approx(1.0f).epsilon(1e-5));
+                REQUIRE(glm::length(f.up) == Approx(1.0f).epsilon(1e-5));
+                REQUIRE(glm::dot(f.right, f.up) == Approx(0.0f).margin(1e-5));
+                const Vec3 toEye = glm::normalize(cam.position - p.position[i]);
+                if (g.orientation == Orientation::view_plane)
+                    REQUIRE(glm::dot(f.normal(), -cam.forward) == Approx(1.0f).epsilon(1e-5));
+                else
+                    REQUIRE(glm::dot(f.normal(), toEye) == Approx(1.0f).epsilon(1e-5));
+                if (g.orientation == Orientation::velocity) {  // right along the velocity seen from the eye
+                    const Vec3 v = p.velocity[i] - glm::dot(p.velocity[i], toEye) * toEye;
+                    REQUIRE(glm::dot(f.right, glm::normalize(v)) == Approx(1.0f).epsilon(1e-4));
+                }
+            }
 
         int hits = 0, mismatches = 0;
         for (std::uint32_t y = 0; y < cam.height; ++y)

@@ -3,7 +3,6 @@
 #include <OpenImageIO/imageio.h>
 
 #include "accretion/io/exr_output.h"
-#include "accretion/particles/disk_generator.h"
 #include "support/test_scenes.h"
 
 using namespace accretion;
@@ -11,18 +10,10 @@ namespace OIIO = OIIO_NAMESPACE;
 
 TEST_CASE("EXR: layers, formats, values and metadata read back with OpenImageIO", "[io][exr]") {
     const auto dir = accretion::test::scratchDir("exr");
-    Settings s;
-    s.particles.count = 300;
-    s.particles.outer_radius = 3.0;
-    s.particles.radius = 0.1;
-    s.camera.position = Vec3(0.0f, 3.0f, 5.0f);
-    s.camera.width = 24;
-    s.camera.height = 16;
+    Settings s = accretion::test::smallDiskSettings();
     s.render.estimator = EstimatorKind::power;
     s.render.samples = 4;
-    Particles p = generateDisk(s.particles, 0);
-    std::fill(p.albedo.begin(), p.albedo.end(), Vec3(0.8f));
-    const FrameImage img = accretion::test::renderParticles(s, p);
+    const FrameImage img = accretion::test::renderParticles(s, ParticleSource(s).frame(0));
 
     const auto file = dir / "frame.exr";
     writeFrameExr(file, img, true, {{"seed", "42"}, {"estimator", "power"}});
@@ -32,8 +23,8 @@ TEST_CASE("EXR: layers, formats, values and metadata read back with OpenImageIO"
     auto in = OIIO::ImageInput::open(file.string());
     REQUIRE(in);
     const OIIO::ImageSpec& spec = in->spec();
-    REQUIRE(spec.width == 24);
-    REQUIRE(spec.height == 16);
+    REQUIRE(spec.width == int(s.camera.width));
+    REQUIRE(spec.height == int(s.camera.height));
     REQUIRE(spec.get_string_attribute("compression") == "zip");
     REQUIRE(spec.get_string_attribute("accretion:seed") == "42");
     REQUIRE(spec.get_string_attribute("accretion:estimator") == "power");

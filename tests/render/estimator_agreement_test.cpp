@@ -5,7 +5,6 @@
 
 #include <cmath>
 
-#include "accretion/particles/disk_generator.h"
 #include "support/statistics.h"
 #include "support/test_scenes.h"
 
@@ -13,26 +12,6 @@ using namespace accretion;
 using accretion::test::renderParticles;
 
 namespace {
-
-/// A small disk seen from above at an angle: 150 particles, visible
-/// occlusion, a dmin clamp that bounds the tails of the one-sample estimates
-/// (so that per-pixel standard errors are reliable), mild emission contrast.
-Settings smallDisk() {
-    Settings s;
-    s.particles.count = 150;
-    s.particles.temperature_exponent = 0.25;
-    s.particles.inner_radius = 0.5;
-    s.particles.outer_radius = 2.0;
-    s.particles.thickness = 0.2;
-    s.particles.radius = 0.08;
-    s.particles.seed = 7;
-    s.camera.position = Vec3(0.0f, 2.5f, 3.5f);
-    s.camera.width = 48;
-    s.camera.height = 32;
-    s.camera.fov = 50.0;
-    s.shading.dmin = 0.4;
-    return s;
-}
 
 struct Agreement {
     double worstPixelP = 1.0;  ///< smallest per-pixel two-sided p-value
@@ -84,15 +63,11 @@ TEST_CASE("uniform, power and ris agree with exact, and a 1% bias is caught", "[
                                    Estimator{EstimatorKind::ris, LightSource::power, 4096, 8});
     INFO(config.name << ", " << enumName(est.kind) << " (source " << enumName(est.source) << ")");
 
-    Settings s = smallDisk();
+    Settings s = accretion::test::smallDiskSettings();
     s.geometry.primitive = config.primitive;
     s.geometry.alpha = config.alpha;
     s.shading.model = config.model;
-    const Particles particles = [&] {
-        Particles p = generateDisk(s.particles, 0);
-        std::fill(p.albedo.begin(), p.albedo.end(), s.shading.albedo);
-        return p;
-    }();
+    const Particles particles = ParticleSource(s).frame(0);
 
     const FrameImage exact = renderParticles(s, particles);
     s.render.estimator = est.kind;

@@ -19,6 +19,23 @@ Settings axisCameraSettings(float dist, std::uint32_t size, double fov) {
     return s;
 }
 
+Settings smallDiskSettings() {
+    Settings s;
+    s.particles.count = 150;
+    s.particles.temperature_exponent = 0.25;
+    s.particles.inner_radius = 0.5;
+    s.particles.outer_radius = 2.0;
+    s.particles.thickness = 0.2;
+    s.particles.radius = 0.08;
+    s.particles.seed = 7;
+    s.camera.position = Vec3(0.0f, 2.5f, 3.5f);
+    s.camera.width = 48;
+    s.camera.height = 32;
+    s.camera.fov = 50.0;
+    s.shading.dmin = 0.4;
+    return s;
+}
+
 FrameImage renderParticles(const Settings& settings, const Particles& particles, std::uint32_t frame) {
     FrameRenderer renderer(settings, ParticleSource::fixed(particles), RenderOptions{true});
     FrameStats stats;

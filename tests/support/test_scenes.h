@@ -11,6 +11,11 @@ namespace accretion::test {
 /// odd square resolution so that the centre pixel's ray is exactly the axis.
 Settings axisCameraSettings(float dist = 10.0f, std::uint32_t size = 33, double fov = 10.0);
 
+/// A small disk seen from above at an angle: 150 particles at 48x32, visible
+/// occlusion, a dmin clamp that bounds the tails of one-sample estimates (so
+/// per-pixel standard errors are reliable), mild emission contrast.
+Settings smallDiskSettings();
+
 /// Render one frame of a fixed particle set.
 FrameImage renderParticles(const Settings& settings, const Particles& particles, std::uint32_t frame = 0);
 

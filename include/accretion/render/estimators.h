@@ -51,8 +51,8 @@ AliasTable buildPowerTable(const Particles& particles);
 /// estimateLighting (MODEL.md sections 3-4): `exact` sums every light i != j
 /// with one shadow ray each; `uniform` / `power` average S one-sample
 /// estimates f I G V / p(i); `ris` averages S one-reservoir RIS estimates of
-/// M candidates each; Monte Carlo estimators also give their standard error. Per-pixel PCG streams
-/// make the result independent of the thread count.
+/// M candidates each. Monte Carlo estimators also give their standard error.
+/// Per-pixel PCG streams make the result independent of the thread count.
 LightingCounters estimateLighting(const LightingInputs& in, LightingImage& out, Progress* progress = nullptr);
 
 }  // namespace accretion
