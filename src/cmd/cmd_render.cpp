@@ -1,5 +1,6 @@
 // accretion render: frames of a scene to EXR + PNG preview + stats.json.
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -47,7 +48,28 @@ struct RenderArgs : SceneArgs {
     std::string output, estimator;
     std::optional<std::uint32_t> spp;
     std::optional<std::uint64_t> seed;
+    std::string targetStderr;
 };
+
+/// "0.5%" -> 0.005, "0.005" -> 0.005.
+double parseRelative(const std::string& text, const char* option) {
+    std::string t = text;
+    double scale = 1.0;
+    if (!t.empty() && t.back() == '%') {
+        t.pop_back();
+        scale = 0.01;
+    }
+    std::size_t used = 0;
+    double v = 0.0;
+    try {
+        v = std::stod(t, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    if (used == 0 || used != t.size() || !(v >= 0.0) || !std::isfinite(v))
+        throw InputError(fmt::format("command line {} {}: expected a non-negative number or percentage", option, text));
+    return v * scale;
+}
 
 /// "out/{scene}.{frame}.exr" -> "out/<scene>" (the {frame} part and extension dropped).
 std::string runStem(const Settings& s) {
@@ -68,6 +90,8 @@ void runRender(const RenderArgs& args) {
     if (!args.estimator.empty()) overrides.push_back("render.estimator=" + args.estimator);
     if (args.spp) overrides.push_back(fmt::format("render.samples={}", *args.spp));
     if (args.seed) overrides.push_back(fmt::format("render.seed={}", *args.seed));
+    if (!args.targetStderr.empty())
+        overrides.push_back(fmt::format("render.target_stderr={}", parseRelative(args.targetStderr, "--target-stderr")));
     appendFrameOverrides(args.frames, overrides);
     const Settings settings = loadScene(args.scene, overrides);
 
@@ -127,6 +151,8 @@ void runRender(const RenderArgs& args) {
         stats["frames"].push_back(fj);
         shadowRays += fs.lighting.shadowRays;
         lightingSeconds += fs.timer.seconds(pass::estimateLighting);
+        if (settings.render.target_stderr > 0.0)
+            fmt::print("  adaptive: mean {:.1f}, max {:.0f} samples per hit pixel\n", fs.meanSpp, fs.maxSpp);
         fmt::print("frame {}: {} ({:.2f} s, {} particles, {} clusters, build {:.1f} ms, {:.2f} M shadow rays/s)\n",
                    frame, exr, fs.seconds, fs.particles, fs.bvh.clusters,
                    1e3 * (fs.bvh.clusterSeconds + fs.bvh.blasSeconds + fs.bvh.tlasSeconds),
@@ -148,7 +174,9 @@ void addRenderCommand(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("render", "Render frames of a scene to EXR (+ PNG preview, stats.json)");
     cmd->add_option("scene", args->scene, "Scene file (TOML)")->required();
     cmd->add_option("-o,--output", args->output, "EXR output path ({scene}, {frame} patterns) = render.output");
-    cmd->add_option("--estimator", args->estimator, "exact | uniform | power | ris  (= render.estimator)");
+    cmd->add_option("--estimator", args->estimator, "exact | uniform | power | tree | ris | restir  (= render.estimator)");
+    cmd->add_option("--target-stderr", args->targetStderr,
+                    "Sample each pixel until its relative standard error is below this (e.g. 0.5%; = render.target_stderr)");
     cmd->add_option("--spp", args->spp, "Light samples per pixel (= render.samples)");
     cmd->add_option("--seed", args->seed, "Render seed (= render.seed)");
     cmd->add_option("--frames", args->frames, "Frames A:B, half-open (= render.frame_start, render.frames)");

@@ -20,5 +20,8 @@ void appendFrameOverrides(const std::string& frames, std::vector<std::string>& o
 
 void addRenderCommand(CLI::App& app);
 void addParticlesCommand(CLI::App& app);
+void addCompareCommand(CLI::App& app);
+void addConvergeCommand(CLI::App& app);
+void addBiasCommand(CLI::App& app);
 
 }  // namespace accretion::cmd

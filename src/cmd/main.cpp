@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
     app.require_subcommand(1);
     accretion::cmd::addRenderCommand(app);
     accretion::cmd::addParticlesCommand(app);
+    accretion::cmd::addCompareCommand(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

@@ -1,6 +1,8 @@
 #include "accretion/io/exr_output.h"
 
+#include <bit>
 #include <cstring>
+#include <functional>
 
 #include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
@@ -14,38 +16,56 @@ namespace accretion {
 namespace OIIO = OIIO_NAMESPACE;
 
 void writeFrameExr(const std::filesystem::path& file, const FrameImage& img, bool withErrors, const OutputMetadata& metadata) {
-    std::vector<std::string> names = {"R", "G", "B", "Le.R", "Le.G", "Le.B", "Lr.R", "Lr.G", "Lr.B",
-                                      "depth.Z", "N.X", "N.Y", "N.Z", "particle.id"};
-    if (withErrors)
-        for (const char* n : {"Lr_stderr.R", "Lr_stderr.G", "Lr_stderr.B", "spp"}) names.push_back(n);
-    const int nch = static_cast<int>(names.size());
-    const int idChannel = 13;
+    // One entry per channel: name, UINT or FLOAT, and the value of pixel px.
+    struct Channel {
+        std::string name;
+        bool isUint;
+        std::function<std::uint32_t(std::size_t)> bits;
+    };
+    std::vector<Channel> channels;
+    auto addVec = [&](const std::string& prefix, const char* const* suffix, const std::vector<Vec3>& v) {
+        for (int c = 0; c < 3; ++c)
+            channels.push_back({prefix + suffix[c], false, [&v, c](std::size_t px) { return std::bit_cast<std::uint32_t>(v[px][c]); }});
+    };
+    auto addFloat = [&](const std::string& name, const std::vector<float>& v) {
+        channels.push_back({name, false, [&v](std::size_t px) { return std::bit_cast<std::uint32_t>(v[px]); }});
+    };
+    static const char* const rgb[3] = {"R", "G", "B"};
+    static const char* const dotRgb[3] = {".R", ".G", ".B"};
+    static const char* const xyz[3] = {".X", ".Y", ".Z"};
+    addVec("", rgb, img.L);
+    addVec("Le", dotRgb, img.Le);
+    addVec("Lr", dotRgb, img.lighting.Lr);
+    addFloat("depth.Z", img.depth);
+    addVec("N", xyz, img.normal);
+    channels.push_back({"particle.id", true, [&](std::size_t px) { return img.particle[px]; }});
+    if (withErrors) {
+        addVec("Lr_stderr", dotRgb, img.lighting.Lr_stderr);
+        addFloat("spp", img.lighting.spp);
+    }
+    if (!img.reservoirs.empty()) {
+        addFloat("restir.W", img.reservoirs.W);
+        addFloat("restir.M", img.reservoirs.M);
+        channels.push_back({"restir.light", true, [&](std::size_t px) { return img.reservoirs.light[px]; }});
+        addFloat("restir.p_hat", img.reservoirs.p_hat);
+    }
+    const int nch = static_cast<int>(channels.size());
 
     OIIO::ImageSpec spec(int(img.width), int(img.height), nch, OIIO::TypeDesc::FLOAT);
-    spec.channelnames = names;
-    spec.channelformats.assign(nch, OIIO::TypeDesc::FLOAT);
-    spec.channelformats[idChannel] = OIIO::TypeDesc::UINT;
+    spec.channelnames.clear();
+    spec.channelformats.clear();
+    for (const Channel& c : channels) {
+        spec.channelnames.push_back(c.name);
+        spec.channelformats.push_back(c.isUint ? OIIO::TypeDesc::UINT : OIIO::TypeDesc::FLOAT);
+    }
     spec.attribute("compression", "zip");
     for (const auto& [k, v] : metadata) spec.attribute("accretion:" + k, v);
 
     // Interleaved pixels in the native per-channel formats (all 4 bytes).
     const std::size_t pixels = std::size_t(img.width) * img.height;
     std::vector<std::uint32_t> buf(pixels * nch);
-    auto putF = [&](std::size_t px, int ch, float v) { std::memcpy(&buf[px * nch + ch], &v, 4); };
-    for (std::size_t px = 0; px < pixels; ++px) {
-        for (int c = 0; c < 3; ++c) {
-            putF(px, c, img.L[px][c]);
-            putF(px, 3 + c, img.Le[px][c]);
-            putF(px, 6 + c, img.lighting.Lr[px][c]);
-            putF(px, 10 + c, img.normal[px][c]);
-        }
-        putF(px, 9, img.depth[px]);
-        buf[px * nch + idChannel] = img.particle[px];
-        if (withErrors) {
-            for (int c = 0; c < 3; ++c) putF(px, 14 + c, img.lighting.Lr_stderr[px][c]);
-            putF(px, 17, img.lighting.spp[px]);
-        }
-    }
+    for (int ch = 0; ch < nch; ++ch)
+        for (std::size_t px = 0; px < pixels; ++px) buf[px * nch + ch] = channels[ch].bits(px);
 
     writeAtomicWith(file, [&](const std::filesystem::path& tmp) {
         auto out = OIIO::ImageOutput::create("openexr");

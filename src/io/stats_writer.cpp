@@ -8,6 +8,7 @@ nlohmann::json frameStatsJson(const FrameStats& s) {
     nlohmann::json passes = nlohmann::json::object();
     for (const auto& [name, seconds] : s.timer.all()) passes[name] = seconds;
     const double lightingSeconds = s.timer.seconds(pass::estimateLighting);
+
     return {
         {"frame", s.frame},
         {"seconds", s.seconds},
@@ -18,7 +19,13 @@ nlohmann::json frameStatsJson(const FrameStats& s) {
           {"primitives", s.bvh.primitives},
           {"triangles", s.bvh.triangles},
           {"hit_pixels", s.hitPixels},
-          {"light_terms", s.lighting.lightTerms}}},
+          {"light_terms", s.lighting.lightTerms},
+          {"reuse_accepted", s.lighting.reuseAccepted},
+          {"reuse_rejected", s.lighting.reuseRejected},
+          {"light_tree_nodes", s.lightTreeNodes},
+          {"reservoir_bytes", s.reservoirBytes},
+          {"mean_spp", s.meanSpp},
+          {"max_spp", s.maxSpp}}},
         {"rays",
          {{"primary", s.primaryRays},
           {"shadow", s.lighting.shadowRays},

@@ -6,22 +6,13 @@
 
 #include "accretion/core/error.h"
 #include "accretion/core/rng.h"
+#include "accretion/lighting/light_arrays.h"
 #include "accretion/lighting/reservoir.h"
 #include "accretion/render/shading.h"
 #include "accretion/render/visibility.h"
 
 namespace accretion {
 namespace {
-
-/// The lights of a frame, as the hot loops read them.
-struct LightArrays {
-    const Vec3* position;
-    const Vec3* emission;
-    const float* radius;
-    std::vector<float> dmin2;  ///< max(r_i, dmin)^2
-    std::uint32_t count;
-    float uniformPdf;          ///< 1 / count
-};
 
 ShadingPoint shadingPoint(const GBufferTexel& g, const Particles& particles) {
     return {g.position, g.normal, g.geomNormal, particles.albedo[g.particle], g.particle};
@@ -43,23 +34,6 @@ Vec3 exactPixel(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint
     return Vec3(sum);
 }
 
-/// One light drawn from the source pmf: uniform, or power (alias table).
-struct LightSample {
-    std::uint32_t i;
-    float pdf;
-};
-
-template <bool Power>
-LightSample sampleLight(const LightArrays& L, const AliasTable* table, Rng& rng) {
-    if constexpr (Power) {
-        const std::uint32_t bucket = rng.uniformInt(L.count);  // sequenced: bucket, then coin
-        const std::uint32_t i = table->sample(bucket, rng.uniform());
-        return {i, table->pmf(i)};
-    } else {
-        return {rng.uniformInt(L.count), L.uniformPdf};
-    }
-}
-
 /// Mean and standard error of the mean of S per-sample estimates (0 counts).
 class SampleMean {
 public:
@@ -78,25 +52,33 @@ private:
     DVec3 s1_{0.0}, s2_{0.0};
 };
 
-/// uniform / power: S one-sample estimates f I G V / p(i) (0 when i = j).
-template <ShadingModel M, Primitive P, bool Power>
-void sampledPixel(const ParticleBvh& bvh, const LightArrays& L, const AliasTable* table, const ShadingPoint& sp,
-                  std::uint32_t S, float eps, Rng& rng, Vec3& mean, Vec3& stderr, LightingCounters& c) {
+/// uniform / power / tree: one-sample estimates f I G V / p(i) (0 when no
+/// light or i = j), in rounds of S until the relative standard error of the
+/// luminance reaches the target (or max_samples); one round when the target is 0.
+template <ShadingModel M, Primitive P, class Sampler>
+std::uint32_t sampledPixel(const ParticleBvh& bvh, const LightArrays& L, Sampler&& sampleOne, const ShadingPoint& sp,
+                           const RenderSettings& rs, float eps, Rng& rng, Vec3& mean, Vec3& stderr,
+                           LightingCounters& c) {
     SampleMean acc;
-    for (std::uint32_t k = 0; k < S; ++k) {
-        const LightSample x = sampleLight<Power>(L, table, rng);
-        if (x.i == sp.self) continue;
-        LightTerm t;
-        ++c.lightTerms;
-        if (!evalLight<M>(sp, L.position[x.i], L.emission[x.i], L.dmin2[x.i], t)) continue;
-        ++c.shadowRays;
-        if (!visible<P>(bvh, sp, t, L.radius[x.i], eps)) {
-            ++c.shadowOccluded;
-            continue;
+    std::uint32_t n = 0;
+    for (;;) {
+        for (std::uint32_t k = 0; k < rs.samples; ++k) {
+            const LightSample x = sampleOne(rng);
+            LightTerm t;
+            ++c.lightTerms;
+            if (!L.term<M>(sp, x.i, t)) continue;
+            ++c.shadowRays;
+            if (!visible<P>(bvh, sp, t, L.radius[x.i], eps)) {
+                ++c.shadowOccluded;
+                continue;
+            }
+            acc.add(DVec3(t.value) / double(x.pdf));
         }
-        acc.add(DVec3(t.value) / double(x.pdf));
+        n += rs.samples;
+        acc.finish(n, mean, stderr);
+        if (!(rs.target_stderr > 0.0) || n + rs.samples > rs.max_samples) return n;
+        if (luminance(stderr) <= rs.target_stderr * luminance(mean)) return n;
     }
-    acc.finish(S, mean, stderr);
 }
 
 /// ris (MODEL.md section 4): per sample, one reservoir streams M candidates
@@ -110,12 +92,11 @@ void risPixel(const ParticleBvh& bvh, const LightArrays& L, const AliasTable* ta
         Reservoir r;
         LightTerm t_y{};
         for (std::uint32_t m = 0; m < rs.candidates; ++m) {
-            const LightSample x = sampleLight<Power>(L, table, rng);
+            const LightSample x = sampleSource<Power>(L, table, rng);
             LightTerm t;
             float p_hat = 0.0f;
             ++c.lightTerms;
-            if (x.i != sp.self && evalLight<M>(sp, L.position[x.i], L.emission[x.i], L.dmin2[x.i], t))
-                p_hat = luminance(t.value);
+            if (L.term<M>(sp, x.i, t)) p_hat = luminance(t.value);
             if (r.update(x.i, p_hat / x.pdf, p_hat, rng.uniform())) t_y = t;
         }
         r.finalize();
@@ -151,15 +132,23 @@ LightingCounters run(const LightingInputs& in, const LightArrays& L, LightingIma
                     continue;
                 }
                 Rng rng(px, in.frame, RngPass::lightSampling, in.render.seed);
+                Vec3& mean = out.Lr[px];
+                Vec3& err = out.Lr_stderr[px];
+                std::uint32_t n = S;
                 if (kind == EstimatorKind::ris && in.render.source == LightSource::power)
-                    risPixel<M, P, true>(in.bvh, L, in.powerTable, sp, in.render, eps, rng, out.Lr[px], out.Lr_stderr[px], c);
+                    risPixel<M, P, true>(in.bvh, L, in.powerTable, sp, in.render, eps, rng, mean, err, c);
                 else if (kind == EstimatorKind::ris)
-                    risPixel<M, P, false>(in.bvh, L, nullptr, sp, in.render, eps, rng, out.Lr[px], out.Lr_stderr[px], c);
+                    risPixel<M, P, false>(in.bvh, L, nullptr, sp, in.render, eps, rng, mean, err, c);
                 else if (kind == EstimatorKind::power)
-                    sampledPixel<M, P, true>(in.bvh, L, in.powerTable, sp, S, eps, rng, out.Lr[px], out.Lr_stderr[px], c);
+                    n = sampledPixel<M, P>(in.bvh, L, [&](Rng& g) { return sampleSource<true>(L, in.powerTable, g); },
+                                           sp, in.render, eps, rng, mean, err, c);
+                else if (kind == EstimatorKind::tree)
+                    n = sampledPixel<M, P>(in.bvh, L, [&](Rng& g) { return in.lightTree->sample(sp, g); }, sp,
+                                           in.render, eps, rng, mean, err, c);
                 else
-                    sampledPixel<M, P, false>(in.bvh, L, nullptr, sp, S, eps, rng, out.Lr[px], out.Lr_stderr[px], c);
-                out.spp[px] = float(S);
+                    n = sampledPixel<M, P>(in.bvh, L, [&](Rng& g) { return sampleSource<false>(L, nullptr, g); }, sp,
+                                           in.render, eps, rng, mean, err, c);
+                out.spp[px] = float(n);
             }
         }
         if (progress) progress->advance(std::uint64_t(r.rows().size()) * r.cols().size());
@@ -178,7 +167,8 @@ LightingCounters dispatchPrimitive(const LightingInputs& in, const LightArrays& 
 }  // namespace
 
 bool needsPowerTable(const RenderSettings& r) {
-    return r.estimator == EstimatorKind::power || (r.estimator == EstimatorKind::ris && r.source == LightSource::power);
+    const bool resampling = r.estimator == EstimatorKind::ris || r.estimator == EstimatorKind::restir;
+    return r.estimator == EstimatorKind::power || (resampling && r.source == LightSource::power);
 }
 
 AliasTable buildPowerTable(const Particles& particles) {
@@ -195,14 +185,9 @@ LightingCounters estimateLighting(const LightingInputs& in, LightingImage& out, 
     if (in.particles.empty()) return {};
     ACC_CHECK(!needsPowerTable(in.render) || in.powerTable);
 
-    LightArrays L{in.particles.position.data(), in.particles.emission.data(), in.particles.radius.data(), {},
-                  static_cast<std::uint32_t>(in.particles.size()), 1.0f / float(in.particles.size())};
-    L.dmin2.resize(L.count);
-    const float dmin = static_cast<float>(in.shading.dmin);
-    for (std::uint32_t i = 0; i < L.count; ++i) {
-        const float d = std::max(in.particles.radius[i], dmin);
-        L.dmin2[i] = d * d;
-    }
+    ACC_CHECK(in.render.estimator != EstimatorKind::tree || in.lightTree);
+    ACC_CHECK(in.render.estimator != EstimatorKind::restir);
+    const LightArrays L(in.particles, in.shading);
     switch (in.shading.model) {
     case ShadingModel::lambert: return dispatchPrimitive<ShadingModel::lambert>(in, L, out, progress);
     case ShadingModel::sphere: return dispatchPrimitive<ShadingModel::sphere>(in, L, out, progress);

@@ -10,7 +10,9 @@ namespace accretion {
 FrameRenderer::FrameRenderer(const Settings& settings, ParticleSource source, RenderOptions options)
     : settings_(settings), source_(std::move(source)), options_(options),
       device_(std::make_unique<EmbreeDevice>()),
-      bvh_(std::make_unique<ParticleBvh>(*device_, settings.geometry)) {}
+      bvh_(std::make_unique<ParticleBvh>(*device_, settings.geometry)) {
+    if (settings_.render.estimator == EstimatorKind::restir) restir_ = std::make_unique<Restir>(settings_);
+}
 
 FrameRenderer::~FrameRenderer() = default;
 
@@ -32,15 +34,19 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats) {
     }
     stats.bvh = bvh_->stats();
 
-    // Light sampler: only the power estimator needs one, and only with light.
+    // Light sampler: only the power and tree estimators need one, and only with light.
     AliasTable powerTable;
+    LightTree lightTree;
     double totalLuminance = 0.0;
     for (const Vec3& I : particles.emission) totalLuminance += luminance(I);
     const bool lit = totalLuminance > 0.0 && glm::length(settings_.shading.albedo) > 0.0f;
     const bool power = lit && needsPowerTable(settings_.render);
-    if (power) {
+    const bool tree = lit && needsLightTree(settings_.render);
+    if (power || tree) {
         auto t = timer.scope(pass::buildLightSampler);
-        powerTable = buildPowerTable(particles);
+        if (power) powerTable = buildPowerTable(particles);
+        if (tree) lightTree = LightTree(particles, settings_.shading);
+        stats.lightTreeNodes = lightTree.nodeCount();
     }
 
     GBuffer gbuffer;
@@ -55,10 +61,14 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats) {
     const std::size_t pixels = std::size_t(img.width) * img.height;
     {
         auto t = timer.scope(pass::estimateLighting);
-        if (lit) {
+        if (lit && restir_) {
+            RestirInputs in{*bvh_, particles, gbuffer, camera, settings_, frame, power ? &powerTable : nullptr};
+            stats.lighting = restir_->render(in, img.lighting, img.reservoirs, timer);
+            stats.reservoirBytes = restir_->reservoirBytes();
+        } else if (lit) {
             Progress progress(fmt::format("frame {} {}", frame, pass::estimateLighting), pixels, options_.quiet);
             LightingInputs in{*bvh_, particles, gbuffer, settings_.shading, settings_.render, frame,
-                              power ? &powerTable : nullptr};
+                              power ? &powerTable : nullptr, tree ? &lightTree : nullptr};
             stats.lighting = estimateLighting(in, img.lighting, &progress);
         } else {
             img.lighting.Lr.assign(pixels, Vec3(0.0f));
@@ -91,6 +101,13 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats) {
             img.normal[px] = g.normal;
         }
         stats.hitPixels = hits;
+        double sppSum = 0.0;
+        for (std::size_t px = 0; px < pixels; ++px)
+            if (gbuffer.texels[px].hit()) {
+                sppSum += img.lighting.spp[px];
+                stats.maxSpp = std::max(stats.maxSpp, double(img.lighting.spp[px]));
+            }
+        stats.meanSpp = hits ? sppSum / double(hits) : 0.0;
     }
     stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return img;

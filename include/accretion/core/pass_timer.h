@@ -13,6 +13,11 @@ inline constexpr std::string_view buildLightSampler = "buildLightSampler";
 inline constexpr std::string_view buildClusters = "buildClusters";
 inline constexpr std::string_view traceGBuffer = "traceGBuffer";
 inline constexpr std::string_view estimateLighting = "estimateLighting";
+inline constexpr std::string_view generateCandidates = "generateCandidates";
+inline constexpr std::string_view temporalResampling = "temporalResampling";
+inline constexpr std::string_view spatialResampling = "spatialResampling";
+inline constexpr std::string_view traceShadowRays = "traceShadowRays";
+inline constexpr std::string_view upsampleLighting = "upsampleLighting";
 inline constexpr std::string_view composeImage = "composeImage";
 inline constexpr std::string_view writeOutputs = "writeOutputs";
 }  // namespace pass

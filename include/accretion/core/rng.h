@@ -8,7 +8,10 @@ namespace accretion {
 /// Fixed pass ids for random streams: a new pass never shifts another's numbers.
 enum class RngPass : std::uint32_t {
     particles = 1,      ///< particle generator
-    lightSampling = 2,  ///< uniform / power light selection
+    lightSampling = 2,  ///< uniform / power / tree light selection, ris
+    restirCandidates = 3,  ///< restir: initial candidates
+    restirTemporal = 4,    ///< restir: temporal resampling
+    restirSpatial = 5,     ///< restir: spatial neighbours and resampling (item mixes the iteration)
 };
 
 /// 64-bit finaliser (SplitMix64), a bijection with good avalanche.

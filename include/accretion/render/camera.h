@@ -27,6 +27,20 @@ struct Camera {
         const float sy = (1.0f - (float(y) + 0.5f) / float(height) * 2.0f) * tanHalfFov;
         return glm::normalize(forward + sx * right + sy * up);
     }
+
+    /// Continuous pixel coordinates (pixel centres at +0.5) and camera-space
+    /// depth of a world point; false when it is not in front of the camera.
+    bool project(const Vec3& p, float& px, float& py, float& depth) const {
+        const Vec3 d = p - position;
+        depth = glm::dot(d, forward);
+        if (!(depth > 0.0f)) return false;
+        const float aspect = float(width) / float(height);
+        const float sx = glm::dot(d, right) / (depth * tanHalfFov * aspect);
+        const float sy = glm::dot(d, up) / (depth * tanHalfFov);
+        px = (sx + 1.0f) * 0.5f * float(width);
+        py = (1.0f - sy) * 0.5f * float(height);
+        return true;
+    }
 };
 
 }  // namespace accretion

@@ -5,6 +5,7 @@
 #include "accretion/core/math.h"
 #include "accretion/core/progress.h"
 #include "accretion/geometry/particle_bvh.h"
+#include "accretion/lighting/light_tree.h"
 #include "accretion/render/alias_table.h"
 #include "accretion/render/gbuffer.h"
 #include "accretion/scene/settings.h"
@@ -23,10 +24,14 @@ struct LightingCounters {
     std::uint64_t lightTerms = 0;     ///< unshadowed terms evaluated
     std::uint64_t shadowRays = 0;     ///< occlusion queries
     std::uint64_t shadowOccluded = 0; ///< queries that found a blocker
+    std::uint64_t reuseAccepted = 0;  ///< restir: temporal/spatial neighbours resampled
+    std::uint64_t reuseRejected = 0;  ///< restir: neighbours rejected (off screen, particle, normal, depth)
     LightingCounters& operator+=(const LightingCounters& o) {
         lightTerms += o.lightTerms;
         shadowRays += o.shadowRays;
         shadowOccluded += o.shadowOccluded;
+        reuseAccepted += o.reuseAccepted;
+        reuseRejected += o.reuseRejected;
         return *this;
     }
 };
@@ -40,18 +45,24 @@ struct LightingInputs {
     const RenderSettings& render;
     std::uint32_t frame = 0;
     const AliasTable* powerTable = nullptr;  ///< required when needsPowerTable()
+    const LightTree* lightTree = nullptr;    ///< required by `tree`
 };
 
 /// True if the estimator samples lights in proportion to their power.
 bool needsPowerTable(const RenderSettings& render);
 
+/// True if the estimator samples lights with the light tree.
+inline bool needsLightTree(const RenderSettings& render) { return render.estimator == EstimatorKind::tree; }
+
 /// Light selection pmf over luminance(I_i), for the `power` estimator.
 AliasTable buildPowerTable(const Particles& particles);
 
 /// estimateLighting (MODEL.md sections 3-4): `exact` sums every light i != j
-/// with one shadow ray each; `uniform` / `power` average S one-sample
-/// estimates f I G V / p(i); `ris` averages S one-reservoir RIS estimates of
-/// M candidates each. Monte Carlo estimators also give their standard error.
+/// with one shadow ray each; `uniform` / `power` / `tree` average one-sample
+/// estimates f I G V / p(i) (S per round, more rounds until target_stderr);
+/// `ris` averages S one-reservoir RIS estimates of M candidates each. Monte
+/// Carlo estimators also give their standard error. (`restir` keeps history
+/// across frames: see lighting/restir.h.)
 /// Per-pixel PCG streams make the result independent of the thread count.
 LightingCounters estimateLighting(const LightingInputs& in, LightingImage& out, Progress* progress = nullptr);
 

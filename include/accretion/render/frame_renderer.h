@@ -6,6 +6,7 @@
 #include "accretion/core/pass_timer.h"
 #include "accretion/geometry/embree_device.h"
 #include "accretion/geometry/particle_bvh.h"
+#include "accretion/lighting/restir.h"
 #include "accretion/particles/particle_source.h"
 #include "accretion/render/camera.h"
 #include "accretion/render/estimators.h"
@@ -23,6 +24,7 @@ struct FrameImage {
     std::vector<float> depth;         ///< camera-space z, +inf on a miss
     std::vector<Vec3> normal;         ///< shading normal
     std::vector<std::uint32_t> particle; ///< hit particle id, kNoParticle on a miss
+    ReservoirImage reservoirs;        ///< restir only: the final reservoirs
 };
 
 /// Counts and times of one frame, for stats.json.
@@ -32,6 +34,10 @@ struct FrameStats {
     BvhStats bvh;
     std::uint64_t primaryRays = 0;
     LightingCounters lighting;
+    std::size_t lightTreeNodes = 0;   ///< tree: nodes of the light tree
+    std::size_t reservoirBytes = 0;   ///< restir: bytes per stored reservoir
+    double meanSpp = 0.0;             ///< light samples per hit pixel, mean (adaptive sampling varies it)
+    double maxSpp = 0.0;              ///< and maximum
     std::size_t hitPixels = 0;
     PassTimer timer;                  ///< wall time per pass name
     double seconds = 0.0;             ///< whole frame
@@ -60,6 +66,7 @@ private:
     RenderOptions options_;
     std::unique_ptr<EmbreeDevice> device_;
     std::unique_ptr<ParticleBvh> bvh_;
+    std::unique_ptr<Restir> restir_;  ///< restir: history across frames
 };
 
 }  // namespace accretion

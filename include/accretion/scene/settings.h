@@ -33,18 +33,22 @@ enum class CameraPath { static_pose, orbit, linear };
 enum class Primitive { billboard, sphere };
 enum class Orientation { view_plane, view_point, velocity };
 enum class AlphaMode { opaque, disc };
-enum class BuildPolicy { rebuild, refit, fast_trace };
+enum class BuildPolicy { rebuild, refit, fast_trace, partial };
 enum class ShadingModel { lambert, sphere, isotropic };
-enum class EstimatorKind { exact, uniform, power, ris };
+enum class EstimatorKind { exact, uniform, power, ris, restir, tree };
+enum class BiasCorrection { none, basic, pairwise };
+enum class ReservoirLayout { full, packed };
 enum class LightSource { uniform, power };
 
 ACC_ENUM_NAMES(CameraPath, "static", "orbit", "linear");
 ACC_ENUM_NAMES(Primitive, "billboard", "sphere");
 ACC_ENUM_NAMES(Orientation, "view_plane", "view_point", "velocity");
 ACC_ENUM_NAMES(AlphaMode, "opaque", "disc");
-ACC_ENUM_NAMES(BuildPolicy, "rebuild", "refit", "fast_trace");
+ACC_ENUM_NAMES(BuildPolicy, "rebuild", "refit", "fast_trace", "partial");
 ACC_ENUM_NAMES(ShadingModel, "lambert", "sphere", "isotropic");
-ACC_ENUM_NAMES(EstimatorKind, "exact", "uniform", "power", "ris");
+ACC_ENUM_NAMES(EstimatorKind, "exact", "uniform", "power", "ris", "restir", "tree");
+ACC_ENUM_NAMES(BiasCorrection, "none", "basic", "pairwise");
+ACC_ENUM_NAMES(ReservoirLayout, "full", "packed");
 ACC_ENUM_NAMES(LightSource, "uniform", "power");
 
 template <class E> constexpr std::string_view enumName(E e) {
@@ -128,13 +132,15 @@ struct GeometrySettings {
     AlphaMode alpha = AlphaMode::opaque;             ///< billboard alpha test
     std::uint32_t cluster_size = 100;                ///< target particles per cluster (one BLAS each)
     BuildPolicy build = BuildPolicy::rebuild;        ///< per-frame BLAS policy
+    double rebuild_fraction = 0.7;                   ///< partial: fraction of clusters rebuilt per frame (seed 004: 70%)
 
     template <class V> void visit(V& v) {
         v.field("primitive", primitive, "particle geometry");
         v.field("orientation", orientation, "billboard orientation");
         v.field("alpha", alpha, "billboard alpha: opaque quad or alpha-tested disc");
         v.field("cluster_size", cluster_size, "target particles per cluster (one BLAS each)", Range{1, 1e7});
-        v.field("build", build, "per-frame BLAS policy");
+        v.field("build", build, "per-frame BLAS policy (partial: rebuild_fraction of the clusters, the rest stale)");
+        v.field("rebuild_fraction", rebuild_fraction, "partial: fraction of clusters rebuilt per frame, round robin", Range{0.0, 1.0, true});
     }
 };
 
@@ -161,8 +167,10 @@ struct RenderSettings {
     std::uint32_t frames = 1;                    ///< number of frames rendered
     EstimatorKind estimator = EstimatorKind::exact; ///< estimator of Lr
     std::uint32_t samples = 16;                  ///< light samples per pixel (Monte Carlo estimators)
-    std::uint32_t candidates = 32;               ///< ris: candidates M per reservoir
-    LightSource source = LightSource::uniform;   ///< ris: source pdf of the candidates
+    std::uint32_t candidates = 16;               ///< ris, restir: candidates M per reservoir (seed 004: 16)
+    LightSource source = LightSource::uniform;   ///< ris, restir: source pdf of the candidates
+    double target_stderr = 0.0;                  ///< tree, uniform, power: relative standard error to reach per pixel (0: fixed samples)
+    std::uint32_t max_samples = 65536;           ///< cap of the adaptive sampling of target_stderr
     std::uint64_t seed = 0;                      ///< render seed
     std::string output = "out/{scene}.{frame}.exr"; ///< EXR path, {scene} and {frame} patterns
     double shadow_epsilon = 1e-4;                ///< relative far-end margin of shadow rays
@@ -174,13 +182,51 @@ struct RenderSettings {
         v.field("frames", frames, "number of frames", Range{1, 1e6});
         v.field("estimator", estimator, "estimator of the reflected light Lr");
         v.field("samples", samples, "light samples per pixel (uniform, power; ris: reservoirs)", Range{1, 1e7});
-        v.field("candidates", candidates, "ris: candidates M per reservoir", Range{1, 1e6});
-        v.field("source", source, "ris: source pdf of the candidates");
+        v.field("candidates", candidates, "ris, restir: candidates M per reservoir", Range{1, 1e6});
+        v.field("source", source, "ris, restir: source pdf of the candidates");
+        v.field("target_stderr", target_stderr, "tree, uniform, power: per-pixel relative standard error to reach, adding `samples` per round (0: off)", Range{0.0, 1.0});
+        v.field("max_samples", max_samples, "cap on samples per pixel when target_stderr is set", Range{1, 1e9});
         v.field("seed", seed, "render seed");
         v.field("output", output, "EXR output path; {scene} and {frame} are replaced");
         v.field("shadow_epsilon", shadow_epsilon, "shadow ray far end: t < d (1 - eps)", Range{1e-7, 0.1});
         v.field("exposure", exposure, "preview exposure (stops)", Range{-64.0, 64.0});
         v.field("auto_exposure", auto_exposure, "preview: scale the 99th luminance percentile to 1");
+    }
+};
+
+/// [restir]: ReSTIR DI reuse (MODEL.md section 4; seed 004's tuning
+/// checklist gives the defaults: M cap 20, 5 neighbours, 30 px, 1 iteration).
+struct RestirSettings {
+    bool temporal = true;                    ///< temporal reuse
+    double m_cap = 20.0;                     ///< history M capped at m_cap x current M
+    std::uint32_t spatial_neighbours = 5;    ///< k neighbours per spatial pass (0: no spatial reuse)
+    double spatial_radius = 30.0;            ///< neighbour disc radius, pixels
+    std::uint32_t spatial_iterations = 1;    ///< spatial passes
+    BiasCorrection bias_correction = BiasCorrection::basic; ///< normalisation of reused samples
+    bool basic_visibility = false;           ///< basic: also trace a shadow ray from each neighbour (unbiased with visibility reuse)
+    bool visibility_reuse = false;           ///< discard an occluded sample before storing it for the next frame
+    double normal_threshold = 0.9;           ///< reject a neighbour whose normal . n is below this
+    double depth_threshold = 0.1;            ///< reject a neighbour whose depth differs by more than this fraction
+    double resolution_scale = 1.0;           ///< lighting resolution relative to the image (bilateral upsample)
+    ReservoirLayout layout = ReservoirLayout::full; ///< stored reservoir: full (16 B) or packed
+    std::uint32_t light_bits = 20;           ///< packed: bits of the light index (the rest of 32 hold M)
+    bool half_weights = true;                ///< packed: W and p_hat as half floats (8 B) rather than floats (12 B)
+
+    template <class V> void visit(V& v) {
+        v.field("temporal", temporal, "temporal reuse through particle motion and the previous camera");
+        v.field("m_cap", m_cap, "history M capped at m_cap x the current M", Range{0.0, 1e6});
+        v.field("spatial_neighbours", spatial_neighbours, "neighbours per spatial pass (0: no spatial reuse)", Range{0, 64});
+        v.field("spatial_radius", spatial_radius, "spatial neighbour disc radius in pixels", Range{0.0, 4096.0});
+        v.field("spatial_iterations", spatial_iterations, "spatial reuse passes", Range{0, 16});
+        v.field("bias_correction", bias_correction, "none (1/M, biased), basic (1/Z over neighbours with p_hat > 0) or pairwise MIS");
+        v.field("basic_visibility", basic_visibility, "basic: count a neighbour only if it also sees the sample (shadow ray)");
+        v.field("visibility_reuse", visibility_reuse, "zero W of an occluded sample before storing it for the next frame");
+        v.field("normal_threshold", normal_threshold, "neighbour rejection: minimum normal dot product", Range{-1.0, 1.0});
+        v.field("depth_threshold", depth_threshold, "neighbour rejection: maximum relative depth difference", kNonNegative);
+        v.field("resolution_scale", resolution_scale, "lighting resolution / image resolution (bilateral upsample)", Range{0.0, 1.0, true});
+        v.field("layout", layout, "stored reservoir layout: full (16 B) or packed (light index + M in 32 bits, weights)");
+        v.field("light_bits", light_bits, "packed: light index bits (M gets 32 - light_bits)", Range{1, 31});
+        v.field("half_weights", half_weights, "packed: W and p_hat as half floats (8 B) instead of floats (12 B)");
     }
 };
 
@@ -191,6 +237,7 @@ struct Settings {
     GeometrySettings geometry;
     ShadingSettings shading;
     RenderSettings render;
+    RestirSettings restir;
 
     std::string sceneName = "scene"; ///< stem of the scene file
     std::string scenePath;           ///< scene file as given
@@ -201,6 +248,7 @@ struct Settings {
         v.section("geometry", geometry);
         v.section("shading", shading);
         v.section("render", render);
+        v.section("restir", restir);
     }
 };
 

@@ -1,0 +1,41 @@
+#pragma once
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "accretion/core/math.h"
+
+namespace accretion {
+
+/// MODEL.md section 5, averaged over pixels and RGB channels:
+/// relMSE = (x - ref)^2 / (ref^2 + eps), MSE = (x - ref)^2,
+/// MAPE = |x - ref| / (|ref| + eps), eps = 1e-2.
+struct ErrorMetrics {
+    double relMSE = 0.0;
+    double MSE = 0.0;
+    double MAPE = 0.0;
+    /// Mean of sigma_ref^2 / (ref^2 + eps): what the reference's own noise
+    /// adds to relMSE in expectation (0 without a stderr layer).
+    double relMSEFloor = 0.0;
+    std::size_t pixels = 0;
+};
+
+inline constexpr double kRelMseEpsilon = 1e-2;
+
+ErrorMetrics computeErrors(const std::vector<Vec3>& x, const std::vector<Vec3>& ref,
+                           const std::vector<Vec3>* refStderr = nullptr, double eps = kRelMseEpsilon);
+
+/// An RGB layer of an EXR file, read back with OpenImageIO.
+struct RgbLayer {
+    std::uint32_t width = 0, height = 0;
+    std::vector<Vec3> rgb;
+};
+
+/// Read layer `layer` ("" = R,G,B; "Lr" = Lr.R, Lr.G, Lr.B; ...). Throws
+/// InputError naming the file when it cannot be read or lacks the channels.
+RgbLayer readExrLayer(const std::filesystem::path& file, const std::string& layer);
+/// True if the file has all three channels of the layer.
+bool exrHasLayer(const std::filesystem::path& file, const std::string& layer);
+
+}  // namespace accretion

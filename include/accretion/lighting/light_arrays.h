@@ -1,0 +1,66 @@
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "accretion/core/math.h"
+#include "accretion/core/rng.h"
+#include "accretion/lighting/light_tree.h"
+#include "accretion/particles/particles.h"
+#include "accretion/render/alias_table.h"
+#include "accretion/render/shading.h"
+#include "accretion/scene/settings.h"
+
+namespace accretion {
+
+/// The lights of a frame as the hot loops read them (views of the particle
+/// arrays plus the squared distance clamps).
+struct LightArrays {
+    const Vec3* position = nullptr;
+    const Vec3* emission = nullptr;
+    const float* radius = nullptr;
+    std::vector<float> dmin2;  ///< max(r_i, dmin)^2
+    std::uint32_t count = 0;
+    float uniformPdf = 0.0f;   ///< 1 / count
+
+    LightArrays() = default;
+    LightArrays(const Particles& particles, const ShadingSettings& shading) {
+        position = particles.position.data();
+        emission = particles.emission.data();
+        radius = particles.radius.data();
+        count = static_cast<std::uint32_t>(particles.size());
+        uniformPdf = count ? 1.0f / float(count) : 0.0f;
+        dmin2.resize(count);
+        const float dmin = static_cast<float>(shading.dmin);
+        for (std::uint32_t i = 0; i < count; ++i) {
+            const float d = std::max(particles.radius[i], dmin);
+            dmin2[i] = d * d;
+        }
+    }
+
+    /// Unshadowed term of light i at the receiver (0 for its own particle).
+    template <ShadingModel M>
+    bool term(const ShadingPoint& sp, std::uint32_t i, LightTerm& t) const {
+        return i != sp.self && i < count && evalLight<M>(sp, position[i], emission[i], dmin2[i], t);
+    }
+    /// RIS target p_hat = luminance(f I G), no visibility.
+    template <ShadingModel M>
+    float targetPdf(const ShadingPoint& sp, std::uint32_t i) const {
+        LightTerm t;
+        return term<M>(sp, i, t) ? luminance(t.value) : 0.0f;
+    }
+};
+
+/// One light from a receiver-independent source pmf: uniform, or in
+/// proportion to power (alias table). Bucket then coin, in that order.
+template <bool Power>
+LightSample sampleSource(const LightArrays& L, const AliasTable* table, Rng& rng) {
+    if constexpr (Power) {
+        const std::uint32_t bucket = rng.uniformInt(L.count);
+        const std::uint32_t i = table->sample(bucket, rng.uniform());
+        return {i, table->pmf(i)};
+    } else {
+        return {rng.uniformInt(L.count), L.uniformPdf};
+    }
+}
+
+}  // namespace accretion

@@ -1,0 +1,67 @@
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "accretion/core/pass_timer.h"
+#include "accretion/geometry/particle_bvh.h"
+#include "accretion/lighting/light_arrays.h"
+#include "accretion/lighting/reservoir_codec.h"
+#include "accretion/render/camera.h"
+#include "accretion/render/estimators.h"
+#include "accretion/render/gbuffer.h"
+#include "accretion/scene/settings.h"
+
+namespace accretion {
+
+/// Per-pixel reservoir AOVs of a restir frame (restir.W, .M, .light, .p_hat).
+struct ReservoirImage {
+    std::vector<float> W;
+    std::vector<float> M;
+    std::vector<std::uint32_t> light;  ///< kNoLight when empty
+    std::vector<float> p_hat;
+    bool empty() const { return W.empty(); }
+};
+
+/// What one restir frame reads.
+struct RestirInputs {
+    const ParticleBvh& bvh;
+    const Particles& particles;
+    const GBuffer& gbuffer;      ///< full resolution
+    const Camera& camera;
+    const Settings& settings;
+    std::uint32_t frame = 0;
+    const AliasTable* powerTable = nullptr;  ///< render.source = power
+};
+
+/// ReSTIR DI (MODEL.md section 4; Bitterli et al. 2020): generateCandidates
+/// (RIS, M candidates, target p_hat without visibility), temporalResampling
+/// (reprojection through particle motion and the previous camera, rejection
+/// on particle / normal / depth, history M capped at C x M), k-neighbour
+/// spatialResampling (1 or more passes), traceShadowRays (one shadow ray
+/// for the kept sample, optionally zeroing an occluded sample before it is
+/// stored), and upsampleLighting when lighting runs at reduced resolution.
+/// Reusing a sample y of reservoir i at pixel q weighs it by
+/// p_hat_q(y) W_i M_i (bias correction none / basic) or by the pairwise MIS
+/// weight. Keeps the previous frame's G-buffer, particles, camera and
+/// reservoirs: the history starts with the first frame rendered.
+class Restir {
+public:
+    explicit Restir(const Settings& settings);
+
+    /// Render Lr of one frame (spp = 1, no per-pixel standard error).
+    LightingCounters render(const RestirInputs& in, LightingImage& out, ReservoirImage& aov, PassTimer& timer);
+
+    /// Bytes of the stored reservoirs per lighting pixel, and of the history.
+    std::size_t reservoirBytes() const { return codec_.bytes(); }
+    const ReservoirCodec& codec() const { return codec_; }
+
+    struct History;  ///< previous frame (defined in restir.cpp)
+
+private:
+    RestirSettings rs_;
+    ReservoirCodec codec_;
+    std::shared_ptr<History> history_;
+};
+
+}  // namespace accretion

@@ -1,0 +1,87 @@
+#include "accretion/analysis/image_metrics.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <OpenImageIO/imageio.h>
+#include <fmt/format.h>
+
+#include "accretion/core/error.h"
+
+namespace accretion {
+
+namespace OIIO = OIIO_NAMESPACE;
+
+ErrorMetrics computeErrors(const std::vector<Vec3>& x, const std::vector<Vec3>& ref, const std::vector<Vec3>* refStderr,
+                           double eps) {
+    ACC_CHECK(x.size() == ref.size());
+    ACC_CHECK(!refStderr || refStderr->size() == ref.size());
+    ErrorMetrics m;
+    m.pixels = x.size();
+    if (x.empty()) return m;
+    double rel = 0.0, mse = 0.0, mape = 0.0, floor = 0.0;
+    for (std::size_t i = 0; i < x.size(); ++i) {
+        for (int c = 0; c < 3; ++c) {
+            const double r = ref[i][c];
+            const double d = double(x[i][c]) - r;
+            rel += d * d / (r * r + eps);
+            mse += d * d;
+            mape += std::fabs(d) / (std::fabs(r) + eps);
+            if (refStderr) {
+                const double s = (*refStderr)[i][c];
+                floor += s * s / (r * r + eps);
+            }
+        }
+    }
+    const double n = 3.0 * double(x.size());
+    m.relMSE = rel / n;
+    m.MSE = mse / n;
+    m.MAPE = mape / n;
+    m.relMSEFloor = floor / n;
+    return m;
+}
+
+namespace {
+
+std::vector<std::string> layerChannels(const std::string& layer) {
+    if (layer.empty()) return {"R", "G", "B"};
+    return {layer + ".R", layer + ".G", layer + ".B"};
+}
+
+}  // namespace
+
+bool exrHasLayer(const std::filesystem::path& file, const std::string& layer) {
+    auto in = OIIO::ImageInput::open(file.string());
+    if (!in) return false;
+    const OIIO::ImageSpec& spec = in->spec();
+    for (const std::string& c : layerChannels(layer))
+        if (spec.channelindex(c) < 0) return false;
+    return true;
+}
+
+RgbLayer readExrLayer(const std::filesystem::path& file, const std::string& layer) {
+    auto in = OIIO::ImageInput::open(file.string());
+    if (!in) throw InputError(fmt::format("{}: cannot read image: {}", file.string(), OIIO::geterror()));
+    const OIIO::ImageSpec& spec = in->spec();
+    RgbLayer out;
+    out.width = static_cast<std::uint32_t>(spec.width);
+    out.height = static_cast<std::uint32_t>(spec.height);
+    const std::size_t pixels = std::size_t(out.width) * out.height;
+    std::vector<float> all(pixels * std::size_t(spec.nchannels));
+    if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
+        throw InputError(fmt::format("{}: cannot read pixels: {}", file.string(), in->geterror()));
+    const auto names = layerChannels(layer);
+    int idx[3];
+    for (int c = 0; c < 3; ++c) {
+        idx[c] = spec.channelindex(names[c]);
+        if (idx[c] < 0)
+            throw InputError(fmt::format("{}: no channel '{}' (layer '{}')", file.string(), names[c],
+                                         layer.empty() ? "RGB" : layer));
+    }
+    out.rgb.resize(pixels);
+    for (std::size_t p = 0; p < pixels; ++p)
+        for (int c = 0; c < 3; ++c) out.rgb[p][c] = all[p * spec.nchannels + idx[c]];
+    return out;
+}
+
+}  // namespace accretion

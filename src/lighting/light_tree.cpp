@@ -1,0 +1,132 @@
+#include "accretion/lighting/light_tree.h"
+
+#include <algorithm>
+
+#include "accretion/core/error.h"
+
+namespace accretion {
+
+LightTree::LightTree(const Particles& particles, const ShadingSettings& shading)
+    : model_(shading.model), dmin_(static_cast<float>(shading.dmin)) {
+    const auto n = static_cast<std::uint32_t>(particles.size());
+    if (n == 0) return;
+    std::vector<std::uint32_t> ids(n);
+    for (std::uint32_t i = 0; i < n; ++i) ids[i] = i;
+    nodes_.reserve(2 * std::size_t(n) - 1);
+    trail_.resize(n);
+    nodes_.resize(1);
+    build(0, ids, 0, n, particles, 0, 0);
+}
+
+/// Median split on the longest axis of the positions' box. Children are
+/// allocated as a pair (right = child + 1) before recursing.
+void LightTree::build(std::uint32_t node, std::vector<std::uint32_t>& ids, std::uint32_t begin, std::uint32_t end,
+                      const Particles& particles, std::uint64_t bits, std::uint32_t depth) {
+    depth_ = std::max(depth_, depth);
+    if (end - begin == 1) {
+        const std::uint32_t i = ids[begin];
+        const float dmin = std::max(particles.radius[i], dmin_);
+        ACC_CHECK(depth < 64);
+        nodes_[node] = Node{particles.position[i], 0.0f, luminance(particles.emission[i]), dmin * dmin, i, 1};
+        trail_[i] = Trail{bits, depth};
+        return;
+    }
+    Vec3 lo(std::numeric_limits<float>::infinity()), hi(-std::numeric_limits<float>::infinity());
+    double power = 0.0;
+    for (std::uint32_t k = begin; k < end; ++k) {
+        lo = glm::min(lo, particles.position[ids[k]]);
+        hi = glm::max(hi, particles.position[ids[k]]);
+        power += luminance(particles.emission[ids[k]]);
+    }
+    const Vec3 extent = hi - lo;
+    const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
+    const std::uint32_t mid = begin + (end - begin) / 2;
+    std::nth_element(ids.begin() + begin, ids.begin() + mid, ids.begin() + end, [&](std::uint32_t a, std::uint32_t b) {
+        return particles.position[a][axis] < particles.position[b][axis];
+    });
+    const Vec3 center = 0.5f * (lo + hi);
+    // Conservative sphere: half the box diagonal, widened for float rounding.
+    const float radius = 0.5f * glm::length(extent) * (1.0f + 1e-5f) + 1e-6f * glm::length(center);
+    const auto child = static_cast<std::uint32_t>(nodes_.size());
+    nodes_[node] = Node{center, radius, static_cast<float>(power), 0.0f, child, 0};
+    nodes_.resize(nodes_.size() + 2);
+    build(child, ids, begin, mid, particles, bits, depth + 1);
+    build(child + 1, ids, mid, end, particles, bits | (std::uint64_t(1) << depth), depth + 1);
+}
+
+float LightTree::importance(const Node& node, const ShadingPoint& sp) const {
+    if (node.leaf) {
+        if (node.child == sp.self || !(node.power > 0.0f)) return 0.0f;
+        const Vec3 delta = node.center - sp.x;
+        const float d2 = glm::dot(delta, delta);
+        float cosTerm = 1.0f;
+        if (model_ != ShadingModel::isotropic) {
+            if (!(d2 > 0.0f)) return 0.0f;
+            cosTerm = glm::dot(sp.n, delta) / std::sqrt(d2);
+            if (!(cosTerm > 0.0f)) return 0.0f;
+        }
+        return node.power * cosTerm / std::max(d2, node.dmin2);
+    }
+    if (!(node.power > 0.0f)) return 0.0f;
+    const Vec3 delta = node.center - sp.x;
+    const float d2 = glm::dot(delta, delta);
+    const float r2 = node.radius * node.radius;
+    float cosBound = 1.0f;
+    if (model_ != ShadingModel::isotropic && d2 > r2) {
+        // cos(max(0, theta_n - theta_b)): theta_n between n and the centre,
+        // theta_b the half-angle the bounding sphere subtends.
+        const float d = std::sqrt(d2);
+        const float cosN = glm::dot(sp.n, delta) / d;
+        const float sinB = node.radius / d;
+        const float cosB = std::sqrt(std::max(0.0f, 1.0f - sinB * sinB));
+        if (cosN < cosB) {
+            const float sinN = std::sqrt(std::max(0.0f, 1.0f - cosN * cosN));
+            cosBound = cosN * cosB + sinN * sinB;
+            if (!(cosBound > 0.0f)) return 0.0f;
+        }
+    }
+    return node.power * cosBound / std::max(d2, r2);
+}
+
+LightSample LightTree::sample(const ShadingPoint& sp, Rng& rng) const {
+    if (nodes_.empty()) return {kNoLightSample, 0.0f};
+    std::uint32_t n = 0;
+    float pdf = 1.0f;
+    while (!nodes_[n].leaf) {
+        const std::uint32_t c = nodes_[n].child;
+        const float a = importance(nodes_[c], sp);
+        const float b = importance(nodes_[c + 1], sp);
+        const float u = rng.uniform();
+        if (!(a + b > 0.0f)) return {kNoLightSample, 0.0f};
+        const float pa = a / (a + b);
+        if (u < pa) {
+            n = c;
+            pdf *= pa;
+        } else {
+            n = c + 1;
+            pdf *= 1.0f - pa;
+        }
+    }
+    if (!(pdf > 0.0f)) return {kNoLightSample, 0.0f};
+    return {nodes_[n].child, pdf};
+}
+
+float LightTree::pdf(const ShadingPoint& sp, std::uint32_t i) const {
+    if (i >= trail_.size()) return 0.0f;
+    const Trail t = trail_[i];
+    std::uint32_t n = 0;
+    float pdf = 1.0f;
+    for (std::uint32_t k = 0; k < t.depth; ++k) {
+        const std::uint32_t c = nodes_[n].child;
+        const float a = importance(nodes_[c], sp);
+        const float b = importance(nodes_[c + 1], sp);
+        if (!(a + b > 0.0f)) return 0.0f;
+        const bool right = (t.bits >> k) & 1u;
+        const float pa = a / (a + b);
+        pdf *= right ? 1.0f - pa : pa;
+        n = right ? c + 1 : c;
+    }
+    return pdf;
+}
+
+}  // namespace accretion

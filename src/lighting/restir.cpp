@@ -1,0 +1,454 @@
+#include "accretion/lighting/restir.h"
+
+#include <cmath>
+
+#include <tbb/blocked_range2d.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include "accretion/core/error.h"
+#include "accretion/core/rng.h"
+#include "accretion/lighting/reservoir.h"
+#include "accretion/render/shading.h"
+#include "accretion/render/visibility.h"
+
+namespace accretion {
+
+/// The previous frame as temporal reuse sees it.
+struct Restir::History {
+    GBuffer gbuffer;                        ///< lighting-resolution G-buffer
+    Particles particles;                    ///< previous positions / emission / albedo
+    LightArrays lights;                     ///< views of `particles`
+    Camera camera;
+    std::vector<StoredReservoir> reservoirs;
+};
+
+namespace {
+
+/// The domain of a reservoir: the receiver and the lights its p_hat used.
+struct Domain {
+    ShadingPoint sp;
+    const LightArrays* lights;
+};
+
+/// A reservoir offered for resampling at the current pixel.
+struct Offer {
+    StoredReservoir r;
+    Domain domain;
+};
+
+ShadingPoint shadingPoint(const GBufferTexel& g, const Particles& particles) {
+    return {g.position, g.normal, g.geomNormal, particles.albedo[g.particle], g.particle};
+}
+
+/// Neighbour rejection shared by the temporal and spatial passes.
+bool similar(const GBufferTexel& a, const GBufferTexel& b, const RestirSettings& rs) {
+    if (!b.hit()) return false;
+    if (glm::dot(a.normal, b.normal) < float(rs.normal_threshold)) return false;
+    return std::fabs(a.depth - b.depth) <= float(rs.depth_threshold) * a.depth;
+}
+
+/// Combines the canonical reservoir (offers[0], in the current domain) with
+/// the others. none: W = w_sum / (M_total p_hat(y)); basic: the sum of M runs
+/// only over domains whose p_hat of y is non-zero (and that see y, with
+/// basic_visibility); pairwise: each neighbour forms a two-strategy balance
+/// heuristic with the canonical, whose confidence is split over the k pairs
+/// (weights sum to 1 for every y; equal p_hat gives M_i / M_total).
+template <ShadingModel SM, Primitive P>
+StoredReservoir combine(const Offer* offers, std::uint32_t n, const LightArrays& L, const RestirSettings& rs,
+                        const ParticleBvh& bvh, float eps, Rng& rng, LightingCounters& c) {
+    const Offer& can = offers[0];
+    const ShadingPoint& sp = can.domain.sp;
+    if (n == 1) return can.r;
+    double Mtotal = 0.0;
+    for (std::uint32_t i = 0; i < n; ++i) Mtotal += offers[i].r.M;
+
+    // p_hat at the current pixel of every offered sample.
+    float pc[1 + 64];
+    pc[0] = can.r.W > 0.0f ? can.r.p_hat : 0.0f;
+    for (std::uint32_t i = 1; i < n; ++i) {
+        pc[i] = offers[i].r.W > 0.0f ? L.targetPdf<SM>(sp, offers[i].r.y) : 0.0f;
+        ++c.lightTerms;
+    }
+
+    Reservoir out;
+    std::uint32_t chosen = 0;
+    if (rs.bias_correction == BiasCorrection::pairwise) {
+        const double k = n - 1;
+        const double Mc = can.r.M;
+        for (std::uint32_t i = 0; i < n; ++i) {
+            const StoredReservoir& r = offers[i].r;
+            double m = 0.0;
+            if (r.W > 0.0f && pc[i] > 0.0f) {
+                if (i == 0) {
+                    for (std::uint32_t j = 1; j < n; ++j) {
+                        const double Mj = offers[j].r.M;
+                        const double pj = offers[j].domain.lights->targetPdf<SM>(offers[j].domain.sp, r.y);
+                        ++c.lightTerms;
+                        const double a = Mj * pj, b = Mc / k * pc[0];
+                        m += (Mj + Mc / k) / Mtotal * (a + b > 0.0 ? b / (a + b) : 0.0);
+                    }
+                } else {
+                    const double a = double(r.M) * r.p_hat, b = Mc / k * pc[i];
+                    m = (r.M + Mc / k) / Mtotal * (a + b > 0.0 ? a / (a + b) : 0.0);
+                }
+            }
+            const float w = static_cast<float>(m * double(pc[i]) * double(r.W));
+            if (out.update(r.y, w, pc[i], rng.uniform())) chosen = i;
+        }
+        StoredReservoir res;
+        res.M = static_cast<std::uint32_t>(std::min(Mtotal, 4294967295.0));
+        if (out.y == kNoLight || !(out.p_hat > 0.0f)) return res;
+        res.y = out.y;
+        res.p_hat = out.p_hat;
+        res.W = out.w_sum / out.p_hat;
+        return res;
+    }
+
+    for (std::uint32_t i = 0; i < n; ++i) {
+        const StoredReservoir& r = offers[i].r;
+        const float w = pc[i] * r.W * float(r.M);
+        if (out.update(r.y, w, pc[i], rng.uniform())) chosen = i;
+    }
+    StoredReservoir res;
+    res.M = static_cast<std::uint32_t>(std::min(Mtotal, 4294967295.0));
+    if (out.y == kNoLight || !(out.p_hat > 0.0f)) return res;
+    double Z = Mtotal;
+    if (rs.bias_correction == BiasCorrection::basic) {
+        Z = offers[chosen].r.M;  // the domain that produced y can produce it
+        for (std::uint32_t i = 0; i < n; ++i) {
+            if (i == chosen) continue;
+            const Domain& d = offers[i].domain;
+            LightTerm t;
+            ++c.lightTerms;
+            if (!d.lights->term<SM>(d.sp, out.y, t) || !(luminance(t.value) > 0.0f)) continue;
+            if (rs.basic_visibility && i != 0) {  // fresh candidates ignore visibility
+                ++c.shadowRays;
+                if (!visible<P>(bvh, d.sp, t, d.lights->radius[out.y], eps)) {
+                    ++c.shadowOccluded;
+                    continue;
+                }
+            }
+            Z += offers[i].r.M;
+        }
+    }
+    res.y = out.y;
+    res.p_hat = out.p_hat;
+    res.W = static_cast<float>(double(out.w_sum) / (Z * double(out.p_hat)));
+    return res;
+}
+
+/// Runs body(px, x, y, counters) over the pixels of a w x h grid in 8x8 tiles.
+template <class Body>
+LightingCounters forEachPixel(std::uint32_t w, std::uint32_t h, Body&& body) {
+    tbb::enumerable_thread_specific<LightingCounters> counters;
+    tbb::parallel_for(tbb::blocked_range2d<std::uint32_t>(0, h, 8, 0, w, 8), [&](const auto& r) {
+        LightingCounters& c = counters.local();
+        for (std::uint32_t y = r.rows().begin(); y != r.rows().end(); ++y)
+            for (std::uint32_t x = r.cols().begin(); x != r.cols().end(); ++x) body(std::size_t(y) * w + x, x, y, c);
+    });
+    LightingCounters total;
+    for (const auto& c : counters) total += c;
+    return total;
+}
+
+struct FrameContext {
+    const RestirInputs& in;
+    const RestirSettings& rs;
+    const ReservoirCodec& codec;
+    const GBuffer& lg;          ///< lighting-resolution G-buffer
+    const LightArrays& L;
+    const Restir::History* prev;
+    float scale;                ///< lighting / image resolution
+    float eps;
+};
+
+template <ShadingModel SM, Primitive P, bool Power>
+LightingCounters generateCandidates(const FrameContext& f, std::vector<StoredReservoir>& out) {
+    const std::uint32_t Mc = f.in.settings.render.candidates;
+    return forEachPixel(f.lg.width, f.lg.height, [&](std::size_t px, std::uint32_t, std::uint32_t, LightingCounters& c) {
+        const GBufferTexel& g = f.lg.texels[px];
+        out[px] = StoredReservoir{};
+        if (!g.hit()) return;
+        const ShadingPoint sp = shadingPoint(g, f.in.particles);
+        Rng rng(px, f.in.frame, RngPass::restirCandidates, f.in.settings.render.seed);
+        Reservoir r;
+        for (std::uint32_t m = 0; m < Mc; ++m) {
+            const LightSample x = sampleSource<Power>(f.L, f.in.powerTable, rng);
+            const float p_hat = f.L.targetPdf<SM>(sp, x.i);
+            ++c.lightTerms;
+            r.update(x.i, p_hat / x.pdf, p_hat, rng.uniform());
+        }
+        r.finalize();
+        StoredReservoir s;
+        s.M = r.M;
+        if (r.W > 0.0f) {
+            s.y = r.y;
+            s.W = r.W;
+            s.p_hat = r.p_hat;
+        }
+        out[px] = f.codec.roundTrip(s);
+    });
+}
+
+template <ShadingModel SM, Primitive P>
+LightingCounters temporalResampling(const FrameContext& f, const std::vector<StoredReservoir>& cur,
+                                    std::vector<StoredReservoir>& out) {
+    const Restir::History& h = *f.prev;
+    const Particles& particles = f.in.particles;
+    return forEachPixel(f.lg.width, f.lg.height, [&](std::size_t px, std::uint32_t, std::uint32_t, LightingCounters& c) {
+        const GBufferTexel& g = f.lg.texels[px];
+        out[px] = cur[px];
+        if (!g.hit()) return;
+        // Where this surface point was: moved back by its particle's motion,
+        // projected with the previous camera onto the previous lighting grid.
+        const std::uint32_t j = g.particle;
+        if (j >= h.particles.size()) {
+            ++c.reuseRejected;
+            return;
+        }
+        const Vec3 xPrev = g.position - (particles.position[j] - h.particles.position[j]);
+        float fx, fy, depth;
+        bool ok = h.camera.project(xPrev, fx, fy, depth);
+        const float lx = fx * f.scale, ly = fy * f.scale;
+        ok = ok && lx >= 0.0f && ly >= 0.0f && lx < float(h.gbuffer.width) && ly < float(h.gbuffer.height);
+        std::size_t q = 0;
+        if (ok) {
+            q = std::size_t(ly) * h.gbuffer.width + std::size_t(lx);
+            const GBufferTexel& gp = h.gbuffer.texels[q];
+            ok = gp.particle == j && glm::dot(gp.normal, g.normal) >= float(f.rs.normal_threshold) &&
+                 std::fabs(gp.depth - depth) <= float(f.rs.depth_threshold) * depth;
+        }
+        if (!ok) {
+            ++c.reuseRejected;
+            return;
+        }
+        ++c.reuseAccepted;
+        const ShadingPoint sp = shadingPoint(g, particles);
+        Offer offers[2];
+        offers[0] = {cur[px], {sp, &f.L}};
+        StoredReservoir prev = h.reservoirs[q];
+        const double cap = f.rs.m_cap * double(std::max<std::uint32_t>(cur[px].M, 1));
+        prev.M = static_cast<std::uint32_t>(std::min(double(prev.M), std::floor(cap)));
+        offers[1] = {prev, {shadingPoint(h.gbuffer.texels[q], h.particles), &h.lights}};
+        Rng rng(px, f.in.frame, RngPass::restirTemporal, f.in.settings.render.seed);
+        out[px] = f.codec.roundTrip(combine<SM, P>(offers, 2, f.L, f.rs, f.in.bvh, f.eps, rng, c));
+    });
+}
+
+template <ShadingModel SM, Primitive P>
+LightingCounters spatialResampling(const FrameContext& f, std::uint32_t iteration, const std::vector<StoredReservoir>& cur,
+                                   std::vector<StoredReservoir>& out) {
+    const std::uint32_t W = f.lg.width, H = f.lg.height;
+    const float radius = std::max(1.0f, float(f.rs.spatial_radius) * f.scale);
+    const std::uint32_t k = f.rs.spatial_neighbours;
+    return forEachPixel(W, H, [&](std::size_t px, std::uint32_t x, std::uint32_t y, LightingCounters& c) {
+        const GBufferTexel& g = f.lg.texels[px];
+        out[px] = cur[px];
+        if (!g.hit()) return;
+        Rng rng(px ^ (std::uint64_t(iteration) << 40), f.in.frame, RngPass::restirSpatial, f.in.settings.render.seed);
+        const ShadingPoint sp = shadingPoint(g, f.in.particles);
+        Offer offers[1 + 64];
+        std::uint32_t n = 0;
+        offers[n++] = {cur[px], {sp, &f.L}};
+        for (std::uint32_t s = 0; s < k; ++s) {
+            // Uniform in the disc of the radius (polar, sqrt for area).
+            const float r = radius * std::sqrt(rng.uniform());
+            const float phi = 6.28318530718f * rng.uniform();
+            const long nx = std::lround(float(x) + r * std::cos(phi));
+            const long ny = std::lround(float(y) + r * std::sin(phi));
+            if (nx < 0 || ny < 0 || nx >= long(W) || ny >= long(H) || (nx == long(x) && ny == long(y))) {
+                ++c.reuseRejected;
+                continue;
+            }
+            const std::size_t q = std::size_t(ny) * W + std::size_t(nx);
+            const GBufferTexel& gn = f.lg.texels[q];
+            if (!similar(g, gn, f.rs)) {
+                ++c.reuseRejected;
+                continue;
+            }
+            ++c.reuseAccepted;
+            offers[n++] = {cur[q], {shadingPoint(gn, f.in.particles), &f.L}};
+        }
+        out[px] = f.codec.roundTrip(combine<SM, P>(offers, n, f.L, f.rs, f.in.bvh, f.eps, rng, c));
+    });
+}
+
+/// One shadow ray for the kept sample; Lr = f I G V W. With visibility
+/// reuse, an occluded sample's W is zeroed in the stored reservoir.
+template <ShadingModel SM, Primitive P>
+LightingCounters traceShadowRays(const FrameContext& f, std::vector<StoredReservoir>& res, std::vector<Vec3>& Lr) {
+    return forEachPixel(f.lg.width, f.lg.height, [&](std::size_t px, std::uint32_t, std::uint32_t, LightingCounters& c) {
+        Lr[px] = Vec3(0.0f);
+        const GBufferTexel& g = f.lg.texels[px];
+        StoredReservoir& r = res[px];
+        if (!g.hit() || !(r.W > 0.0f)) return;
+        const ShadingPoint sp = shadingPoint(g, f.in.particles);
+        LightTerm t;
+        ++c.lightTerms;
+        if (!f.L.term<SM>(sp, r.y, t)) return;
+        ++c.shadowRays;
+        if (!visible<P>(f.in.bvh, sp, t, f.L.radius[r.y], f.eps)) {
+            ++c.shadowOccluded;
+            if (f.rs.visibility_reuse) r = f.codec.roundTrip(StoredReservoir{kNoLight, 0.0f, r.M, 0.0f});
+            return;
+        }
+        Lr[px] = t.value * r.W;
+    });
+}
+
+/// Bilateral upsample of Lr / rho from the lighting grid: bilinear weights
+/// times depth and normal similarity, then times the pixel's own albedo.
+void upsampleLighting(const GBuffer& full, const GBuffer& lg, const Particles& particles, const std::vector<Vec3>& lowLr,
+                      float scale, const RestirSettings& rs, std::vector<Vec3>& Lr) {
+    tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, full.height), [&](const auto& rows) {
+        for (std::uint32_t y = rows.begin(); y != rows.end(); ++y) {
+            for (std::uint32_t x = 0; x < full.width; ++x) {
+                const std::size_t px = std::size_t(y) * full.width + x;
+                const GBufferTexel& g = full.texels[px];
+                Lr[px] = Vec3(0.0f);
+                if (!g.hit()) continue;
+                const float fx = (float(x) + 0.5f) * scale - 0.5f, fy = (float(y) + 0.5f) * scale - 0.5f;
+                const int x0 = int(std::floor(fx)), y0 = int(std::floor(fy));
+                Vec3 sum(0.0f);
+                float wsum = 0.0f;
+                for (int dy = 0; dy < 2; ++dy) {
+                    for (int dx = 0; dx < 2; ++dx) {
+                        const int lx = std::clamp(x0 + dx, 0, int(lg.width) - 1);
+                        const int ly = std::clamp(y0 + dy, 0, int(lg.height) - 1);
+                        const float bw = (dx ? fx - float(x0) : 1.0f - (fx - float(x0))) *
+                                         (dy ? fy - float(y0) : 1.0f - (fy - float(y0)));
+                        const std::size_t q = std::size_t(ly) * lg.width + std::size_t(lx);
+                        const GBufferTexel& gl = lg.texels[q];
+                        if (!gl.hit() || !similar(g, gl, rs)) continue;
+                        const Vec3 rho = particles.albedo[gl.particle];
+                        const Vec3 e = glm::max(rho, Vec3(1e-8f));
+                        const float w = std::max(bw, 1e-4f);
+                        sum += w * lowLr[q] / e;
+                        wsum += w;
+                    }
+                }
+                if (wsum > 0.0f) Lr[px] = sum / wsum * particles.albedo[g.particle];
+            }
+        }
+    });
+}
+
+template <ShadingModel SM, Primitive P>
+LightingCounters runFrame(const FrameContext& f, std::vector<StoredReservoir>& a, std::vector<StoredReservoir>& b,
+                          std::vector<Vec3>& lowLr, PassTimer& timer) {
+    LightingCounters total;
+    {
+        auto t = timer.scope(pass::generateCandidates);
+        total += f.in.settings.render.source == LightSource::power ? generateCandidates<SM, P, true>(f, a)
+                                                                    : generateCandidates<SM, P, false>(f, a);
+    }
+    if (f.rs.temporal && f.prev) {
+        auto t = timer.scope(pass::temporalResampling);
+        total += temporalResampling<SM, P>(f, a, b);
+        std::swap(a, b);
+    }
+    if (f.rs.spatial_neighbours > 0) {
+        auto t = timer.scope(pass::spatialResampling);
+        for (std::uint32_t it = 0; it < f.rs.spatial_iterations; ++it) {
+            total += spatialResampling<SM, P>(f, it, a, b);
+            std::swap(a, b);
+        }
+    }
+    {
+        auto t = timer.scope(pass::traceShadowRays);
+        total += traceShadowRays<SM, P>(f, a, lowLr);
+    }
+    return total;
+}
+
+template <ShadingModel SM>
+LightingCounters dispatchPrimitive(const FrameContext& f, std::vector<StoredReservoir>& a, std::vector<StoredReservoir>& b,
+                                   std::vector<Vec3>& lowLr, PassTimer& timer) {
+    return f.in.bvh.settings().primitive == Primitive::sphere ? runFrame<SM, Primitive::sphere>(f, a, b, lowLr, timer)
+                                                              : runFrame<SM, Primitive::billboard>(f, a, b, lowLr, timer);
+}
+
+}  // namespace
+
+Restir::Restir(const Settings& settings) : rs_(settings.restir), codec_(settings.restir) {}
+
+LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, ReservoirImage& aov, PassTimer& timer) {
+    const GBuffer& full = in.gbuffer;
+    const std::size_t pixels = std::size_t(full.width) * full.height;
+    out.Lr.assign(pixels, Vec3(0.0f));
+    out.Lr_stderr.assign(pixels, Vec3(0.0f));
+    out.spp.assign(pixels, 0.0f);
+    codec_.checkCapacity(in.particles.size(), in.settings.scenePath.empty() ? "restir" : in.settings.scenePath);
+
+    // The lighting grid: the image at resolution_scale, each texel the
+    // G-buffer texel of the image pixel that contains its centre.
+    const float scale = static_cast<float>(rs_.resolution_scale);
+    GBuffer reduced;
+    const GBuffer* lg = &full;
+    if (scale < 1.0f) {
+        reduced.width = std::max(1u, std::uint32_t(std::lround(full.width * scale)));
+        reduced.height = std::max(1u, std::uint32_t(std::lround(full.height * scale)));
+        reduced.texels.resize(std::size_t(reduced.width) * reduced.height);
+        for (std::uint32_t y = 0; y < reduced.height; ++y)
+            for (std::uint32_t x = 0; x < reduced.width; ++x) {
+                const auto fx = std::min(full.width - 1, std::uint32_t((float(x) + 0.5f) / scale));
+                const auto fy = std::min(full.height - 1, std::uint32_t((float(y) + 0.5f) / scale));
+                reduced.texels[std::size_t(y) * reduced.width + x] = full.at(fx, fy);
+            }
+        lg = &reduced;
+    }
+    const std::size_t lpixels = std::size_t(lg->width) * lg->height;
+    const LightArrays L(in.particles, in.settings.shading);
+    const History* prev = history_ && history_->gbuffer.width == lg->width && history_->gbuffer.height == lg->height
+                              ? history_.get() : nullptr;
+    FrameContext f{in, rs_, codec_, *lg, L, prev, lg == &full ? 1.0f : float(lg->width) / float(full.width),
+                   static_cast<float>(in.settings.render.shadow_epsilon)};
+
+    std::vector<StoredReservoir> a(lpixels), b(lpixels);
+    std::vector<Vec3> lowLr(lpixels);
+    LightingCounters counters;
+    if (!in.particles.empty()) {
+        switch (in.settings.shading.model) {
+        case ShadingModel::lambert: counters = dispatchPrimitive<ShadingModel::lambert>(f, a, b, lowLr, timer); break;
+        case ShadingModel::sphere: counters = dispatchPrimitive<ShadingModel::sphere>(f, a, b, lowLr, timer); break;
+        case ShadingModel::isotropic: counters = dispatchPrimitive<ShadingModel::isotropic>(f, a, b, lowLr, timer); break;
+        }
+    }
+
+    if (lg == &full) {
+        out.Lr = lowLr;
+    } else {
+        auto t = timer.scope(pass::upsampleLighting);
+        upsampleLighting(full, *lg, in.particles, lowLr, f.scale, rs_, out.Lr);
+    }
+    aov.W.assign(pixels, 0.0f);
+    aov.M.assign(pixels, 0.0f);
+    aov.light.assign(pixels, kNoLight);
+    aov.p_hat.assign(pixels, 0.0f);
+    for (std::uint32_t y = 0; y < full.height; ++y)
+        for (std::uint32_t x = 0; x < full.width; ++x) {
+            const std::size_t px = std::size_t(y) * full.width + x;
+            if (!full.texels[px].hit()) continue;
+            out.spp[px] = 1.0f;
+            const auto lx = std::min(lg->width - 1, std::uint32_t(float(x) * f.scale));
+            const auto ly = std::min(lg->height - 1, std::uint32_t(float(y) * f.scale));
+            const StoredReservoir& r = a[std::size_t(ly) * lg->width + lx];
+            aov.W[px] = r.W;
+            aov.M[px] = float(r.M);
+            aov.light[px] = r.W > 0.0f ? r.y : kNoLight;
+            aov.p_hat[px] = r.p_hat;
+        }
+
+    // History for the next frame.
+    auto h = std::make_shared<History>();
+    h->gbuffer = *lg;
+    h->particles = in.particles;
+    h->lights = LightArrays(h->particles, in.settings.shading);
+    h->camera = in.camera;
+    h->reservoirs = std::move(a);
+    history_ = std::move(h);
+    return counters;
+}
+
+}  // namespace accretion
