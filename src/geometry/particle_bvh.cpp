@@ -1,6 +1,7 @@
 #include "accretion/geometry/particle_bvh.h"
 
 #include <chrono>
+#include <cmath>
 
 #include <tbb/parallel_for.h>
 
@@ -119,10 +120,13 @@ void ParticleBvh::buildTlas() {
 void ParticleBvh::build(const Particles& particles, const Camera& camera) {
     stats_ = BvhStats{};
     const std::size_t n = particles.size();
-    const bool refit = settings_.build == BuildPolicy::refit && !blas_.empty() && clusters_.particle.size() == n;
+    // refit and partial keep the clusters (and BLAS objects) of the first build.
+    const bool keep = (settings_.build == BuildPolicy::refit || settings_.build == BuildPolicy::partial) &&
+                      !blas_.empty() && clusters_.particle.size() == n;
+    const bool refit = keep && settings_.build == BuildPolicy::refit;
 
     auto t0 = std::chrono::steady_clock::now();
-    if (!refit) {
+    if (!keep) {
         clusters_ = clusterParticles(particles.position, settings_.cluster_size);
         stats_.reclustered = true;
     }
@@ -138,14 +142,24 @@ void ParticleBvh::build(const Particles& particles, const Camera& camera) {
     } else {
         std::fill(frames_.begin(), frames_.end(), BillboardFrame{camera.right, camera.up});
     }
-    if (!refit) {
+    if (!keep) {
         releaseBlas();
         blas_.assign(clusters_.count(), nullptr);
         geometry_.assign(clusters_.count(), nullptr);
     }
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, clusters_.count(), 1), [&](const auto& r) {
-        for (std::size_t c = r.begin(); c != r.end(); ++c) buildBlas(c, particles, !refit);
+    // partial: a window of rebuild_fraction of the clusters, advancing round
+    // robin frame by frame; the others keep last frame's (stale) geometry.
+    const std::size_t C = clusters_.count();
+    std::size_t first = 0, count = C;
+    if (keep && settings_.build == BuildPolicy::partial) {
+        count = std::min(C, static_cast<std::size_t>(std::ceil(settings_.rebuild_fraction * double(C))));
+        first = partialCursor_ % std::max<std::size_t>(C, 1);
+        partialCursor_ += count;
+    }
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 1), [&](const auto& r) {
+        for (std::size_t k = r.begin(); k != r.end(); ++k) buildBlas((first + k) % C, particles, !keep);
     });
+    stats_.rebuiltClusters = count;
     device_.check("buildClusters (BLAS)");
     stats_.blasSeconds = secondsSince(t0);
 
@@ -155,6 +169,7 @@ void ParticleBvh::build(const Particles& particles, const Camera& camera) {
     stats_.tlasSeconds = secondsSince(t0);
 
     stats_.refitted = refit;
+    stats_.partial = keep && settings_.build == BuildPolicy::partial;
     stats_.clusters = clusters_.count();
     stats_.primitives = settings_.primitive == Primitive::billboard ? 2 * n : n;
     stats_.triangles = settings_.primitive == Primitive::billboard ? stats_.primitives : 0;

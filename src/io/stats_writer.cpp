@@ -34,6 +34,8 @@ nlohmann::json frameStatsJson(const FrameStats& s) {
         {"bvh",
          {{"reclustered", s.bvh.reclustered},
           {"refitted", s.bvh.refitted},
+          {"partial", s.bvh.partial},
+          {"rebuilt_clusters", s.bvh.rebuiltClusters},
           {"cluster_seconds", s.bvh.clusterSeconds},
           {"blas_seconds", s.bvh.blasSeconds},
           {"tlas_seconds", s.bvh.tlasSeconds},

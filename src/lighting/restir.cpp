@@ -72,7 +72,6 @@ StoredReservoir combine(const Offer* offers, std::uint32_t n, const LightArrays&
     }
 
     Reservoir out;
-    std::uint32_t chosen = 0;
     if (rs.bias_correction == BiasCorrection::pairwise) {
         const double k = n - 1;
         const double Mc = can.r.M;
@@ -94,7 +93,7 @@ StoredReservoir combine(const Offer* offers, std::uint32_t n, const LightArrays&
                 }
             }
             const float w = static_cast<float>(m * double(pc[i]) * double(r.W));
-            if (out.update(r.y, w, pc[i], rng.uniform())) chosen = i;
+            out.merge(r.y, w, pc[i], r.M, rng.uniform());
         }
         StoredReservoir res;
         res.M = static_cast<std::uint32_t>(std::min(Mtotal, 4294967295.0));
@@ -105,10 +104,11 @@ StoredReservoir combine(const Offer* offers, std::uint32_t n, const LightArrays&
         return res;
     }
 
+    std::uint32_t chosen = 0;
     for (std::uint32_t i = 0; i < n; ++i) {
         const StoredReservoir& r = offers[i].r;
         const float w = pc[i] * r.W * float(r.M);
-        if (out.update(r.y, w, pc[i], rng.uniform())) chosen = i;
+        if (out.merge(r.y, w, pc[i], r.M, rng.uniform())) chosen = i;
     }
     StoredReservoir res;
     res.M = static_cast<std::uint32_t>(std::min(Mtotal, 4294967295.0));

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
+
+#include <tbb/parallel_for.h>
 
 namespace accretion {
 namespace {
@@ -26,9 +29,13 @@ double planck(double nm, double kelvin) {
 
 }  // namespace
 
-Vec3 blackbodyColor(double kelvin) {
+namespace {
+
+/// Linear Rec.709 of the blackbody, normalised to luminance 1, from a
+/// tabulated 1 nm CIE sampling (cie[k] at 360 + k nm).
+Vec3 blackbodyFromCie(double kelvin, const std::vector<DVec3>& cie) {
     DVec3 xyz(0.0);
-    for (double nm = 360.0; nm <= 830.0; nm += 1.0) xyz += planck(nm, kelvin) * cieXYZ(nm);
+    for (std::size_t k = 0; k < cie.size(); ++k) xyz += planck(360.0 + double(k), kelvin) * cie[k];
     // XYZ -> linear Rec.709 (D65).
     DVec3 rgb(3.2404542 * xyz.x - 1.5371385 * xyz.y - 0.4985314 * xyz.z,
               -0.9692660 * xyz.x + 1.8760108 * xyz.y + 0.0415560 * xyz.z,
@@ -38,10 +45,22 @@ Vec3 blackbodyColor(double kelvin) {
     return y > 0.0 ? Vec3(rgb / y) : Vec3(0.0f);
 }
 
+std::vector<DVec3> cieTable() {
+    std::vector<DVec3> cie;
+    for (int nm = 360; nm <= 830; ++nm) cie.push_back(cieXYZ(double(nm)));
+    return cie;
+}
+
+}  // namespace
+
+Vec3 blackbodyColor(double kelvin) { return blackbodyFromCie(kelvin, cieTable()); }
+
 BlackbodyTable::BlackbodyTable(double minKelvin, double maxKelvin, int entries)
     : logMin_(std::log(minKelvin)), logMax_(std::log(maxKelvin)), table_(entries) {
-    for (int i = 0; i < entries; ++i)
-        table_[i] = blackbodyColor(std::exp(logMin_ + (logMax_ - logMin_) * i / (entries - 1)));
+    const std::vector<DVec3> cie = cieTable();
+    tbb::parallel_for(0, entries, [&](int i) {
+        table_[i] = blackbodyFromCie(std::exp(logMin_ + (logMax_ - logMin_) * i / (entries - 1)), cie);
+    });
 }
 
 Vec3 BlackbodyTable::operator()(double kelvin) const {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include <tbb/parallel_for.h>
 
@@ -19,10 +20,12 @@ std::uint8_t temperatureType(const ParticleSettings& s, double kelvin) {
     return static_cast<std::uint8_t>(it - s.type_bands.begin());
 }
 
-Particles generateDisk(const ParticleSettings& s, std::uint32_t frame) {
+Particles generateDisk(const ParticleSettings& s, std::uint32_t frame, const BlackbodyTable* table) {
     Particles out;
     out.resize(s.count);
-    const BlackbodyTable blackbody;
+    std::optional<BlackbodyTable> own;
+    if (!table) table = &own.emplace();
+    const BlackbodyTable& blackbody = *table;
     const double t = double(frame) * s.time_step;
     const double rIn2 = s.inner_radius * s.inner_radius, rOut2 = s.outer_radius * s.outer_radius;
 

@@ -8,7 +8,9 @@
 namespace accretion {
 
 ParticleSource::ParticleSource(const Settings& settings)
-    : particles_(settings.particles), albedo_(settings.shading.albedo) {}
+    : particles_(settings.particles), albedo_(settings.shading.albedo) {
+    if (particles_.file.empty()) blackbody_ = std::make_shared<const BlackbodyTable>();
+}
 
 ParticleSource ParticleSource::fixed(Particles particles) {
     ParticleSource s;
@@ -26,7 +28,7 @@ Particles ParticleSource::frame(std::uint32_t frame) const {
     if (fixed_) return *fixed_;
     Particles p;
     if (particles_.file.empty()) {
-        p = generateDisk(particles_, frame);
+        p = generateDisk(particles_, frame, blackbody_.get());
     } else {
         const std::string path = expandPattern(particles_.file, "", frame);
         p = readParticles(path);

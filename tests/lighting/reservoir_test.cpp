@@ -41,3 +41,33 @@ TEST_CASE("an empty or all-zero reservoir has W = 0", "[reservoir]") {
     REQUIRE(r.W == 0.0f);
     REQUIRE(r.M == 1);
 }
+
+TEST_CASE("merging reservoirs keeps candidate i with probability w_i / sum w (chi-square)", "[reservoir][statistical]") {
+    // Two reservoirs stream disjoint halves; merging them with weight w_sum of
+    // each (= p_hat W M for a shared target) must select from the union with
+    // the same frequencies as one stream.
+    const std::vector<float> w = {0.5f, 2.0f, 3.0f, 1.0f, 0.25f, 6.0f, 2.0f, 0.0f, 1.5f, 4.0f, 0.75f};
+    const std::uint32_t split = 4;
+    double total = 0.0;
+    for (float x : w) total += x;
+    const int trials = 400'000;
+    std::vector<double> observed(w.size(), 0.0), expected(w.size());
+    Rng rng(1, 0, RngPass::lightSampling, 78);
+    for (int t = 0; t < trials; ++t) {
+        Reservoir a, b;
+        for (std::uint32_t i = 0; i < split; ++i) a.update(i, w[i], w[i], rng.uniform());
+        for (std::uint32_t i = split; i < w.size(); ++i) b.update(i, w[i], w[i], rng.uniform());
+        a.finalize();
+        b.finalize();
+        Reservoir m;
+        m.merge(a.y, a.p_hat * a.W * float(a.M), a.p_hat, a.M, rng.uniform());
+        m.merge(b.y, b.p_hat * b.W * float(b.M), b.p_hat, b.M, rng.uniform());
+        m.finalize();
+        REQUIRE(m.M == w.size());
+        REQUIRE(m.w_sum == Approx(total).epsilon(1e-5));
+        ++observed[m.y];
+    }
+    for (std::size_t i = 0; i < w.size(); ++i) expected[i] = trials * w[i] / total;
+    REQUIRE(observed[7] == 0.0);
+    CHECK(accretion::test::chiSquarePValue(observed, expected) > 1e-4);
+}

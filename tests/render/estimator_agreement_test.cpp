@@ -42,7 +42,7 @@ Agreement compare(const FrameImage& mc, const FrameImage& exact, float scale = 1
 
 }  // namespace
 
-TEST_CASE("uniform, power and ris agree with exact, and a 1% bias is caught", "[estimators][statistical]") {
+TEST_CASE("uniform, power, tree and ris agree with exact, and a 1% bias is caught", "[estimators][statistical]") {
     struct Config {
         const char* name;
         Primitive primitive;
@@ -59,6 +59,7 @@ TEST_CASE("uniform, power and ris agree with exact, and a 1% bias is caught", "[
     };
     const Estimator est = GENERATE(Estimator{EstimatorKind::uniform, LightSource::uniform, 16384, 1},
                                    Estimator{EstimatorKind::power, LightSource::uniform, 16384, 1},
+                                   Estimator{EstimatorKind::tree, LightSource::uniform, 4096, 1},
                                    Estimator{EstimatorKind::ris, LightSource::uniform, 4096, 8},
                                    Estimator{EstimatorKind::ris, LightSource::power, 4096, 8});
     INFO(config.name << ", " << enumName(est.kind) << " (source " << enumName(est.source) << ")");

@@ -21,6 +21,8 @@ struct BvhStats {
     std::size_t triangles = 0;      ///< 2 per billboard, 0 for spheres
     bool reclustered = false;       ///< clusters recomputed this frame
     bool refitted = false;          ///< BLAS refitted instead of rebuilt
+    bool partial = false;           ///< partial rebuild: only rebuiltClusters were updated
+    std::size_t rebuiltClusters = 0;///< BLAS built or refitted this frame
     double clusterSeconds = 0.0;    ///< spatial clustering time
     double blasSeconds = 0.0;       ///< all bottom-level builds (parallel)
     double tlasSeconds = 0.0;       ///< top-level build
@@ -71,6 +73,7 @@ private:
     std::vector<RTCScene> blas_;
     std::vector<RTCGeometry> geometry_;  // one per BLAS, owned by its scene
     RTCScene tlas_ = nullptr;
+    std::size_t partialCursor_ = 0;  ///< partial: first cluster of the next window
     BvhStats stats_;
 };
 

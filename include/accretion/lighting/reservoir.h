@@ -29,6 +29,15 @@ struct Reservoir {
         return false;
     }
 
+    /// Merge a reservoir of M_other candidates whose sample x carries
+    /// resampling weight w (p_hat(x) W M_other for a finalized one, MODEL.md
+    /// section 4): keeps x with probability w / w_sum.
+    bool merge(std::uint32_t x, float w, float p_hat_x, std::uint32_t M_other, float u) {
+        const bool kept = update(x, w, p_hat_x, u);
+        M += M_other - 1;
+        return kept;
+    }
+
     /// W = w_sum / (M p_hat(y)), 0 when nothing was selected.
     void finalize() { W = (y != kNoLight && p_hat > 0.0f && M > 0) ? w_sum / (float(M) * p_hat) : 0.0f; }
 };

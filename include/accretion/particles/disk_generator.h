@@ -1,6 +1,7 @@
 #pragma once
 #include <cstdint>
 
+#include "accretion/particles/blackbody.h"
 #include "accretion/particles/particles.h"
 #include "accretion/scene/settings.h"
 
@@ -16,6 +17,7 @@ std::uint8_t temperatureType(const ParticleSettings& s, double kelvin);
 /// [r_in, r_out], flared Gaussian height, Keplerian orbits (angular speed
 /// sqrt(GM / r^3)), blackbody emission of T(r) with luminance
 /// luminosity * (T / T_in)^4. Particle k depends only on (seed, k, frame).
-Particles generateDisk(const ParticleSettings& s, std::uint32_t frame);
+/// `table` (optional) saves building the blackbody table on every call.
+Particles generateDisk(const ParticleSettings& s, std::uint32_t frame, const BlackbodyTable* table = nullptr);
 
 }  // namespace accretion

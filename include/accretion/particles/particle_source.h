@@ -1,7 +1,9 @@
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <optional>
 
+#include "accretion/particles/blackbody.h"
 #include "accretion/particles/particles.h"
 #include "accretion/scene/settings.h"
 
@@ -26,6 +28,7 @@ private:
     ParticleSettings particles_;
     Vec3 albedo_{0.8f};
     std::optional<Particles> fixed_;
+    std::shared_ptr<const BlackbodyTable> blackbody_;  ///< generator: built once per source
 };
 
 }  // namespace accretion
