@@ -16,6 +16,8 @@ int main(int argc, char** argv) {
     accretion::cmd::addRenderCommand(app);
     accretion::cmd::addParticlesCommand(app);
     accretion::cmd::addCompareCommand(app);
+    accretion::cmd::addConvergeCommand(app);
+    accretion::cmd::addBiasCommand(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

@@ -75,6 +75,28 @@ void writeFrameExr(const std::filesystem::path& file, const FrameImage& img, boo
     });
 }
 
+void writeChannelsExr(const std::filesystem::path& file, std::uint32_t width, std::uint32_t height,
+                      const std::vector<FloatChannel>& channels, const OutputMetadata& metadata) {
+    const int nch = static_cast<int>(channels.size());
+    OIIO::ImageSpec spec(int(width), int(height), nch, OIIO::TypeDesc::FLOAT);
+    spec.channelnames.clear();
+    for (const FloatChannel& c : channels) spec.channelnames.push_back(c.name);
+    spec.attribute("compression", "zip");
+    for (const auto& [k, v] : metadata) spec.attribute("accretion:" + k, v);
+    const std::size_t pixels = std::size_t(width) * height;
+    std::vector<float> buf(pixels * nch);
+    for (int ch = 0; ch < nch; ++ch) {
+        ACC_CHECK(channels[ch].values.size() == pixels);
+        for (std::size_t px = 0; px < pixels; ++px) buf[px * nch + ch] = channels[ch].values[px];
+    }
+    writeAtomicWith(file, [&](const std::filesystem::path& tmp) {
+        auto out = OIIO::ImageOutput::create("openexr");
+        if (!out) throw InternalError("OpenImageIO has no OpenEXR writer");
+        if (!out->open(tmp.string(), spec) || !out->write_image(OIIO::TypeDesc::FLOAT, buf.data()) || !out->close())
+            throw InputError(fmt::format("{}: cannot write EXR: {}", file.string(), out->geterror()));
+    });
+}
+
 void writePreviewPng(const std::filesystem::path& file, const std::vector<Vec3>& rgb, std::uint32_t width,
                      std::uint32_t height, bool autoExposure, double exposure) {
     double scale = std::exp2(exposure);

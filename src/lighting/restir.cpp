@@ -25,10 +25,13 @@ struct Restir::History {
 
 namespace {
 
-/// The domain of a reservoir: the receiver and the lights its p_hat used.
+/// The domain of a reservoir: the receiver and the lights its p_hat used,
+/// and whether its samples passed a visibility test (then its support is
+/// that of p_hat x V, and basic_visibility must test V to count it).
 struct Domain {
     ShadingPoint sp;
     const LightArrays* lights;
+    bool visibilityTested = false;
 };
 
 /// A reservoir offered for resampling at the current pixel.
@@ -122,7 +125,7 @@ StoredReservoir combine(const Offer* offers, std::uint32_t n, const LightArrays&
             LightTerm t;
             ++c.lightTerms;
             if (!d.lights->term<SM>(d.sp, out.y, t) || !(luminance(t.value) > 0.0f)) continue;
-            if (rs.basic_visibility && i != 0) {  // fresh candidates ignore visibility
+            if (rs.basic_visibility && d.visibilityTested) {
                 ++c.shadowRays;
                 if (!visible<P>(bvh, d.sp, t, d.lights->radius[out.y], eps)) {
                     ++c.shadowOccluded;
@@ -180,6 +183,17 @@ LightingCounters generateCandidates(const FrameContext& f, std::vector<StoredRes
             r.update(x.i, p_hat / x.pdf, p_hat, rng.uniform());
         }
         r.finalize();
+        if (f.rs.candidate_visibility && r.W > 0.0f) {
+            // Bitterli et al. 2020, Alg. 5: drop an occluded candidate before reuse.
+            LightTerm t;
+            if (f.L.term<SM>(sp, r.y, t)) {
+                ++c.shadowRays;
+                if (!visible<P>(f.in.bvh, sp, t, f.L.radius[r.y], f.eps)) {
+                    ++c.shadowOccluded;
+                    r.W = 0.0f;
+                }
+            }
+        }
         StoredReservoir s;
         s.M = r.M;
         if (r.W > 0.0f) {
@@ -226,11 +240,12 @@ LightingCounters temporalResampling(const FrameContext& f, const std::vector<Sto
         ++c.reuseAccepted;
         const ShadingPoint sp = shadingPoint(g, particles);
         Offer offers[2];
-        offers[0] = {cur[px], {sp, &f.L}};
+        offers[0] = {cur[px], {sp, &f.L, f.rs.candidate_visibility}};
         StoredReservoir prev = h.reservoirs[q];
         const double cap = f.rs.m_cap * double(std::max<std::uint32_t>(cur[px].M, 1));
         prev.M = static_cast<std::uint32_t>(std::min(double(prev.M), std::floor(cap)));
-        offers[1] = {prev, {shadingPoint(h.gbuffer.texels[q], h.particles), &h.lights}};
+        offers[1] = {prev, {shadingPoint(h.gbuffer.texels[q], h.particles), &h.lights,
+                            f.rs.candidate_visibility || f.rs.visibility_reuse}};
         Rng rng(px, f.in.frame, RngPass::restirTemporal, f.in.settings.render.seed);
         out[px] = f.codec.roundTrip(combine<SM, P>(offers, 2, f.L, f.rs, f.in.bvh, f.eps, rng, c));
     });
@@ -250,7 +265,7 @@ LightingCounters spatialResampling(const FrameContext& f, std::uint32_t iteratio
         const ShadingPoint sp = shadingPoint(g, f.in.particles);
         Offer offers[1 + 64];
         std::uint32_t n = 0;
-        offers[n++] = {cur[px], {sp, &f.L}};
+        offers[n++] = {cur[px], {sp, &f.L, f.rs.candidate_visibility}};
         for (std::uint32_t s = 0; s < k; ++s) {
             // Uniform in the disc of the radius (polar, sqrt for area).
             const float r = radius * std::sqrt(rng.uniform());
@@ -268,7 +283,7 @@ LightingCounters spatialResampling(const FrameContext& f, std::uint32_t iteratio
                 continue;
             }
             ++c.reuseAccepted;
-            offers[n++] = {cur[q], {shadingPoint(gn, f.in.particles), &f.L}};
+            offers[n++] = {cur[q], {shadingPoint(gn, f.in.particles), &f.L, f.rs.candidate_visibility}};
         }
         out[px] = f.codec.roundTrip(combine<SM, P>(offers, n, f.L, f.rs, f.in.bvh, f.eps, rng, c));
     });

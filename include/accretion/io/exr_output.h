@@ -19,6 +19,14 @@ void writeFrameExr(const std::filesystem::path& file, const FrameImage& image, b
 /// Tonemapped 8-bit sRGB preview of an RGB buffer: scale so that the 99.5th
 /// luminance percentile of non-black pixels maps to 1 (when autoExposure),
 /// times 2^exposure, clip. Atomic.
+/// A float EXR of named channels (e.g. bias maps), written atomically.
+struct FloatChannel {
+    std::string name;
+    std::vector<float> values;  ///< width x height, row-major
+};
+void writeChannelsExr(const std::filesystem::path& file, std::uint32_t width, std::uint32_t height,
+                      const std::vector<FloatChannel>& channels, const OutputMetadata& metadata);
+
 void writePreviewPng(const std::filesystem::path& file, const std::vector<Vec3>& rgb, std::uint32_t width,
                      std::uint32_t height, bool autoExposure, double exposure);
 

@@ -205,6 +205,7 @@ struct RestirSettings {
     BiasCorrection bias_correction = BiasCorrection::basic; ///< normalisation of reused samples
     bool basic_visibility = false;           ///< basic: also trace a shadow ray from each neighbour (unbiased with visibility reuse)
     bool visibility_reuse = false;           ///< discard an occluded sample before storing it for the next frame
+    bool candidate_visibility = false;       ///< one more shadow ray: drop an occluded initial candidate before reuse
     double normal_threshold = 0.9;           ///< reject a neighbour whose normal . n is below this
     double depth_threshold = 0.1;            ///< reject a neighbour whose depth differs by more than this fraction
     double resolution_scale = 1.0;           ///< lighting resolution relative to the image (bilateral upsample)
@@ -219,8 +220,9 @@ struct RestirSettings {
         v.field("spatial_radius", spatial_radius, "spatial neighbour disc radius in pixels", Range{0.0, 4096.0});
         v.field("spatial_iterations", spatial_iterations, "spatial reuse passes", Range{0, 16});
         v.field("bias_correction", bias_correction, "none (1/M, biased), basic (1/Z over neighbours with p_hat > 0) or pairwise MIS");
-        v.field("basic_visibility", basic_visibility, "basic: count a neighbour only if it also sees the sample (shadow ray)");
+        v.field("basic_visibility", basic_visibility, "basic: count a visibility-tested neighbour only if it also sees the sample (shadow ray): unbiased with visibility reuse");
         v.field("visibility_reuse", visibility_reuse, "zero W of an occluded sample before storing it for the next frame");
+        v.field("candidate_visibility", candidate_visibility, "trace a shadow ray for the initial candidate and drop it if occluded, before any reuse (Bitterli et al. Alg. 5)");
         v.field("normal_threshold", normal_threshold, "neighbour rejection: minimum normal dot product", Range{-1.0, 1.0});
         v.field("depth_threshold", depth_threshold, "neighbour rejection: maximum relative depth difference", kNonNegative);
         v.field("resolution_scale", resolution_scale, "lighting resolution / image resolution (bilateral upsample)", Range{0.0, 1.0, true});

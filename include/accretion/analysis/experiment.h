@@ -1,0 +1,43 @@
+#pragma once
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "accretion/render/frame_renderer.h"
+#include "accretion/scene/settings.h"
+
+namespace accretion {
+
+/// One estimator variant of an experiment, from `--estimators`:
+/// name[:option...] where an option is a restir bias correction (none,
+/// basic, pairwise, basic+vis), a candidate source (uniform, power) or a
+/// setting override key=value. Examples: `uniform`, `ris:power`,
+/// `restir:pairwise`, `restir:none:restir.m_cap=5`.
+struct EstimatorSpec {
+    std::string label;                   ///< the spec as written
+    EstimatorKind kind = EstimatorKind::uniform;
+    std::vector<std::string> overrides;  ///< -D style overrides it implies
+};
+
+/// Parse a comma-separated list; errors name `option` and the bad entry.
+std::vector<EstimatorSpec> parseEstimatorSpecs(const std::string& list, const std::string& option);
+
+/// The scene's settings for one spec (base overrides, then the spec's).
+Settings specSettings(const std::filesystem::path& scene, const std::vector<std::string>& base, const EstimatorSpec& spec);
+
+/// The result of rendering one frame for an experiment.
+struct ExperimentRender {
+    FrameImage image;
+    FrameStats stats;           ///< of the measured (last) frame
+    double frameSeconds = 0.0;  ///< wall time of the measured frame
+    double totalSeconds = 0.0;  ///< including restir's history frames
+};
+
+/// Render `frame` with the settings; restir first renders the `history`
+/// frames before it (frame - history .. frame - 1, clamped at 0), so its
+/// temporal reuse is in steady state as on the GPU.
+ExperimentRender renderForExperiment(const Settings& settings, const ParticleSource& source, std::uint32_t frame,
+                                     std::uint32_t history);
+
+}  // namespace accretion

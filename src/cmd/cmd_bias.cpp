@@ -1,0 +1,188 @@
+// accretion bias: per estimator, the mean signed error over many seeds with
+// its standard error, the energy loss, and a per-pixel bias map, so a bias
+// can be told apart from noise (MODEL.md section 5).
+#include <cmath>
+#include <filesystem>
+#include <memory>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+#include <tbb/global_control.h>
+
+#include "accretion/analysis/experiment.h"
+#include "accretion/analysis/image_metrics.h"
+#include "accretion/core/error.h"
+#include "accretion/core/version.h"
+#include "accretion/io/atomic_file.h"
+#include "accretion/io/exr_output.h"
+#include "accretion/io/plot.h"
+#include "accretion/io/stats_writer.h"
+#include "accretion/scene/scene_parser.h"
+#include "commands.h"
+
+namespace accretion::cmd {
+namespace {
+
+struct BiasArgs : SceneArgs {
+    std::string reference, estimators = "ris,restir:none,restir:basic,restir:pairwise", out;
+    std::uint32_t seeds = 64, history = 8;
+    double zCritical = 3.29;  ///< two-sided 99.9%
+    std::optional<std::uint32_t> frame;
+};
+
+struct BiasRow {
+    std::string label;
+    std::uint32_t seeds = 0;
+    double meanError = 0.0;    ///< mean over seeds of the image-mean signed error (x - ref)
+    double stderr = 0.0;       ///< its standard error (seeds and reference noise)
+    double z = 0.0;
+    double energyLossPct = 0.0;
+    double secondsPerRender = 0.0;
+    bool biased = false;
+};
+
+void runBias(const BiasArgs& a) {
+    std::vector<std::string> base = a.defines;
+    appendFrameOverrides(a.frames, base);
+    const Settings sceneSettings = loadScene(a.scene, base);
+    const auto specs = parseEstimatorSpecs(a.estimators, "--estimators");
+    if (a.seeds < 2) throw InputError("command line --seeds: at least 2 seeds are needed for a standard error");
+    const std::uint32_t frame = a.frame.value_or(sceneSettings.render.frame_start);
+    std::optional<tbb::global_control> threads;
+    if (a.threads > 0) threads.emplace(tbb::global_control::max_allowed_parallelism, std::size_t(a.threads));
+    const std::string prefix = a.out.empty() ? "out/" + sceneSettings.sceneName + ".bias" : a.out;
+    if (auto dir = std::filesystem::path(prefix).parent_path(); !dir.empty()) std::filesystem::create_directories(dir);
+
+    const RgbLayer ref = readExrLayer(a.reference, "Lr");
+    const std::uint32_t W = ref.width, H = ref.height;
+    if (W != sceneSettings.camera.width || H != sceneSettings.camera.height)
+        throw InputError(fmt::format("{}: reference is {}x{}, the scene renders {}x{}", a.reference, W, H,
+                                     sceneSettings.camera.width, sceneSettings.camera.height));
+    const std::size_t pixels = std::size_t(W) * H;
+    const double n = 3.0 * double(pixels);
+    double refMean = 0.0, refVar = 0.0;
+    const bool refHasStderr = exrHasLayer(a.reference, "Lr_stderr");
+    const std::vector<Vec3> refErr = refHasStderr ? readExrLayer(a.reference, "Lr_stderr").rgb : std::vector<Vec3>();
+    for (std::size_t p = 0; p < pixels; ++p)
+        for (int c = 0; c < 3; ++c) {
+            refMean += ref.rgb[p][c];
+            if (refHasStderr) refVar += double(refErr[p][c]) * refErr[p][c];
+        }
+    refMean /= n;
+    const double refMeanStderr = std::sqrt(refVar) / n;  // independent pixels
+
+    const ParticleSource source(sceneSettings);
+    std::vector<BiasRow> rows;
+    for (const EstimatorSpec& spec : specs) {
+        const Settings specBase = specSettings(a.scene, base, spec);
+        std::vector<DVec3> s1(pixels, DVec3(0.0)), s2(pixels, DVec3(0.0));
+        double e1 = 0.0, e2 = 0.0, seconds = 0.0;
+        for (std::uint32_t k = 0; k < a.seeds; ++k) {
+            Settings s = specBase;
+            s.render.seed = specBase.render.seed + k;
+            const ExperimentRender r = renderForExperiment(s, source, frame, a.history);
+            seconds += r.totalSeconds;
+            double e = 0.0;
+            for (std::size_t p = 0; p < pixels; ++p) {
+                const DVec3 d = DVec3(r.image.lighting.Lr[p]) - DVec3(ref.rgb[p]);
+                s1[p] += d;
+                s2[p] += d * d;
+                e += d.x + d.y + d.z;
+            }
+            e /= n;
+            e1 += e;
+            e2 += e * e;
+            if (!a.quiet)
+                fmt::print(stderr, "\rbias: {} seed {}/{} ({:.2f} s)", spec.label, k + 1, a.seeds, r.totalSeconds);
+        }
+        if (!a.quiet) fmt::print(stderr, "\n");
+        const double S = a.seeds;
+        BiasRow row;
+        row.label = spec.label;
+        row.seeds = a.seeds;
+        row.meanError = e1 / S;
+        const double seedVar = std::max(0.0, (e2 / S - row.meanError * row.meanError) * S / (S - 1.0));
+        row.stderr = std::sqrt(seedVar / S + refMeanStderr * refMeanStderr);
+        row.z = row.stderr > 0.0 ? row.meanError / row.stderr : 0.0;
+        row.energyLossPct = refMean > 0.0 ? -100.0 * row.meanError / refMean : 0.0;
+        row.secondsPerRender = seconds / S;
+        row.biased = std::fabs(row.z) > a.zCritical;
+        rows.push_back(row);
+
+        // Per-pixel bias map: mean signed error, its standard error, z (luminance).
+        std::vector<FloatChannel> ch = {{"bias.R", {}}, {"bias.G", {}}, {"bias.B", {}},
+                                        {"bias_stderr.R", {}}, {"bias_stderr.G", {}}, {"bias_stderr.B", {}}, {"bias_z.Y", {}}};
+        for (auto& c : ch) c.values.resize(pixels);
+        for (std::size_t p = 0; p < pixels; ++p) {
+            const DVec3 m = s1[p] / S;
+            const DVec3 var = glm::max((s2[p] / S - m * m) * (S / (S - 1.0)), DVec3(0.0));
+            DVec3 se = glm::sqrt(var / S);
+            if (refHasStderr) se = glm::sqrt(se * se + DVec3(refErr[p]) * DVec3(refErr[p]));
+            for (int c = 0; c < 3; ++c) {
+                ch[c].values[p] = float(m[c]);
+                ch[3 + c].values[p] = float(se[c]);
+            }
+            const double mY = luminance(Vec3(m)), seY = luminance(Vec3(se));
+            ch[6].values[p] = seY > 0.0 ? float(mY / seY) : 0.0f;
+        }
+        std::string safe = spec.label;
+        for (char& c : safe)
+            if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
+        writeChannelsExr(prefix + "." + safe + ".exr", W, H, ch,
+                         {{"version", std::string(version())}, {"estimator", spec.label},
+                          {"seeds", std::to_string(a.seeds)}, {"reference", a.reference},
+                          {"settings", settingsToToml(specBase)}});
+    }
+
+    std::string csv = "estimator,seeds,mean_signed_error,stderr,z,energy_loss_pct,energy_loss_stderr_pct,biased,seconds_per_render\n";
+    fmt::print("{:<28} {:>6} {:>13} {:>11} {:>8} {:>15} {:>9}  verdict (|z| > {:.2f}: 99.9%)\n", "estimator", "seeds",
+               "mean error", "stderr", "z", "energy loss %", "s/render", a.zCritical);
+    nlohmann::json jrows = nlohmann::json::array();
+    for (const BiasRow& r : rows) {
+        const double lossSe = refMean > 0.0 ? 100.0 * r.stderr / refMean : 0.0;
+        csv += fmt::format("{},{},{:.8g},{:.8g},{:.5g},{:.6g},{:.6g},{},{:.6g}\n", r.label, r.seeds, r.meanError, r.stderr,
+                           r.z, r.energyLossPct, lossSe, r.biased ? 1 : 0, r.secondsPerRender);
+        fmt::print("{:<28} {:>6} {:>13.5g} {:>11.3g} {:>8.2f} {:>8.3f} +- {:<5.3f} {:>9.3f}  {}\n", r.label, r.seeds,
+                   r.meanError, r.stderr, r.z, r.energyLossPct, lossSe, r.secondsPerRender,
+                   r.biased ? "BIASED" : fmt::format("no bias detected (|bias| < {:.2g}%)", a.zCritical * lossSe + std::fabs(r.energyLossPct)));
+        jrows.push_back({{"estimator", r.label}, {"seeds", r.seeds}, {"mean_signed_error", r.meanError},
+                         {"stderr", r.stderr}, {"z", r.z}, {"energy_loss_pct", r.energyLossPct},
+                         {"energy_loss_stderr_pct", lossSe}, {"biased", r.biased},
+                         {"seconds_per_render", r.secondsPerRender}});
+    }
+    writeFileAtomic(prefix + ".csv", csv);
+    writeJson(prefix + ".json", {{"version", std::string(version())}, {"command", "bias"},
+                                 {"scene", sceneSettings.scenePath}, {"reference", a.reference},
+                                 {"frame", frame}, {"history_frames", a.history}, {"z_critical", a.zCritical},
+                                 {"reference_mean", refMean}, {"reference_mean_stderr", refMeanStderr},
+                                 {"settings", settingsToToml(sceneSettings)}, {"rows", jrows}});
+    const std::string script = fmt::format(
+        "set datafile separator ','\nset style fill solid 0.5\nset boxwidth 0.6\nset grid ytics\n"
+        "set ylabel 'energy loss % (bars: {0:.2f} standard errors)'\nset xtics rotate by -30\nset key off\n"
+        "plot {1} skip 1 using 0:6:xtic(1) with boxes, {1} skip 1 using 0:6:($7*{0}) with yerrorbars lc rgb 'black' pt 0\n",
+        a.zCritical, gnuplotQuote(prefix + ".csv"));
+    plotPng(prefix + ".png", script);
+    fmt::print("bias: {}.csv, {}.png, {}.json, bias maps {}.<estimator>.exr\n", prefix, prefix, prefix, prefix);
+}
+
+}  // namespace
+
+void addBiasCommand(CLI::App& app) {
+    auto args = std::make_shared<BiasArgs>();
+    CLI::App* cmd = app.add_subcommand("bias", "Mean signed error over many seeds per estimator, with its standard error");
+    cmd->add_option("scene", args->scene, "Scene file (TOML)")->required();
+    cmd->add_option("--reference", args->reference, "Reference EXR with an Lr layer (and Lr_stderr if noisy)")->required();
+    cmd->add_option("--estimators", args->estimators, "Comma-separated specs, as for converge");
+    cmd->add_option("--seeds", args->seeds, "Independent renders per estimator")->check(CLI::Range(2u, 1000000u));
+    cmd->add_option("--frame", args->frame, "Frame measured (default render.frame_start)");
+    cmd->add_option("--history", args->history, "restir: frames rendered before the measured one");
+    cmd->add_option("--z", args->zCritical, "Two-sided critical |z| for the verdict (3.29: 99.9%)");
+    cmd->add_option("-o,--out", args->out, "Output prefix (default out/<scene>.bias): .csv, .png, .json, bias-map EXRs");
+    cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")->check(CLI::Range(0, 4096));
+    cmd->add_flag("-q,--quiet", args->quiet, "No progress on stderr");
+    cmd->add_option("-D,--define", args->defines, "Override a setting: -D section.key=value")->allow_extra_args(false);
+    cmd->callback([args] { runBias(*args); });
+}
+
+}  // namespace accretion::cmd
