@@ -1,0 +1,129 @@
+// compare, converge and bias as a user runs them: real processes, real EXR
+// files read back with OpenImageIO.
+#include <catch2/catch.hpp>
+
+#include <fstream>
+#include <sstream>
+
+#include "accretion/io/exr_output.h"
+#include "support/test_scenes.h"
+
+using namespace accretion;
+using accretion::test::runCommand;
+using Catch::Matchers::Contains;
+
+namespace {
+
+const std::string kBin = ACCRETION_BINARY;
+
+/// A small disk filling a 96x64 image (tests/data/small_disk.toml).
+std::string tinyScene() { return std::string(ACCRETION_SOURCE_DIR) + "/tests/data/small_disk.toml"; }
+
+void writeConstant(const std::filesystem::path& file, float value) {
+    const std::size_t pixels = 4 * 3;
+    std::vector<FloatChannel> ch = {{"R", std::vector<float>(pixels, value)}, {"G", std::vector<float>(pixels, value)},
+                                    {"B", std::vector<float>(pixels, value)}};
+    writeChannelsExr(file, 4, 3, ch, {});
+}
+
+std::vector<std::vector<std::string>> readCsv(const std::filesystem::path& file) {
+    std::ifstream in(file);
+    REQUIRE(in);
+    std::vector<std::vector<std::string>> rows;
+    for (std::string line; std::getline(in, line);) {
+        std::vector<std::string> cells;
+        std::stringstream ss(line);
+        for (std::string cell; std::getline(ss, cell, ',');) cells.push_back(cell);
+        rows.push_back(cells);
+    }
+    return rows;
+}
+
+}  // namespace
+
+TEST_CASE("compare prints relMSE, MSE and MAPE against the second image", "[cli][experiments]") {
+    const auto dir = accretion::test::scratchDir("compare");
+    writeConstant(dir / "ref.exr", 1.0f);
+    writeConstant(dir / "x.exr", 1.1f);
+    std::string out;
+    REQUIRE(runCommand(kBin + " compare " + (dir / "x.exr").string() + " " + (dir / "ref.exr").string(), out) == 0);
+    // Closed form with d = 0.1 (as float), ref = 1, eps = 1e-2.
+    const double d = double(1.1f) - 1.0;
+    double rel = 0, mse = 0, mape = 0;
+    REQUIRE(std::sscanf(out.c_str(), "relMSE %lf\nMSE %lf\nMAPE %lf", &rel, &mse, &mape) == 3);
+    CHECK(rel == Approx(d * d / 1.01).epsilon(1e-6));
+    CHECK(mse == Approx(d * d).epsilon(1e-6));
+    CHECK(mape == Approx(d / 1.01).epsilon(1e-6));
+    REQUIRE(runCommand(kBin + " compare --json " + (dir / "ref.exr").string() + " " + (dir / "ref.exr").string(), out) == 0);
+    CHECK_THAT(out, Contains("\"relMSE\": 0.0") && Contains("\"MAPE\": 0.0"));
+    // Different sizes: an error naming the file, exit 1.
+    writeChannelsExr(dir / "small.exr", 2, 2, {{"R", std::vector<float>(4)}, {"G", std::vector<float>(4)}, {"B", std::vector<float>(4)}}, {});
+    CHECK(runCommand(kBin + " compare " + (dir / "small.exr").string() + " " + (dir / "ref.exr").string(), out) == 1);
+    CHECK_THAT(out, Contains("small.exr"));
+}
+
+TEST_CASE("converge: error falls with effort, CSV and plot written", "[cli][experiments]") {
+    const auto dir = accretion::test::scratchDir("converge");
+    std::string out;
+    REQUIRE(runCommand(kBin + " render " + tinyScene() + " --quiet --estimator exact -o " + (dir / "exact.exr").string(), out) == 0);
+    const std::string cmd = kBin + " converge " + tinyScene() + " --quiet --reference " + (dir / "exact.exr").string() +
+                            " --estimators uniform,tree,restir:pairwise --budget 3s --max-effort 64 -o " + (dir / "c").string();
+    INFO(cmd << "\n" << out);
+    REQUIRE(runCommand(cmd, out) == 0);
+    const auto rows = readCsv(dir / "c.csv");
+    REQUIRE(rows.size() > 4);
+    REQUIRE(rows[0][0] == "estimator");
+    REQUIRE(rows[0][7] == "relMSE");
+    std::map<std::string, std::vector<double>> rel;
+    for (std::size_t k = 1; k < rows.size(); ++k) rel[rows[k][0]].push_back(std::stod(rows[k][7]));
+    REQUIRE(rel.size() == 3);
+    // The exact reference has no noise: relMSE of uniform at the largest effort
+    // is well below that at 1 spp (Monte Carlo: ~1/spp).
+    REQUIRE(rel["uniform"].size() >= 4);
+    CHECK(rel["uniform"].back() < 0.25 * rel["uniform"].front());
+    CHECK(std::filesystem::exists(dir / "c.json"));
+    CHECK(std::filesystem::exists(dir / "c.png"));
+}
+
+TEST_CASE("bias: 1/M restir is flagged, uniform Monte Carlo is not", "[cli][experiments][statistical]") {
+    const auto dir = accretion::test::scratchDir("bias");
+    std::string out;
+    REQUIRE(runCommand(kBin + " render " + tinyScene() + " --quiet --estimator exact -o " + (dir / "exact.exr").string(), out) == 0);
+    const std::string run = kBin + " bias " + tinyScene() + " -D render.samples=16 --quiet --reference " +
+                            (dir / "exact.exr").string() + " --estimators uniform,restir:none --seeds 24 --history 2 -o " +
+                            (dir / "b").string();
+    INFO(run << "\n" << out);
+    REQUIRE(runCommand(run, out) == 0);
+    const auto rows = readCsv(dir / "b.csv");
+    REQUIRE(rows.size() == 3);
+    REQUIRE(rows[0][4] == "z");
+    REQUIRE(rows[0][7] == "biased");
+    // Verdict at |z| > 3.29 (99.9%): the unbiased estimator passes (false
+    // alarm 1e-3), 1/M normalisation loses energy and is flagged.
+    CHECK(rows[1][0] == "uniform");
+    CHECK(rows[1][7] == "0");
+    CHECK(rows[2][0] == "restir:none");
+    CHECK(rows[2][7] == "1");
+    CHECK(std::stod(rows[2][5]) > 0.0);  // energy loss, not gain
+    CHECK(std::filesystem::exists(dir / "b.restir_none.exr"));
+    CHECK(std::filesystem::exists(dir / "b.png"));
+}
+
+TEST_CASE("experiment and restir input errors: one clear message, exit 1", "[cli][errors]") {
+    const auto dir = accretion::test::scratchDir("experiment_errors");
+    std::string out;
+    CHECK(runCommand(kBin + " converge " + tinyScene() + " --reference nothere.exr --estimators uniform", out) == 1);
+    CHECK_THAT(out, Contains("nothere.exr"));
+    CHECK(runCommand(kBin + " bias " + tinyScene() + " --reference x.exr --estimators unifrom", out) == 1);
+    CHECK_THAT(out, Contains("--estimators 'unifrom': unknown estimator"));
+    CHECK(runCommand(kBin + " bias " + tinyScene() + " --reference x.exr --estimators uniform:pairwise", out) == 1);
+    CHECK_THAT(out, Contains("restir only"));
+    // 800 particles need 10 light-index bits; 8 are rejected before any output is written.
+    const auto exr = dir / "r.exr";
+    CHECK(runCommand(kBin + " render " + tinyScene() + " --quiet --estimator restir -D restir.layout=\"packed\" "
+                     "-D restir.light_bits=8 -o " + exr.string(), out) == 1);
+    CHECK_THAT(out, Contains("needs 10 bits"));
+    CHECK_FALSE(std::filesystem::exists(exr));
+    CHECK(runCommand(kBin + " render " + tinyScene() + " --quiet --estimator tree --target-stderr 5x -o " + exr.string(), out) == 1);
+    CHECK_THAT(out, Contains("--target-stderr 5x"));
+}
