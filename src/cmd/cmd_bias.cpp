@@ -176,6 +176,7 @@ void addBiasCommand(CLI::App& app) {
     cmd->add_option("--estimators", args->estimators, "Comma-separated specs, as for converge");
     cmd->add_option("--seeds", args->seeds, "Independent renders per estimator")->check(CLI::Range(2u, 1000000u));
     cmd->add_option("--frame", args->frame, "Frame measured (default render.frame_start)");
+    cmd->add_option("--frames", args->frames, "Frames A:B (= render.frame_start, render.frames); the first is measured");
     cmd->add_option("--history", args->history, "restir: frames rendered before the measured one");
     cmd->add_option("--z", args->zCritical, "Two-sided critical |z| for the verdict (3.29: 99.9%)");
     cmd->add_option("-o,--out", args->out, "Output prefix (default out/<scene>.bias): .csv, .png, .json, bias-map EXRs");

@@ -1,6 +1,7 @@
 // accretion converge: error against time and against samples / rays, per
 // estimator, on the same frame (or, with --sequence, per frame of an
 // animated sequence), against a reference EXR.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <memory>
@@ -25,7 +26,7 @@ namespace {
 
 struct ConvergeArgs : SceneArgs {
     std::string reference, estimators = "uniform,power,tree,ris,restir", budget = "60s", out;
-    std::uint32_t history = 8, sequence = 0, maxEffort = 1u << 16;
+    std::uint32_t history = 8, sequence = 0, maxEffort = 1u << 16, seeds = 1;
     std::optional<std::uint32_t> frame;
 };
 
@@ -58,20 +59,21 @@ struct Point {
     ErrorMetrics err;
 };
 
-/// relMSE at time t on an estimator's curve: log-log interpolation, and a
-/// 1/t extrapolation (Monte Carlo rate) beyond its ends.
+/// The baseline's time to reach an error, from the Monte Carlo rate
+/// relMSE = c / t fitted to its whole curve (c = geometric mean of relMSE x t):
+/// single renders' relMSE is heavy-tailed (fireflies), so interpolating
+/// between two noisy points would be less reliable than the known rate.
 double timeAtError(const std::vector<Point>& curve, double relMSE) {
-    if (curve.empty()) return NAN;
-    auto err = [](const Point& p) { return std::max(p.err.relMSE - p.err.relMSEFloor, 1e-300); };
-    for (std::size_t k = 1; k < curve.size(); ++k) {
-        const double e0 = err(curve[k - 1]), e1 = err(curve[k]);
-        if ((e0 - relMSE) * (e1 - relMSE) <= 0.0 && e0 != e1) {
-            const double a = (std::log(relMSE) - std::log(e0)) / (std::log(e1) - std::log(e0));
-            return std::exp(std::log(curve[k - 1].seconds) + a * (std::log(curve[k].seconds) - std::log(curve[k - 1].seconds)));
-        }
+    double logC = 0.0;
+    std::size_t n = 0;
+    for (const Point& p : curve) {
+        const double e = p.err.relMSE - p.err.relMSEFloor;
+        if (!(e > 0.0) || !(p.seconds > 0.0)) continue;
+        logC += std::log(e * p.seconds);
+        ++n;
     }
-    const Point& end = relMSE < err(curve.back()) ? curve.back() : curve.front();
-    return end.seconds * err(end) / relMSE;
+    if (n == 0 || !(relMSE > 0.0)) return NAN;
+    return std::exp(logC / double(n)) / relMSE;
 }
 
 void runConverge(const ConvergeArgs& a) {
@@ -138,17 +140,35 @@ void runConverge(const ConvergeArgs& a) {
                 else extra.push_back(fmt::format("render.samples={}", effort));
                 EstimatorSpec level = spec;
                 level.overrides = extra;
-                const Settings s = specSettings(a.scene, base, level);
-                const ExperimentRender r = renderForExperiment(s, source, frame, a.history);
-                Point p{spec.label, frame, effort, r.frameSeconds, r.totalSeconds, r.stats.lighting.shadowRays,
-                        r.stats.lighting.lightTerms,
-                        computeErrors(r.image.lighting.Lr, ref.Lr, ref.hasStderr ? &ref.stderr : nullptr)};
+                Settings s = specSettings(a.scene, base, level);
+                // Metrics are means over --seeds independent renders; time per frame is their median.
+                Point p{spec.label, frame, effort, 0.0, 0.0, 0, 0, {}};
+                std::vector<double> frameSeconds;
+                const std::uint64_t seed0 = s.render.seed;
+                for (std::uint32_t k = 0; k < a.seeds; ++k) {
+                    s.render.seed = seed0 + k;
+                    const ExperimentRender r = renderForExperiment(s, source, frame, a.history);
+                    const ErrorMetrics e = computeErrors(r.image.lighting.Lr, ref.Lr, ref.hasStderr ? &ref.stderr : nullptr);
+                    frameSeconds.push_back(r.frameSeconds);
+                    p.totalSeconds += r.totalSeconds;
+                    p.shadowRays += r.stats.lighting.shadowRays;
+                    p.lightTerms += r.stats.lighting.lightTerms;
+                    p.err.relMSE += e.relMSE / a.seeds;
+                    p.err.MSE += e.MSE / a.seeds;
+                    p.err.MAPE += e.MAPE / a.seeds;
+                    p.err.relMSEFloor = e.relMSEFloor;
+                    p.err.pixels = e.pixels;
+                }
+                std::sort(frameSeconds.begin(), frameSeconds.end());
+                p.seconds = frameSeconds[frameSeconds.size() / 2];
+                p.shadowRays /= a.seeds;
+                p.lightTerms /= a.seeds;
                 if (!a.quiet)
                     fmt::print(stderr, "converge: {} x{}: {:.3f} s, relMSE {:.4g} (reference noise {:.3g})\n", spec.label,
                                effort, p.seconds, p.err.relMSE, p.err.relMSEFloor);
                 points.push_back(p);
-                spent += r.totalSeconds;
-                last = r.totalSeconds;
+                spent += p.totalSeconds;
+                last = p.totalSeconds;
                 if (spec.kind == EstimatorKind::exact) break;
             }
         }
@@ -199,6 +219,8 @@ void runConverge(const ConvergeArgs& a) {
                                  {"frame", frame},
                                  {"budget_seconds", budget},
                                  {"history_frames", a.history},
+                                 {"seeds_per_point", a.seeds},
+                                 {"speedup_model", "baseline relMSE = c / seconds, c fitted over its curve"},
                                  {"estimators", a.estimators},
                                  {"settings", settingsToToml(sceneSettings)},
                                  {"points", summary}});
@@ -238,9 +260,12 @@ void addConvergeCommand(CLI::App& app) {
                     "options key=value override settings");
     cmd->add_option("--budget", args->budget, "Time budget per estimator (e.g. 60s, 2m)");
     cmd->add_option("--frame", args->frame, "Frame measured (default render.frame_start)");
+    cmd->add_option("--frames", args->frames, "Frames A:B (= render.frame_start, render.frames); the first is measured");
     cmd->add_option("--history", args->history, "restir: frames rendered before the measured one");
     cmd->add_option("--sequence", args->sequence, "Error per frame over N frames from --frame (one history per estimator)");
     cmd->add_option("--max-effort", args->maxEffort, "Largest spp (restir: candidates) tried");
+    cmd->add_option("--seeds", args->seeds, "Renders per point: errors are their means, time their median")
+        ->check(CLI::Range(1u, 100000u));
     cmd->add_option("-o,--out", args->out, "Output prefix (default out/<scene>.converge): .csv, .png, .json");
     cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")->check(CLI::Range(0, 4096));
     cmd->add_flag("-q,--quiet", args->quiet, "No progress on stderr");

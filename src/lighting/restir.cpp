@@ -32,6 +32,7 @@ struct Domain {
     ShadingPoint sp;
     const LightArrays* lights;
     bool visibilityTested = false;
+    const ParticleBvh* bvh = nullptr;  ///< the geometry of the domain's frame (visibility tests)
 };
 
 /// A reservoir offered for resampling at the current pixel.
@@ -59,7 +60,7 @@ bool similar(const GBufferTexel& a, const GBufferTexel& b, const RestirSettings&
 /// (weights sum to 1 for every y; equal p_hat gives M_i / M_total).
 template <ShadingModel SM, Primitive P>
 StoredReservoir combine(const Offer* offers, std::uint32_t n, const LightArrays& L, const RestirSettings& rs,
-                        const ParticleBvh& bvh, float eps, Rng& rng, LightingCounters& c) {
+                        float eps, Rng& rng, LightingCounters& c) {
     const Offer& can = offers[0];
     const ShadingPoint& sp = can.domain.sp;
     if (n == 1) return can.r;
@@ -127,7 +128,7 @@ StoredReservoir combine(const Offer* offers, std::uint32_t n, const LightArrays&
             if (!d.lights->term<SM>(d.sp, out.y, t) || !(luminance(t.value) > 0.0f)) continue;
             if (rs.basic_visibility && d.visibilityTested) {
                 ++c.shadowRays;
-                if (!visible<P>(bvh, d.sp, t, d.lights->radius[out.y], eps)) {
+                if (!visible<P>(*d.bvh, d.sp, t, d.lights->radius[out.y], eps)) {
                     ++c.shadowOccluded;
                     continue;
                 }
@@ -240,14 +241,17 @@ LightingCounters temporalResampling(const FrameContext& f, const std::vector<Sto
         ++c.reuseAccepted;
         const ShadingPoint sp = shadingPoint(g, particles);
         Offer offers[2];
-        offers[0] = {cur[px], {sp, &f.L, f.rs.candidate_visibility}};
+        offers[0] = {cur[px], {sp, &f.L, f.rs.candidate_visibility, &f.in.bvh}};
         StoredReservoir prev = h.reservoirs[q];
         const double cap = f.rs.m_cap * double(std::max<std::uint32_t>(cur[px].M, 1));
         prev.M = static_cast<std::uint32_t>(std::min(double(prev.M), std::floor(cap)));
+        // The previous frame's visibility needs the previous frame's BVH
+        // (kept by the frame renderer when basic_visibility asks for it).
         offers[1] = {prev, {shadingPoint(h.gbuffer.texels[q], h.particles), &h.lights,
-                            f.rs.candidate_visibility || f.rs.visibility_reuse}};
+                            f.rs.candidate_visibility || f.rs.visibility_reuse,
+                            f.in.previousBvh ? f.in.previousBvh : &f.in.bvh}};
         Rng rng(px, f.in.frame, RngPass::restirTemporal, f.in.settings.render.seed);
-        out[px] = f.codec.roundTrip(combine<SM, P>(offers, 2, f.L, f.rs, f.in.bvh, f.eps, rng, c));
+        out[px] = f.codec.roundTrip(combine<SM, P>(offers, 2, f.L, f.rs, f.eps, rng, c));
     });
 }
 
@@ -265,7 +269,12 @@ LightingCounters spatialResampling(const FrameContext& f, std::uint32_t iteratio
         const ShadingPoint sp = shadingPoint(g, f.in.particles);
         Offer offers[1 + 64];
         std::uint32_t n = 0;
-        offers[n++] = {cur[px], {sp, &f.L, f.rs.candidate_visibility}};
+        // With temporal reuse as well, a temporal output also holds samples
+        // that passed the previous frame's test, not this pixel's: treating it
+        // as tested here is then an approximation (measured by `accretion
+        // bias`); exact with temporal off.
+        const bool tested = f.rs.candidate_visibility;
+        offers[n++] = {cur[px], {sp, &f.L, tested, &f.in.bvh}};
         for (std::uint32_t s = 0; s < k; ++s) {
             // Uniform in the disc of the radius (polar, sqrt for area).
             const float r = radius * std::sqrt(rng.uniform());
@@ -283,9 +292,9 @@ LightingCounters spatialResampling(const FrameContext& f, std::uint32_t iteratio
                 continue;
             }
             ++c.reuseAccepted;
-            offers[n++] = {cur[q], {shadingPoint(gn, f.in.particles), &f.L, f.rs.candidate_visibility}};
+            offers[n++] = {cur[q], {shadingPoint(gn, f.in.particles), &f.L, tested, &f.in.bvh}};
         }
-        out[px] = f.codec.roundTrip(combine<SM, P>(offers, n, f.L, f.rs, f.in.bvh, f.eps, rng, c));
+        out[px] = f.codec.roundTrip(combine<SM, P>(offers, n, f.L, f.rs, f.eps, rng, c));
     });
 }
 
@@ -385,6 +394,13 @@ LightingCounters dispatchPrimitive(const FrameContext& f, std::vector<StoredRese
 }
 
 }  // namespace
+
+bool needsPreviousBvh(const Settings& s) {
+    return s.render.estimator == EstimatorKind::restir && s.restir.temporal &&
+           s.restir.bias_correction == BiasCorrection::basic && s.restir.basic_visibility &&
+           (s.restir.visibility_reuse || s.restir.candidate_visibility) &&
+           (s.geometry.build == BuildPolicy::rebuild || s.geometry.build == BuildPolicy::fast_trace);
+}
 
 Restir::Restir(const Settings& settings) : rs_(settings.restir), codec_(settings.restir) {}
 

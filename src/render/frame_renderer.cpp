@@ -30,6 +30,10 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats) {
     stats.particles = particles.size();
     {
         auto t = timer.scope(pass::buildClusters);
+        if (needsPreviousBvh(settings_)) {  // double buffer: last frame's BVH stays valid
+            std::swap(bvh_, previousBvh_);
+            if (!bvh_) bvh_ = std::make_unique<ParticleBvh>(*device_, settings_.geometry);
+        }
         bvh_->build(particles, camera);
     }
     stats.bvh = bvh_->stats();
@@ -62,7 +66,8 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats) {
     {
         auto t = timer.scope(pass::estimateLighting);
         if (lit && restir_) {
-            RestirInputs in{*bvh_, particles, gbuffer, camera, settings_, frame, power ? &powerTable : nullptr};
+            RestirInputs in{*bvh_, particles, gbuffer, camera, settings_, frame, power ? &powerTable : nullptr,
+                            previousBvh_.get()};
             stats.lighting = restir_->render(in, img.lighting, img.reservoirs, timer);
             stats.reservoirBytes = restir_->reservoirBytes();
         } else if (lit) {

@@ -32,7 +32,13 @@ struct RestirInputs {
     const Settings& settings;
     std::uint32_t frame = 0;
     const AliasTable* powerTable = nullptr;  ///< render.source = power
+    const ParticleBvh* previousBvh = nullptr; ///< last frame's BVH (see needsPreviousBvh), else the current one is used
 };
+
+/// basic_visibility tests the previous frame's samples against the previous
+/// frame's geometry: the frame renderer keeps that BVH (for rebuild and
+/// fast_trace policies; refit and partial update one BVH in place).
+bool needsPreviousBvh(const Settings& settings);
 
 /// ReSTIR DI (MODEL.md section 4; Bitterli et al. 2020): generateCandidates
 /// (RIS, M candidates, target p_hat without visibility), temporalResampling

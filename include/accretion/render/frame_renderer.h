@@ -66,6 +66,7 @@ private:
     RenderOptions options_;
     std::unique_ptr<EmbreeDevice> device_;
     std::unique_ptr<ParticleBvh> bvh_;
+    std::unique_ptr<ParticleBvh> previousBvh_;  ///< last frame's, when needsPreviousBvh()
     std::unique_ptr<Restir> restir_;  ///< restir: history across frames
 };
 
