@@ -74,22 +74,36 @@ Settings restirScene(bool animated) {
 }  // namespace
 
 TEST_CASE("restir with basic or pairwise correction agrees with exact; none (1/M) is biased", "[restir][statistical]") {
+    struct Mode {
+        const char* name;
+        BiasCorrection correction;
+        bool visibilityReuse, basicVisibility, biased;
+    };
     const bool animated = GENERATE(false, true);
-    const BiasCorrection mode = GENERATE(BiasCorrection::basic, BiasCorrection::pairwise, BiasCorrection::none);
-    INFO((animated ? "animated" : "static") << ", bias correction " << enumName(mode));
+    const Mode mode = GENERATE(Mode{"basic", BiasCorrection::basic, false, false, false},
+                               Mode{"pairwise", BiasCorrection::pairwise, false, false, false},
+                               Mode{"none (1/M)", BiasCorrection::none, false, false, true},
+                               // Visibility reuse changes the history's support to p_hat V:
+                               // basic must test V (against the previous frame's BVH) to stay unbiased.
+                               Mode{"basic + visibility reuse + basic_visibility", BiasCorrection::basic, true, true, false},
+                               Mode{"basic + visibility reuse, no visibility test", BiasCorrection::basic, true, false, true});
+    INFO((animated ? "animated" : "static") << ", " << mode.name);
     Settings s = restirScene(animated);
-    s.restir.bias_correction = mode;
+    s.restir.bias_correction = mode.correction;
+    s.restir.visibility_reuse = mode.visibilityReuse;
+    s.restir.basic_visibility = mode.basicVisibility;
     const std::uint32_t frames = 4, seeds = 300;
     const double exact = exactSum(s, frames - 1);
     const SeedStats r = restirSums(s, frames, seeds);
     const double z = (r.mean - exact) / r.stderr;
     INFO("exact " << exact << ", restir " << r.mean << " +- " << r.stderr << ", z " << z);
     // Confidence: |z| < 4.4 is p ~ 1e-5 for an unbiased estimator (300 seeds: CLT).
-    if (mode == BiasCorrection::none) {
+    if (mode.biased) {
         CHECK(std::fabs(z) > 4.4);
     } else {
         CHECK(std::fabs(z) < 4.4);
-        // The harness resolves a 2% bias (meta-test on the same numbers).
-        CHECK(std::fabs((r.mean - 1.02 * exact) / r.stderr) > 4.4);
+        // The harness has the power to see a 5% bias: 4.4 + 1 standard errors
+        // (detected with probability ~0.84) stay below 5% of the exact sum.
+        CHECK(5.4 * r.stderr < 0.05 * exact);
     }
 }
