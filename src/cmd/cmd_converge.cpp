@@ -26,7 +26,7 @@ namespace {
 
 struct ConvergeArgs : SceneArgs {
     std::string reference, estimators = "uniform,power,tree,ris,restir", budget = "60s", out;
-    std::uint32_t history = 8, sequence = 0, maxEffort = 1u << 16, seeds = 1;
+    std::uint32_t history = 8, sequence = 0, minEffort = 1, maxEffort = 1u << 16, seeds = 1;
     std::optional<std::uint32_t> frame;
 };
 
@@ -133,7 +133,7 @@ void runConverge(const ConvergeArgs& a) {
         const Ref ref = loadRef(frame);
         for (const EstimatorSpec& spec : specs) {
             double spent = 0.0, last = 0.0;
-            for (std::uint32_t effort = 1; effort <= a.maxEffort; effort *= 2) {
+            for (std::uint32_t effort = a.minEffort; effort <= a.maxEffort; effort *= 2) {
                 if (spent > 0.0 && spent + 2.2 * last > budget) break;  // the next level would overrun the budget
                 std::vector<std::string> extra = spec.overrides;
                 if (spec.kind == EstimatorKind::restir) extra.push_back(fmt::format("render.candidates={}", effort));
@@ -263,6 +263,8 @@ void addConvergeCommand(CLI::App& app) {
     cmd->add_option("--frames", args->frames, "Frames A:B (= render.frame_start, render.frames); the first is measured");
     cmd->add_option("--history", args->history, "restir: frames rendered before the measured one");
     cmd->add_option("--sequence", args->sequence, "Error per frame over N frames from --frame (one history per estimator)");
+    cmd->add_option("--min-effort", args->minEffort, "First spp (restir: candidates) tried; doubled from there")
+        ->check(CLI::Range(1u, 1u << 30));
     cmd->add_option("--max-effort", args->maxEffort, "Largest spp (restir: candidates) tried");
     cmd->add_option("--seeds", args->seeds, "Renders per point: errors are their means, time their median")
         ->check(CLI::Range(1u, 100000u));
@@ -270,7 +272,7 @@ void addConvergeCommand(CLI::App& app) {
     cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")->check(CLI::Range(0, 4096));
     cmd->add_flag("-q,--quiet", args->quiet, "No progress on stderr");
     cmd->add_option("-D,--define", args->defines, "Override a setting: -D section.key=value")->allow_extra_args(false);
-    cmd->footer("Effort doubles from 1 (spp; ris reservoirs; restir candidates) until the budget is spent.\n"
+    cmd->footer("Effort doubles from --min-effort (spp; ris reservoirs; restir candidates) until the budget is spent.\n"
                 "relMSE_corrected subtracts the reference's own noise (its Lr_stderr layer) in expectation.");
     cmd->callback([args] { runConverge(*args); });
 }

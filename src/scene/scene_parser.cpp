@@ -12,6 +12,7 @@
 #include <toml++/toml.h>
 
 #include "accretion/core/error.h"
+#include "accretion/lighting/reservoir_codec.h"
 
 namespace accretion {
 namespace {
@@ -239,6 +240,13 @@ void validate(const Settings& s, const std::map<std::string, std::string>& loc, 
     if (s.render.output.empty()) fail("render.output", "must not be empty");
     if (s.render.frames > 1 && s.render.output.find("{frame}") == std::string::npos)
         fail("render.output", "a multi-frame render needs a {frame} pattern in the output path");
+    if (s.render.estimator == EstimatorKind::restir && s.restir.layout == ReservoirLayout::packed &&
+        s.particles.file.empty() && s.particles.count > (std::uint64_t(1) << s.restir.light_bits))
+        fail("restir.light_bits", fmt::format("{} bits address {} lights but particles.count = {}: the packed layout needs {} bits",
+                                              s.restir.light_bits, std::uint64_t(1) << s.restir.light_bits,
+                                              s.particles.count, ReservoirCodec::bitsFor(s.particles.count)));
+    if (s.render.target_stderr > 0.0 && s.render.max_samples < s.render.samples)
+        fail("render.max_samples", fmt::format("must be at least render.samples ({}) when target_stderr is set", s.render.samples));
     if (s.geometry.primitive == Primitive::sphere && s.geometry.alpha == AlphaMode::disc)
         fail("geometry.alpha", "disc alpha applies to billboards only (primitive = \"sphere\")");
 }

@@ -5,12 +5,15 @@
 #include <fstream>
 #include <sstream>
 
+#include <OpenImageIO/imageio.h>
+
 #include "accretion/io/exr_output.h"
 #include "support/test_scenes.h"
 
 using namespace accretion;
 using accretion::test::runCommand;
 using Catch::Matchers::Contains;
+namespace OIIO = OIIO_NAMESPACE;
 
 namespace {
 
@@ -126,4 +129,49 @@ TEST_CASE("experiment and restir input errors: one clear message, exit 1", "[cli
     CHECK_FALSE(std::filesystem::exists(exr));
     CHECK(runCommand(kBin + " render " + tinyScene() + " --quiet --estimator tree --target-stderr 5x -o " + exr.string(), out) == 1);
     CHECK_THAT(out, Contains("--target-stderr 5x"));
+}
+
+TEST_CASE("a restir EXR carries the reservoir AOVs, consistent with the image", "[cli][restir]") {
+    const auto dir = accretion::test::scratchDir("restir_aovs");
+    std::string out;
+    const std::string cmd = kBin + " render " + tinyScene() + " --quiet --estimator restir -D render.frames=3 -o " +
+                            (dir / "r.{frame}.exr").string();
+    INFO(cmd << "\n" << out);
+    REQUIRE(runCommand(cmd, out) == 0);
+    auto in = OIIO::ImageInput::open((dir / "r.0002.exr").string());
+    REQUIRE(in);
+    const OIIO::ImageSpec spec = in->spec();
+    const int W = spec.channelindex("restir.W"), M = spec.channelindex("restir.M"),
+              light = spec.channelindex("restir.light"), p = spec.channelindex("restir.p_hat"),
+              id = spec.channelindex("particle.id"), lr = spec.channelindex("Lr.G");
+    REQUIRE(W >= 0);
+    REQUIRE(M >= 0);
+    REQUIRE(light >= 0);
+    REQUIRE(p >= 0);
+    CHECK(spec.channelformat(light) == OIIO::TypeDesc::UINT);
+    const std::size_t pixels = std::size_t(spec.width) * spec.height;
+    std::vector<float> f(pixels * spec.nchannels);
+    REQUIRE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, f.data()));
+    // OIIO normalises integer channels when converting to float: read the id channels as integers.
+    std::vector<std::uint32_t> ids(pixels), lights(pixels);
+    REQUIRE(in->read_image(0, 0, id, id + 1, OIIO::TypeDesc::UINT, ids.data()));
+    REQUIRE(in->read_image(0, 0, light, light + 1, OIIO::TypeDesc::UINT, lights.data()));
+    std::size_t withSample = 0;
+    for (std::size_t px = 0; px < pixels; ++px) {
+        const float* c = &f[px * spec.nchannels];
+        if (ids[px] == 0xffffffffu) {
+            CHECK(c[W] == 0.0f);
+            continue;
+        }
+        // A pixel with light has a sample with W > 0 and p_hat > 0 that is not its own particle.
+        if (c[lr] > 0.0f) {
+            CHECK(c[W] > 0.0f);
+            CHECK(c[p] > 0.0f);
+            CHECK(lights[px] != ids[px]);
+            CHECK(lights[px] < 800u);
+            ++withSample;
+        }
+        CHECK(c[M] >= 16.0f);  // at least this frame's candidates
+    }
+    CHECK(withSample > 100);
 }
