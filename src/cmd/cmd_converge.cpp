@@ -115,17 +115,42 @@ void runConverge(const ConvergeArgs& a) {
         std::vector<Ref> refs;
         for (std::uint32_t k = 0; k < a.sequence; ++k) refs.push_back(loadRef(frame + k));
         for (const EstimatorSpec& spec : specs) {
-            const Settings s = specSettings(a.scene, base, spec);
-            FrameRenderer renderer(s, source, RenderOptions{true});
+            // One history per seed; each frame's metrics are means over the seeds, its time their median.
+            Settings s = specSettings(a.scene, base, spec);
+            const std::uint64_t seed0 = s.render.seed;
+            std::vector<Point> perFrame(a.sequence);
+            std::vector<std::vector<double>> frameSeconds(a.sequence);
+            for (std::uint32_t seed = 0; seed < a.seeds; ++seed) {
+                s.render.seed = seed0 + seed;
+                FrameRenderer renderer(s, source, RenderOptions{true});
+                for (std::uint32_t k = 0; k < a.sequence; ++k) {
+                    FrameStats stats;
+                    const FrameImage img = renderer.render(frame + k, stats);
+                    const ErrorMetrics e =
+                        computeErrors(img.lighting.Lr, refs[k].Lr, refs[k].hasStderr ? &refs[k].stderr : nullptr);
+                    Point& p = perFrame[k];
+                    p.label = spec.label;
+                    p.frame = frame + k;
+                    p.totalSeconds += stats.seconds;
+                    p.shadowRays += stats.lighting.shadowRays;
+                    p.lightTerms += stats.lighting.lightTerms;
+                    p.err.relMSE += e.relMSE / a.seeds;
+                    p.err.MSE += e.MSE / a.seeds;
+                    p.err.MAPE += e.MAPE / a.seeds;
+                    p.err.relMSEFloor = e.relMSEFloor;
+                    p.err.pixels = e.pixels;
+                    frameSeconds[k].push_back(stats.seconds);
+                }
+            }
             for (std::uint32_t k = 0; k < a.sequence; ++k) {
-                FrameStats stats;
-                const FrameImage img = renderer.render(frame + k, stats);
-                Point p{spec.label, frame + k, 0, stats.seconds, stats.seconds, stats.lighting.shadowRays,
-                        stats.lighting.lightTerms,
-                        computeErrors(img.lighting.Lr, refs[k].Lr, refs[k].hasStderr ? &refs[k].stderr : nullptr)};
+                Point& p = perFrame[k];
+                std::sort(frameSeconds[k].begin(), frameSeconds[k].end());
+                p.seconds = frameSeconds[k][frameSeconds[k].size() / 2];
+                p.shadowRays /= a.seeds;
+                p.lightTerms /= a.seeds;
                 if (!a.quiet)
-                    fmt::print(stderr, "converge: {} frame {}: {:.3f} s, relMSE {:.4g}\n", spec.label, p.frame, p.seconds,
-                               p.err.relMSE);
+                    fmt::print(stderr, "converge: {} frame {}: {:.3f} s, relMSE {:.4g}, MAPE {:.4g}\n", spec.label, p.frame,
+                               p.seconds, p.err.relMSE, p.err.MAPE);
                 points.push_back(p);
             }
         }
@@ -238,6 +263,21 @@ void runConverge(const ConvergeArgs& a) {
     };
     std::string script = "set datafile separator ','\nset key outside right\nset grid\nset ylabel 'relMSE'\nset logscale y\n";
     if (a.sequence > 0) {
+        // Table: relMSE (MAPE) at frames 0, 1, 3, 7, 15, 31, ... of the sequence.
+        std::vector<std::uint32_t> shown;
+        for (std::uint32_t k = 1; k <= a.sequence; k *= 2) shown.push_back(k - 1);
+        if (shown.back() != a.sequence - 1) shown.push_back(a.sequence - 1);
+        fmt::print("{:<44}", "relMSE (MAPE) at sequence frame");
+        for (std::uint32_t k : shown) fmt::print(" {:>15}", k);
+        fmt::print("\n");
+        for (const EstimatorSpec& spec : specs) {
+            fmt::print("{:<44}", spec.label);
+            for (std::uint32_t k : shown)
+                for (const Point& p : points)
+                    if (p.label == spec.label && p.frame == frame + k)
+                        fmt::print(" {:>15}", fmt::format("{:.3g} ({:.3f})", p.err.relMSE, p.err.MAPE));
+            fmt::print("\n");
+        }
         script += "set xlabel 'frame'\nplot " + withColumn("2") + "\n";
         plotPng(prefix + ".png", script);
     } else {
