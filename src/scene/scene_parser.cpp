@@ -5,10 +5,12 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <ranges>
 #include <set>
 #include <sstream>
 
 #include <fmt/format.h>
+
 #include <toml++/toml.h>
 
 #include "accretion/core/error.h"
@@ -247,6 +249,12 @@ void validate(const Settings& s, const std::map<std::string, std::string>& loc, 
                                               s.particles.count, ReservoirCodec::bitsFor(s.particles.count)));
     if (s.render.target_stderr > 0.0 && s.render.max_samples < s.render.samples)
         fail("render.max_samples", fmt::format("must be at least render.samples ({}) when target_stderr is set", s.render.samples));
+    if (s.gpu.omm != OmmMode::off && s.geometry.alpha != AlphaMode::disc)
+        fail("gpu.omm", "opacity micromaps apply to disc-alpha billboards (geometry.alpha = \"disc\")");
+    for (std::string_view c : std::views::split(std::string_view(s.gpu.ser_key), ',') |
+                                  std::views::transform([](auto r) { return std::string_view(r.begin(), r.end()); }))
+        if (c != "hit" && c != "type" && c != "cluster" && c != "hint")
+            fail("gpu.ser_key", fmt::format("unknown component \"{}\" (expected hit, type, cluster, hint)", c));
     if (s.geometry.primitive == Primitive::sphere && s.geometry.alpha == AlphaMode::disc)
         fail("geometry.alpha", "disc alpha applies to billboards only (primitive = \"sphere\")");
 }

@@ -39,6 +39,7 @@ enum class EstimatorKind { exact, uniform, power, ris, restir, tree };
 enum class BiasCorrection { none, basic, pairwise };
 enum class ReservoirLayout { full, packed };
 enum class LightSource { uniform, power };
+enum class OmmMode { off, two_state, four_state };
 
 ACC_ENUM_NAMES(CameraPath, "static", "orbit", "linear");
 ACC_ENUM_NAMES(Primitive, "billboard", "sphere");
@@ -50,6 +51,7 @@ ACC_ENUM_NAMES(EstimatorKind, "exact", "uniform", "power", "ris", "restir", "tre
 ACC_ENUM_NAMES(BiasCorrection, "none", "basic", "pairwise");
 ACC_ENUM_NAMES(ReservoirLayout, "full", "packed");
 ACC_ENUM_NAMES(LightSource, "uniform", "power");
+ACC_ENUM_NAMES(OmmMode, "off", "2state", "4state");
 
 template <class E> constexpr std::string_view enumName(E e) {
     return EnumNames<E>::names[static_cast<std::size_t>(e)];
@@ -232,6 +234,47 @@ struct RestirSettings {
     }
 };
 
+/// [gpu]: the GPU model (MODEL.md section 6): counters, warps, SER, opacity
+/// micromaps, memory estimates and the cost model's coefficients.
+struct GpuSettings {
+    bool counters = false;                    ///< record per-pass, per-pixel counters (costs time)
+    std::uint32_t group_width = 8;            ///< thread group width
+    std::uint32_t group_height = 8;           ///< thread group height
+    std::uint32_t warp_size = 32;             ///< lanes per warp
+    std::string ser_key = "hit,type";         ///< SER sort key components, most significant first
+    std::uint32_t ser_hint_bits = 0;          ///< coherence-hint bits appended to the SER key
+    std::uint32_t ser_window = 2048;          ///< threads regrouped together (those an SM holds)
+    double ser_reorder_cost = 0.25;           ///< reorder cost per thread, in lane-steps
+    OmmMode omm = OmmMode::off;               ///< opacity micromaps on disc-alpha billboards
+    std::uint32_t omm_level = 4;              ///< OMM subdivision level L (4^L micro-triangles per triangle)
+    double blas_bytes_per_triangle = 48.0;    ///< GPU BLAS estimate: bytes per triangle (leaf data)
+    double blas_bytes_per_node = 64.0;        ///< GPU BLAS estimate: bytes per internal node
+    std::uint32_t bvh_width = 4;              ///< GPU BVH branching factor (internal nodes = (tris - 1) / (width - 1))
+    double blas_compaction = 0.6;             ///< compacted / built BLAS size
+    std::uint32_t blas_alignment = 65536;     ///< alignment of one allocation per BLAS
+    std::uint32_t pool_alignment = 256;       ///< alignment of a BLAS in a pooled buffer
+    std::string coefficients;                 ///< cost model coefficients (JSON from `accretion calibrate`); empty: defaults
+    template <class V> void visit(V& v) {
+        v.field("counters", counters, "record per-pass, per-pixel GPU counters (heatmap AOVs, stats)");
+        v.field("group_width", group_width, "thread group width", Range{1, 64});
+        v.field("group_height", group_height, "thread group height", Range{1, 64});
+        v.field("warp_size", warp_size, "lanes per warp", Range{1, 128});
+        v.field("ser_key", ser_key, "SER sort key: comma-separated hit, type, cluster, hint (most significant first)");
+        v.field("ser_hint_bits", ser_hint_bits, "coherence-hint bits in the SER key", Range{0, 16});
+        v.field("ser_window", ser_window, "threads regrouped together by SER", Range{1, 1 << 20});
+        v.field("ser_reorder_cost", ser_reorder_cost, "SER cost per reordered thread, in lane-steps", kNonNegative);
+        v.field("omm", omm, "opacity micromaps for disc alpha: off, 2state, 4state");
+        v.field("omm_level", omm_level, "OMM subdivision level (0-6)", Range{0, 6});
+        v.field("blas_bytes_per_triangle", blas_bytes_per_triangle, "GPU BLAS estimate: bytes per triangle", kNonNegative);
+        v.field("blas_bytes_per_node", blas_bytes_per_node, "GPU BLAS estimate: bytes per internal node", kNonNegative);
+        v.field("bvh_width", bvh_width, "GPU BVH branching factor", Range{2, 16});
+        v.field("blas_compaction", blas_compaction, "compacted / built BLAS size", Range{0.0, 1.0, true});
+        v.field("blas_alignment", blas_alignment, "alignment of one allocation per BLAS (bytes)", Range{1, 1 << 30});
+        v.field("pool_alignment", pool_alignment, "alignment of a BLAS in a pooled buffer (bytes)", Range{1, 1 << 30});
+        v.field("coefficients", coefficients, "cost model coefficients file (from accretion calibrate); empty: defaults");
+    }
+};
+
 /// Every setting of a run, parsed and validated in one place (scene_parser).
 struct Settings {
     ParticleSettings particles;
@@ -240,6 +283,7 @@ struct Settings {
     ShadingSettings shading;
     RenderSettings render;
     RestirSettings restir;
+    GpuSettings gpu;
 
     std::string sceneName = "scene"; ///< stem of the scene file
     std::string scenePath;           ///< scene file as given
@@ -251,6 +295,7 @@ struct Settings {
         v.section("shading", shading);
         v.section("render", render);
         v.section("restir", restir);
+        v.section("gpu", gpu);
     }
 };
 

@@ -1,0 +1,105 @@
+#pragma once
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace accretion {
+
+/// What one ray query did, as a GPU would count it (MODEL.md section 6).
+struct RayCounters {
+    std::uint32_t blasEntries = 0;  ///< TLAS leaves entered (BLAS traversals started)
+    std::uint32_t anyHits = 0;      ///< any-hit invocations (alpha-tested candidates)
+    std::uint32_t candidates = 0;   ///< non-opaque candidates seen (RayQuery Proceed() returning true)
+};
+
+/// The work of one pixel's thread in one pass (MODEL.md section 6). The
+/// branch key of a thread is (hit, type): a miss is key 0, a hit on a
+/// particle of type t is key 1 + t. cluster and hint feed SER sort keys.
+struct ThreadCounters {
+    std::uint8_t active = 0;        ///< the thread exists (pixel inside the dispatch)
+    std::uint8_t hit = 0;           ///< primary hit (else the miss path)
+    std::uint8_t type = 0;          ///< particle type of the hit
+    std::uint32_t cluster = 0;      ///< cluster (BLAS) of the hit
+    std::uint32_t hint = 0;         ///< coherence hint (e.g. the sampled light's cluster)
+    std::uint32_t trips = 0;        ///< loop trips (candidates, neighbours, samples)
+    std::uint32_t rays = 0;         ///< rays traced
+    std::uint32_t proceeds = 0;     ///< RayQuery Proceed() iterations: candidates + 1 per ray
+    std::uint32_t blasEntries = 0;  ///< BLAS instances entered, summed over the thread's rays
+    std::uint32_t anyHits = 0;      ///< any-hit invocations
+    std::uint32_t bytesRead = 0;    ///< G-buffer, reservoirs, particle records read
+    std::uint32_t bytesWritten = 0; ///< G-buffer, reservoirs, radiance written
+
+    std::uint32_t branchKey() const { return hit ? 1u + type : 0u; }
+    void addRay(const RayCounters& r) {
+        ++rays;
+        proceeds += r.candidates + 1;
+        blasEntries += r.blasEntries;
+        anyHits += r.anyHits;
+    }
+};
+
+/// One pass's dispatch: a width x height grid of threads (pixels; for
+/// buildClusters one thread per cluster, height 1).
+struct PassCounters {
+    std::string pass;
+    std::uint32_t width = 0, height = 0;
+    std::vector<ThreadCounters> threads;
+
+    PassCounters() = default;
+    PassCounters(std::string_view name, std::uint32_t w, std::uint32_t h)
+        : pass(name), width(w), height(h), threads(std::size_t(w) * h) {}
+};
+
+/// Counters of every pass of a frame, in execution order.
+struct FrameCounters {
+    std::vector<PassCounters> passes;
+
+    /// A new pass record; a pass that runs twice (spatial iterations) is merged on `find`.
+    PassCounters& add(std::string_view name, std::uint32_t w, std::uint32_t h) {
+        passes.emplace_back(name, w, h);
+        return passes.back();
+    }
+    const PassCounters* find(std::string_view name) const {
+        for (const PassCounters& p : passes)
+            if (p.pass == name) return &p;
+        return nullptr;
+    }
+    bool empty() const { return passes.empty(); }
+};
+
+/// The compile-time switch of the passes: Recorder<false> compiles to nothing.
+template <bool On> struct Recorder;
+
+template <> struct Recorder<false> {
+    explicit Recorder(ThreadCounters*) {}
+    static constexpr bool on = false;
+    void shade(bool, std::uint32_t, std::uint32_t) {}
+    void trip(std::uint32_t = 1) {}
+    void ray(const RayCounters&) {}
+    void read(std::uint32_t) {}
+    void write(std::uint32_t) {}
+    void hint(std::uint32_t) {}
+    RayCounters* rayCounters(RayCounters&) { return nullptr; }
+};
+
+template <> struct Recorder<true> {
+    explicit Recorder(ThreadCounters* t) : t_(t) { t_->active = 1; }
+    static constexpr bool on = true;
+    void shade(bool hit, std::uint32_t type, std::uint32_t cluster) {
+        t_->hit = hit;
+        t_->type = static_cast<std::uint8_t>(type);
+        t_->cluster = cluster;
+    }
+    void trip(std::uint32_t n = 1) { t_->trips += n; }
+    void ray(const RayCounters& r) { t_->addRay(r); }
+    void read(std::uint32_t bytes) { t_->bytesRead += bytes; }
+    void write(std::uint32_t bytes) { t_->bytesWritten += bytes; }
+    void hint(std::uint32_t h) { t_->hint = h; }
+    RayCounters* rayCounters(RayCounters& r) { r = RayCounters{}; return &r; }
+
+private:
+    ThreadCounters* t_;
+};
+
+}  // namespace accretion

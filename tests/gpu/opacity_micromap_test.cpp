@@ -1,0 +1,73 @@
+// Opacity micromap classification of the disc against dense point sampling
+// of every micro-triangle, at every level.
+#include <catch2/catch.hpp>
+
+#include <set>
+
+#include "accretion/geometry/billboard.h"
+#include "accretion/gpu/opacity_micromap.h"
+
+using namespace accretion;
+
+TEST_CASE("micro-triangle indexing covers the triangle once and round-trips", "[gpu][omm]") {
+    for (std::uint32_t L = 0; L <= 6; ++L) {
+        const std::uint32_t m = 1u << (2 * L);
+        double area = 0.0;
+        for (std::uint32_t k = 0; k < m; ++k) {
+            const auto c = OpacityMicromap::microCorners(L, k);
+            const Vec2 centroid = (c[0] + c[1] + c[2]) / 3.0f;
+            REQUIRE(OpacityMicromap::microIndex(L, centroid.x, centroid.y) == k);
+            area += 0.5 * std::abs(double(c[1].x - c[0].x) * (c[2].y - c[0].y) - double(c[2].x - c[0].x) * (c[1].y - c[0].y));
+        }
+        CHECK(area == Approx(0.5).epsilon(1e-9));
+    }
+}
+
+TEST_CASE("OMM classification of the disc matches dense point sampling at every level", "[gpu][omm]") {
+    for (std::uint32_t L = 0; L <= 6; ++L) {
+        const OpacityMicromap omm(L, true);
+        std::uint64_t unknown = 0;
+        for (std::uint32_t tri = 0; tri < 2; ++tri)
+            for (std::uint32_t k = 0; k < omm.microTriangles(); ++k) {
+                const auto b = OpacityMicromap::microCorners(L, k);
+                // 32 x 32 barycentric samples, corners and edges included.
+                constexpr int S = 32;
+                int inside = 0, total = 0;
+                float nearest = 1.0f;  // closest approach of a sample to the circle
+                for (int a = 0; a <= S; ++a)
+                    for (int c = 0; c <= S - a; ++c) {
+                        const Vec2 bary = b[0] + (float(a) / S) * (b[1] - b[0]) + (float(c) / S) * (b[2] - b[0]);
+                        const Vec2 uv = OpacityMicromap::quadUvOf(tri, bary);
+                        inside += insideDisc(uv);
+                        nearest = std::min(nearest, std::abs(glm::length(uv - Vec2(0.5f)) - 0.5f));
+                        ++total;
+                    }
+                const OmmState s = omm.state(tri, k);
+                INFO("level " << L << " triangle " << tri << " micro " << k);
+                if (s == OmmState::opaque) REQUIRE(inside == total);
+                if (s == OmmState::transparent) REQUIRE(inside == 0);
+                if (s == OmmState::unknown) {
+                    ++unknown;
+                    // Crossed by the circle: both sides are sampled, or the
+                    // circle only grazes it, within one sample spacing.
+                    const bool both = inside > 0 && inside < total;
+                    if (!both) CHECK(nearest < 1.5f * 1.4143f / float(1u << L) / S);
+                }
+            }
+        // The unknown micro-triangles hug the circle: their number grows like 2^L, their area falls like 2^-L.
+        if (L >= 2) CHECK(double(unknown) / omm.microTriangles() < 8.0 / double(1u << L));
+        CHECK(omm.count(OmmState::opaque) + omm.count(OmmState::transparent) + omm.count(OmmState::unknown) ==
+              2u * omm.microTriangles());
+    }
+}
+
+TEST_CASE("2-state OMM has no unknown micro-triangles; memory is shared across billboards", "[gpu][omm]") {
+    const OpacityMicromap two(4, false), four(4, true);
+    CHECK(two.count(OmmState::unknown) == 0);
+    CHECK(four.count(OmmState::unknown) > 0);
+    CHECK(four.arrayBytes() == 256u * 2u / 8u);
+    CHECK(two.arrayBytes() == 256u / 8u);
+    const OmmMemory m = ommMemory(four, 1000);
+    CHECK(m.sharedBytes == 2u * 64u + 2u * 2000u);
+    CHECK(m.perTriangleBytes == 2000u * 64u + 4u * 2000u);
+}
