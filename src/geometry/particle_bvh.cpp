@@ -1,6 +1,7 @@
 #include "accretion/geometry/particle_bvh.h"
 
 #include <chrono>
+#include <algorithm>
 #include <cmath>
 
 #include <tbb/parallel_for.h>
@@ -15,14 +16,101 @@ double secondsSince(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-/// Any-hit of the disc alpha test: reject candidate hits outside the inscribed circle.
+/// Every query's context: the counters of the ray (null unless counting).
+struct QueryContext {
+    RTCIntersectContext base;
+    RayCounters* counters;
+};
+
+QueryContext queryContext(RayCounters* counters) {
+    QueryContext c;
+    rtcInitIntersectContext(&c.base);
+    c.counters = counters;
+    return c;
+}
+
+/// Any-hit of the disc alpha test: reject candidate hits outside the
+/// inscribed circle. With an opacity micromap, opaque and transparent
+/// micro-triangles are decided without the any-hit (nor its count).
 void discAlphaFilter(const RTCFilterFunctionNArguments* args) {
+    const auto* alpha = static_cast<const AlphaTest*>(args->geometryUserPtr);
+    RayCounters* counters = reinterpret_cast<const QueryContext*>(args->context)->counters;
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] != -1) continue;
-        const Vec2 uv = quadUv(RTCHitN_primID(args->hit, args->N, i), RTCHitN_u(args->hit, args->N, i),
-                               RTCHitN_v(args->hit, args->N, i));
-        if (!insideDisc(uv)) args->valid[i] = 0;
+        const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
+        const float u = RTCHitN_u(args->hit, args->N, i), v = RTCHitN_v(args->hit, args->N, i);
+        if (alpha->omm) {
+            const OmmState s = alpha->omm->lookup(prim & 1u, u, v);
+            if (s == OmmState::opaque) continue;
+            if (s == OmmState::transparent) {
+                args->valid[i] = 0;
+                continue;
+            }
+        }
+        if (counters) {
+            ++counters->anyHits;
+            ++counters->candidates;
+        }
+        if (!insideDisc(quadUv(prim, u, v))) args->valid[i] = 0;
     }
+}
+
+/// The counting TLAS: one user-geometry primitive per cluster, bounded by
+/// its BLAS; entering it counts one BLAS entry and traverses that BLAS.
+void instanceBounds(const RTCBoundsFunctionArguments* args) {
+    const auto* bvh = static_cast<const ParticleBvh*>(args->geometryUserPtr);
+    const RTCBounds& b = bvh->blasBounds(args->primID);
+    args->bounds_o->lower_x = b.lower_x;
+    args->bounds_o->lower_y = b.lower_y;
+    args->bounds_o->lower_z = b.lower_z;
+    args->bounds_o->upper_x = b.upper_x;
+    args->bounds_o->upper_y = b.upper_y;
+    args->bounds_o->upper_z = b.upper_z;
+}
+
+/// The instance's box test, as GPU traversal does before entering a BLAS
+/// (Embree may call a leaf's callbacks without testing each primitive's box).
+bool overlapsBounds(const RTCBounds& b, const float org[3], const float dir[3], float tnear, float tfar) {
+    const float lo[3] = {b.lower_x, b.lower_y, b.lower_z}, hi[3] = {b.upper_x, b.upper_y, b.upper_z};
+    float t0 = tnear, t1 = tfar;
+    for (int k = 0; k < 3; ++k) {
+        const float inv = 1.0f / dir[k];
+        float a = (lo[k] - org[k]) * inv, c = (hi[k] - org[k]) * inv;
+        if (a > c) std::swap(a, c);
+        t0 = std::max(t0, a);
+        t1 = std::min(t1, c * (1.0f + 2e-7f * 3.0f));  // conservative, as in robust slab tests
+        if (t0 > t1) return false;
+    }
+    return true;
+}
+
+void instanceIntersect(const RTCIntersectFunctionNArguments* args) {
+    if (args->N != 1 || args->valid[0] != -1) return;
+    const auto* bvh = static_cast<const ParticleBvh*>(args->geometryUserPtr);
+    auto* ray = reinterpret_cast<RTCRayHit*>(args->rayhit);
+    const float org[3] = {ray->ray.org_x, ray->ray.org_y, ray->ray.org_z}, dir[3] = {ray->ray.dir_x, ray->ray.dir_y, ray->ray.dir_z};
+    if (!overlapsBounds(bvh->blasBounds(args->primID), org, dir, ray->ray.tnear, ray->ray.tfar)) return;
+    if (RayCounters* c = reinterpret_cast<QueryContext*>(args->context)->counters) ++c->blasEntries;
+    auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
+    const RTCHit saved = rh->hit;
+    rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    args->context->instID[0] = args->primID;
+    rtcIntersect1(bvh->blas(args->primID), args->context, rh);
+    args->context->instID[0] = RTC_INVALID_GEOMETRY_ID;
+    if (rh->hit.geomID == RTC_INVALID_GEOMETRY_ID) rh->hit = saved;
+    else rh->hit.instID[0] = args->primID;
+}
+
+void instanceOccluded(const RTCOccludedFunctionNArguments* args) {
+    if (args->N != 1 || args->valid[0] != -1) return;
+    const auto* bvh = static_cast<const ParticleBvh*>(args->geometryUserPtr);
+    const auto* ray = reinterpret_cast<const RTCRay*>(args->ray);
+    const float org[3] = {ray->org_x, ray->org_y, ray->org_z}, dir[3] = {ray->dir_x, ray->dir_y, ray->dir_z};
+    if (!overlapsBounds(bvh->blasBounds(args->primID), org, dir, ray->tnear, ray->tfar)) return;
+    if (RayCounters* c = reinterpret_cast<QueryContext*>(args->context)->counters) ++c->blasEntries;
+    args->context->instID[0] = args->primID;
+    rtcOccluded1(bvh->blas(args->primID), args->context, reinterpret_cast<RTCRay*>(args->ray));
+    args->context->instID[0] = RTC_INVALID_GEOMETRY_ID;
 }
 
 RTCBuildQuality sceneQuality(BuildPolicy p) {
@@ -31,12 +119,17 @@ RTCBuildQuality sceneQuality(BuildPolicy p) {
 
 }  // namespace
 
-ParticleBvh::ParticleBvh(const EmbreeDevice& device, const GeometrySettings& settings)
-    : device_(device), settings_(settings) {}
+ParticleBvh::ParticleBvh(const EmbreeDevice& device, const GeometrySettings& settings, const GpuSettings& gpu)
+    : device_(device), settings_(settings), counting_(gpu.counters) {
+    if (settings.alpha == AlphaMode::disc && gpu.omm != OmmMode::off)
+        omm_ = std::make_unique<OpacityMicromap>(gpu.omm_level, gpu.omm == OmmMode::four_state);
+    alpha_.omm = omm_.get();
+}
 
 ParticleBvh::~ParticleBvh() {
     releaseBlas();
     if (tlas_) rtcReleaseScene(tlas_);
+    if (countingTlas_) rtcReleaseScene(countingTlas_);
 }
 
 void ParticleBvh::releaseBlas() {
@@ -66,6 +159,7 @@ void ParticleBvh::buildBlas(std::size_t c, const Particles& particles, bool crea
                 std::copy(tri, tri + 6, idx + 6 * k);
             }
             if (settings_.alpha == AlphaMode::disc) {
+                rtcSetGeometryUserData(geom, &alpha_);
                 rtcSetGeometryIntersectFilterFunction(geom, &discAlphaFilter);
                 rtcSetGeometryOccludedFilterFunction(geom, &discAlphaFilter);
             }
@@ -117,6 +211,24 @@ void ParticleBvh::buildTlas() {
     rtcCommitScene(tlas_);
 }
 
+void ParticleBvh::buildCountingTlas() {
+    if (countingTlas_) rtcReleaseScene(countingTlas_);
+    countingTlas_ = rtcNewScene(device_.get());
+    rtcSetSceneBuildQuality(countingTlas_, sceneQuality(settings_.build));
+    blasBounds_.resize(blas_.size());
+    for (std::size_t c = 0; c < blas_.size(); ++c) rtcGetSceneBounds(blas_[c], &blasBounds_[c]);
+    RTCGeometry g = rtcNewGeometry(device_.get(), RTC_GEOMETRY_TYPE_USER);
+    rtcSetGeometryUserPrimitiveCount(g, static_cast<unsigned>(blas_.size()));
+    rtcSetGeometryUserData(g, this);
+    rtcSetGeometryBoundsFunction(g, &instanceBounds, this);
+    rtcSetGeometryIntersectFunction(g, &instanceIntersect);
+    rtcSetGeometryOccludedFunction(g, &instanceOccluded);
+    rtcCommitGeometry(g);
+    rtcAttachGeometryByID(countingTlas_, g, 0);
+    rtcReleaseGeometry(g);
+    rtcCommitScene(countingTlas_);
+}
+
 void ParticleBvh::build(const Particles& particles, const Camera& camera) {
     stats_ = BvhStats{};
     const std::size_t n = particles.size();
@@ -165,6 +277,7 @@ void ParticleBvh::build(const Particles& particles, const Camera& camera) {
 
     t0 = std::chrono::steady_clock::now();
     buildTlas();
+    if (counting_) buildCountingTlas();
     device_.check("buildClusters (TLAS)");
     stats_.tlasSeconds = secondsSince(t0);
 
@@ -176,9 +289,8 @@ void ParticleBvh::build(const Particles& particles, const Camera& camera) {
     stats_.embreeBytes = device_.bytesInUse();
 }
 
-bool ParticleBvh::intersect(const Vec3& o, const Vec3& d, float tfar, SurfaceHit& hit) const {
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
+bool ParticleBvh::intersect(const Vec3& o, const Vec3& d, float tfar, SurfaceHit& hit, RayCounters* counters) const {
+    QueryContext context = queryContext(counters);
     RTCRayHit rh;
     rh.ray.org_x = o.x;
     rh.ray.org_y = o.y;
@@ -194,7 +306,7 @@ bool ParticleBvh::intersect(const Vec3& o, const Vec3& d, float tfar, SurfaceHit
     rh.ray.flags = 0;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(tlas_, &context, &rh);
+    rtcIntersect1(counters && countingTlas_ ? countingTlas_ : tlas_, &context.base, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
     const std::uint32_t c = rh.hit.instID[0];
     const bool billboards = settings_.primitive == Primitive::billboard;
@@ -206,9 +318,8 @@ bool ParticleBvh::intersect(const Vec3& o, const Vec3& d, float tfar, SurfaceHit
     return true;
 }
 
-bool ParticleBvh::occluded(const Vec3& o, const Vec3& d, float tfar) const {
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
+bool ParticleBvh::occluded(const Vec3& o, const Vec3& d, float tfar, RayCounters* counters) const {
+    QueryContext context = queryContext(counters);
     RTCRay ray;
     ray.org_x = o.x;
     ray.org_y = o.y;
@@ -222,7 +333,7 @@ bool ParticleBvh::occluded(const Vec3& o, const Vec3& d, float tfar) const {
     ray.mask = ~0u;
     ray.id = 0;
     ray.flags = 0;
-    rtcOccluded1(tlas_, &context, &ray);
+    rtcOccluded1(counters && countingTlas_ ? countingTlas_ : tlas_, &context.base, &ray);
     return ray.tfar < 0.0f;
 }
 

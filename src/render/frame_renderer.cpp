@@ -10,7 +10,7 @@ namespace accretion {
 FrameRenderer::FrameRenderer(const Settings& settings, ParticleSource source, RenderOptions options)
     : settings_(settings), source_(std::move(source)), options_(options),
       device_(std::make_unique<EmbreeDevice>()),
-      bvh_(std::make_unique<ParticleBvh>(*device_, settings.geometry)) {
+      bvh_(std::make_unique<ParticleBvh>(*device_, settings.geometry, settings.gpu)) {
     if (settings_.render.estimator == EstimatorKind::restir) restir_ = std::make_unique<Restir>(settings_);
 }
 
@@ -32,7 +32,7 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats) {
         auto t = timer.scope(pass::buildClusters);
         if (needsPreviousBvh(settings_)) {  // double buffer: last frame's BVH stays valid
             std::swap(bvh_, previousBvh_);
-            if (!bvh_) bvh_ = std::make_unique<ParticleBvh>(*device_, settings_.geometry);
+            if (!bvh_) bvh_ = std::make_unique<ParticleBvh>(*device_, settings_.geometry, settings_.gpu);
         }
         bvh_->build(particles, camera);
     }

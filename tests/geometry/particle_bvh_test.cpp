@@ -133,3 +133,86 @@ TEST_CASE("build stats: clusters, primitives and Embree memory", "[geometry][bvh
     // At least the vertex and index buffers (48 + 24 bytes per billboard).
     REQUIRE(bvh.stats().embreeBytes >= std::int64_t(72 * ps.count));
 }
+
+namespace {
+
+/// Clusters whose BLAS bounds the ray o + t d, t in [0, tfar), overlaps (slab
+/// test; slack > 0 widens the exit distances, < 0 narrows them).
+std::uint32_t overlappedClusters(const ParticleBvh& bvh, const Vec3& o, const Vec3& d, float tfar, float slack = 1e-5f) {
+    std::uint32_t n = 0;
+    for (std::size_t c = 0; c < bvh.clusters().count(); ++c) {
+        const RTCBounds& b = bvh.blasBounds(c);
+        const float lo[3] = {b.lower_x, b.lower_y, b.lower_z}, hi[3] = {b.upper_x, b.upper_y, b.upper_z};
+        float t0 = 0.0f, t1 = tfar;
+        for (int k = 0; k < 3; ++k) {
+            const float inv = 1.0f / d[k];
+            float a = (lo[k] - o[k]) * inv, bb = (hi[k] - o[k]) * inv;
+            if (a > bb) std::swap(a, bb);
+            t0 = std::max(t0, a);
+            t1 = std::min(t1, bb * (1.0f + slack));
+        }
+        n += t0 <= t1;
+    }
+    return n;
+}
+
+}  // namespace
+
+TEST_CASE("counting queries: same answers, BLAS entries bounded by the overlapped clusters, any-hits only with alpha",
+          "[geometry][bvh][gpu]") {
+    GeometrySettings g;
+    g.primitive = GENERATE(Primitive::billboard, Primitive::sphere);
+    g.alpha = g.primitive == Primitive::sphere ? AlphaMode::opaque : GENERATE(AlphaMode::opaque, AlphaMode::disc);
+    g.build = GENERATE(BuildPolicy::rebuild, BuildPolicy::refit);
+    g.cluster_size = 16;
+    INFO(enumName(g.primitive) << " " << enumName(g.alpha) << " " << enumName(g.build));
+    ParticleSettings ps;
+    ps.count = 400;
+    ps.outer_radius = 3.0;
+    ps.radius = 0.1;
+    CameraSettings cs;
+    cs.position = Vec3(0.0f, 3.0f, 6.0f);
+    cs.width = 40;
+    cs.height = 30;
+    EmbreeDevice device;
+    GpuSettings gpu;
+    gpu.counters = true;
+    ParticleBvh bvh(device, g, gpu);
+    for (std::uint32_t frame = 0; frame < 2; ++frame) {
+        const Particles p = generateDisk(ps, frame);
+        const Camera cam = Camera::atFrame(cs, frame);
+        bvh.build(p, cam);
+        std::uint64_t entries = 0, anyHits = 0, hits = 0;
+        for (std::uint32_t y = 0; y < cam.height; ++y)
+            for (std::uint32_t x = 0; x < cam.width; ++x) {
+                const Vec3 d = cam.pixelDirection(x, y);
+                SurfaceHit plain, counted;
+                RayCounters rc;
+                const bool a = bvh.intersect(cam.position, d, 1e30f, plain);
+                const bool b = bvh.intersect(cam.position, d, 1e30f, counted, &rc);
+                REQUIRE(a == b);
+                if (a) {
+                    REQUIRE(counted.particle == plain.particle);
+                    REQUIRE(counted.cluster == plain.cluster);
+                    REQUIRE(counted.t == plain.t);
+                    REQUIRE(rc.blasEntries >= 1);
+                    ++hits;
+                }
+                // Traversal enters every box that starts before the closest hit
+                // (tfar never drops below it), and no box the ray misses.
+                REQUIRE(rc.blasEntries <= overlappedClusters(bvh, cam.position, d, 1e30f));
+                REQUIRE(rc.blasEntries >= overlappedClusters(bvh, cam.position, d, a ? plain.t * (1.0f - 1e-4f) : 1e30f, -1e-5f));
+                if (g.alpha == AlphaMode::opaque) REQUIRE(rc.anyHits == 0);
+                REQUIRE(rc.candidates == rc.anyHits);
+                entries += rc.blasEntries;
+                anyHits += rc.anyHits;
+                RayCounters oc;
+                const float tfar = a ? plain.t * 1.01f : 1e30f;
+                REQUIRE(bvh.occluded(cam.position, d, tfar) == bvh.occluded(cam.position, d, tfar, &oc));
+                REQUIRE(oc.blasEntries <= overlappedClusters(bvh, cam.position, d, tfar));
+            }
+        REQUIRE(hits > 50);
+        REQUIRE(entries >= hits);
+        if (g.alpha == AlphaMode::disc) REQUIRE(anyHits >= hits);
+    }
+}

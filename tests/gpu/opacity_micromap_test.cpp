@@ -71,3 +71,59 @@ TEST_CASE("2-state OMM has no unknown micro-triangles; memory is shared across b
     CHECK(m.sharedBytes == 2u * 64u + 2u * 2000u);
     CHECK(m.perTriangleBytes == 2000u * 64u + 4u * 2000u);
 }
+
+#include "accretion/geometry/particle_bvh.h"
+#include "accretion/particles/disk_generator.h"
+#include "accretion/render/camera.h"
+
+TEST_CASE("4-state OMM keeps every hit of alpha testing with fewer any-hits as L grows; 2-state none", "[gpu][omm][bvh]") {
+    GeometrySettings g;
+    g.alpha = AlphaMode::disc;
+    g.cluster_size = 32;
+    ParticleSettings ps;
+    ps.count = 2000;
+    ps.outer_radius = 3.0;
+    ps.radius = 0.08;
+    CameraSettings cs;
+    cs.position = Vec3(0.0f, 2.0f, 6.0f);
+    cs.width = 96;
+    cs.height = 64;
+    const Particles p = generateDisk(ps, 0);
+    const Camera cam = Camera::atFrame(cs, 0);
+    EmbreeDevice device;
+
+    auto trace = [&](const GpuSettings& gpu, std::vector<std::uint32_t>& ids) {
+        ParticleBvh bvh(device, g, gpu);
+        bvh.build(p, cam);
+        std::uint64_t anyHits = 0;
+        ids.clear();
+        for (std::uint32_t y = 0; y < cam.height; ++y)
+            for (std::uint32_t x = 0; x < cam.width; ++x) {
+                SurfaceHit hit;
+                RayCounters rc;
+                ids.push_back(bvh.intersect(cam.position, cam.pixelDirection(x, y), 1e30f, hit, &rc) ? hit.particle : ~0u);
+                anyHits += rc.anyHits;
+            }
+        return anyHits;
+    };
+    GpuSettings gpu;
+    gpu.counters = true;
+    std::vector<std::uint32_t> reference, ids;
+    const std::uint64_t alphaAnyHits = trace(gpu, reference);
+    REQUIRE(alphaAnyHits > 1000);
+    std::uint64_t previous = alphaAnyHits;
+    gpu.omm = OmmMode::four_state;
+    for (std::uint32_t L = 0; L <= 6; ++L) {
+        gpu.omm_level = L;
+        const std::uint64_t n = trace(gpu, ids);
+        INFO("level " << L << ": " << n << " any-hits (alpha " << alphaAnyHits << ")");
+        CHECK(ids == reference);  // the same image as alpha testing
+        CHECK(n <= previous);
+        previous = n;
+    }
+    CHECK(previous * 5 < alphaAnyHits);  // level 6 leaves a thin band of unknown micro-triangles
+    gpu.omm = OmmMode::two_state;
+    gpu.omm_level = 2;
+    CHECK(trace(gpu, ids) == 0);
+    CHECK(ids != reference);  // 2-state changes coverage at level 2
+}

@@ -1,5 +1,6 @@
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <embree3/rtcore.h>
@@ -7,6 +8,8 @@
 #include "accretion/geometry/billboard.h"
 #include "accretion/geometry/clustering.h"
 #include "accretion/geometry/embree_device.h"
+#include "accretion/gpu/opacity_micromap.h"
+#include "accretion/gpu/thread_counters.h"
 #include "accretion/particles/particles.h"
 #include "accretion/scene/settings.h"
 
@@ -37,12 +40,20 @@ struct SurfaceHit {
     Vec2 uv;                 ///< quad uv (billboards)
 };
 
+/// The any-hit of disc-alpha billboards: an opacity micromap (if any) decides
+/// opaque and transparent micro-triangles without invoking it.
+struct AlphaTest {
+    const OpacityMicromap* omm = nullptr;
+};
+
 /// The GPU's acceleration structure on Embree (MODEL.md section 2): one BLAS
 /// per particle cluster, instanced in a TLAS; billboards as two triangles
 /// (optionally with the disc alpha test as a filter function) or spheres.
 class ParticleBvh {
 public:
-    ParticleBvh(const EmbreeDevice& device, const GeometrySettings& settings);
+    /// counting: also build a TLAS of user-geometry instances that count the
+    /// BLAS entries of each ray (used only by queries given RayCounters).
+    ParticleBvh(const EmbreeDevice& device, const GeometrySettings& settings, const GpuSettings& gpu = GpuSettings{});
     ~ParticleBvh();
     ParticleBvh(const ParticleBvh&) = delete;
     ParticleBvh& operator=(const ParticleBvh&) = delete;
@@ -50,10 +61,20 @@ public:
     /// Build (rebuild / refit / fast_trace, per the settings) for a frame.
     void build(const Particles& particles, const Camera& camera);
 
-    /// Closest hit along o + t d, t in [0, tfar). d need not be unit.
-    bool intersect(const Vec3& o, const Vec3& d, float tfar, SurfaceHit& hit) const;
+    /// Closest hit along o + t d, t in [0, tfar). d need not be unit. With
+    /// counters (counting mode only), the BLAS entries and any-hits are added.
+    bool intersect(const Vec3& o, const Vec3& d, float tfar, SurfaceHit& hit, RayCounters* counters = nullptr) const;
     /// Any hit along o + t d, t in [0, tfar): the search stops at the first.
-    bool occluded(const Vec3& o, const Vec3& d, float tfar) const;
+    bool occluded(const Vec3& o, const Vec3& d, float tfar, RayCounters* counters = nullptr) const;
+
+    /// True when queries can count (the counting TLAS is built).
+    bool counting() const { return counting_; }
+    /// The opacity micromap in use (null without one).
+    const OpacityMicromap* micromap() const { return omm_.get(); }
+    /// BLAS of cluster c (for the counting instances).
+    RTCScene blas(std::size_t c) const { return blas_[c]; }
+    /// World bounds of cluster c's BLAS in the current build.
+    const RTCBounds& blasBounds(std::size_t c) const { return blasBounds_[c]; }
 
     /// The billboard frame of a particle in the current build.
     const BillboardFrame& frame(std::uint32_t particle) const { return frames_[particle]; }
@@ -65,6 +86,7 @@ private:
     void releaseBlas();
     void buildBlas(std::size_t c, const Particles& particles, bool create);
     void buildTlas();
+    void buildCountingTlas();
 
     const EmbreeDevice& device_;
     GeometrySettings settings_;
@@ -73,6 +95,11 @@ private:
     std::vector<RTCScene> blas_;
     std::vector<RTCGeometry> geometry_;  // one per BLAS, owned by its scene
     RTCScene tlas_ = nullptr;
+    bool counting_ = false;
+    RTCScene countingTlas_ = nullptr;      ///< user-geometry instances that count entries
+    std::vector<RTCBounds> blasBounds_;
+    std::unique_ptr<OpacityMicromap> omm_;
+    AlphaTest alpha_;
     std::size_t partialCursor_ = 0;  ///< partial: first cluster of the next window
     BvhStats stats_;
 };

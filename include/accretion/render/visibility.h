@@ -29,15 +29,17 @@ inline Vec3 offsetRayOrigin(const Vec3& p, const Vec3& n) {
 /// V(x, p_i) of MODEL.md section 3: the segment from the (offset) receiver to
 /// the light, ending short of the light's own geometry: billboards
 /// t < d (1 - eps) (p_i lies on its own quad), spheres t < (d - r_i)(1 - eps).
-/// One occlusion query that stops at the first hit.
+/// One occlusion query that stops at the first hit (counted into `counters`
+/// when given: counting mode).
 template <Primitive P>
-inline bool visible(const ParticleBvh& bvh, const ShadingPoint& sp, const LightTerm& light, float lightRadius, float eps) {
+inline bool visible(const ParticleBvh& bvh, const ShadingPoint& sp, const LightTerm& light, float lightRadius, float eps,
+                    RayCounters* counters = nullptr) {
     float tfar;
     if constexpr (P == Primitive::sphere) tfar = (light.dist - lightRadius) * (1.0f - eps);
     else tfar = light.dist * (1.0f - eps);
     if (!(tfar > 0.0f)) return true;
     const Vec3 side = glm::dot(sp.ng, light.w) >= 0.0f ? sp.ng : -sp.ng;
-    return !bvh.occluded(offsetRayOrigin(sp.x, side), light.w, tfar);
+    return !bvh.occluded(offsetRayOrigin(sp.x, side), light.w, tfar, counters);
 }
 
 }  // namespace accretion
