@@ -11,6 +11,7 @@
 
 #include "accretion/core/error.h"
 #include "accretion/core/version.h"
+#include "accretion/gpu/gpu_report.h"
 #include "accretion/io/atomic_file.h"
 #include "accretion/io/exr_output.h"
 #include "accretion/io/stats_writer.h"
@@ -148,6 +149,15 @@ void runRender(const RenderArgs& args) {
         }
         nlohmann::json fj = frameStatsJson(fs);
         fj["outputs"] = {{"exr", exr}, {"png", base.string() + ".png"}, {"lr_png", base.string() + ".Lr.png"}};
+        if (settings.gpu.counters) {
+            // The GPU model of the frame, and a PNG of each counter heatmap.
+            fj["gpu"] = toJson(makeGpuReport(image.counters, renderer.bvh(), settings, fs.reservoirBytes));
+            for (const Heatmap& h : image.heatmaps) {
+                const std::string png = base.string() + "." + h.name + ".png";
+                writeHeatmapPng(png, h.values, image.width, image.height);
+                fj["outputs"][h.name + "_png"] = png;
+            }
+        }
         stats["frames"].push_back(fj);
         shadowRays += fs.lighting.shadowRays;
         lightingSeconds += fs.timer.seconds(pass::estimateLighting);

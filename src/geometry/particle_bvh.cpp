@@ -277,7 +277,12 @@ void ParticleBvh::build(const Particles& particles, const Camera& camera) {
 
     t0 = std::chrono::steady_clock::now();
     buildTlas();
-    if (counting_) buildCountingTlas();
+    if (counting_) {
+        buildCountingTlas();
+        clusterOf_.assign(n, 0);
+        for (std::size_t c = 0; c < clusters_.count(); ++c)
+            for (std::uint32_t i : clusters_.members(c)) clusterOf_[i] = static_cast<std::uint32_t>(c);
+    }
     device_.check("buildClusters (TLAS)");
     stats_.tlasSeconds = secondsSince(t0);
 

@@ -49,6 +49,7 @@ void writeFrameExr(const std::filesystem::path& file, const FrameImage& img, boo
         channels.push_back({"restir.light", true, [&](std::size_t px) { return img.reservoirs.light[px]; }});
         addFloat("restir.p_hat", img.reservoirs.p_hat);
     }
+    for (const Heatmap& h : img.heatmaps) addFloat(h.name, h.values);
     const int nch = static_cast<int>(channels.size());
 
     OIIO::ImageSpec spec(int(img.width), int(img.height), nch, OIIO::TypeDesc::FLOAT);
@@ -94,6 +95,38 @@ void writeChannelsExr(const std::filesystem::path& file, std::uint32_t width, st
         if (!out) throw InternalError("OpenImageIO has no OpenEXR writer");
         if (!out->open(tmp.string(), spec) || !out->write_image(OIIO::TypeDesc::FLOAT, buf.data()) || !out->close())
             throw InputError(fmt::format("{}: cannot write EXR: {}", file.string(), out->geterror()));
+    });
+}
+
+void writeHeatmapPng(const std::filesystem::path& file, const std::vector<float>& values, std::uint32_t width,
+                     std::uint32_t height) {
+    std::vector<float> nz;
+    for (float v : values)
+        if (v > 0.0f && std::isfinite(v)) nz.push_back(v);
+    float top = 1.0f;
+    if (!nz.empty()) {
+        const std::size_t k = std::min(nz.size() - 1, std::size_t(0.995 * double(nz.size())));
+        std::nth_element(nz.begin(), nz.begin() + std::ptrdiff_t(k), nz.end());
+        top = nz[k] > 0.0f ? nz[k] : 1.0f;
+    }
+    // A viridis-like ramp: dark blue, blue, teal, green, yellow.
+    static const float ramp[5][3] = {{0.27f, 0.00f, 0.33f}, {0.23f, 0.32f, 0.55f}, {0.13f, 0.57f, 0.55f},
+                                     {0.37f, 0.79f, 0.38f}, {0.99f, 0.91f, 0.14f}};
+    std::vector<std::uint8_t> px(values.size() * 3, 0);
+    for (std::size_t i = 0; i < values.size(); ++i) {
+        if (!(values[i] > 0.0f)) continue;
+        const float t = std::clamp(values[i] / top, 0.0f, 1.0f) * 4.0f;
+        const int a = std::min(3, int(t));
+        const float f = t - float(a);
+        for (int c = 0; c < 3; ++c)
+            px[3 * i + c] = static_cast<std::uint8_t>(std::lround(255.0f * (ramp[a][c] + f * (ramp[a + 1][c] - ramp[a][c]))));
+    }
+    OIIO::ImageSpec spec(int(width), int(height), 3, OIIO::TypeDesc::UINT8);
+    writeAtomicWith(file, [&](const std::filesystem::path& tmp) {
+        auto out = OIIO::ImageOutput::create("png");
+        if (!out) throw InternalError("OpenImageIO has no PNG writer");
+        if (!out->open(tmp.string(), spec) || !out->write_image(OIIO::TypeDesc::UINT8, px.data()) || !out->close())
+            throw InputError(fmt::format("{}: cannot write PNG: {}", file.string(), out->geterror()));
     });
 }
 

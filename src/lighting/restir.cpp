@@ -8,6 +8,7 @@
 
 #include "accretion/core/error.h"
 #include "accretion/core/rng.h"
+#include "accretion/gpu/gpu_layouts.h"
 #include "accretion/lighting/reservoir.h"
 #include "accretion/render/shading.h"
 #include "accretion/render/visibility.h"
@@ -58,9 +59,9 @@ bool similar(const GBufferTexel& a, const GBufferTexel& b, const RestirSettings&
 /// basic_visibility); pairwise: each neighbour forms a two-strategy balance
 /// heuristic with the canonical, whose confidence is split over the k pairs
 /// (weights sum to 1 for every y; equal p_hat gives M_i / M_total).
-template <ShadingModel SM, Primitive P>
+template <ShadingModel SM, Primitive P, bool Count>
 StoredReservoir combine(const Offer* offers, std::uint32_t n, const LightArrays& L, const RestirSettings& rs,
-                        float eps, Rng& rng, LightingCounters& c) {
+                        float eps, Rng& rng, LightingCounters& c, Recorder<Count>& rec) {
     const Offer& can = offers[0];
     const ShadingPoint& sp = can.domain.sp;
     if (n == 1) return can.r;
@@ -128,7 +129,10 @@ StoredReservoir combine(const Offer* offers, std::uint32_t n, const LightArrays&
             if (!d.lights->term<SM>(d.sp, out.y, t) || !(luminance(t.value) > 0.0f)) continue;
             if (rs.basic_visibility && d.visibilityTested) {
                 ++c.shadowRays;
-                if (!visible<P>(*d.bvh, d.sp, t, d.lights->radius[out.y], eps)) {
+                RayCounters rc;
+                const bool seen = visible<P>(*d.bvh, d.sp, t, d.lights->radius[out.y], eps, rec.rayCounters(rc));
+                rec.ray(rc);
+                if (!seen) {
                     ++c.shadowOccluded;
                     continue;
                 }
@@ -165,15 +169,44 @@ struct FrameContext {
     const Restir::History* prev;
     float scale;                ///< lighting / image resolution
     float eps;
+    FrameCounters* counters;    ///< counting mode: per-pass thread records
 };
 
-template <ShadingModel SM, Primitive P, bool Power>
+/// The counters of a pass about to run (counting mode), else null.
+template <bool Count>
+PassCounters* passCounters(const FrameContext& f, std::string_view name) {
+    if constexpr (Count) return &f.counters->add(name, f.lg.width, f.lg.height);
+    return nullptr;
+}
+
+template <bool Count>
+Recorder<Count> recorder(PassCounters* pc, std::size_t px) {
+    if constexpr (Count) return Recorder<true>(&pc->threads[px]);
+    else return Recorder<false>(nullptr);
+}
+
+/// The branch key of a lighting-grid texel (counting mode).
+template <bool Count>
+void recordHit(Recorder<Count>& rec, const FrameContext& f, const GBufferTexel& g) {
+    rec.read(gpu_layout::kGBufferTexel);
+    if constexpr (Count)
+        if (g.hit()) rec.shade(true, f.in.particles.type[g.particle], f.in.bvh.clusterOf(g.particle));
+}
+
+template <ShadingModel SM, Primitive P, bool Power, bool Count>
 LightingCounters generateCandidates(const FrameContext& f, std::vector<StoredReservoir>& out) {
     const std::uint32_t Mc = f.in.settings.render.candidates;
+    PassCounters* pc = passCounters<Count>(f, pass::generateCandidates);
+    const std::uint32_t R = f.codec.bytes();
     return forEachPixel(f.lg.width, f.lg.height, [&](std::size_t px, std::uint32_t, std::uint32_t, LightingCounters& c) {
         const GBufferTexel& g = f.lg.texels[px];
+        auto rec = recorder<Count>(pc, px);
+        recordHit(rec, f, g);
         out[px] = StoredReservoir{};
         if (!g.hit()) return;
+        rec.trip(Mc);
+        rec.read(Mc * (gpu_layout::kParticleRecord + (Power ? gpu_layout::kAliasEntry : 0u)));
+        rec.write(R);
         const ShadingPoint sp = shadingPoint(g, f.in.particles);
         Rng rng(px, f.in.frame, RngPass::restirCandidates, f.in.settings.render.seed);
         Reservoir r;
@@ -189,7 +222,10 @@ LightingCounters generateCandidates(const FrameContext& f, std::vector<StoredRes
             LightTerm t;
             if (f.L.term<SM>(sp, r.y, t)) {
                 ++c.shadowRays;
-                if (!visible<P>(f.in.bvh, sp, t, f.L.radius[r.y], f.eps)) {
+                RayCounters rc;
+                const bool seen = visible<P>(f.in.bvh, sp, t, f.L.radius[r.y], f.eps, rec.rayCounters(rc));
+                rec.ray(rc);
+                if (!seen) {
                     ++c.shadowOccluded;
                     r.W = 0.0f;
                 }
@@ -206,15 +242,22 @@ LightingCounters generateCandidates(const FrameContext& f, std::vector<StoredRes
     });
 }
 
-template <ShadingModel SM, Primitive P>
+template <ShadingModel SM, Primitive P, bool Count>
 LightingCounters temporalResampling(const FrameContext& f, const std::vector<StoredReservoir>& cur,
                                     std::vector<StoredReservoir>& out) {
     const Restir::History& h = *f.prev;
     const Particles& particles = f.in.particles;
+    PassCounters* pc = passCounters<Count>(f, pass::temporalResampling);
+    const std::uint32_t R = f.codec.bytes();
     return forEachPixel(f.lg.width, f.lg.height, [&](std::size_t px, std::uint32_t, std::uint32_t, LightingCounters& c) {
         const GBufferTexel& g = f.lg.texels[px];
+        auto rec = recorder<Count>(pc, px);
+        recordHit(rec, f, g);
         out[px] = cur[px];
         if (!g.hit()) return;
+        rec.trip();
+        rec.read(R + 2 * gpu_layout::kParticleRecord);  // the reservoir, the particle now and before
+        rec.write(R);
         // Where this surface point was: moved back by its particle's motion,
         // projected with the previous camera onto the previous lighting grid.
         const std::uint32_t j = g.particle;
@@ -229,6 +272,7 @@ LightingCounters temporalResampling(const FrameContext& f, const std::vector<Sto
         ok = ok && lx >= 0.0f && ly >= 0.0f && lx < float(h.gbuffer.width) && ly < float(h.gbuffer.height);
         std::size_t q = 0;
         if (ok) {
+            rec.read(gpu_layout::kGBufferTexel);
             q = std::size_t(ly) * h.gbuffer.width + std::size_t(lx);
             const GBufferTexel& gp = h.gbuffer.texels[q];
             ok = gp.particle == j && glm::dot(gp.normal, g.normal) >= float(f.rs.normal_threshold) &&
@@ -239,6 +283,7 @@ LightingCounters temporalResampling(const FrameContext& f, const std::vector<Sto
             return;
         }
         ++c.reuseAccepted;
+        rec.read(R + gpu_layout::kParticleRecord);  // the previous reservoir and its light
         const ShadingPoint sp = shadingPoint(g, particles);
         Offer offers[2];
         offers[0] = {cur[px], {sp, &f.L, f.rs.candidate_visibility, &f.in.bvh}};
@@ -251,20 +296,27 @@ LightingCounters temporalResampling(const FrameContext& f, const std::vector<Sto
                             f.rs.candidate_visibility || f.rs.visibility_reuse,
                             f.in.previousBvh ? f.in.previousBvh : &f.in.bvh}};
         Rng rng(px, f.in.frame, RngPass::restirTemporal, f.in.settings.render.seed);
-        out[px] = f.codec.roundTrip(combine<SM, P>(offers, 2, f.L, f.rs, f.eps, rng, c));
+        out[px] = f.codec.roundTrip(combine<SM, P, Count>(offers, 2, f.L, f.rs, f.eps, rng, c, rec));
     });
 }
 
-template <ShadingModel SM, Primitive P>
+template <ShadingModel SM, Primitive P, bool Count>
 LightingCounters spatialResampling(const FrameContext& f, std::uint32_t iteration, const std::vector<StoredReservoir>& cur,
                                    std::vector<StoredReservoir>& out) {
     const std::uint32_t W = f.lg.width, H = f.lg.height;
     const float radius = std::max(1.0f, float(f.rs.spatial_radius) * f.scale);
     const std::uint32_t k = f.rs.spatial_neighbours;
+    PassCounters* pc = passCounters<Count>(f, pass::spatialResampling);
+    const std::uint32_t R = f.codec.bytes();
     return forEachPixel(W, H, [&](std::size_t px, std::uint32_t x, std::uint32_t y, LightingCounters& c) {
         const GBufferTexel& g = f.lg.texels[px];
+        auto rec = recorder<Count>(pc, px);
+        recordHit(rec, f, g);
         out[px] = cur[px];
         if (!g.hit()) return;
+        rec.trip(k);
+        rec.read(R + gpu_layout::kParticleRecord);
+        rec.write(R);
         Rng rng(px ^ (std::uint64_t(iteration) << 40), f.in.frame, RngPass::restirSpatial, f.in.settings.render.seed);
         const ShadingPoint sp = shadingPoint(g, f.in.particles);
         Offer offers[1 + 64];
@@ -287,34 +339,52 @@ LightingCounters spatialResampling(const FrameContext& f, std::uint32_t iteratio
             }
             const std::size_t q = std::size_t(ny) * W + std::size_t(nx);
             const GBufferTexel& gn = f.lg.texels[q];
+            rec.read(gpu_layout::kGBufferTexel);
             if (!similar(g, gn, f.rs)) {
                 ++c.reuseRejected;
                 continue;
             }
             ++c.reuseAccepted;
+            rec.read(R + gpu_layout::kParticleRecord);
             offers[n++] = {cur[q], {shadingPoint(gn, f.in.particles), &f.L, tested, &f.in.bvh}};
         }
-        out[px] = f.codec.roundTrip(combine<SM, P>(offers, n, f.L, f.rs, f.eps, rng, c));
+        out[px] = f.codec.roundTrip(combine<SM, P, Count>(offers, n, f.L, f.rs, f.eps, rng, c, rec));
     });
 }
 
 /// One shadow ray for the kept sample; Lr = f I G V W. With visibility
 /// reuse, an occluded sample's W is zeroed in the stored reservoir.
-template <ShadingModel SM, Primitive P>
+template <ShadingModel SM, Primitive P, bool Count>
 LightingCounters traceShadowRays(const FrameContext& f, std::vector<StoredReservoir>& res, std::vector<Vec3>& Lr) {
+    PassCounters* pc = passCounters<Count>(f, pass::traceShadowRays);
+    const std::uint32_t R = f.codec.bytes();
     return forEachPixel(f.lg.width, f.lg.height, [&](std::size_t px, std::uint32_t, std::uint32_t, LightingCounters& c) {
         Lr[px] = Vec3(0.0f);
         const GBufferTexel& g = f.lg.texels[px];
+        auto rec = recorder<Count>(pc, px);
+        recordHit(rec, f, g);
+        rec.write(gpu_layout::kRadiance);
         StoredReservoir& r = res[px];
-        if (!g.hit() || !(r.W > 0.0f)) return;
+        if (!g.hit()) return;
+        rec.read(R);
+        if (!(r.W > 0.0f)) return;
+        rec.read(gpu_layout::kParticleRecord);
+        if constexpr (Count) rec.hint(f.in.bvh.clusterOf(r.y));
         const ShadingPoint sp = shadingPoint(g, f.in.particles);
         LightTerm t;
         ++c.lightTerms;
         if (!f.L.term<SM>(sp, r.y, t)) return;
         ++c.shadowRays;
-        if (!visible<P>(f.in.bvh, sp, t, f.L.radius[r.y], f.eps)) {
+        rec.trip();
+        RayCounters rc;
+        const bool seen = visible<P>(f.in.bvh, sp, t, f.L.radius[r.y], f.eps, rec.rayCounters(rc));
+        rec.ray(rc);
+        if (!seen) {
             ++c.shadowOccluded;
-            if (f.rs.visibility_reuse) r = f.codec.roundTrip(StoredReservoir{kNoLight, 0.0f, r.M, 0.0f});
+            if (f.rs.visibility_reuse) {
+                r = f.codec.roundTrip(StoredReservoir{kNoLight, 0.0f, r.M, 0.0f});
+                rec.write(R);
+            }
             return;
         }
         Lr[px] = t.value * r.W;
@@ -358,30 +428,30 @@ void upsampleLighting(const GBuffer& full, const GBuffer& lg, const Particles& p
     });
 }
 
-template <ShadingModel SM, Primitive P>
+template <ShadingModel SM, Primitive P, bool Count>
 LightingCounters runFrame(const FrameContext& f, std::vector<StoredReservoir>& a, std::vector<StoredReservoir>& b,
                           std::vector<Vec3>& lowLr, PassTimer& timer) {
     LightingCounters total;
     {
         auto t = timer.scope(pass::generateCandidates);
-        total += f.in.settings.render.source == LightSource::power ? generateCandidates<SM, P, true>(f, a)
-                                                                    : generateCandidates<SM, P, false>(f, a);
+        total += f.in.settings.render.source == LightSource::power ? generateCandidates<SM, P, true, Count>(f, a)
+                                                                    : generateCandidates<SM, P, false, Count>(f, a);
     }
     if (f.rs.temporal && f.prev) {
         auto t = timer.scope(pass::temporalResampling);
-        total += temporalResampling<SM, P>(f, a, b);
+        total += temporalResampling<SM, P, Count>(f, a, b);
         std::swap(a, b);
     }
     if (f.rs.spatial_neighbours > 0) {
         auto t = timer.scope(pass::spatialResampling);
         for (std::uint32_t it = 0; it < f.rs.spatial_iterations; ++it) {
-            total += spatialResampling<SM, P>(f, it, a, b);
+            total += spatialResampling<SM, P, Count>(f, it, a, b);
             std::swap(a, b);
         }
     }
     {
         auto t = timer.scope(pass::traceShadowRays);
-        total += traceShadowRays<SM, P>(f, a, lowLr);
+        total += traceShadowRays<SM, P, Count>(f, a, lowLr);
     }
     return total;
 }
@@ -389,8 +459,12 @@ LightingCounters runFrame(const FrameContext& f, std::vector<StoredReservoir>& a
 template <ShadingModel SM>
 LightingCounters dispatchPrimitive(const FrameContext& f, std::vector<StoredReservoir>& a, std::vector<StoredReservoir>& b,
                                    std::vector<Vec3>& lowLr, PassTimer& timer) {
-    return f.in.bvh.settings().primitive == Primitive::sphere ? runFrame<SM, Primitive::sphere>(f, a, b, lowLr, timer)
-                                                              : runFrame<SM, Primitive::billboard>(f, a, b, lowLr, timer);
+    const bool spheres = f.in.bvh.settings().primitive == Primitive::sphere;
+    if (f.counters)
+        return spheres ? runFrame<SM, Primitive::sphere, true>(f, a, b, lowLr, timer)
+                       : runFrame<SM, Primitive::billboard, true>(f, a, b, lowLr, timer);
+    return spheres ? runFrame<SM, Primitive::sphere, false>(f, a, b, lowLr, timer)
+                   : runFrame<SM, Primitive::billboard, false>(f, a, b, lowLr, timer);
 }
 
 }  // namespace
@@ -434,7 +508,7 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
     const History* prev = history_ && history_->gbuffer.width == lg->width && history_->gbuffer.height == lg->height
                               ? history_.get() : nullptr;
     FrameContext f{in, rs_, codec_, *lg, L, prev, lg == &full ? 1.0f : float(lg->width) / float(full.width),
-                   static_cast<float>(in.settings.render.shadow_epsilon)};
+                   static_cast<float>(in.settings.render.shadow_epsilon), in.counters};
 
     std::vector<StoredReservoir> a(lpixels), b(lpixels);
     std::vector<Vec3> lowLr(lpixels);
@@ -452,6 +526,23 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
     } else {
         auto t = timer.scope(pass::upsampleLighting);
         upsampleLighting(full, *lg, in.particles, lowLr, f.scale, rs_, out.Lr);
+        if (in.counters) {
+            // Per image pixel: its texel, then four lighting texels (G-buffer + radiance) as loop trips.
+            PassCounters& pc = in.counters->add(pass::upsampleLighting, full.width, full.height);
+            for (std::size_t px = 0; px < pixels; ++px) {
+                const GBufferTexel& g = full.texels[px];
+                ThreadCounters& t = pc.threads[px];
+                t.active = 1;
+                t.bytesRead = gpu_layout::kGBufferTexel;
+                t.bytesWritten = gpu_layout::kRadiance;
+                if (!g.hit()) continue;
+                t.hit = 1;
+                t.type = in.particles.type[g.particle];
+                t.cluster = in.bvh.clusterOf(g.particle);
+                t.trips = 4;
+                t.bytesRead += 4 * (gpu_layout::kGBufferTexel + gpu_layout::kRadiance);
+            }
+        }
     }
     aov.W.assign(pixels, 0.0f);
     aov.M.assign(pixels, 0.0f);

@@ -6,6 +6,7 @@
 
 #include "accretion/core/error.h"
 #include "accretion/core/rng.h"
+#include "accretion/gpu/gpu_layouts.h"
 #include "accretion/lighting/light_arrays.h"
 #include "accretion/lighting/reservoir.h"
 #include "accretion/render/shading.h"
@@ -20,7 +21,8 @@ ShadingPoint shadingPoint(const GBufferTexel& g, const Particles& particles) {
 
 /// exact: sum over every light i != j of f I G V, in double.
 template <ShadingModel M, Primitive P>
-Vec3 exactPixel(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint& sp, float eps, LightingCounters& c) {
+Vec3 exactPixel(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint& sp, float eps, LightingCounters& c,
+                RayCounters* rc) {
     DVec3 sum(0.0);
     for (std::uint32_t i = 0; i < L.count; ++i) {
         if (i == sp.self) continue;
@@ -28,7 +30,7 @@ Vec3 exactPixel(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint
         ++c.lightTerms;
         if (!evalLight<M>(sp, L.position[i], L.emission[i], L.dmin2[i], t)) continue;
         ++c.shadowRays;
-        if (visible<P>(bvh, sp, t, L.radius[i], eps)) sum += DVec3(t.value);
+        if (visible<P>(bvh, sp, t, L.radius[i], eps, rc)) sum += DVec3(t.value);
         else ++c.shadowOccluded;
     }
     return Vec3(sum);
@@ -58,7 +60,7 @@ private:
 template <ShadingModel M, Primitive P, class Sampler>
 std::uint32_t sampledPixel(const ParticleBvh& bvh, const LightArrays& L, Sampler&& sampleOne, const ShadingPoint& sp,
                            const RenderSettings& rs, float eps, Rng& rng, Vec3& mean, Vec3& stderr,
-                           LightingCounters& c) {
+                           LightingCounters& c, RayCounters* rc) {
     SampleMean acc;
     std::uint32_t n = 0;
     for (;;) {
@@ -68,7 +70,7 @@ std::uint32_t sampledPixel(const ParticleBvh& bvh, const LightArrays& L, Sampler
             ++c.lightTerms;
             if (!L.term<M>(sp, x.i, t)) continue;
             ++c.shadowRays;
-            if (!visible<P>(bvh, sp, t, L.radius[x.i], eps)) {
+            if (!visible<P>(bvh, sp, t, L.radius[x.i], eps, rc)) {
                 ++c.shadowOccluded;
                 continue;
             }
@@ -86,7 +88,8 @@ std::uint32_t sampledPixel(const ParticleBvh& bvh, const LightArrays& L, Sampler
 /// without visibility; the kept y gets one shadow ray, weighted by W.
 template <ShadingModel M, Primitive P, bool Power>
 void risPixel(const ParticleBvh& bvh, const LightArrays& L, const AliasTable* table, const ShadingPoint& sp,
-              const RenderSettings& rs, float eps, Rng& rng, Vec3& mean, Vec3& stderr, LightingCounters& c) {
+              const RenderSettings& rs, float eps, Rng& rng, Vec3& mean, Vec3& stderr, LightingCounters& c,
+              RayCounters* rc) {
     SampleMean acc;
     for (std::uint32_t k = 0; k < rs.samples; ++k) {
         Reservoir r;
@@ -102,7 +105,7 @@ void risPixel(const ParticleBvh& bvh, const LightArrays& L, const AliasTable* ta
         r.finalize();
         if (r.W <= 0.0f) continue;
         ++c.shadowRays;
-        if (!visible<P>(bvh, sp, t_y, L.radius[r.y], eps)) {
+        if (!visible<P>(bvh, sp, t_y, L.radius[r.y], eps, rc)) {
             ++c.shadowOccluded;
             continue;
         }
@@ -111,7 +114,9 @@ void risPixel(const ParticleBvh& bvh, const LightArrays& L, const AliasTable* ta
     acc.finish(rs.samples, mean, stderr);
 }
 
-template <ShadingModel M, Primitive P>
+/// Counters (counting mode): per pixel, its key, the light terms as loop
+/// trips, the shadow rays with their traversal counts, and bytes.
+template <ShadingModel M, Primitive P, bool Count>
 LightingCounters run(const LightingInputs& in, const LightArrays& L, LightingImage& out, Progress* progress) {
     const GBuffer& gb = in.gbuffer;
     const float eps = static_cast<float>(in.render.shadow_epsilon);
@@ -125,10 +130,32 @@ LightingCounters run(const LightingInputs& in, const LightArrays& L, LightingIma
             for (std::uint32_t x = r.cols().begin(); x != r.cols().end(); ++x) {
                 const std::size_t px = std::size_t(y) * gb.width + x;
                 const GBufferTexel& g = gb.texels[px];
-                if (!g.hit()) continue;
+                [[maybe_unused]] const LightingCounters before = c;
+                RayCounters raySum;
+                RayCounters* rc = Count ? &raySum : nullptr;
+                const auto record = [&] {
+                    if constexpr (Count) {
+                        ThreadCounters& t = in.counters->threads[px];
+                        t.active = 1;
+                        t.bytesRead += gpu_layout::kGBufferTexel;
+                        t.bytesWritten += gpu_layout::kRadiance;
+                        if (!g.hit()) return;
+                        t.hit = 1;
+                        t.type = in.particles.type[g.particle];
+                        t.cluster = in.bvh.clusterOf(g.particle);
+                        t.trips = static_cast<std::uint32_t>(c.lightTerms - before.lightTerms);
+                        t.bytesRead += t.trips * gpu_layout::kParticleRecord;
+                        t.addRays(raySum, static_cast<std::uint32_t>(c.shadowRays - before.shadowRays));
+                    }
+                };
+                if (!g.hit()) {
+                    record();
+                    continue;
+                }
                 const ShadingPoint sp = shadingPoint(g, in.particles);
                 if (kind == EstimatorKind::exact) {
-                    out.Lr[px] = exactPixel<M, P>(in.bvh, L, sp, eps, c);
+                    out.Lr[px] = exactPixel<M, P>(in.bvh, L, sp, eps, c, rc);
+                    record();
                     continue;
                 }
                 Rng rng(px, in.frame, RngPass::lightSampling, in.render.seed);
@@ -136,19 +163,20 @@ LightingCounters run(const LightingInputs& in, const LightArrays& L, LightingIma
                 Vec3& err = out.Lr_stderr[px];
                 std::uint32_t n = S;
                 if (kind == EstimatorKind::ris && in.render.source == LightSource::power)
-                    risPixel<M, P, true>(in.bvh, L, in.powerTable, sp, in.render, eps, rng, mean, err, c);
+                    risPixel<M, P, true>(in.bvh, L, in.powerTable, sp, in.render, eps, rng, mean, err, c, rc);
                 else if (kind == EstimatorKind::ris)
-                    risPixel<M, P, false>(in.bvh, L, nullptr, sp, in.render, eps, rng, mean, err, c);
+                    risPixel<M, P, false>(in.bvh, L, nullptr, sp, in.render, eps, rng, mean, err, c, rc);
                 else if (kind == EstimatorKind::power)
                     n = sampledPixel<M, P>(in.bvh, L, [&](Rng& g) { return sampleSource<true>(L, in.powerTable, g); },
-                                           sp, in.render, eps, rng, mean, err, c);
+                                           sp, in.render, eps, rng, mean, err, c, rc);
                 else if (kind == EstimatorKind::tree)
                     n = sampledPixel<M, P>(in.bvh, L, [&](Rng& g) { return in.lightTree->sample(sp, g); }, sp,
-                                           in.render, eps, rng, mean, err, c);
+                                           in.render, eps, rng, mean, err, c, rc);
                 else
                     n = sampledPixel<M, P>(in.bvh, L, [&](Rng& g) { return sampleSource<false>(L, nullptr, g); }, sp,
-                                           in.render, eps, rng, mean, err, c);
+                                           in.render, eps, rng, mean, err, c, rc);
                 out.spp[px] = float(n);
+                record();
             }
         }
         if (progress) progress->advance(std::uint64_t(r.rows().size()) * r.cols().size());
@@ -160,8 +188,10 @@ LightingCounters run(const LightingInputs& in, const LightArrays& L, LightingIma
 
 template <ShadingModel M>
 LightingCounters dispatchPrimitive(const LightingInputs& in, const LightArrays& L, LightingImage& out, Progress* p) {
-    return in.bvh.settings().primitive == Primitive::sphere ? run<M, Primitive::sphere>(in, L, out, p)
-                                                            : run<M, Primitive::billboard>(in, L, out, p);
+    const bool spheres = in.bvh.settings().primitive == Primitive::sphere;
+    if (in.counters)
+        return spheres ? run<M, Primitive::sphere, true>(in, L, out, p) : run<M, Primitive::billboard, true>(in, L, out, p);
+    return spheres ? run<M, Primitive::sphere, false>(in, L, out, p) : run<M, Primitive::billboard, false>(in, L, out, p);
 }
 
 }  // namespace

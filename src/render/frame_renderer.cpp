@@ -5,7 +5,45 @@
 
 #include <fmt/format.h>
 
+#include "accretion/gpu/gpu_layouts.h"
+
 namespace accretion {
+namespace {
+
+/// buildClusters as a dispatch of one thread per cluster (counting mode):
+/// its primitives as loop trips, particle records read, BLAS bytes written.
+void recordClusterBuild(const ParticleBvh& bvh, const Particles& particles, FrameCounters& counters) {
+    const Clusters& clusters = bvh.clusters();
+    PassCounters& pc = counters.add(pass::buildClusters, static_cast<std::uint32_t>(clusters.count()), 1);
+    const bool billboards = bvh.settings().primitive == Primitive::billboard;
+    for (std::size_t c = 0; c < clusters.count(); ++c) {
+        ThreadCounters& t = pc.threads[c];
+        const auto n = static_cast<std::uint32_t>(clusters.members(c).size());
+        t.active = 1;
+        t.cluster = static_cast<std::uint32_t>(c);
+        t.trips = billboards ? 2 * n : n;
+        t.bytesRead = n * gpu_layout::kParticleRecord;
+        t.bytesWritten = billboards ? n * (4 * 12 + 2 * 12) : n * 16;  // vertex + index buffers, or sphere points
+    }
+}
+
+/// composeImage (the final shading, Le + Lr) per pixel (counting mode).
+void recordCompose(const GBuffer& gbuffer, const Particles& particles, const ParticleBvh& bvh, PassCounters& pc) {
+    for (std::size_t px = 0; px < gbuffer.texels.size(); ++px) {
+        const GBufferTexel& g = gbuffer.texels[px];
+        ThreadCounters& t = pc.threads[px];
+        t.active = 1;
+        t.bytesRead = gpu_layout::kGBufferTexel;
+        t.bytesWritten = gpu_layout::kRadiance;
+        if (!g.hit()) continue;
+        t.hit = 1;
+        t.type = particles.type[g.particle];
+        t.cluster = bvh.clusterOf(g.particle);
+        t.bytesRead += gpu_layout::kRadiance + gpu_layout::kParticleRecord;
+    }
+}
+
+}  // namespace
 
 FrameRenderer::FrameRenderer(const Settings& settings, ParticleSource source, RenderOptions options)
     : settings_(settings), source_(std::move(source)), options_(options),
@@ -37,6 +75,9 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats) {
         bvh_->build(particles, camera);
     }
     stats.bvh = bvh_->stats();
+    FrameImage img;
+    const bool counting = settings_.gpu.counters;
+    if (counting) recordClusterBuild(*bvh_, particles, img.counters);
 
     // Light sampler: only the power and tree estimators need one, and only with light.
     AliasTable powerTable;
@@ -56,10 +97,10 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats) {
     GBuffer gbuffer;
     {
         auto t = timer.scope(pass::traceGBuffer);
-        stats.primaryRays = traceGBuffer(*bvh_, particles, camera, settings_.shading.model, gbuffer);
+        PassCounters* pc = counting ? &img.counters.add(pass::traceGBuffer, camera.width, camera.height) : nullptr;
+        stats.primaryRays = traceGBuffer(*bvh_, particles, camera, settings_.shading.model, gbuffer, pc);
     }
 
-    FrameImage img;
     img.width = camera.width;
     img.height = camera.height;
     const std::size_t pixels = std::size_t(img.width) * img.height;
@@ -67,13 +108,14 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats) {
         auto t = timer.scope(pass::estimateLighting);
         if (lit && restir_) {
             RestirInputs in{*bvh_, particles, gbuffer, camera, settings_, frame, power ? &powerTable : nullptr,
-                            previousBvh_.get()};
+                            previousBvh_.get(), counting ? &img.counters : nullptr};
             stats.lighting = restir_->render(in, img.lighting, img.reservoirs, timer);
             stats.reservoirBytes = restir_->reservoirBytes();
         } else if (lit) {
             Progress progress(fmt::format("frame {} {}", frame, pass::estimateLighting), pixels, options_.quiet);
             LightingInputs in{*bvh_, particles, gbuffer, settings_.shading, settings_.render, frame,
-                              power ? &powerTable : nullptr, tree ? &lightTree : nullptr};
+                              power ? &powerTable : nullptr, tree ? &lightTree : nullptr,
+                              counting ? &img.counters.add(pass::estimateLighting, camera.width, camera.height) : nullptr};
             stats.lighting = estimateLighting(in, img.lighting, &progress);
         } else {
             img.lighting.Lr.assign(pixels, Vec3(0.0f));
@@ -106,6 +148,7 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats) {
             img.normal[px] = g.normal;
         }
         stats.hitPixels = hits;
+        if (counting) recordCompose(gbuffer, particles, *bvh_, img.counters.add(pass::composeImage, img.width, img.height));
         double sppSum = 0.0;
         for (std::size_t px = 0; px < pixels; ++px)
             if (gbuffer.texels[px].hit()) {
@@ -114,6 +157,7 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats) {
             }
         stats.meanSpp = hits ? sppSum / double(hits) : 0.0;
     }
+    if (counting) img.heatmaps = counterHeatmaps(img.counters, img.width, img.height);
     stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return img;
 }

@@ -4,23 +4,33 @@
 #include <tbb/parallel_for.h>
 
 #include "accretion/geometry/billboard.h"
+#include "accretion/gpu/gpu_layouts.h"
 
 namespace accretion {
 
-std::uint64_t traceGBuffer(const ParticleBvh& bvh, const Particles& particles, const Camera& camera,
-                           ShadingModel model, GBuffer& gbuffer) {
-    gbuffer.width = camera.width;
-    gbuffer.height = camera.height;
-    gbuffer.texels.assign(std::size_t(camera.width) * camera.height, GBufferTexel{});
+namespace {
+
+template <bool Count>
+void trace(const ParticleBvh& bvh, const Particles& particles, const Camera& camera, ShadingModel model,
+           GBuffer& gbuffer, PassCounters* counters) {
     const bool spheres = bvh.settings().primitive == Primitive::sphere;
 
     tbb::parallel_for(tbb::blocked_range2d<std::uint32_t>(0, camera.height, 8, 0, camera.width, 8), [&](const auto& r) {
         for (std::uint32_t y = r.rows().begin(); y != r.rows().end(); ++y)
             for (std::uint32_t x = r.cols().begin(); x != r.cols().end(); ++x) {
+                const std::size_t px = std::size_t(y) * camera.width + x;
                 const Vec3 dir = camera.pixelDirection(x, y);
                 SurfaceHit hit;
-                if (!bvh.intersect(camera.position, dir, std::numeric_limits<float>::infinity(), hit)) continue;
-                GBufferTexel& g = gbuffer.texels[std::size_t(y) * camera.width + x];
+                Recorder<Count> rec(Count ? &counters->threads[px] : nullptr);
+                RayCounters rc;
+                const bool found =
+                    bvh.intersect(camera.position, dir, std::numeric_limits<float>::infinity(), hit, rec.rayCounters(rc));
+                rec.ray(rc);
+                rec.write(gpu_layout::kGBufferTexel);
+                if (!found) continue;
+                rec.shade(true, particles.type[hit.particle], hit.cluster);
+                rec.read(gpu_layout::kParticleRecord);
+                GBufferTexel& g = gbuffer.texels[px];
                 const std::uint32_t j = hit.particle;
                 const Vec3 p = particles.position[j];
                 const float rj = particles.radius[j];
@@ -45,6 +55,17 @@ std::uint64_t traceGBuffer(const ParticleBvh& bvh, const Particles& particles, c
                 g.depth = glm::dot(g.position - camera.position, camera.forward);
             }
     });
+}
+
+}  // namespace
+
+std::uint64_t traceGBuffer(const ParticleBvh& bvh, const Particles& particles, const Camera& camera,
+                           ShadingModel model, GBuffer& gbuffer, PassCounters* counters) {
+    gbuffer.width = camera.width;
+    gbuffer.height = camera.height;
+    gbuffer.texels.assign(std::size_t(camera.width) * camera.height, GBufferTexel{});
+    if (counters) trace<true>(bvh, particles, camera, model, gbuffer, counters);
+    else trace<false>(bvh, particles, camera, model, gbuffer, nullptr);
     return std::uint64_t(camera.width) * camera.height;
 }
 

@@ -71,6 +71,8 @@ public:
     bool counting() const { return counting_; }
     /// The opacity micromap in use (null without one).
     const OpacityMicromap* micromap() const { return omm_.get(); }
+    /// Cluster of particle i (counting mode only).
+    std::uint32_t clusterOf(std::uint32_t i) const { return clusterOf_[i]; }
     /// BLAS of cluster c (for the counting instances).
     RTCScene blas(std::size_t c) const { return blas_[c]; }
     /// World bounds of cluster c's BLAS in the current build.
@@ -98,6 +100,7 @@ private:
     bool counting_ = false;
     RTCScene countingTlas_ = nullptr;      ///< user-geometry instances that count entries
     std::vector<RTCBounds> blasBounds_;
+    std::vector<std::uint32_t> clusterOf_;  ///< counting: particle -> cluster
     std::unique_ptr<OpacityMicromap> omm_;
     AlphaTest alpha_;
     std::size_t partialCursor_ = 0;  ///< partial: first cluster of the next window

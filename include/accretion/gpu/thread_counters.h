@@ -31,6 +31,13 @@ struct ThreadCounters {
     std::uint32_t bytesWritten = 0; ///< G-buffer, reservoirs, radiance written
 
     std::uint32_t branchKey() const { return hit ? 1u + type : 0u; }
+    /// n rays whose counters sum to r.
+    void addRays(const RayCounters& r, std::uint32_t n) {
+        rays += n;
+        proceeds += r.candidates + n;
+        blasEntries += r.blasEntries;
+        anyHits += r.anyHits;
+    }
     void addRay(const RayCounters& r) {
         ++rays;
         proceeds += r.candidates + 1;
@@ -80,6 +87,7 @@ template <> struct Recorder<false> {
     void read(std::uint32_t) {}
     void write(std::uint32_t) {}
     void hint(std::uint32_t) {}
+    void rays(const RayCounters&, std::uint32_t) {}
     RayCounters* rayCounters(RayCounters&) { return nullptr; }
 };
 
@@ -93,6 +101,7 @@ template <> struct Recorder<true> {
     }
     void trip(std::uint32_t n = 1) { t_->trips += n; }
     void ray(const RayCounters& r) { t_->addRay(r); }
+    void rays(const RayCounters& r, std::uint32_t n) { t_->addRays(r, n); }
     void read(std::uint32_t bytes) { t_->bytesRead += bytes; }
     void write(std::uint32_t bytes) { t_->bytesWritten += bytes; }
     void hint(std::uint32_t h) { t_->hint = h; }

@@ -27,6 +27,11 @@ struct FloatChannel {
 void writeChannelsExr(const std::filesystem::path& file, std::uint32_t width, std::uint32_t height,
                       const std::vector<FloatChannel>& channels, const OutputMetadata& metadata);
 
+/// A counter heatmap as an 8-bit PNG: 0 black, the 99.5th percentile of the
+/// non-zero values (or the maximum) bright yellow, through a perceptual ramp. Atomic.
+void writeHeatmapPng(const std::filesystem::path& file, const std::vector<float>& values, std::uint32_t width,
+                     std::uint32_t height);
+
 void writePreviewPng(const std::filesystem::path& file, const std::vector<Vec3>& rgb, std::uint32_t width,
                      std::uint32_t height, bool autoExposure, double exposure);
 

@@ -5,6 +5,7 @@
 
 #include "accretion/core/pass_timer.h"
 #include "accretion/geometry/particle_bvh.h"
+#include "accretion/gpu/thread_counters.h"
 #include "accretion/lighting/light_arrays.h"
 #include "accretion/lighting/reservoir_codec.h"
 #include "accretion/render/camera.h"
@@ -33,6 +34,7 @@ struct RestirInputs {
     std::uint32_t frame = 0;
     const AliasTable* powerTable = nullptr;  ///< render.source = power
     const ParticleBvh* previousBvh = nullptr; ///< last frame's BVH (see needsPreviousBvh), else the current one is used
+    FrameCounters* counters = nullptr;        ///< counting mode: each pass adds its thread records (the BVH must count)
 };
 
 /// basic_visibility tests the previous frame's samples against the previous

@@ -5,6 +5,7 @@
 #include "accretion/core/math.h"
 #include "accretion/core/progress.h"
 #include "accretion/geometry/particle_bvh.h"
+#include "accretion/gpu/thread_counters.h"
 #include "accretion/lighting/light_tree.h"
 #include "accretion/render/alias_table.h"
 #include "accretion/render/gbuffer.h"
@@ -46,6 +47,7 @@ struct LightingInputs {
     std::uint32_t frame = 0;
     const AliasTable* powerTable = nullptr;  ///< required when needsPowerTable()
     const LightTree* lightTree = nullptr;    ///< required by `tree`
+    PassCounters* counters = nullptr;        ///< counting mode: one thread record per pixel (the BVH must count)
 };
 
 /// True if the estimator samples lights in proportion to their power.

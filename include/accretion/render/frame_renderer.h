@@ -6,6 +6,8 @@
 #include "accretion/core/pass_timer.h"
 #include "accretion/geometry/embree_device.h"
 #include "accretion/geometry/particle_bvh.h"
+#include "accretion/gpu/gpu_report.h"
+#include "accretion/gpu/thread_counters.h"
 #include "accretion/lighting/restir.h"
 #include "accretion/particles/particle_source.h"
 #include "accretion/render/camera.h"
@@ -25,6 +27,8 @@ struct FrameImage {
     std::vector<Vec3> normal;         ///< shading normal
     std::vector<std::uint32_t> particle; ///< hit particle id, kNoParticle on a miss
     ReservoirImage reservoirs;        ///< restir only: the final reservoirs
+    FrameCounters counters;           ///< gpu.counters: every pass's thread records
+    std::vector<Heatmap> heatmaps;    ///< gpu.counters: per-pixel counter AOVs (gpu.*)
 };
 
 /// Counts and times of one frame, for stats.json.
@@ -59,6 +63,8 @@ public:
     FrameImage render(std::uint32_t frame, FrameStats& stats);
 
     const Settings& settings() const { return settings_; }
+    /// The BVH of the last frame rendered.
+    const ParticleBvh& bvh() const { return *bvh_; }
 
 private:
     Settings settings_;

@@ -5,6 +5,7 @@
 
 #include "accretion/core/math.h"
 #include "accretion/geometry/particle_bvh.h"
+#include "accretion/gpu/thread_counters.h"
 #include "accretion/render/camera.h"
 
 namespace accretion {
@@ -29,8 +30,9 @@ struct GBuffer {
 };
 
 /// traceGBuffer: one primary ray per pixel through its centre (MODEL.md
-/// section 3). Returns the number of rays traced.
+/// section 3). Returns the number of rays traced. With counters (counting
+/// mode), records each pixel's thread: hit key, the ray, bytes.
 std::uint64_t traceGBuffer(const ParticleBvh& bvh, const Particles& particles, const Camera& camera,
-                           ShadingModel model, GBuffer& gbuffer);
+                           ShadingModel model, GBuffer& gbuffer, PassCounters* counters = nullptr);
 
 }  // namespace accretion

@@ -1,0 +1,20 @@
+#pragma once
+#include <cstdint>
+
+namespace accretion::gpu_layout {
+
+/// Bytes of the GPU's buffers as the counters charge them (MODEL.md section 6).
+/// G-buffer texel: position float3 (12) + octahedral normal (4) + depth (4) + particle id (4).
+inline constexpr std::uint32_t kGBufferTexel = 24;
+/// Particle record: the raw 32-byte GPU record (position, radius, emission, opacity, type).
+inline constexpr std::uint32_t kParticleRecord = 32;
+/// Radiance written per pixel: RGBA16F.
+inline constexpr std::uint32_t kRadiance = 8;
+/// Alias-table entry (probability + alias) read per power-sampled candidate.
+inline constexpr std::uint32_t kAliasEntry = 8;
+/// Ray payloads of the pipeline (TraceRay) form: primary hit (t, instance,
+/// primitive, barycentrics) and shadow visibility.
+inline constexpr std::uint32_t kPrimaryPayload = 16;
+inline constexpr std::uint32_t kShadowPayload = 4;
+
+}  // namespace accretion::gpu_layout

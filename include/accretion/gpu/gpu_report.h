@@ -1,0 +1,82 @@
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "accretion/gpu/gpu_memory.h"
+#include "accretion/gpu/thread_counters.h"
+#include "accretion/gpu/warp_model.h"
+#include "accretion/scene/settings.h"
+
+namespace accretion {
+
+class ParticleBvh;
+
+/// One pass's counters, summed, with its SIMT/SER statistics and the
+/// inline-RayQuery vs pipeline-TraceRay advice of seed 003.
+struct PassReport {
+    std::string pass;
+    std::uint32_t width = 0, height = 0;
+    std::uint64_t threads = 0, hitThreads = 0;
+    std::uint64_t trips = 0, rays = 0, proceeds = 0, blasEntries = 0, anyHits = 0;
+    std::uint64_t bytesRead = 0, bytesWritten = 0;
+    std::uint32_t maxTrips = 0;
+    SerReport ser;
+    std::string rayModel;  ///< "inline", "pipeline", or "-" (no rays)
+    std::string reason;
+
+    std::uint64_t warpSteps() const { return ser.branchBefore.steps + ser.loopBefore.steps; }
+    double perRay(std::uint64_t n) const { return rays ? double(n) / double(rays) : 0.0; }
+};
+
+/// Reservoir, G-buffer and payload layouts and the bandwidth they imply.
+struct LayoutReport {
+    std::uint32_t reservoirBytes = 0;      ///< per stored reservoir (0 without restir)
+    std::uint32_t gbufferTexelBytes = 0;
+    std::uint32_t primaryPayloadBytes = 0, shadowPayloadBytes = 0;
+    std::uint64_t reservoirBufferBytes = 0;  ///< current + history
+    std::uint64_t gbufferBufferBytes = 0;    ///< current (+ previous with temporal reuse)
+    std::uint64_t bytesPerFrame = 0;         ///< read + written by every pass
+};
+
+struct OmmReport {
+    bool enabled = false;
+    std::uint32_t level = 0;
+    bool fourState = false;
+    std::uint64_t opaque = 0, transparent = 0, unknown = 0;  ///< micro-triangles of the two uv triangles
+    std::uint64_t sharedBytes = 0, perTriangleBytes = 0;
+};
+
+/// The GPU model of one frame (MODEL.md section 6).
+struct GpuReport {
+    WarpLayout layout;
+    std::string serKey;
+    std::uint32_t serWindow = 0;
+    std::vector<PassReport> passes;
+    BlasMemory blas;
+    LayoutReport layouts;
+    OmmReport omm;
+};
+
+/// Summarise a frame's counters (the BVH gives cluster sizes, Embree memory and the OMM).
+GpuReport makeGpuReport(const FrameCounters& counters, const ParticleBvh& bvh, const Settings& settings,
+                        std::size_t reservoirBytes);
+
+/// SIMT / SER of one pass under another key or window (the cost command's key sweep).
+SerReport serOf(const PassCounters& pass, const GpuSettings& gpu, const SerKey& key);
+
+nlohmann::json toJson(const PassReport& p);
+nlohmann::json toJson(const GpuReport& r);
+
+/// Per-pixel heatmaps at image resolution, summed over the pixel passes
+/// (a reduced-resolution pass counts at its texel): gpu.rays,
+/// gpu.blas_entries, gpu.any_hits, gpu.trips, gpu.bytes.
+struct Heatmap {
+    std::string name;
+    std::vector<float> values;
+};
+std::vector<Heatmap> counterHeatmaps(const FrameCounters& counters, std::uint32_t width, std::uint32_t height);
+
+}  // namespace accretion

@@ -1,0 +1,228 @@
+#include "accretion/gpu/gpu_report.h"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+
+#include "accretion/core/pass_timer.h"
+#include "accretion/geometry/particle_bvh.h"
+#include "accretion/gpu/gpu_layouts.h"
+
+namespace accretion {
+namespace {
+
+WarpLayout warpLayout(const GpuSettings& gpu) { return {gpu.group_width, gpu.group_height, gpu.warp_size}; }
+
+/// Seed 003's rule: pipeline TraceRay pays off with many any-hits per ray
+/// (they run as a compact separate shader) or divergence SER can regroup;
+/// inline RayQuery wins for simple occlusion queries with no any-hit, a
+/// trivial miss and a small payload.
+void adviseRayModel(PassReport& p) {
+    if (p.rays == 0) {
+        p.rayModel = "-";
+        p.reason = "no rays";
+        return;
+    }
+    const double anyHitsPerRay = p.perRay(p.anyHits);
+    const double serGain = p.ser.predictedSpeedup;
+    const double efficiency = p.ser.branchBefore.efficiency * 0.5 + p.ser.loopBefore.efficiency * 0.5;
+    if (anyHitsPerRay > 4.0) {
+        p.rayModel = "pipeline";
+        p.reason = fmt::format("{:.1f} any-hits per ray: a separate any-hit shader keeps the caller's registers", anyHitsPerRay);
+    } else if (serGain > 1.15) {
+        p.rayModel = "pipeline";
+        p.reason = fmt::format("SER regrouping predicts {:.2f}x (SIMT efficiency {:.0f}%)", serGain, 100.0 * efficiency);
+    } else if (anyHitsPerRay < 0.5) {
+        p.rayModel = "inline";
+        p.reason = fmt::format("{:.2f} any-hits per ray, SER gain {:.2f}x: a simple query, no payload to marshal",
+                               anyHitsPerRay, serGain);
+    } else {
+        p.rayModel = "inline";
+        p.reason = fmt::format("{:.1f} any-hits per ray and SER gain {:.2f}x are too small for the pipeline's overhead",
+                               anyHitsPerRay, serGain);
+    }
+}
+
+PassReport summarise(const PassCounters& pc, const GpuSettings& gpu, const SerKey& key) {
+    PassReport p;
+    p.pass = pc.pass;
+    p.width = pc.width;
+    p.height = pc.height;
+    for (const ThreadCounters& t : pc.threads) {
+        p.threads += t.active;
+        p.hitThreads += t.hit;
+        p.trips += t.trips;
+        p.maxTrips = std::max(p.maxTrips, t.trips);
+        p.rays += t.rays;
+        p.proceeds += t.proceeds;
+        p.blasEntries += t.blasEntries;
+        p.anyHits += t.anyHits;
+        p.bytesRead += t.bytesRead;
+        p.bytesWritten += t.bytesWritten;
+    }
+    p.ser = serOf(pc, gpu, key);
+    adviseRayModel(p);
+    return p;
+}
+
+}  // namespace
+
+SerReport serOf(const PassCounters& pass, const GpuSettings& gpu, const SerKey& key) {
+    return serReport(pass, warpLayout(gpu), key, gpu.ser_window, gpu.ser_reorder_cost);
+}
+
+GpuReport makeGpuReport(const FrameCounters& counters, const ParticleBvh& bvh, const Settings& settings,
+                        std::size_t reservoirBytes) {
+    const GpuSettings& gpu = settings.gpu;
+    GpuReport r;
+    r.layout = warpLayout(gpu);
+    const SerKey key = SerKey::parse(gpu.ser_key, gpu.ser_hint_bits, "gpu.ser_key");
+    r.serKey = key.label();
+    r.serWindow = gpu.ser_window;
+    std::map<std::string, int> seen;
+    for (const PassCounters& pc : counters.passes) {
+        PassReport p = summarise(pc, gpu, key);
+        if (int n = ++seen[pc.pass]; n > 1) p.pass = fmt::format("{}[{}]", pc.pass, n);
+        r.passes.push_back(std::move(p));
+        r.layouts.bytesPerFrame += r.passes.back().bytesRead + r.passes.back().bytesWritten;
+    }
+
+    const Clusters& clusters = bvh.clusters();
+    std::vector<std::uint32_t> tris(clusters.count());
+    const bool billboards = bvh.settings().primitive == Primitive::billboard;
+    for (std::size_t c = 0; c < clusters.count(); ++c)
+        tris[c] = static_cast<std::uint32_t>(clusters.members(c).size()) * (billboards ? 2u : 1u);
+    r.blas = blasMemory(tris, gpu, bvh.stats().embreeBytes);
+
+    const std::uint64_t pixels = std::uint64_t(settings.camera.width) * settings.camera.height;
+    const double s = settings.render.estimator == EstimatorKind::restir ? settings.restir.resolution_scale : 1.0;
+    const std::uint64_t lightingPixels = static_cast<std::uint64_t>(double(pixels) * s * s + 0.5);
+    const bool temporal = settings.render.estimator == EstimatorKind::restir && settings.restir.temporal;
+    r.layouts.reservoirBytes = static_cast<std::uint32_t>(reservoirBytes);
+    r.layouts.gbufferTexelBytes = gpu_layout::kGBufferTexel;
+    r.layouts.primaryPayloadBytes = gpu_layout::kPrimaryPayload;
+    r.layouts.shadowPayloadBytes = gpu_layout::kShadowPayload;
+    r.layouts.reservoirBufferBytes = reservoirBytes * lightingPixels * (temporal ? 2 : 1);
+    r.layouts.gbufferBufferBytes = gpu_layout::kGBufferTexel * pixels * (temporal ? 2 : 1);
+
+    if (const OpacityMicromap* omm = bvh.micromap()) {
+        r.omm.enabled = true;
+        r.omm.level = omm->level();
+        r.omm.fourState = omm->fourState();
+        r.omm.opaque = omm->count(OmmState::opaque);
+        r.omm.transparent = omm->count(OmmState::transparent);
+        r.omm.unknown = omm->count(OmmState::unknown);
+        const OmmMemory m = ommMemory(*omm, bvh.stats().primitives / 2);
+        r.omm.sharedBytes = m.sharedBytes;
+        r.omm.perTriangleBytes = m.perTriangleBytes;
+    }
+    return r;
+}
+
+namespace {
+
+nlohmann::json simtJson(const SimtStats& s) {
+    return {{"efficiency", s.efficiency},   {"active_threads_per_step", s.activeThreadsPerStep},
+            {"distinct_keys_per_warp", s.distinctKeysPerWarp}, {"warps", s.warps},
+            {"lane_work", s.laneWork},      {"steps", s.steps}};
+}
+
+}  // namespace
+
+nlohmann::json toJson(const PassReport& p) {
+    return {{"pass", p.pass},
+            {"width", p.width},
+            {"height", p.height},
+            {"threads", p.threads},
+            {"hit_threads", p.hitThreads},
+            {"trips", p.trips},
+            {"max_trips", p.maxTrips},
+            {"rays", p.rays},
+            {"proceeds", p.proceeds},
+            {"blas_entries", p.blasEntries},
+            {"blas_entries_per_ray", p.perRay(p.blasEntries)},
+            {"any_hit", p.anyHits},
+            {"any_hits_per_ray", p.perRay(p.anyHits)},
+            {"bytes_read", p.bytesRead},
+            {"bytes_written", p.bytesWritten},
+            {"warp_steps", p.warpSteps()},
+            {"simt_efficiency", {{"branch", simtJson(p.ser.branchBefore)}, {"loop", simtJson(p.ser.loopBefore)}}},
+            {"ser",
+             {{"key", p.ser.key},
+              {"branch_after", simtJson(p.ser.branchAfter)},
+              {"loop_after", simtJson(p.ser.loopAfter)},
+              {"distinct_sort_keys_per_warp_before", p.ser.distinctSortKeysBefore},
+              {"distinct_sort_keys_per_warp_after", p.ser.distinctSortKeysAfter},
+              {"reorder_steps", p.ser.reorderSteps},
+              {"predicted_speedup", p.ser.predictedSpeedup}}},
+            {"ray_model", {{"recommendation", p.rayModel}, {"reason", p.reason}}}};
+}
+
+nlohmann::json toJson(const GpuReport& r) {
+    nlohmann::json passes = nlohmann::json::array();
+    for (const PassReport& p : r.passes) passes.push_back(toJson(p));
+    const BlasMemory& b = r.blas;
+    return {{"warp_layout", {{"group_width", r.layout.groupWidth}, {"group_height", r.layout.groupHeight},
+                             {"warp_size", r.layout.warpSize}}},
+            {"ser_key", r.serKey},
+            {"ser_window", r.serWindow},
+            {"passes", passes},
+            {"blas_bytes",
+             {{"clusters", b.clusters},
+              {"triangles", b.triangles},
+              {"gpu_estimate", b.gpuBytes},
+              {"per_blas_allocation", b.perBlasAllocBytes},
+              {"per_blas_allocation_waste", b.perBlasWaste()},
+              {"pooled", b.pooledBytes},
+              {"pooled_waste", b.pooledWaste()},
+              {"compacted_pooled", b.compactedPooledBytes},
+              {"embree", b.embreeBytes},
+              {"embree_per_cluster", b.clusters ? double(b.embreeBytes) / double(b.clusters) : 0.0}}},
+            {"layouts",
+             {{"reservoir_bytes", r.layouts.reservoirBytes},
+              {"gbuffer_texel_bytes", r.layouts.gbufferTexelBytes},
+              {"primary_payload_bytes", r.layouts.primaryPayloadBytes},
+              {"shadow_payload_bytes", r.layouts.shadowPayloadBytes},
+              {"reservoir_buffer_bytes", r.layouts.reservoirBufferBytes},
+              {"gbuffer_buffer_bytes", r.layouts.gbufferBufferBytes},
+              {"bytes_per_frame", r.layouts.bytesPerFrame},
+              {"bandwidth_gb_s_at_60fps", double(r.layouts.bytesPerFrame) * 60.0 / 1e9}}},
+            {"omm",
+             {{"enabled", r.omm.enabled},
+              {"level", r.omm.level},
+              {"states", r.omm.fourState ? 4 : 2},
+              {"opaque", r.omm.opaque},
+              {"transparent", r.omm.transparent},
+              {"unknown", r.omm.unknown},
+              {"shared_bytes", r.omm.sharedBytes},
+              {"per_triangle_bytes", r.omm.perTriangleBytes}}}};
+}
+
+std::vector<Heatmap> counterHeatmaps(const FrameCounters& counters, std::uint32_t width, std::uint32_t height) {
+    const std::size_t pixels = std::size_t(width) * height;
+    std::vector<Heatmap> maps{{"gpu.rays", std::vector<float>(pixels, 0.0f)},
+                              {"gpu.blas_entries", std::vector<float>(pixels, 0.0f)},
+                              {"gpu.any_hits", std::vector<float>(pixels, 0.0f)},
+                              {"gpu.trips", std::vector<float>(pixels, 0.0f)},
+                              {"gpu.bytes", std::vector<float>(pixels, 0.0f)}};
+    for (const PassCounters& pc : counters.passes) {
+        if (pc.pass == pass::buildClusters || pc.width == 0 || pc.height == 0) continue;
+        for (std::uint32_t y = 0; y < height; ++y)
+            for (std::uint32_t x = 0; x < width; ++x) {
+                const std::uint32_t lx = std::min(pc.width - 1, std::uint32_t(std::uint64_t(x) * pc.width / width));
+                const std::uint32_t ly = std::min(pc.height - 1, std::uint32_t(std::uint64_t(y) * pc.height / height));
+                const ThreadCounters& t = pc.threads[std::size_t(ly) * pc.width + lx];
+                const std::size_t px = std::size_t(y) * width + x;
+                // A texel shared by several image pixels: each gets its share.
+                const float share = float(pc.width) * float(pc.height) / (float(width) * float(height));
+                maps[0].values[px] += share * float(t.rays);
+                maps[1].values[px] += share * float(t.blasEntries);
+                maps[2].values[px] += share * float(t.anyHits);
+                maps[3].values[px] += share * float(t.trips);
+                maps[4].values[px] += share * float(t.bytesRead + t.bytesWritten);
+            }
+    }
+    return maps;
+}
+
+}  // namespace accretion
