@@ -23,5 +23,7 @@ void addParticlesCommand(CLI::App& app);
 void addCompareCommand(CLI::App& app);
 void addConvergeCommand(CLI::App& app);
 void addBiasCommand(CLI::App& app);
+void addCostCommand(CLI::App& app);
+void addCalibrateCommand(CLI::App& app);
 
 }  // namespace accretion::cmd

@@ -18,6 +18,8 @@ int main(int argc, char** argv) {
     accretion::cmd::addCompareCommand(app);
     accretion::cmd::addConvergeCommand(app);
     accretion::cmd::addBiasCommand(app);
+    accretion::cmd::addCostCommand(app);
+    accretion::cmd::addCalibrateCommand(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

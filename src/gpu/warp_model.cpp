@@ -108,7 +108,8 @@ std::uint64_t SerKey::of(const ThreadCounters& t) const {
 std::string SerKey::label() const {
     std::string s;
     for (const std::string& c : components) s += (s.empty() ? "" : "+") + c;
-    if (hintBits > 0) s += fmt::format("({} hint bits)", hintBits);
+    if (hintBits > 0 && std::find(components.begin(), components.end(), "hint") != components.end())
+        s += fmt::format("({} bits)", hintBits);
     return s;
 }
 

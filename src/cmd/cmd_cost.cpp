@@ -1,0 +1,333 @@
+// accretion cost: the GPU model of one frame (MODEL.md section 6): every
+// pass's counters, SIMT and SER, any-hits with opacity micromaps, BLAS
+// memory, layouts, ray-model advice, the counting overhead, and the
+// predicted time per pass; JSON + CSV (the counters calibrate reads).
+#include <algorithm>
+#include <filesystem>
+#include <memory>
+#include <sstream>
+
+#include <fmt/core.h>
+#include <tbb/global_control.h>
+
+#include "accretion/analysis/image_metrics.h"
+#include "accretion/core/error.h"
+#include "accretion/core/version.h"
+#include "accretion/geometry/particle_bvh.h"
+#include "accretion/gpu/cost_model.h"
+#include "accretion/io/atomic_file.h"
+#include "accretion/io/exr_output.h"
+#include "accretion/io/stats_writer.h"
+#include "accretion/render/frame_renderer.h"
+#include "accretion/scene/scene_parser.h"
+#include "commands.h"
+
+namespace accretion::cmd {
+namespace {
+
+struct CostArgs : SceneArgs {
+    std::string output;
+    std::string config;
+    std::uint32_t history = 8;
+    std::uint32_t overhead = 3;
+    std::string clusterSizes = "10,100,1000";
+    std::string ommLevels = "2,4,6";
+    std::vector<std::string> serKeys = {"hit", "hit,type", "hit,type,cluster", "hit,cluster", "hit,type,hint"};
+};
+
+std::vector<std::uint32_t> parseList(const std::string& text, const char* option, std::uint32_t lo, std::uint32_t hi) {
+    std::vector<std::uint32_t> out;
+    if (text.empty()) return out;
+    std::stringstream ss(text);
+    std::string part;
+    while (std::getline(ss, part, ',')) {
+        std::size_t used = 0;
+        unsigned long v = 0;
+        try {
+            v = std::stoul(part, &used);
+        } catch (...) {
+            used = 0;
+        }
+        if (used == 0 || used != part.size() || v < lo || v > hi)
+            throw InputError(fmt::format("command line {} {}: expected integers in [{}, {}] separated by commas", option, text, lo, hi));
+        out.push_back(static_cast<std::uint32_t>(v));
+    }
+    return out;
+}
+
+/// One rendered frame with its history (restir), counters per the settings.
+struct CountedFrame {
+    FrameImage image;
+    FrameStats stats;
+    GpuReport report;
+};
+
+CountedFrame renderCounted(const Settings& s, const ParticleSource& source, std::uint32_t frame, std::uint32_t history) {
+    FrameRenderer renderer(s, source, RenderOptions{true});
+    const std::uint32_t first = s.render.estimator == EstimatorKind::restir ? frame - std::min(frame, history) : frame;
+    CountedFrame out;
+    for (std::uint32_t f = first; f <= frame; ++f) {
+        out.stats = FrameStats{};
+        out.image = renderer.render(f, out.stats);
+    }
+    if (s.gpu.counters) out.report = makeGpuReport(out.image.counters, renderer.bvh(), s, out.stats.reservoirBytes);
+    return out;
+}
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+void runCost(const CostArgs& a) {
+    std::vector<std::string> overrides = a.defines;
+    appendFrameOverrides(a.frames, overrides);
+    overrides.push_back("gpu.counters=true");
+    const Settings settings = loadScene(a.scene, overrides);
+    const std::vector<std::uint32_t> clusterSizes = parseList(a.clusterSizes, "--cluster-sizes", 1, 10000000);
+    const std::vector<std::uint32_t> ommLevels = parseList(a.ommLevels, "--omm-levels", 0, 6);
+    std::vector<SerKey> serKeys;
+    for (const std::string& k : a.serKeys) serKeys.push_back(SerKey::parse(k, std::max(settings.gpu.ser_hint_bits, 4u), "--ser-keys " + k));
+    const CostCoefficients coef = settings.gpu.coefficients.empty() ? CostCoefficients::defaults()
+                                                                    : CostCoefficients::load(settings.gpu.coefficients);
+    std::optional<tbb::global_control> threads;
+    if (a.threads > 0) threads.emplace(tbb::global_control::max_allowed_parallelism, std::size_t(a.threads));
+    const std::string prefix = a.output.empty() ? "out/" + settings.sceneName + ".cost" : std::filesystem::path(a.output).replace_extension().string();
+    const std::string config = a.config.empty() ? settings.sceneName : a.config;
+    const std::uint32_t frame = settings.render.frame_start;
+    const ParticleSource source(settings);
+    auto log = [&](const std::string& msg) {
+        if (!a.quiet) fmt::print(stderr, "cost: {}\n", msg);
+    };
+
+    log(fmt::format("frame {} of {} with counters ({} history frames)", frame, settings.scenePath,
+                    settings.render.estimator == EstimatorKind::restir ? std::min(frame, a.history) : 0));
+    const CountedFrame main = renderCounted(settings, source, frame, a.history);
+    const GpuReport& r = main.report;
+
+    // Per-pass table.
+    fmt::print("{}: frame {}, {}x{}, {} particles, {} clusters, estimator {}; warps {}x{} groups of {} lanes; cost: {}\n",
+               settings.sceneName, frame, settings.camera.width, settings.camera.height, main.stats.particles,
+               main.stats.bvh.clusters, enumName(settings.render.estimator), r.layout.groupWidth, r.layout.groupHeight,
+               r.layout.warpSize, coef.source);
+    fmt::print("{:<20} {:>9} {:>11} {:>10} {:>8} {:>8} {:>8} {:>9} {:>9} {:>7} {:>7} {:>6} {:>9} {:>9}\n", "pass", "threads",
+               "trips", "rays", "BLAS/ray", "AH/ray", "proc/ray", "MB read", "MB write", "SIMTbr", "SIMTlp", "SER", "model",
+               "pred. ms");
+    nlohmann::json passes = nlohmann::json::array();
+    std::string csv = "config,pass";
+    for (std::string_view f : kCostFeatures) csv += fmt::format(",{}", f);
+    csv += ",predicted_ms\n";
+    double totalMs = 0.0;
+    for (const PassReport& p : r.passes) {
+        const CostFeatures f = costFeatures(p);
+        const double ms = coef.predictMs(f);
+        totalMs += ms;
+        fmt::print("{:<20} {:>9} {:>11} {:>10} {:>8.2f} {:>8.2f} {:>8.2f} {:>9.1f} {:>9.1f} {:>6.1f}% {:>6.1f}% {:>5.2f}x {:>9} {:>9.3f}\n",
+                   p.pass, p.threads, p.trips, p.rays, p.perRay(p.blasEntries), p.perRay(p.anyHits), p.perRay(p.proceeds),
+                   1e-6 * double(p.bytesRead), 1e-6 * double(p.bytesWritten), 100.0 * p.ser.branchBefore.efficiency,
+                   100.0 * p.ser.loopBefore.efficiency, p.ser.predictedSpeedup, p.rayModel, ms);
+        nlohmann::json j = toJson(p);
+        j["predicted_ms"] = ms;
+        passes.push_back(j);
+        csv += fmt::format("{},{}", config, p.pass);
+        for (double v : f) csv += fmt::format(",{}", v);
+        csv += fmt::format(",{:.6g}\n", ms);
+    }
+    fmt::print("{:<20} predicted {:.3f} ms per frame\n", "total", totalMs);
+    for (const PassReport& p : r.passes)
+        if (p.rays > 0) fmt::print("  {}: {} ({})\n", p.pass, p.rayModel, p.reason);
+
+    // SER key sweep on every pass with hits: efficiency before / after per key.
+    nlohmann::json serSweep = nlohmann::json::array();
+    fmt::print("\nSER (window {} threads, reorder cost {} lane-steps per thread): branch SIMT efficiency before -> after, "
+               "distinct keys per warp, predicted speed-up\n", settings.gpu.ser_window, settings.gpu.ser_reorder_cost);
+    for (const PassCounters& pc : main.image.counters.passes) {
+        if (pc.pass == pass::buildClusters) continue;
+        std::string best;
+        double bestGain = 0.0;
+        for (const SerKey& k : serKeys) {
+            const SerReport s = serOf(pc, settings.gpu, k);
+            fmt::print("  {:<20} {:<26} {:5.1f}% -> {:5.1f}%  keys {:5.2f} -> {:5.2f}  loop {:5.1f}% -> {:5.1f}%  {:5.2f}x\n",
+                       pc.pass, s.key, 100.0 * s.branchBefore.efficiency, 100.0 * s.branchAfter.efficiency,
+                       s.distinctSortKeysBefore, s.distinctSortKeysAfter, 100.0 * s.loopBefore.efficiency,
+                       100.0 * s.loopAfter.efficiency, s.predictedSpeedup);
+            serSweep.push_back({{"pass", pc.pass},
+                                {"key", s.key},
+                                {"branch_efficiency_before", s.branchBefore.efficiency},
+                                {"branch_efficiency_after", s.branchAfter.efficiency},
+                                {"loop_efficiency_before", s.loopBefore.efficiency},
+                                {"loop_efficiency_after", s.loopAfter.efficiency},
+                                {"distinct_keys_per_warp_before", s.distinctSortKeysBefore},
+                                {"distinct_keys_per_warp_after", s.distinctSortKeysAfter},
+                                {"predicted_speedup", s.predictedSpeedup}});
+            if (s.predictedSpeedup > bestGain) {
+                bestGain = s.predictedSpeedup;
+                best = s.key;
+            }
+        }
+        fmt::print("  {:<20} best key: {} ({:.2f}x)\n", pc.pass, best, bestGain);
+    }
+
+    // Any-hit and opacity micromaps: alpha testing against OMM levels (4-state: same image; 2-state: its error).
+    nlohmann::json omm = nlohmann::json::array();
+    if (settings.geometry.alpha == AlphaMode::disc && !ommLevels.empty()) {
+        fmt::print("\nany-hit per ray (primary / shadow) and OMM memory (shared arrays vs one per triangle):\n");
+        auto anyHits = [](const GpuReport& g, bool shadow) {
+            std::uint64_t ah = 0, rays = 0;
+            for (const PassReport& p : g.passes) {
+                const bool isPrimary = p.pass == pass::traceGBuffer;
+                if (p.rays == 0 || isPrimary == shadow) continue;
+                ah += p.anyHits;
+                rays += p.rays;
+            }
+            return rays ? double(ah) / double(rays) : 0.0;
+        };
+        Settings alpha = settings;
+        alpha.gpu.omm = OmmMode::off;
+        const CountedFrame base = settings.gpu.omm == OmmMode::off ? CountedFrame{} : renderCounted(alpha, source, frame, a.history);
+        const CountedFrame& ref = settings.gpu.omm == OmmMode::off ? main : base;
+        fmt::print("  {:<14} {:>8} {:>8}\n", "", "primary", "shadow");
+        fmt::print("  {:<14} {:>8.3f} {:>8.3f}\n", "alpha test", anyHits(ref.report, false), anyHits(ref.report, true));
+        omm.push_back({{"variant", "alpha"}, {"any_hits_per_primary_ray", anyHits(ref.report, false)},
+                       {"any_hits_per_shadow_ray", anyHits(ref.report, true)}});
+        for (const bool four : {true, false})
+            for (std::uint32_t L : ommLevels) {
+                Settings s = settings;
+                s.gpu.omm = four ? OmmMode::four_state : OmmMode::two_state;
+                s.gpu.omm_level = L;
+                log(fmt::format("OMM {}-state level {}", four ? 4 : 2, L));
+                const CountedFrame v = renderCounted(s, source, frame, a.history);
+                const ErrorMetrics e = computeErrors(v.image.L, ref.image.L);
+                std::size_t changed = 0;  // pixels whose visible particle differs from alpha testing
+                for (std::size_t px = 0; px < v.image.particle.size(); ++px) changed += v.image.particle[px] != ref.image.particle[px];
+                const double changedFraction = double(changed) / double(std::max<std::size_t>(1, v.image.particle.size()));
+                const std::string name = fmt::format("omm {}-state L{}", four ? 4 : 2, L);
+                fmt::print("  {:<14} {:>8.3f} {:>8.3f}  image vs alpha: relMSE {:.3g} MAPE {:.3g}, {:.2f}% of pixels see another "
+                           "particle; bytes {} shared vs {}\n", name, anyHits(v.report, false), anyHits(v.report, true), e.relMSE,
+                           e.MAPE, 100.0 * changedFraction, v.report.omm.sharedBytes, v.report.omm.perTriangleBytes);
+                omm.push_back({{"variant", name},
+                               {"states", four ? 4 : 2},
+                               {"level", L},
+                               {"any_hits_per_primary_ray", anyHits(v.report, false)},
+                               {"any_hits_per_shadow_ray", anyHits(v.report, true)},
+                               {"image_relMSE_vs_alpha", e.relMSE},
+                               {"image_MAPE_vs_alpha", e.MAPE},
+                               {"image_identical", v.image.L == ref.image.L},
+                               {"pixels_changed_fraction", changedFraction},
+                               {"micro_triangles", {{"opaque", v.report.omm.opaque}, {"transparent", v.report.omm.transparent},
+                                                    {"unknown", v.report.omm.unknown}}},
+                               {"shared_bytes", v.report.omm.sharedBytes},
+                               {"per_triangle_bytes", v.report.omm.perTriangleBytes}});
+            }
+    }
+
+    // BLAS memory at other cluster sizes: the frame's particles, rebuilt.
+    nlohmann::json memory = nlohmann::json::array();
+    if (!clusterSizes.empty()) {
+        fmt::print("\nBLAS memory (GPU estimate {} B/triangle, {} B/node, width {}; Embree measured):\n",
+                   settings.gpu.blas_bytes_per_triangle, settings.gpu.blas_bytes_per_node, settings.gpu.bvh_width);
+        fmt::print("  {:>8} {:>8} {:>12} {:>14} {:>7} {:>12} {:>7} {:>12} {:>12}\n", "cluster", "BLASes", "GPU bytes",
+                   "own alloc", "waste", "pooled", "waste", "compacted", "Embree");
+        const Particles particles = source.frame(frame);
+        const Camera camera = Camera::atFrame(settings.camera, frame);
+        for (std::uint32_t size : clusterSizes) {
+            GeometrySettings g = settings.geometry;
+            g.cluster_size = size;
+            g.build = BuildPolicy::rebuild;
+            GpuSettings gpu = settings.gpu;
+            gpu.counters = false;
+            const EmbreeDevice device;
+            ParticleBvh bvh(device, g, gpu);
+            bvh.build(particles, camera);
+            std::vector<std::uint32_t> tris;
+            for (std::size_t c = 0; c < bvh.clusters().count(); ++c)
+                tris.push_back(std::uint32_t(bvh.clusters().members(c).size()) * (g.primitive == Primitive::billboard ? 2u : 1u));
+            const BlasMemory m = blasMemory(tris, settings.gpu, bvh.stats().embreeBytes);
+            fmt::print("  {:>8} {:>8} {:>12} {:>14} {:>6.1f}% {:>12} {:>6.1f}% {:>12} {:>12}\n", size, m.clusters, m.gpuBytes,
+                       m.perBlasAllocBytes, 100.0 * m.perBlasWaste(), m.pooledBytes, 100.0 * m.pooledWaste(),
+                       m.compactedPooledBytes, m.embreeBytes);
+            memory.push_back({{"cluster_size", size},
+                              {"clusters", m.clusters},
+                              {"triangles", m.triangles},
+                              {"gpu_bytes", m.gpuBytes},
+                              {"per_blas_allocation_bytes", m.perBlasAllocBytes},
+                              {"per_blas_allocation_waste", m.perBlasWaste()},
+                              {"pooled_bytes", m.pooledBytes},
+                              {"pooled_waste", m.pooledWaste()},
+                              {"compacted_pooled_bytes", m.compactedPooledBytes},
+                              {"embree_bytes", m.embreeBytes}});
+        }
+    }
+    const LayoutReport& L = r.layouts;
+    fmt::print("\nlayouts: reservoir {} B, G-buffer texel {} B, payloads {} B primary / {} B shadow; buffers: reservoirs {:.1f} MB, "
+               "G-buffer {:.1f} MB; traffic {:.1f} MB per frame = {:.1f} GB/s at 60 fps\n",
+               L.reservoirBytes, L.gbufferTexelBytes, L.primaryPayloadBytes, L.shadowPayloadBytes,
+               1e-6 * double(L.reservoirBufferBytes), 1e-6 * double(L.gbufferBufferBytes), 1e-6 * double(L.bytesPerFrame),
+               double(L.bytesPerFrame) * 60.0 / 1e9);
+
+    // Counting overhead: the same frame with counters off and on, medians of N.
+    nlohmann::json overhead;
+    if (a.overhead > 0) {
+        Settings off = settings;
+        off.gpu.counters = false;
+        std::vector<double> tOff, tOn;
+        for (std::uint32_t k = 0; k < a.overhead; ++k) {
+            log(fmt::format("counting overhead {}/{}", k + 1, a.overhead));
+            tOff.push_back(renderCounted(off, source, frame, a.history).stats.seconds);
+            tOn.push_back(renderCounted(settings, source, frame, a.history).stats.seconds);
+        }
+        const double mOff = median(tOff), mOn = median(tOn);
+        fmt::print("counting overhead: frame {:.3f} s without counters, {:.3f} s with ({:.2f}x, median of {})\n", mOff, mOn,
+                   mOn / mOff, a.overhead);
+        overhead = {{"seconds_off", mOff}, {"seconds_on", mOn}, {"ratio", mOn / mOff}, {"runs", a.overhead}};
+    }
+
+    nlohmann::json doc = toJson(r);
+    doc["passes"] = passes;
+    doc["version"] = std::string(version());
+    doc["scene"] = settings.scenePath;
+    doc["config"] = config;
+    doc["frame"] = frame;
+    doc["seed"] = settings.render.seed;
+    doc["settings"] = settingsToToml(settings);
+    doc["coefficients"] = coef.toJson();
+    doc["predicted_ms"] = totalMs;
+    doc["ser_sweep"] = serSweep;
+    doc["any_hit_omm"] = omm;
+    doc["blas_memory_by_cluster_size"] = memory;
+    doc["counting_overhead"] = overhead;
+    doc["frame_seconds"] = main.stats.seconds;
+    writeJson(prefix + ".json", doc);
+    writeFileAtomic(prefix + ".csv", csv);
+    std::vector<FloatChannel> maps;
+    for (const Heatmap& h : main.image.heatmaps) {
+        maps.push_back({h.name, h.values});
+        writeHeatmapPng(prefix + "." + h.name + ".png", h.values, main.image.width, main.image.height);
+    }
+    writeChannelsExr(prefix + ".heatmaps.exr", main.image.width, main.image.height, maps,
+                     {{"version", std::string(version())}, {"scene", settings.scenePath}, {"frame", std::to_string(frame)}});
+    fmt::print("cost: {}.json, {}.csv, {}.heatmaps.exr, {}.gpu.*.png\n", prefix, prefix, prefix, prefix);
+}
+
+}  // namespace
+
+void addCostCommand(CLI::App& app) {
+    auto args = std::make_shared<CostArgs>();
+    CLI::App* cmd = app.add_subcommand("cost", "GPU model of a frame: counters, SIMT/SER, any-hit/OMM, memory, predicted time");
+    cmd->add_option("scene", args->scene, "Scene file (TOML)")->required();
+    cmd->add_option("-o,--output", args->output, "Output JSON (the CSV, heatmap EXR and PNGs go beside it); default out/<scene>.cost.json");
+    cmd->add_option("--frames", args->frames, "Frame A (or A:B, the first is measured)");
+    cmd->add_option("--history", args->history, "restir: frames rendered before the measured one");
+    cmd->add_option("--config", args->config, "Configuration label of the CSV rows (default: the scene name)");
+    cmd->add_option("--overhead", args->overhead, "Measure the counting overhead: renders with counters off and on, median of N (0: skip)");
+    cmd->add_option("--cluster-sizes", args->clusterSizes, "BLAS memory table at these cluster sizes (empty: skip)");
+    cmd->add_option("--omm-levels", args->ommLevels, "Disc alpha: OMM levels compared with alpha testing (empty: skip)");
+    cmd->add_option("--ser-keys", args->serKeys, "SER sort keys compared (each comma-separated hit,type,cluster,hint)");
+    cmd->add_option("--threads", args->threads, "Worker threads (default: all cores); never changes the counters")
+        ->check(CLI::Range(0, 4096));
+    cmd->add_flag("-q,--quiet", args->quiet, "No progress on stderr");
+    cmd->add_option("-D,--define", args->defines, "Override a setting: -D section.key=value (TOML value)")->allow_extra_args(false);
+    cmd->callback([args] { runCost(*args); });
+}
+
+}  // namespace accretion::cmd

@@ -1,0 +1,184 @@
+// The GPU model as a user runs it: accretion cost and calibrate, and the
+// counters' effect on rendering (none), as real processes.
+#include <catch2/catch.hpp>
+
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <OpenImageIO/imageio.h>
+#include <nlohmann/json.hpp>
+
+#include "accretion/gpu/cost_model.h"
+#include "support/test_scenes.h"
+
+using namespace accretion;
+using accretion::test::runCommand;
+using Catch::Matchers::Contains;
+namespace OIIO = OIIO_NAMESPACE;
+
+namespace {
+
+const std::string kBin = ACCRETION_BINARY;
+
+std::string tinyScene() { return std::string(ACCRETION_SOURCE_DIR) + "/tests/data/small_disk.toml"; }
+
+std::string slurp(const std::filesystem::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    REQUIRE(in);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+std::vector<float> readChannels(const std::filesystem::path& file, const std::vector<std::string>& names) {
+    auto in = OIIO::ImageInput::open(file.string());
+    REQUIRE(in);
+    const OIIO::ImageSpec spec = in->spec();
+    std::vector<float> all(std::size_t(spec.width) * spec.height * spec.nchannels);
+    REQUIRE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()));
+    std::vector<float> out;
+    for (const std::string& n : names) {
+        const int c = spec.channelindex(n);
+        REQUIRE(c >= 0);
+        for (std::size_t px = 0; px < std::size_t(spec.width) * spec.height; ++px) out.push_back(all[px * spec.nchannels + c]);
+    }
+    return out;
+}
+
+const std::string kRestirDisc = " -D render.estimator=\\\"restir\\\" -D geometry.alpha=\\\"disc\\\" --frames 3 --history 3 ";
+
+}  // namespace
+
+TEST_CASE("accretion cost writes every counter, SER, any-hit/OMM and BLAS memory; 4-state keeps the image", "[cli][gpu]") {
+    const auto dir = accretion::test::scratchDir("gpu_cost");
+    std::string out;
+    const std::string cmd = kBin + " cost " + tinyScene() + kRestirDisc + "--overhead 0 -q -o " + (dir / "c.json").string();
+    INFO(cmd);
+    REQUIRE(runCommand(cmd, out) == 0);
+    INFO(out);
+    const nlohmann::json j = nlohmann::json::parse(slurp(dir / "c.json"));
+    for (const char* key : {"passes", "blas_bytes", "omm", "layouts", "ser_sweep", "any_hit_omm", "coefficients"})
+        CHECK(j.contains(key));
+    std::set<std::string> passes;
+    for (const auto& p : j["passes"]) {
+        passes.insert(p["pass"].get<std::string>());
+        for (const char* key : {"simt_efficiency", "ser", "any_hit", "blas_entries", "bytes_read", "predicted_ms", "ray_model"})
+            CHECK(p.contains(key));
+        // Any-hits happen on rays only; every ray enters at most all clusters.
+        if (p["rays"].get<double>() == 0) CHECK(p["any_hit"].get<double>() == 0);
+    }
+    for (const char* pass : {"buildClusters", "traceGBuffer", "generateCandidates", "temporalResampling", "spatialResampling",
+                             "traceShadowRays", "composeImage"})
+        CHECK(passes.count(pass));
+    // OMM: 4-state leaves the image as alpha testing made it and any-hits fall with the level; 2-state has none.
+    double previous = 1e30;
+    for (const auto& v : j["any_hit_omm"]) {
+        if (v["variant"] == "alpha") {
+            previous = v["any_hits_per_shadow_ray"].get<double>() + v["any_hits_per_primary_ray"].get<double>();
+            CHECK(previous > 0.0);
+            continue;
+        }
+        if (v["states"] == 4) {
+            CHECK(v["image_identical"].get<bool>());
+            const double n = v["any_hits_per_shadow_ray"].get<double>() + v["any_hits_per_primary_ray"].get<double>();
+            CHECK(n < previous);
+            previous = n;
+        } else {
+            CHECK(v["any_hits_per_shadow_ray"].get<double>() == 0.0);
+            CHECK_FALSE(v["image_identical"].get<bool>());
+            CHECK(v["image_MAPE_vs_alpha"].get<double>() > 0.0);
+        }
+    }
+    // Pooled BLAS memory wastes less than one allocation per BLAS at every cluster size.
+    REQUIRE(j["blas_memory_by_cluster_size"].size() == 3);
+    for (const auto& m : j["blas_memory_by_cluster_size"])
+        CHECK(m["pooled_bytes"].get<double>() < m["per_blas_allocation_bytes"].get<double>());
+    CHECK(std::filesystem::exists(dir / "c.csv"));
+    CHECK(std::filesystem::exists(dir / "c.heatmaps.exr"));
+    CHECK(std::filesystem::exists(dir / "c.gpu.rays.png"));
+}
+
+TEST_CASE("counters are identical for 1 and 2 threads", "[cli][gpu]") {
+    const auto dir = accretion::test::scratchDir("gpu_threads");
+    std::string out;
+    for (int t : {1, 2}) {
+        const std::string cmd = kBin + " cost " + tinyScene() + kRestirDisc + "--overhead 0 --omm-levels \"\" --cluster-sizes \"\" -q --threads " +
+                                std::to_string(t) + " -o " + (dir / ("t" + std::to_string(t) + ".json")).string();
+        REQUIRE(runCommand(cmd, out) == 0);
+    }
+    CHECK(slurp(dir / "t1.csv") == slurp(dir / "t2.csv"));
+    const std::vector<std::string> maps{"gpu.rays", "gpu.blas_entries", "gpu.any_hits", "gpu.trips", "gpu.bytes"};
+    CHECK(readChannels(dir / "t1.heatmaps.exr", maps) == readChannels(dir / "t2.heatmaps.exr", maps));
+    auto passes = [&](const std::string& f) { return nlohmann::json::parse(slurp(dir / f))["passes"].dump(); };
+    CHECK(passes("t1.json") == passes("t2.json"));
+}
+
+TEST_CASE("counters on and off render the same image", "[cli][gpu]") {
+    const auto dir = accretion::test::scratchDir("gpu_onoff");
+    std::string out;
+    for (const char* on : {"false", "true"}) {
+        const std::string cmd = kBin + " render " + tinyScene() +
+                                " --quiet -D render.estimator=\\\"restir\\\" -D geometry.alpha=\\\"disc\\\" -D gpu.omm=\\\"4state\\\" "
+                                "-D render.frames=3 -D gpu.counters=" + on + " -o " + (dir / (std::string(on) + ".{frame}.exr")).string();
+        REQUIRE(runCommand(cmd, out) == 0);
+    }
+    const std::vector<std::string> ch{"R", "G", "B", "Lr.R", "Lr.G", "Lr.B", "restir.W", "restir.M"};
+    for (const char* f : {".0000.exr", ".0002.exr"})
+        CHECK(readChannels(dir / (std::string("false") + f), ch) == readChannels(dir / (std::string("true") + f), ch));
+    const auto stats = nlohmann::json::parse(slurp(dir / "true.stats.json"));
+    CHECK(stats["frames"][2].contains("gpu"));
+    CHECK(std::filesystem::exists(dir / "true.0002.gpu.any_hits.png"));
+}
+
+TEST_CASE("calibrate recovers the coefficients that made the timings of real cost counters", "[cli][gpu]") {
+    const auto dir = accretion::test::scratchDir("gpu_calibrate");
+    std::string out;
+    // Three configurations: restir with disc alpha, power with opaque quads, exact.
+    const std::vector<std::pair<std::string, std::string>> configs = {
+        {"restir_disc", kRestirDisc},
+        {"power", " -D render.estimator=\\\"power\\\" -D render.samples=4 "},
+        {"restir_scale", " -D render.estimator=\\\"restir\\\" -D restir.resolution_scale=0.5 -D restir.basic_visibility=true "
+                         "-D restir.visibility_reuse=true --frames 2 "}};
+    std::vector<std::string> csvs;
+    for (const auto& [name, flags] : configs) {
+        const auto file = dir / (name + ".json");
+        REQUIRE(runCommand(kBin + " cost " + tinyScene() + flags + "--overhead 0 --omm-levels \"\" --cluster-sizes \"\" -q --config " +
+                               name + " -o " + file.string(), out) == 0);
+        csvs.push_back((dir / (name + ".csv")).string());
+    }
+    // Timings from known coefficients (what a GPU profile would give).
+    CostCoefficients truth;
+    truth.ns = {0.05, 0.9, 0.6, 0.25, 1.5, 0.003};
+    std::string timings = "config,pass,ms\n";
+    for (const std::string& csv : csvs)
+        for (const CostRow& r : readCounterCsv(csv))
+            timings += r.config + "," + r.pass + "," + std::to_string(truth.predictMs(r.features)) + "\n";
+    {
+        std::ofstream(dir / "timings.csv") << timings;
+    }
+    std::string cmd = kBin + " calibrate";
+    for (const std::string& c : csvs) cmd += " " + c;
+    cmd += " " + (dir / "timings.csv").string() + " -o " + (dir / "coef.json").string();
+    REQUIRE(runCommand(cmd, out) == 0);
+    INFO(out);
+    const CostCoefficients fitted = CostCoefficients::load((dir / "coef.json").string());
+    // std::to_string keeps 6 decimals of ms: the fit is exact to that rounding.
+    for (std::size_t k = 0; k < truth.ns.size(); ++k) {
+        INFO(kCostFeatures[k]);
+        CHECK(fitted.ns[k] == Approx(truth.ns[k]).epsilon(0.02));
+    }
+    // The cost command reads the fitted file.
+    REQUIRE(runCommand(kBin + " cost " + tinyScene() + " --overhead 0 --omm-levels \"\" --cluster-sizes \"\" -q -D gpu.coefficients=\\\"" +
+                           (dir / "coef.json").string() + "\\\" -o " + (dir / "again.json").string(), out) == 0);
+    CHECK(nlohmann::json::parse(slurp(dir / "again.json"))["coefficients"]["source"] == (dir / "coef.json").string());
+
+    // Bad input: a timing row without counters, a malformed number.
+    std::ofstream(dir / "bad1.csv") << "config,pass,ms\npower,noSuchPass,1.0\n";
+    CHECK(runCommand(kBin + " calibrate " + csvs[0] + " " + (dir / "bad1.csv").string() + " -o " + (dir / "x.json").string(), out) == 1);
+    CHECK_THAT(out, Contains("no counters for config 'power' pass 'noSuchPass'"));
+    std::ofstream(dir / "bad2.csv") << "config,pass,ms\nrestir_disc,traceGBuffer,fast\n";
+    CHECK(runCommand(kBin + " calibrate " + csvs[0] + " " + (dir / "bad2.csv").string() + " -o " + (dir / "x.json").string(), out) == 1);
+    CHECK_THAT(out, Contains("bad2.csv:2: ms: 'fast' is not a finite non-negative number"));
+    CHECK_FALSE(std::filesystem::exists(dir / "x.json"));
+}
