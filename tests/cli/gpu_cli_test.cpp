@@ -88,6 +88,8 @@ TEST_CASE("accretion cost writes every counter, SER, any-hit/OMM and BLAS memory
             CHECK(v["any_hits_per_shadow_ray"].get<double>() == 0.0);
             CHECK_FALSE(v["image_identical"].get<bool>());
             CHECK(v["image_MAPE_vs_alpha"].get<double>() > 0.0);
+            CHECK(v["Le_MAPE_vs_alpha"].get<double>() > 0.0);
+            CHECK(v["pixels_changed_fraction"].get<double>() > 0.0);
         }
     }
     // Pooled BLAS memory wastes less than one allocation per BLAS at every cluster size.
