@@ -37,10 +37,12 @@ void discAlphaFilter(const RTCFilterFunctionNArguments* args) {
     RayCounters* counters = reinterpret_cast<const QueryContext*>(args->context)->counters;
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] != -1) continue;
-        const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
-        const float u = RTCHitN_u(args->hit, args->N, i), v = RTCHitN_v(args->hit, args->N, i);
+        // Embree's quad parametrisation is the billboard's uv.
+        const Vec2 uv(RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i));
         if (alpha->omm) {
-            const OmmState s = alpha->omm->lookup(prim & 1u, u, v);
+            Vec2 bary;
+            const unsigned tri = quadTriangle(uv, bary);
+            const OmmState s = alpha->omm->lookup(tri, bary.x, bary.y);
             if (s == OmmState::opaque) continue;
             if (s == OmmState::transparent) {
                 args->valid[i] = 0;
@@ -51,7 +53,7 @@ void discAlphaFilter(const RTCFilterFunctionNArguments* args) {
             ++counters->anyHits;
             ++counters->candidates;
         }
-        if (!insideDisc(quadUv(prim, u, v))) args->valid[i] = 0;
+        if (!insideDisc(uv)) args->valid[i] = 0;
     }
 }
 
@@ -147,17 +149,15 @@ void ParticleBvh::buildBlas(std::size_t c, const Particles& particles, bool crea
         RTCScene scene = rtcNewScene(device_.get());
         rtcSetSceneBuildQuality(scene, sceneQuality(settings_.build));
         if (settings_.build == BuildPolicy::refit) rtcSetSceneFlags(scene, RTC_SCENE_FLAG_DYNAMIC);
-        geom = rtcNewGeometry(device_.get(), billboards ? RTC_GEOMETRY_TYPE_TRIANGLE : RTC_GEOMETRY_TYPE_SPHERE_POINT);
+        // Billboards are Embree quads (one primitive, builds ~1.5x faster than
+        // two triangles); the GPU's two triangles are recovered from uv.
+        geom = rtcNewGeometry(device_.get(), billboards ? RTC_GEOMETRY_TYPE_QUAD : RTC_GEOMETRY_TYPE_SPHERE_POINT);
         if (settings_.build == BuildPolicy::refit) rtcSetGeometryBuildQuality(geom, RTC_BUILD_QUALITY_REFIT);
         if (billboards) {
             rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, sizeof(float) * 3, 4 * n);
             auto* idx = static_cast<std::uint32_t*>(
-                rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, sizeof(std::uint32_t) * 3, 2 * n));
-            for (std::uint32_t k = 0; k < n; ++k) {
-                const std::uint32_t v = 4 * k;
-                const std::uint32_t tri[6] = {v, v + 1, v + 2, v, v + 2, v + 3};
-                std::copy(tri, tri + 6, idx + 6 * k);
-            }
+                rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT4, sizeof(std::uint32_t) * 4, n));
+            for (std::uint32_t k = 0; k < 4 * n; ++k) idx[k] = k;
             if (settings_.alpha == AlphaMode::disc) {
                 rtcSetGeometryUserData(geom, &alpha_);
                 rtcSetGeometryIntersectFilterFunction(geom, &discAlphaFilter);
@@ -314,12 +314,11 @@ bool ParticleBvh::intersect(const Vec3& o, const Vec3& d, float tfar, SurfaceHit
     rtcIntersect1(counters && countingTlas_ ? countingTlas_ : tlas_, &context.base, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
     const std::uint32_t c = rh.hit.instID[0];
-    const bool billboards = settings_.primitive == Primitive::billboard;
-    const std::uint32_t local = billboards ? rh.hit.primID >> 1 : rh.hit.primID;
+    const std::uint32_t local = rh.hit.primID;
     hit.cluster = c;
     hit.particle = clusters_.particle[clusters_.offset[c] + local];
     hit.t = rh.ray.tfar;
-    hit.uv = billboards ? quadUv(rh.hit.primID, rh.hit.u, rh.hit.v) : Vec2(rh.hit.u, rh.hit.v);
+    hit.uv = Vec2(rh.hit.u, rh.hit.v);
     return true;
 }
 

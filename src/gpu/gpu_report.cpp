@@ -19,7 +19,7 @@ WarpLayout warpLayout(const GpuSettings& gpu) { return {gpu.group_width, gpu.gro
 /// trivial miss and a small payload.
 void adviseRayModel(PassReport& p) {
     if (p.rays == 0) {
-        p.rayModel = "-";
+        p.rayModel = std::string(1, '-');
         p.reason = "no rays";
         return;
     }

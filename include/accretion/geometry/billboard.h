@@ -25,6 +25,17 @@ inline Vec2 quadUv(unsigned primID, float u, float v) {
     return (primID & 1u) ? Vec2(u, u + v) : Vec2(u + v, v);
 }
 
+/// The GPU's triangle of a quad uv, (0,1,2) below the diagonal (u >= v) or
+/// (0,2,3) above, and the barycentrics (u, v) on it (inverse of quadUv).
+inline unsigned quadTriangle(Vec2 uv, Vec2& bary) {
+    if (uv.x >= uv.y) {
+        bary = Vec2(uv.x - uv.y, uv.y);
+        return 0;
+    }
+    bary = Vec2(uv.x, uv.y - uv.x);
+    return 1;
+}
+
 /// Inside the inscribed disc of the quad (the `disc` alpha test).
 inline bool insideDisc(Vec2 uv) {
     const Vec2 c = uv - Vec2(0.5f);

@@ -20,8 +20,8 @@ struct Camera;
 /// What one build of the acceleration structure did and holds.
 struct BvhStats {
     std::size_t clusters = 0;       ///< BLAS count (= TLAS instances)
-    std::size_t primitives = 0;     ///< triangles (billboards) or spheres
-    std::size_t triangles = 0;      ///< 2 per billboard, 0 for spheres
+    std::size_t primitives = 0;     ///< the GPU's primitives: triangles (billboards) or spheres
+    std::size_t triangles = 0;      ///< 2 per billboard (Embree holds one quad), 0 for spheres
     bool reclustered = false;       ///< clusters recomputed this frame
     bool refitted = false;          ///< BLAS refitted instead of rebuilt
     bool partial = false;           ///< partial rebuild: only rebuiltClusters were updated
@@ -47,7 +47,7 @@ struct AlphaTest {
 };
 
 /// The GPU's acceleration structure on Embree (MODEL.md section 2): one BLAS
-/// per particle cluster, instanced in a TLAS; billboards as two triangles
+/// per particle cluster, instanced in a TLAS; billboards as quads (the GPU's two triangles)
 /// (optionally with the disc alpha test as a filter function) or spheres.
 class ParticleBvh {
 public:
