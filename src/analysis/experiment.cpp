@@ -79,10 +79,13 @@ Settings specSettings(const std::filesystem::path& scene, const std::vector<std:
 ExperimentRender renderForExperiment(const Settings& settings, const ParticleSource& source, std::uint32_t frame,
                                      std::uint32_t history) {
     ExperimentRender r;
-    FrameRenderer renderer(settings, source, RenderOptions{true});
-    const auto start = std::chrono::steady_clock::now();
     const std::uint32_t first =
         settings.render.estimator == EstimatorKind::restir ? frame - std::min(frame, history) : frame;
+    Settings run = settings;  // the frames rendered, so that the pass plan keeps restir's history
+    run.render.frame_start = first;
+    run.render.frames = frame - first + 1;
+    FrameRenderer renderer(run, source, RenderOptions{true});
+    const auto start = std::chrono::steady_clock::now();
     for (std::uint32_t f = first; f <= frame; ++f) {
         FrameStats stats;
         r.image = renderer.render(f, stats);

@@ -117,6 +117,8 @@ void runConverge(const ConvergeArgs& a) {
         for (const EstimatorSpec& spec : specs) {
             // One history per seed; each frame's metrics are means over the seeds, its time their median.
             Settings s = specSettings(a.scene, base, spec);
+            s.render.frame_start = frame;
+            s.render.frames = a.sequence;
             const std::uint64_t seed0 = s.render.seed;
             std::vector<Point> perFrame(a.sequence);
             std::vector<std::vector<double>> frameSeconds(a.sequence);

@@ -63,8 +63,11 @@ struct CountedFrame {
 };
 
 CountedFrame renderCounted(const Settings& s, const ParticleSource& source, std::uint32_t frame, std::uint32_t history) {
-    FrameRenderer renderer(s, source, RenderOptions{true});
     const std::uint32_t first = s.render.estimator == EstimatorKind::restir ? frame - std::min(frame, history) : frame;
+    Settings run = s;  // the frames rendered, so that the pass plan keeps restir's history
+    run.render.frame_start = first;
+    run.render.frames = frame - first + 1;
+    FrameRenderer renderer(run, source, RenderOptions{true});
     CountedFrame out;
     for (std::uint32_t f = first; f <= frame; ++f) {
         out.stats = FrameStats{};

@@ -25,5 +25,6 @@ void addConvergeCommand(CLI::App& app);
 void addBiasCommand(CLI::App& app);
 void addCostCommand(CLI::App& app);
 void addCalibrateCommand(CLI::App& app);
+void addPlanCommand(CLI::App& app);
 
 }  // namespace accretion::cmd

@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
     accretion::cmd::addBiasCommand(app);
     accretion::cmd::addCostCommand(app);
     accretion::cmd::addCalibrateCommand(app);
+    accretion::cmd::addPlanCommand(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

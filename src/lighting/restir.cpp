@@ -61,7 +61,7 @@ bool similar(const GBufferTexel& a, const GBufferTexel& b, const RestirSettings&
 /// (weights sum to 1 for every y; equal p_hat gives M_i / M_total).
 template <ShadingModel SM, Primitive P, bool Count>
 StoredReservoir combine(const Offer* offers, std::uint32_t n, const LightArrays& L, const RestirSettings& rs,
-                        float eps, Rng& rng, LightingCounters& c, Recorder<Count>& rec) {
+                        float eps, bool shadows, Rng& rng, LightingCounters& c, Recorder<Count>& rec) {
     const Offer& can = offers[0];
     const ShadingPoint& sp = can.domain.sp;
     if (n == 1) return can.r;
@@ -127,7 +127,7 @@ StoredReservoir combine(const Offer* offers, std::uint32_t n, const LightArrays&
             LightTerm t;
             ++c.lightTerms;
             if (!d.lights->term<SM>(d.sp, out.y, t) || !(luminance(t.value) > 0.0f)) continue;
-            if (rs.basic_visibility && d.visibilityTested) {
+            if (rs.basic_visibility && d.visibilityTested && shadows) {
                 ++c.shadowRays;
                 RayCounters rc;
                 const bool seen = visible<P>(*d.bvh, d.sp, t, d.lights->radius[out.y], eps, rec.rayCounters(rc));
@@ -169,6 +169,7 @@ struct FrameContext {
     const Restir::History* prev;
     float scale;                ///< lighting / image resolution
     float eps;
+    bool shadows;               ///< shading.visibility: trace shadow rays (off: V = 1)
     FrameCounters* counters;    ///< counting mode: per-pass thread records
 };
 
@@ -217,7 +218,7 @@ LightingCounters generateCandidates(const FrameContext& f, std::vector<StoredRes
             r.update(x.i, p_hat / x.pdf, p_hat, rng.uniform());
         }
         r.finalize();
-        if (f.rs.candidate_visibility && r.W > 0.0f) {
+        if (f.rs.candidate_visibility && f.shadows && r.W > 0.0f) {
             // Bitterli et al. 2020, Alg. 5: drop an occluded candidate before reuse.
             LightTerm t;
             if (f.L.term<SM>(sp, r.y, t)) {
@@ -296,7 +297,7 @@ LightingCounters temporalResampling(const FrameContext& f, const std::vector<Sto
                             f.rs.candidate_visibility || f.rs.visibility_reuse,
                             f.in.previousBvh ? f.in.previousBvh : &f.in.bvh}};
         Rng rng(px, f.in.frame, RngPass::restirTemporal, f.in.settings.render.seed);
-        out[px] = f.codec.roundTrip(combine<SM, P, Count>(offers, 2, f.L, f.rs, f.eps, rng, c, rec));
+        out[px] = f.codec.roundTrip(combine<SM, P, Count>(offers, 2, f.L, f.rs, f.eps, f.shadows, rng, c, rec));
     });
 }
 
@@ -348,7 +349,7 @@ LightingCounters spatialResampling(const FrameContext& f, std::uint32_t iteratio
             rec.read(R + gpu_layout::kParticleRecord);
             offers[n++] = {cur[q], {shadingPoint(gn, f.in.particles), &f.L, tested, &f.in.bvh}};
         }
-        out[px] = f.codec.roundTrip(combine<SM, P, Count>(offers, n, f.L, f.rs, f.eps, rng, c, rec));
+        out[px] = f.codec.roundTrip(combine<SM, P, Count>(offers, n, f.L, f.rs, f.eps, f.shadows, rng, c, rec));
     });
 }
 
@@ -374,11 +375,14 @@ LightingCounters traceShadowRays(const FrameContext& f, std::vector<StoredReserv
         LightTerm t;
         ++c.lightTerms;
         if (!f.L.term<SM>(sp, r.y, t)) return;
-        ++c.shadowRays;
-        rec.trip();
-        RayCounters rc;
-        const bool seen = visible<P>(f.in.bvh, sp, t, f.L.radius[r.y], f.eps, rec.rayCounters(rc));
-        rec.ray(rc);
+        bool seen = true;
+        if (f.shadows) {
+            ++c.shadowRays;
+            rec.trip();
+            RayCounters rc;
+            seen = visible<P>(f.in.bvh, sp, t, f.L.radius[r.y], f.eps, rec.rayCounters(rc));
+            rec.ray(rc);
+        }
         if (!seen) {
             ++c.shadowOccluded;
             if (f.rs.visibility_reuse) {
@@ -476,7 +480,8 @@ bool needsPreviousBvh(const Settings& s) {
            (s.geometry.build == BuildPolicy::rebuild || s.geometry.build == BuildPolicy::fast_trace);
 }
 
-Restir::Restir(const Settings& settings) : rs_(settings.restir), codec_(settings.restir) {}
+Restir::Restir(const Settings& settings, bool keepHistory)
+    : rs_(settings.restir), keepHistory_(keepHistory), codec_(settings.restir) {}
 
 LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, ReservoirImage& aov, PassTimer& timer) {
     const GBuffer& full = in.gbuffer;
@@ -508,7 +513,7 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
     const History* prev = history_ && history_->gbuffer.width == lg->width && history_->gbuffer.height == lg->height
                               ? history_.get() : nullptr;
     FrameContext f{in, rs_, codec_, *lg, L, prev, lg == &full ? 1.0f : float(lg->width) / float(full.width),
-                   static_cast<float>(in.settings.render.shadow_epsilon), in.counters};
+                   static_cast<float>(in.settings.render.shadow_epsilon), in.settings.shading.visibility, in.counters};
 
     std::vector<StoredReservoir> a(lpixels), b(lpixels);
     std::vector<Vec3> lowLr(lpixels);
@@ -563,6 +568,7 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
         }
 
     // History for the next frame.
+    if (!keepHistory_) return counters;
     auto h = std::make_shared<History>();
     h->gbuffer = *lg;
     h->particles = in.particles;

@@ -21,14 +21,18 @@ ShadingPoint shadingPoint(const GBufferTexel& g, const Particles& particles) {
 
 /// exact: sum over every light i != j of f I G V, in double.
 template <ShadingModel M, Primitive P>
-Vec3 exactPixel(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint& sp, float eps, LightingCounters& c,
-                RayCounters* rc) {
+Vec3 exactPixel(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint& sp, float eps, bool shadows,
+                LightingCounters& c, RayCounters* rc) {
     DVec3 sum(0.0);
     for (std::uint32_t i = 0; i < L.count; ++i) {
         if (i == sp.self) continue;
         LightTerm t;
         ++c.lightTerms;
         if (!evalLight<M>(sp, L.position[i], L.emission[i], L.dmin2[i], t)) continue;
+        if (!shadows) {
+            sum += DVec3(t.value);
+            continue;
+        }
         ++c.shadowRays;
         if (visible<P>(bvh, sp, t, L.radius[i], eps, rc)) sum += DVec3(t.value);
         else ++c.shadowOccluded;
@@ -59,7 +63,7 @@ private:
 /// luminance reaches the target (or max_samples); one round when the target is 0.
 template <ShadingModel M, Primitive P, class Sampler>
 std::uint32_t sampledPixel(const ParticleBvh& bvh, const LightArrays& L, Sampler&& sampleOne, const ShadingPoint& sp,
-                           const RenderSettings& rs, float eps, Rng& rng, Vec3& mean, Vec3& stderr,
+                           const RenderSettings& rs, float eps, bool shadows, Rng& rng, Vec3& mean, Vec3& stderr,
                            LightingCounters& c, RayCounters* rc) {
     SampleMean acc;
     std::uint32_t n = 0;
@@ -69,10 +73,12 @@ std::uint32_t sampledPixel(const ParticleBvh& bvh, const LightArrays& L, Sampler
             LightTerm t;
             ++c.lightTerms;
             if (!L.term<M>(sp, x.i, t)) continue;
-            ++c.shadowRays;
-            if (!visible<P>(bvh, sp, t, L.radius[x.i], eps, rc)) {
-                ++c.shadowOccluded;
-                continue;
+            if (shadows) {
+                ++c.shadowRays;
+                if (!visible<P>(bvh, sp, t, L.radius[x.i], eps, rc)) {
+                    ++c.shadowOccluded;
+                    continue;
+                }
             }
             acc.add(DVec3(t.value) / double(x.pdf));
         }
@@ -88,8 +94,8 @@ std::uint32_t sampledPixel(const ParticleBvh& bvh, const LightArrays& L, Sampler
 /// without visibility; the kept y gets one shadow ray, weighted by W.
 template <ShadingModel M, Primitive P, bool Power>
 void risPixel(const ParticleBvh& bvh, const LightArrays& L, const AliasTable* table, const ShadingPoint& sp,
-              const RenderSettings& rs, float eps, Rng& rng, Vec3& mean, Vec3& stderr, LightingCounters& c,
-              RayCounters* rc) {
+              const RenderSettings& rs, float eps, bool shadows, Rng& rng, Vec3& mean, Vec3& stderr,
+              LightingCounters& c, RayCounters* rc) {
     SampleMean acc;
     for (std::uint32_t k = 0; k < rs.samples; ++k) {
         Reservoir r;
@@ -104,10 +110,12 @@ void risPixel(const ParticleBvh& bvh, const LightArrays& L, const AliasTable* ta
         }
         r.finalize();
         if (r.W <= 0.0f) continue;
-        ++c.shadowRays;
-        if (!visible<P>(bvh, sp, t_y, L.radius[r.y], eps, rc)) {
-            ++c.shadowOccluded;
-            continue;
+        if (shadows) {
+            ++c.shadowRays;
+            if (!visible<P>(bvh, sp, t_y, L.radius[r.y], eps, rc)) {
+                ++c.shadowOccluded;
+                continue;
+            }
         }
         acc.add(DVec3(t_y.value) * double(r.W));
     }
@@ -121,6 +129,7 @@ LightingCounters run(const LightingInputs& in, const LightArrays& L, LightingIma
     const GBuffer& gb = in.gbuffer;
     const float eps = static_cast<float>(in.render.shadow_epsilon);
     const EstimatorKind kind = in.render.estimator;
+    const bool shadows = in.shading.visibility;  // off: V = 1, no shadow rays
     const std::uint32_t S = in.render.samples;
     tbb::enumerable_thread_specific<LightingCounters> counters;
 
@@ -154,7 +163,7 @@ LightingCounters run(const LightingInputs& in, const LightArrays& L, LightingIma
                 }
                 const ShadingPoint sp = shadingPoint(g, in.particles);
                 if (kind == EstimatorKind::exact) {
-                    out.Lr[px] = exactPixel<M, P>(in.bvh, L, sp, eps, c, rc);
+                    out.Lr[px] = exactPixel<M, P>(in.bvh, L, sp, eps, shadows, c, rc);
                     record();
                     continue;
                 }
@@ -163,18 +172,18 @@ LightingCounters run(const LightingInputs& in, const LightArrays& L, LightingIma
                 Vec3& err = out.Lr_stderr[px];
                 std::uint32_t n = S;
                 if (kind == EstimatorKind::ris && in.render.source == LightSource::power)
-                    risPixel<M, P, true>(in.bvh, L, in.powerTable, sp, in.render, eps, rng, mean, err, c, rc);
+                    risPixel<M, P, true>(in.bvh, L, in.powerTable, sp, in.render, eps, shadows, rng, mean, err, c, rc);
                 else if (kind == EstimatorKind::ris)
-                    risPixel<M, P, false>(in.bvh, L, nullptr, sp, in.render, eps, rng, mean, err, c, rc);
+                    risPixel<M, P, false>(in.bvh, L, nullptr, sp, in.render, eps, shadows, rng, mean, err, c, rc);
                 else if (kind == EstimatorKind::power)
                     n = sampledPixel<M, P>(in.bvh, L, [&](Rng& g) { return sampleSource<true>(L, in.powerTable, g); },
-                                           sp, in.render, eps, rng, mean, err, c, rc);
+                                           sp, in.render, eps, shadows, rng, mean, err, c, rc);
                 else if (kind == EstimatorKind::tree)
                     n = sampledPixel<M, P>(in.bvh, L, [&](Rng& g) { return in.lightTree->sample(sp, g); }, sp,
-                                           in.render, eps, rng, mean, err, c, rc);
+                                           in.render, eps, shadows, rng, mean, err, c, rc);
                 else
                     n = sampledPixel<M, P>(in.bvh, L, [&](Rng& g) { return sampleSource<false>(L, nullptr, g); }, sp,
-                                           in.render, eps, rng, mean, err, c, rc);
+                                           in.render, eps, shadows, rng, mean, err, c, rc);
                 out.spp[px] = float(n);
                 record();
             }

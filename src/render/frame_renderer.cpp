@@ -46,10 +46,11 @@ void recordCompose(const GBuffer& gbuffer, const Particles& particles, const Par
 }  // namespace
 
 FrameRenderer::FrameRenderer(const Settings& settings, ParticleSource source, RenderOptions options)
-    : settings_(settings), source_(std::move(source)), options_(options),
+    : settings_(settings), plan_(planPasses(settings)), source_(std::move(source)), options_(options),
       device_(std::make_unique<EmbreeDevice>()),
       bvh_(std::make_unique<ParticleBvh>(*device_, settings.geometry, settings.gpu)) {
-    if (settings_.render.estimator == EstimatorKind::restir) restir_ = std::make_unique<Restir>(settings_);
+    if (settings_.render.estimator == EstimatorKind::restir && plan_.lighting)
+        restir_ = std::make_unique<Restir>(settings_, plan_.history);
 }
 
 FrameRenderer::~FrameRenderer() = default;
@@ -60,21 +61,31 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats) {
     const Camera camera = Camera::atFrame(settings_.camera, frame);
     PassTimer& timer = stats.timer;
 
-    Particles particles;
-    {
+    // A static scene loads its particles and builds its BVH once for all frames.
+    const bool reuse = plan_.staticGeometry && built_;
+    Particles loaded;
+    if (!reuse) {
         auto t = timer.scope(pass::loadParticles);
-        particles = source_.frame(frame);
+        loaded = source_.frame(frame);
+        if (plan_.staticGeometry) staticParticles_ = std::move(loaded);
     }
+    const Particles& particles = plan_.staticGeometry ? staticParticles_ : loaded;
     stats.particles = particles.size();
-    {
+    if (!reuse) {
         auto t = timer.scope(pass::buildClusters);
-        if (needsPreviousBvh(settings_)) {  // double buffer: last frame's BVH stays valid
+        if (plan_.previousBvh) {  // double buffer: last frame's BVH stays valid
             std::swap(bvh_, previousBvh_);
             if (!bvh_) bvh_ = std::make_unique<ParticleBvh>(*device_, settings_.geometry, settings_.gpu);
         }
         bvh_->build(particles, camera);
+        built_ = true;
     }
     stats.bvh = bvh_->stats();
+    if (reuse) {
+        stats.bvh.built = false;
+        stats.bvh.rebuiltClusters = 0;
+        stats.bvh.clusterSeconds = stats.bvh.blasSeconds = stats.bvh.tlasSeconds = 0.0;
+    }
     FrameImage img;
     const bool counting = settings_.gpu.counters;
     if (counting) recordClusterBuild(*bvh_, particles, img.counters);

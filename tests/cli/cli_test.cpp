@@ -130,3 +130,17 @@ TEST_CASE("particles command: the GPU buffer renders the same image as the gener
                            " -o " + (dir / "file.exr").string(), out) == 0);
     REQUIRE(bitIdentical(readPixels(dir / "gen.exr"), readPixels(dir / "file.exr")));
 }
+
+TEST_CASE("accretion plan prints every pass, the skipped ones with their reason", "[cli][plan]") {
+    std::string out;
+    const std::string scene = std::string(ACCRETION_SOURCE_DIR) + "/scenes/quickstart.toml";
+    REQUIRE(accretion::test::runCommand(std::string(ACCRETION_BINARY) + " plan " + scene +
+                                            " -D geometry.alpha=\\\"disc\\\" -D shading.visibility=false", out) == 0);
+    CHECK_THAT(out, Catch::Matches("(.|\n)*alpha filter callbacks +runs +disc alpha(.|\n)*"));
+    CHECK_THAT(out, Catch::Matches("(.|\n)*shadow rays +skipped +visibility off: no shadow rays(.|\n)*"));
+    REQUIRE(accretion::test::runCommand(std::string(ACCRETION_BINARY) + " plan " + scene +
+                                            " -D render.estimator=\\\"restir\\\" --frames 0:1", out) == 0);
+    CHECK_THAT(out, Catch::Matches("(.|\n)*temporalResampling +skipped +one frame: no history buffers or motion(.|\n)*"));
+    CHECK(accretion::test::runCommand(std::string(ACCRETION_BINARY) + " plan no_such_scene.toml", out) == 1);
+    CHECK_THAT(out, Catch::Contains("no_such_scene.toml"));
+}

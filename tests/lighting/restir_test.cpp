@@ -27,6 +27,7 @@ struct SeedStats {
 /// Image sum of the last of `frames` restir frames, over `seeds` histories.
 SeedStats restirSums(Settings s, std::uint32_t frames, std::uint32_t seeds) {
     s.render.estimator = EstimatorKind::restir;
+    s.render.frames = frames;  // the pass plan keeps the history for more than one frame
     const ParticleSource source(s);  // copies share the generator's tables
     double s1 = 0.0, s2 = 0.0;
     for (std::uint32_t seed = 0; seed < seeds; ++seed) {

@@ -22,6 +22,7 @@ struct BvhStats {
     std::size_t clusters = 0;       ///< BLAS count (= TLAS instances)
     std::size_t primitives = 0;     ///< the GPU's primitives: triangles (billboards) or spheres
     std::size_t triangles = 0;      ///< 2 per billboard (Embree holds one quad), 0 for spheres
+    bool built = true;              ///< false: a static scene's BVH reused from an earlier frame
     bool reclustered = false;       ///< clusters recomputed this frame
     bool refitted = false;          ///< BLAS refitted instead of rebuilt
     bool partial = false;           ///< partial rebuild: only rebuiltClusters were updated

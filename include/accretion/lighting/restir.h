@@ -55,7 +55,9 @@ bool needsPreviousBvh(const Settings& settings);
 /// reservoirs: the history starts with the first frame rendered.
 class Restir {
 public:
-    explicit Restir(const Settings& settings);
+    /// keepHistory: keep this frame for the next one's temporal reuse
+    /// (false for one frame or temporal off: no history buffers or motion).
+    Restir(const Settings& settings, bool keepHistory);
 
     /// Render Lr of one frame (spp = 1, no per-pixel standard error).
     LightingCounters render(const RestirInputs& in, LightingImage& out, ReservoirImage& aov, PassTimer& timer);
@@ -68,6 +70,7 @@ public:
 
 private:
     RestirSettings rs_;
+    bool keepHistory_;
     ReservoirCodec codec_;
     std::shared_ptr<History> history_;
 };

@@ -13,6 +13,7 @@
 #include "accretion/render/camera.h"
 #include "accretion/render/estimators.h"
 #include "accretion/render/gbuffer.h"
+#include "accretion/render/pass_plan.h"
 #include "accretion/scene/settings.h"
 
 namespace accretion {
@@ -65,10 +66,15 @@ public:
     const Settings& settings() const { return settings_; }
     /// The BVH of the last frame rendered.
     const ParticleBvh& bvh() const { return *bvh_; }
+    /// The passes every frame runs (and those it skips).
+    const PassPlan& plan() const { return plan_; }
 
 private:
     Settings settings_;
+    PassPlan plan_;
     ParticleSource source_;
+    Particles staticParticles_;  ///< static scenes: loaded once
+    bool built_ = false;         ///< static scenes: the BVH is built
     RenderOptions options_;
     std::unique_ptr<EmbreeDevice> device_;
     std::unique_ptr<ParticleBvh> bvh_;

@@ -153,6 +153,7 @@ struct ShadingSettings {
     double self_emission = 1.0;                 ///< s_e in Le = s_e I
     double dmin = 0.0;                          ///< global distance clamp; dmin_i = max(r_i, dmin)
     Vec3 background{0.0f, 0.0f, 0.0f};          ///< radiance of a miss
+    bool visibility = true;                     ///< V(x, p_i) by shadow rays; false: V = 1 (no shadow rays)
 
     template <class V> void visit(V& v) {
         v.field("model", model, "shading model");
@@ -160,6 +161,7 @@ struct ShadingSettings {
         v.field("self_emission", self_emission, "self-emission scale s_e", kNonNegative);
         v.field("dmin", dmin, "global distance clamp (dmin_i = max(r_i, dmin))", kNonNegative);
         v.field("background", background, "background radiance (RGB)", kNonNegative);
+        v.field("visibility", visibility, "shadow rays for V(x, p_i); false: every light visible (no shadow rays)");
     }
 };
 

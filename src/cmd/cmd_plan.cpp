@@ -1,0 +1,34 @@
+// accretion plan: the passes a scene's frames run, and why the others are skipped.
+#include <memory>
+
+#include <fmt/core.h>
+
+#include "accretion/render/pass_plan.h"
+#include "accretion/scene/scene_parser.h"
+#include "commands.h"
+
+namespace accretion::cmd {
+namespace {
+
+void runPlan(const SceneArgs& a) {
+    std::vector<std::string> overrides = a.defines;
+    appendFrameOverrides(a.frames, overrides);
+    const Settings s = loadScene(a.scene, overrides);
+    const PassPlan plan = planPasses(s);
+    fmt::print("{}: {} frame{} from {}, estimator {}, {}x{}\n", s.scenePath, s.render.frames, s.render.frames > 1 ? "s" : "",
+               s.render.frame_start, enumName(s.render.estimator), s.camera.width, s.camera.height);
+    fmt::print("{}", formatPlan(plan));
+}
+
+}  // namespace
+
+void addPlanCommand(CLI::App& app) {
+    auto args = std::make_shared<SceneArgs>();
+    CLI::App* cmd = app.add_subcommand("plan", "Print the passes a scene's frames run, with the reason for every pass skipped");
+    cmd->add_option("scene", args->scene, "Scene file (TOML)")->required();
+    cmd->add_option("--frames", args->frames, "Frames A:B (= render.frame_start, render.frames)");
+    cmd->add_option("-D,--define", args->defines, "Override a setting: -D section.key=value (TOML value)")->allow_extra_args(false);
+    cmd->callback([args] { runPlan(*args); });
+}
+
+}  // namespace accretion::cmd

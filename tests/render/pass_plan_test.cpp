@@ -1,0 +1,137 @@
+// Only the work a scene needs: the pass plan, and the counters that show the
+// skipped work really is not done (no shadow rays, no any-hit calls, one BVH
+// build for a static scene, no history for one frame, no lighting for albedo 0).
+#include <catch2/catch.hpp>
+
+#include "accretion/render/frame_renderer.h"
+#include "accretion/render/pass_plan.h"
+#include "support/test_scenes.h"
+
+using namespace accretion;
+
+namespace {
+
+const PlannedStep& step(const PassPlan& plan, const std::string& name) {
+    for (const PlannedStep& s : plan.steps)
+        if (s.name == name) return s;
+    FAIL("no step " << name);
+    return plan.steps.front();
+}
+
+std::vector<FrameStats> render(const Settings& s, std::vector<FrameImage>* images = nullptr) {
+    FrameRenderer r(s, ParticleSource(s), RenderOptions{true});
+    std::vector<FrameStats> stats;
+    for (std::uint32_t f = 0; f < s.render.frames; ++f) {
+        FrameStats fs;
+        FrameImage img = r.render(s.render.frame_start + f, fs);
+        if (images) images->push_back(std::move(img));
+        stats.push_back(std::move(fs));
+    }
+    return stats;
+}
+
+Settings small() {
+    Settings s = accretion::test::smallDiskSettings();
+    s.render.estimator = EstimatorKind::uniform;
+    s.render.samples = 2;
+    return s;
+}
+
+}  // namespace
+
+TEST_CASE("visibility off: no shadow rays planned or traced, and more light", "[plan]") {
+    Settings s = small();
+    const auto with = render(s);
+    s.shading.visibility = false;
+    const PassPlan plan = planPasses(s);
+    CHECK_FALSE(step(plan, "shadow rays").runs);
+    CHECK_THAT(step(plan, "shadow rays").why, Catch::Contains("visibility off"));
+    std::vector<FrameImage> img;
+    const auto without = render(s, &img);
+    CHECK(with[0].lighting.shadowRays > 0);
+    CHECK(without[0].lighting.shadowRays == 0);
+    CHECK(without[0].lighting.lightTerms > 0);
+    for (EstimatorKind e : {EstimatorKind::exact, EstimatorKind::ris, EstimatorKind::restir}) {
+        s.render.estimator = e;
+        CHECK(render(s)[0].lighting.shadowRays == 0);
+    }
+}
+
+TEST_CASE("no alpha test: no filter callbacks; disc alpha: any-hits counted", "[plan][gpu]") {
+    Settings s = small();
+    s.gpu.counters = true;
+    CHECK_FALSE(step(planPasses(s), "alpha filter callbacks").runs);
+    auto anyHits = [](const Settings& st) {
+        FrameRenderer r(st, ParticleSource(st), RenderOptions{true});
+        FrameStats fs;
+        const FrameImage img = r.render(0, fs);
+        std::uint64_t n = 0;
+        for (const PassCounters& p : img.counters.passes)
+            for (const ThreadCounters& t : p.threads) n += t.anyHits;
+        return n;
+    };
+    CHECK(anyHits(s) == 0);
+    s.geometry.alpha = AlphaMode::disc;
+    CHECK(step(planPasses(s), "alpha filter callbacks").runs);
+    CHECK(anyHits(s) > 0);
+}
+
+TEST_CASE("static particles and camera: one BVH build for all frames, the same image", "[plan]") {
+    Settings s = small();
+    s.particles.gm = 0.0;
+    s.render.estimator = EstimatorKind::exact;
+    s.render.frames = 3;
+    const PassPlan plan = planPasses(s);
+    CHECK(plan.staticGeometry);
+    CHECK_THAT(step(plan, "buildClusters").why, Catch::Contains("once for all frames"));
+    std::vector<FrameImage> img;
+    const auto stats = render(s, &img);
+    CHECK(stats[0].bvh.built);
+    CHECK_FALSE(stats[1].bvh.built);
+    CHECK_FALSE(stats[2].bvh.built);
+    CHECK(stats[2].timer.seconds(pass::buildClusters) == 0.0);
+    CHECK(img[2].L == img[0].L);
+    // Moving particles rebuild every frame.
+    s.particles.gm = 20.0;
+    CHECK_FALSE(planPasses(s).staticGeometry);
+    const auto moving = render(s);
+    CHECK(moving[2].bvh.built);
+}
+
+TEST_CASE("restir: one frame or temporal off keeps no history; one neighbour-less frame skips spatial", "[plan][restir]") {
+    Settings s = small();
+    s.render.estimator = EstimatorKind::restir;
+    s.render.frames = 1;
+    CHECK_FALSE(planPasses(s).history);
+    CHECK_THAT(step(planPasses(s), "temporalResampling").why, Catch::Contains("one frame"));
+    s.render.frames = 3;
+    CHECK(planPasses(s).history);
+    const auto kept = render(s);
+    CHECK(kept[2].timer.seconds(pass::temporalResampling) > 0.0);
+    s.restir.temporal = false;
+    CHECK_THAT(step(planPasses(s), "temporalResampling").why, Catch::Contains("temporal off"));
+    const auto none = render(s);
+    CHECK(none[2].timer.seconds(pass::temporalResampling) == 0.0);
+    CHECK(none[2].lighting.reuseAccepted + none[2].lighting.reuseRejected > 0);  // spatial still runs
+    s.restir.spatial_neighbours = 0;
+    CHECK_FALSE(step(planPasses(s), "spatialResampling").runs);
+    CHECK(render(s)[2].lighting.reuseAccepted + render(s)[2].lighting.reuseRejected == 0);
+}
+
+TEST_CASE("albedo 0: no lighting passes; exact: no reservoirs; counters off: no counting code", "[plan]") {
+    Settings s = small();
+    s.shading.albedo = Vec3(0.0f);
+    const PassPlan plan = planPasses(s);
+    CHECK_FALSE(plan.lighting);
+    CHECK_FALSE(step(plan, "estimateLighting").runs);
+    CHECK_FALSE(step(plan, "buildLightSampler").runs);
+    const auto stats = render(s);
+    CHECK(stats[0].lighting.shadowRays == 0);
+    CHECK(stats[0].lighting.lightTerms == 0);
+    s.shading.albedo = Vec3(0.8f);
+    s.render.estimator = EstimatorKind::exact;
+    CHECK_THAT(step(planPasses(s), "reservoirs").why, Catch::Contains("no reservoirs"));
+    CHECK_THAT(step(planPasses(s), "counters").why, Catch::Contains("no counting code"));
+    s.gpu.counters = true;
+    CHECK(step(planPasses(s), "counters").runs);
+}
