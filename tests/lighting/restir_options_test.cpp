@@ -83,8 +83,9 @@ TEST_CASE("reduced-resolution lighting resamples a quarter of the pixels and ups
     double sumA = 0.0, sumB = 0.0;
     for (std::uint64_t seed = 0; seed < 16; ++seed) {
         s.render.seed = h.render.seed = seed;
-        for (const Vec3& v : renderFrames(s, 1)[0].lighting.Lr) sumA += luminance(v);
-        for (const Vec3& v : renderFrames(h, 1)[0].lighting.Lr) sumB += luminance(v);
+        const auto fa = renderFrames(s, 1), fb = renderFrames(h, 1);  // (a range-for over a member of a temporary dangles)
+        for (const Vec3& v : fa[0].lighting.Lr) sumA += luminance(v);
+        for (const Vec3& v : fb[0].lighting.Lr) sumB += luminance(v);
     }
     CHECK(sumB == Approx(sumA).epsilon(0.2));
 }
