@@ -10,6 +10,7 @@
 #include <tbb/info.h>
 
 #include "accretion/core/error.h"
+#include "accretion/core/memory.h"
 #include "accretion/core/version.h"
 #include "accretion/gpu/gpu_report.h"
 #include "accretion/io/atomic_file.h"
@@ -172,6 +173,7 @@ void runRender(const RenderArgs& args) {
     }
     const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     stats["total_seconds"] = total;
+    stats["peak_rss_bytes"] = peakResidentBytes();
     stats["shadow_rays_per_second"] = lightingSeconds > 0 ? double(shadowRays) / lightingSeconds : 0.0;
     writeJson(stem + ".stats.json", stats);
     fmt::print("stats: {}.stats.json\nsettings: {}.settings.toml\ntotal: {:.2f} s\n", stem, stem, total);

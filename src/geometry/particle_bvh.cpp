@@ -3,6 +3,7 @@
 #include <chrono>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <tbb/parallel_for.h>
 
@@ -320,6 +321,40 @@ bool ParticleBvh::intersect(const Vec3& o, const Vec3& d, float tfar, SurfaceHit
     hit.t = rh.ray.tfar;
     hit.uv = Vec2(rh.hit.u, rh.hit.v);
     return true;
+}
+
+void ParticleBvh::intersect8(const Vec3& o, const Vec3* d, int n, SurfaceHit* hit, bool* found) const {
+    QueryContext context = queryContext(nullptr);
+    alignas(32) int valid[8];
+    alignas(32) RTCRayHit8 rh;
+    for (int k = 0; k < 8; ++k) {
+        valid[k] = k < n ? -1 : 0;
+        const Vec3 dk = d[k < n ? k : 0];
+        rh.ray.org_x[k] = o.x;
+        rh.ray.org_y[k] = o.y;
+        rh.ray.org_z[k] = o.z;
+        rh.ray.dir_x[k] = dk.x;
+        rh.ray.dir_y[k] = dk.y;
+        rh.ray.dir_z[k] = dk.z;
+        rh.ray.tnear[k] = 0.0f;
+        rh.ray.tfar[k] = std::numeric_limits<float>::infinity();
+        rh.ray.time[k] = 0.0f;
+        rh.ray.mask[k] = ~0u;
+        rh.ray.id[k] = 0;
+        rh.ray.flags[k] = 0;
+        rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect8(valid, tlas_, &context.base, &rh);
+    for (int k = 0; k < n; ++k) {
+        found[k] = rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID;
+        if (!found[k]) continue;
+        const std::uint32_t c = rh.hit.instID[0][k];
+        hit[k].cluster = c;
+        hit[k].particle = clusters_.particle[clusters_.offset[c] + rh.hit.primID[k]];
+        hit[k].t = rh.ray.tfar[k];
+        hit[k].uv = Vec2(rh.hit.u[k], rh.hit.v[k]);
+    }
 }
 
 bool ParticleBvh::occluded(const Vec3& o, const Vec3& d, float tfar, RayCounters* counters) const {

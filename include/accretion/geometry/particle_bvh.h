@@ -65,9 +65,15 @@ public:
     /// Closest hit along o + t d, t in [0, tfar). d need not be unit. With
     /// counters (counting mode only), the BLAS entries and any-hits are added.
     bool intersect(const Vec3& o, const Vec3& d, float tfar, SurfaceHit& hit, RayCounters* counters = nullptr) const;
+    /// Closest hits of up to 8 rays from one origin (a packet: coherent
+    /// primary rays trace ~1.6x faster); found[k] says whether ray k hit.
+    /// Lanes k >= n are inactive. Not for counting.
+    void intersect8(const Vec3& o, const Vec3* d, int n, SurfaceHit* hit, bool* found) const;
     /// Any hit along o + t d, t in [0, tfar): the search stops at the first.
     bool occluded(const Vec3& o, const Vec3& d, float tfar, RayCounters* counters = nullptr) const;
 
+    /// The TLAS (for bare Embree loops over the same BVH: benchmarks).
+    RTCScene scene() const { return tlas_; }
     /// True when queries can count (the counting TLAS is built).
     bool counting() const { return counting_; }
     /// The opacity micromap in use (null without one).

@@ -26,6 +26,22 @@ inline Vec3 offsetRayOrigin(const Vec3& p, const Vec3& n) {
     return out;
 }
 
+/// The shadow ray of V(x, p_i): origin, direction (unit) and far end; tfar
+/// <= 0 when the light is too close for any ray (then V = 1).
+struct ShadowRay {
+    Vec3 o, d;
+    float tfar;
+};
+
+template <Primitive P>
+inline ShadowRay shadowRay(const ShadingPoint& sp, const LightTerm& light, float lightRadius, float eps) {
+    float tfar;
+    if constexpr (P == Primitive::sphere) tfar = (light.dist - lightRadius) * (1.0f - eps);
+    else tfar = light.dist * (1.0f - eps);
+    const Vec3 side = glm::dot(sp.ng, light.w) >= 0.0f ? sp.ng : -sp.ng;
+    return {offsetRayOrigin(sp.x, side), light.w, tfar > 0.0f ? tfar : 0.0f};
+}
+
 /// V(x, p_i) of MODEL.md section 3: the segment from the (offset) receiver to
 /// the light, ending short of the light's own geometry: billboards
 /// t < d (1 - eps) (p_i lies on its own quad), spheres t < (d - r_i)(1 - eps).
@@ -34,12 +50,9 @@ inline Vec3 offsetRayOrigin(const Vec3& p, const Vec3& n) {
 template <Primitive P>
 inline bool visible(const ParticleBvh& bvh, const ShadingPoint& sp, const LightTerm& light, float lightRadius, float eps,
                     RayCounters* counters = nullptr) {
-    float tfar;
-    if constexpr (P == Primitive::sphere) tfar = (light.dist - lightRadius) * (1.0f - eps);
-    else tfar = light.dist * (1.0f - eps);
-    if (!(tfar > 0.0f)) return true;
-    const Vec3 side = glm::dot(sp.ng, light.w) >= 0.0f ? sp.ng : -sp.ng;
-    return !bvh.occluded(offsetRayOrigin(sp.x, side), light.w, tfar, counters);
+    const ShadowRay r = shadowRay<P>(sp, light, lightRadius, eps);
+    if (!(r.tfar > 0.0f)) return true;
+    return !bvh.occluded(r.o, r.d, r.tfar, counters);
 }
 
 }  // namespace accretion

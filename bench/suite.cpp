@@ -1,0 +1,526 @@
+// accretion_suite: the performance bars of issue 5, each measured side by
+// side with the limit that matters (a bare Embree loop over the same data),
+// plus scaling curves, per-pass breakdowns and peak memory. Writes
+// bench/results.json, bench/scaling_particles.csv, bench/scaling_resolution.csv
+// and their PNG plots, and prints a table.
+//   ./build/bench/accretion_suite [--quick] [--out bench] [--accretion build/accretion]
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <spawn.h>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+
+#include <CLI/CLI.hpp>
+#include <embree3/rtcore.h>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/info.h>
+#include <tbb/parallel_for.h>
+
+#include "accretion/core/rng.h"
+#include "accretion/core/version.h"
+#include "accretion/geometry/particle_bvh.h"
+#include "accretion/io/atomic_file.h"
+#include "accretion/io/plot.h"
+#include "accretion/lighting/light_arrays.h"
+#include "accretion/particles/particle_source.h"
+#include "accretion/render/estimators.h"
+#include "accretion/render/frame_renderer.h"
+#include "accretion/render/gbuffer.h"
+#include "accretion/render/visibility.h"
+#include "accretion/scene/scene_parser.h"
+
+extern char** environ;
+
+using namespace accretion;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double seconds(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+/// Median wall time of `runs` calls.
+double timeIt(int runs, const std::function<void()>& f) {
+    std::vector<double> t;
+    for (int k = 0; k < runs; ++k) {
+        const auto t0 = Clock::now();
+        f();
+        t.push_back(seconds(t0));
+    }
+    return median(t);
+}
+
+void log(const std::string& s) { fmt::print(stderr, "suite: {}\n", s); }
+
+nlohmann::json bar(double project, double limit, double limitRatio) {
+    return {{"project_s", project}, {"limit_s", limit}, {"ratio", project / limit}, {"limit_ratio", limitRatio}};
+}
+
+/// The disk of scenes/disk_100k.toml with another particle count / resolution.
+Settings diskScene(const std::string& sceneFile, std::uint32_t particles, std::uint32_t width, std::uint32_t height) {
+    Settings s = loadScene(sceneFile);
+    s.particles.count = particles;
+    s.camera.width = width;
+    s.camera.height = height;
+    return s;
+}
+
+// ---------------------------------------------------------------- BVH build
+
+/// The limit: a bare loop that builds the same clusters (one quad BLAS each,
+/// camera-facing corners) in parallel with TBB, then the TLAS of instances.
+struct BareBuilder {
+    RTCDevice device = rtcNewDevice(nullptr);
+    std::vector<RTCScene> blas;
+    RTCScene tlas = nullptr;
+    ~BareBuilder() {
+        release();
+        rtcReleaseDevice(device);
+    }
+    void release() {
+        for (RTCScene s : blas) rtcReleaseScene(s);
+        blas.clear();
+        if (tlas) rtcReleaseScene(tlas);
+        tlas = nullptr;
+    }
+    void build(const Clusters& clusters, const Particles& p, const Camera& cam) {
+        release();
+        blas.assign(clusters.count(), nullptr);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, clusters.count(), 1), [&](const auto& r) {
+            for (std::size_t c = r.begin(); c != r.end(); ++c) {
+                const auto m = clusters.members(c);
+                RTCScene scene = rtcNewScene(device);
+                rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_LOW);
+                RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_QUAD);
+                auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                                     12, 4 * m.size()));
+                auto* idx = static_cast<std::uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0,
+                                                                                RTC_FORMAT_UINT4, 16, m.size()));
+                for (std::size_t k = 0; k < m.size(); ++k) {
+                    const Vec3 q = p.position[m[k]];
+                    const float rad = p.radius[m[k]];
+                    const Vec3 a = rad * cam.right, b = rad * cam.up;
+                    const Vec3 corner[4] = {q - a - b, q + a - b, q + a + b, q - a + b};
+                    for (int j = 0; j < 4; ++j)
+                        for (int d = 0; d < 3; ++d) v[12 * k + 3 * j + d] = corner[j][d];
+                    for (int j = 0; j < 4; ++j) idx[4 * k + j] = std::uint32_t(4 * k + j);
+                }
+                rtcCommitGeometry(g);
+                rtcAttachGeometry(scene, g);
+                rtcReleaseGeometry(g);
+                rtcCommitScene(scene);
+                blas[c] = scene;
+            }
+        });
+        tlas = rtcNewScene(device);
+        rtcSetSceneBuildQuality(tlas, RTC_BUILD_QUALITY_LOW);
+        for (RTCScene s : blas) {
+            RTCGeometry inst = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
+            rtcSetGeometryInstancedScene(inst, s);
+            rtcCommitGeometry(inst);
+            rtcAttachGeometry(tlas, inst);
+            rtcReleaseGeometry(inst);
+        }
+        rtcCommitScene(tlas);
+    }
+};
+
+// ---------------------------------------------------------------- rays
+
+struct RayBatch {
+    std::vector<float> ox, oy, oz, dx, dy, dz, tfar;
+    std::size_t size() const { return ox.size(); }
+    void push(const Vec3& o, const Vec3& d, float t) {
+        ox.push_back(o.x), oy.push_back(o.y), oz.push_back(o.z);
+        dx.push_back(d.x), dy.push_back(d.y), dz.push_back(d.z);
+        tfar.push_back(t);
+    }
+};
+
+/// The shadow rays the `uniform` estimator traces (same streams, same order
+/// per pixel), rebuilt outside the pass.
+RayBatch uniformShadowRays(const ParticleBvh& bvh, const Particles& p, const GBuffer& gb, const Settings& s) {
+    const LightArrays L(p, s.shading);
+    const float eps = float(s.render.shadow_epsilon);
+    RayBatch rays;
+    for (std::size_t px = 0; px < gb.texels.size(); ++px) {
+        const GBufferTexel& g = gb.texels[px];
+        if (!g.hit()) continue;
+        const ShadingPoint sp{g.position, g.normal, g.geomNormal, p.albedo[g.particle], g.particle};
+        Rng rng(px, 0, RngPass::lightSampling, s.render.seed);
+        for (std::uint32_t k = 0; k < s.render.samples; ++k) {
+            const LightSample x = sampleSource<false>(L, nullptr, rng);
+            LightTerm t;
+            if (!L.term<ShadingModel::lambert>(sp, x.i, t)) continue;
+            const ShadowRay r = shadowRay<Primitive::billboard>(sp, t, L.radius[x.i], eps);
+            if (r.tfar > 0.0f) rays.push(r.o, r.d, r.tfar);
+        }
+    }
+    (void)bvh;
+    return rays;
+}
+
+/// rtcOccluded1 over every ray, in parallel; returns the occluded count.
+std::size_t bareOccluded1(RTCScene scene, const RayBatch& r) {
+    std::atomic<std::size_t> occluded{0};
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, r.size(), 1024), [&](const auto& range) {
+        std::size_t n = 0;
+        RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+            RTCRay ray{r.ox[i], r.oy[i], r.oz[i], 0.0f, r.dx[i], r.dy[i], r.dz[i], 0.0f, r.tfar[i], ~0u, 0, 0};
+            rtcOccluded1(scene, &ctx, &ray);
+            n += ray.tfar < 0.0f;
+        }
+        occluded += n;
+    });
+    return occluded;
+}
+
+/// rtcOccluded8 over groups of 8 consecutive rays (neighbouring pixels' samples).
+std::size_t bareOccluded8(RTCScene scene, const RayBatch& r) {
+    std::atomic<std::size_t> occluded{0};
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, (r.size() + 7) / 8, 128), [&](const auto& range) {
+        std::size_t n = 0;
+        RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        for (std::size_t b = range.begin(); b != range.end(); ++b) {
+            alignas(32) int valid[8];
+            alignas(32) RTCRay8 ray;
+            for (int k = 0; k < 8; ++k) {
+                const std::size_t i = std::min(r.size() - 1, 8 * b + k);
+                valid[k] = 8 * b + k < r.size() ? -1 : 0;
+                ray.org_x[k] = r.ox[i], ray.org_y[k] = r.oy[i], ray.org_z[k] = r.oz[i];
+                ray.dir_x[k] = r.dx[i], ray.dir_y[k] = r.dy[i], ray.dir_z[k] = r.dz[i];
+                ray.tnear[k] = 0.0f, ray.tfar[k] = r.tfar[i], ray.time[k] = 0.0f;
+                ray.mask[k] = ~0u, ray.id[k] = 0, ray.flags[k] = 0;
+            }
+            rtcOccluded8(valid, scene, &ctx, &ray);
+            for (int k = 0; k < 8; ++k) n += valid[k] && ray.tfar[k] < 0.0f;
+        }
+        occluded += n;
+    });
+    return occluded;
+}
+
+/// rtcIntersect1 / rtcIntersect8 (8x1 pixel rows) over the camera's pixel rays.
+std::size_t bareIntersect(RTCScene scene, const Camera& cam, bool packets) {
+    std::atomic<std::size_t> hits{0};
+    tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, cam.height, 4), [&](const auto& rows) {
+        std::size_t n = 0;
+        RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        for (std::uint32_t y = rows.begin(); y != rows.end(); ++y) {
+            if (!packets) {
+                for (std::uint32_t x = 0; x < cam.width; ++x) {
+                    const Vec3 d = cam.pixelDirection(x, y);
+                    RTCRayHit rh{};
+                    rh.ray = {cam.position.x, cam.position.y, cam.position.z, 0.0f, d.x, d.y, d.z, 0.0f,
+                              std::numeric_limits<float>::infinity(), ~0u, 0, 0};
+                    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+                    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+                    rtcIntersect1(scene, &ctx, &rh);
+                    n += rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+                }
+                continue;
+            }
+            for (std::uint32_t x0 = 0; x0 < cam.width; x0 += 8) {
+                alignas(32) int valid[8];
+                alignas(32) RTCRayHit8 rh;
+                for (int k = 0; k < 8; ++k) {
+                    const std::uint32_t x = std::min(cam.width - 1, x0 + k);
+                    valid[k] = x0 + k < cam.width ? -1 : 0;
+                    const Vec3 d = cam.pixelDirection(x, y);
+                    rh.ray.org_x[k] = cam.position.x, rh.ray.org_y[k] = cam.position.y, rh.ray.org_z[k] = cam.position.z;
+                    rh.ray.dir_x[k] = d.x, rh.ray.dir_y[k] = d.y, rh.ray.dir_z[k] = d.z;
+                    rh.ray.tnear[k] = 0.0f, rh.ray.tfar[k] = std::numeric_limits<float>::infinity();
+                    rh.ray.time[k] = 0.0f, rh.ray.mask[k] = ~0u, rh.ray.id[k] = 0, rh.ray.flags[k] = 0;
+                    rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+                    rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+                }
+                rtcIntersect8(valid, scene, &ctx, &rh);
+                for (int k = 0; k < 8; ++k) n += valid[k] && rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID;
+            }
+        }
+        hits += n;
+    });
+    return hits;
+}
+
+// ---------------------------------------------------------------- frames
+
+struct FrameTiming {
+    double frameSeconds = 0.0;
+    std::map<std::string, double> passes;
+    std::uint64_t shadowRays = 0, hitPixels = 0;
+};
+
+/// Median frame time (and its passes) of `measured` frames after `history` frames.
+FrameTiming timeFrames(const Settings& s, const ParticleSource& source, std::uint32_t first, std::uint32_t history,
+                       std::uint32_t measured) {
+    Settings run = s;
+    run.render.frame_start = first;
+    run.render.frames = history + measured;
+    FrameRenderer renderer(run, source, RenderOptions{true});
+    std::vector<FrameStats> stats;
+    for (std::uint32_t f = 0; f < history + measured; ++f) {
+        FrameStats fs;
+        renderer.render(first + f, fs);
+        if (f >= history) stats.push_back(std::move(fs));
+    }
+    std::sort(stats.begin(), stats.end(), [](const FrameStats& a, const FrameStats& b) { return a.seconds < b.seconds; });
+    const FrameStats& m = stats[stats.size() / 2];
+    FrameTiming t;
+    t.frameSeconds = m.seconds;
+    for (const auto& [name, sec] : m.timer.all()) t.passes[name] = sec;
+    t.shadowRays = m.lighting.shadowRays;
+    t.hitPixels = m.hitPixels;
+    return t;
+}
+
+/// Runs a child process; true if it exits 0.
+bool runChild(const std::vector<std::string>& argv) {
+    std::vector<char*> args;
+    for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
+    pid_t pid;
+    if (posix_spawn(&pid, args[0], nullptr, nullptr, args.data(), environ) != 0) return false;
+    int status = 0;
+    return waitpid(pid, &status, 0) == pid && WIFEXITED(status) && WEXITSTATUS(status) == 0;
+}
+
+std::string machine() {
+    std::ifstream in("/proc/cpuinfo");
+    std::string line;
+    while (std::getline(in, line))
+        if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
+    return "unknown";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"accretion performance suite: bars against bare Embree loops, scaling curves, memory"};
+    bool quick = false;
+    std::string outDir = "bench", binary = "build/accretion", scene = "scenes/disk_100k.toml";
+    app.add_flag("--quick", quick, "Skip the tree 1% reference and the 1M-particle frame (for CI smoke runs)");
+    app.add_option("--out", outDir, "Directory of results.json and the scaling CSV/PNG");
+    app.add_option("--accretion", binary, "The accretion binary (memory runs)");
+    app.add_option("--scene", scene, "The disk scene");
+    CLI11_PARSE(app, argc, argv);
+    const int cores = tbb::info::default_concurrency();
+    std::filesystem::create_directories(outDir);
+    nlohmann::json results = {{"version", std::string(version())},
+                              {"machine", {{"cpu", machine()}, {"cores", cores}}},
+                              {"scene", scene},
+                              {"quick", quick}};
+    nlohmann::json bars, figures;
+
+    // --- BVH rebuild at 100K, clusters of ~100, fast build.
+    const Settings disk = diskScene(scene, 100'000, 1280, 720);
+    const ParticleSource diskSource(disk);
+    const Particles p0 = diskSource.frame(0), p1 = diskSource.frame(1);
+    const Camera cam = Camera::atFrame(disk.camera, 0);
+    EmbreeDevice device;
+    double build100k = 0.0;
+    {
+        log("BVH rebuild, 100K particles");
+        ParticleBvh bvh(device, disk.geometry);
+        int f = 0;
+        bvh.build(p0, cam);
+        build100k = timeIt(9, [&] { bvh.build(++f % 2 ? p1 : p0, cam); });
+        BareBuilder bare;
+        const Clusters clusters = bvh.clusters();
+        bare.build(clusters, p0, cam);
+        const double limit = timeIt(9, [&] { bare.build(clusters, ++f % 2 ? p1 : p0, cam); });
+        bars["bvh_rebuild_100k"] = bar(build100k, limit, 1.3);
+        const BvhStats& st = bvh.stats();
+        figures["bvh_rebuild_100k_breakdown_s"] = {{"cluster", st.clusterSeconds}, {"blas", st.blasSeconds},
+                                                   {"tlas", st.tlasSeconds}, {"clusters", st.clusters}};
+        // Refit and partial rebuild against the moved fraction.
+        nlohmann::json policies;
+        Settings g = disk;
+        g.geometry.build = BuildPolicy::refit;
+        ParticleBvh refit(device, g.geometry);
+        refit.build(p0, cam);
+        policies["refit"] = timeIt(9, [&] { refit.build(++f % 2 ? p1 : p0, cam); });
+        for (double fraction : {0.1, 0.3, 0.7, 1.0}) {
+            g.geometry.build = BuildPolicy::partial;
+            g.geometry.rebuild_fraction = fraction;
+            ParticleBvh partial(device, g.geometry);
+            partial.build(p0, cam);
+            policies[fmt::format("partial_{}", fraction)] = timeIt(9, [&] { partial.build(++f % 2 ? p1 : p0, cam); });
+        }
+        policies["rebuild"] = build100k;
+        figures["bvh_policies_100k_s"] = policies;
+    }
+    {
+        log("BVH rebuild, 1M particles");
+        const Settings big = diskScene(scene, 1'000'000, 1280, 720);
+        const ParticleSource src(big);
+        const Particles q0 = src.frame(0), q1 = src.frame(1);
+        ParticleBvh bvh(device, big.geometry);
+        int f = 0;
+        bvh.build(q0, cam);
+        const double t = timeIt(5, [&] { bvh.build(++f % 2 ? q1 : q0, cam); });
+        bars["bvh_rebuild_1m_vs_100k"] = bar(t, build100k, 10.0);
+    }
+
+    // --- Rays: the real passes against bare Embree loops over the same rays and BVH.
+    {
+        log("primary and shadow rays, 100K particles at 1280x720");
+        ParticleBvh bvh(device, disk.geometry);
+        bvh.build(p0, cam);
+        GBuffer gb;
+        const double primary = timeIt(5, [&] { traceGBuffer(bvh, p0, cam, disk.shading.model, gb); });
+        const double bare1 = timeIt(5, [&] { bareIntersect(bvh.scene(), cam, false); });
+        const double bare8 = timeIt(5, [&] { bareIntersect(bvh.scene(), cam, true); });
+        const double primaryLimit = std::min(bare1, bare8);
+        bars["primary_rays"] = bar(primary, primaryLimit, 1.25);
+        const double nPrimary = double(cam.width) * cam.height;
+        figures["primary_rays_per_s_per_core"] = {{"project", nPrimary / primary / cores},
+                                                  {"bare_rtcIntersect1", nPrimary / bare1 / cores},
+                                                  {"bare_rtcIntersect8", nPrimary / bare8 / cores}};
+
+        Settings u = disk;
+        u.render.estimator = EstimatorKind::uniform;
+        u.render.samples = 4;
+        const RayBatch rays = uniformShadowRays(bvh, p0, gb, u);
+        LightingImage out;
+        std::uint64_t traced = 0;
+        const double shadow = timeIt(5, [&] {
+            LightingInputs in{bvh, p0, gb, u.shading, u.render, 0, nullptr, nullptr};
+            traced = estimateLighting(in, out).shadowRays;
+        });
+        std::size_t occ1 = 0, occ8 = 0;
+        const double s1 = timeIt(5, [&] { occ1 = bareOccluded1(bvh.scene(), rays); });
+        const double s8 = timeIt(5, [&] { occ8 = bareOccluded8(bvh.scene(), rays); });
+        if (traced != rays.size() || occ1 != occ8)
+            log(fmt::format("warning: {} rays traced by the pass, {} rebuilt; occluded {} vs {}", traced, rays.size(), occ1, occ8));
+        bars["shadow_rays"] = bar(shadow, std::min(s1, s8), 1.25);
+        const double n = double(rays.size());
+        figures["shadow_rays_per_s_per_core"] = {{"project", n / shadow / cores},
+                                                 {"bare_rtcOccluded1", n / s1 / cores},
+                                                 {"bare_rtcOccluded8", n / s8 / cores},
+                                                 {"rays", rays.size()},
+                                                 {"occluded_fraction", double(occ1) / n}};
+    }
+
+    // --- ReSTIR frame: per-pass breakdown and candidates per second per core.
+    Settings restir = disk;
+    restir.render.estimator = EstimatorKind::restir;
+    {
+        log("restir frame, 100K particles at 1280x720");
+        const FrameTiming t = timeFrames(restir, diskSource, 4, 4, 3);
+        double lighting = 0.0;
+        nlohmann::json passes;
+        for (const auto& [name, sec] : t.passes) passes[name] = sec;
+        for (const char* name : {"generateCandidates", "temporalResampling", "spatialResampling"})
+            lighting += t.passes.count(name) ? t.passes.at(name) : 0.0;
+        const double candidates = double(t.hitPixels) * restir.render.candidates;
+        figures["restir_frame_100k_720p"] = {
+            {"seconds", t.frameSeconds},
+            {"passes_s", passes},
+            {"resampling_share", lighting / t.frameSeconds},
+            {"candidates_per_s_per_core", candidates / t.passes.at("generateCandidates") / cores},
+            {"shadow_rays", t.shadowRays}};
+    }
+
+    // --- The tree reference to 1% per-pixel relative standard error on the same frame.
+    if (!quick) {
+        log("tree to 1% relative standard error (minutes)");
+        Settings tree = disk;
+        tree.render.estimator = EstimatorKind::tree;
+        tree.render.samples = 64;
+        tree.render.target_stderr = 0.01;
+        tree.render.max_samples = 4096;
+        const FrameTiming t = timeFrames(tree, diskSource, 8, 0, 1);
+        figures["tree_to_1pct_100k_720p_s"] = t.frameSeconds;
+    }
+
+    // --- Scaling curves.
+    std::string csvP = "particles,bvh_build_s,restir_frame_s,trace_shadow_rays_s,shadow_rays\n";
+    std::vector<std::uint32_t> counts = {10'000, 30'000, 100'000, 300'000, 1'000'000};
+    if (quick) counts.pop_back();
+    for (std::uint32_t n : counts) {
+        log(fmt::format("scaling: {} particles", n));
+        Settings s = restir;
+        s.particles.count = n;
+        const ParticleSource src(s);
+        const FrameTiming t = timeFrames(s, src, 2, 2, 1);
+        csvP += fmt::format("{},{:.6f},{:.6f},{:.6f},{}\n", n, t.passes.at("buildClusters"), t.frameSeconds,
+                            t.passes.at("traceShadowRays"), t.shadowRays);
+    }
+    writeFileAtomic(outDir + "/scaling_particles.csv", csvP);
+    std::string csvR = "width,height,pixels,restir_frame_s,trace_gbuffer_s\n";
+    for (auto [w, h] : std::vector<std::pair<std::uint32_t, std::uint32_t>>{{640, 360}, {960, 540}, {1280, 720}, {1920, 1080}}) {
+        log(fmt::format("scaling: {}x{}", w, h));
+        Settings s = restir;
+        s.camera.width = w;
+        s.camera.height = h;
+        const FrameTiming t = timeFrames(s, diskSource, 2, 2, 1);
+        csvR += fmt::format("{},{},{},{:.6f},{:.6f}\n", w, h, std::uint64_t(w) * h, t.frameSeconds, t.passes.at("traceGBuffer"));
+    }
+    writeFileAtomic(outDir + "/scaling_resolution.csv", csvR);
+    try {
+        plotPng(outDir + "/scaling_particles.png",
+                "set datafile separator ','\nset key top left\nset grid\nset logscale xy\nset xlabel 'particles'\n"
+                "set ylabel 'seconds'\nplot '" + outDir + "/scaling_particles.csv' every ::1 using 1:2 with linespoints title "
+                "'buildClusters', '' every ::1 using 1:3 with linespoints title 'restir frame (720p)', '' every ::1 using 1:4 "
+                "with linespoints title 'traceShadowRays'\n");
+        plotPng(outDir + "/scaling_resolution.png",
+                "set datafile separator ','\nset key top left\nset grid\nset xlabel 'pixels'\nset ylabel 'seconds'\n"
+                "plot '" + outDir + "/scaling_resolution.csv' every ::1 using 3:4 with linespoints title 'restir frame "
+                "(100K particles)', '' every ::1 using 3:5 with linespoints title 'traceGBuffer'\n");
+    } catch (const std::exception& e) {
+        log(fmt::format("no plot: {}", e.what()));
+    }
+
+    // --- Peak resident memory per particle (a child process per count).
+    {
+        nlohmann::json mem;
+        std::vector<std::uint32_t> sizes = {100'000, 1'000'000};
+        long base = 0;
+        for (std::uint32_t n : sizes) {
+            log(fmt::format("peak memory: {} particles", n));
+            // The child's own high-water mark (its stats.json), so the suite's memory does not count.
+            const auto dir = std::filesystem::temp_directory_path() / "accretion_suite_mem";
+            const std::string out = (dir / "m.exr").string();
+            long rss = -1;
+            if (runChild({binary, "render", scene, "--quiet", "--frames", "0:1", "-D", fmt::format("particles.count={}", n), "-o", out})) {
+                std::ifstream in(dir / "m.stats.json");
+                rss = nlohmann::json::parse(in)["peak_rss_bytes"].get<long>();
+            }
+            mem[fmt::format("peak_rss_bytes_{}", n)] = rss;
+            mem[fmt::format("bytes_per_particle_{}", n)] = rss > 0 ? double(rss) / n : 0.0;
+            if (n == sizes[0]) base = rss;
+            else if (rss > 0 && base > 0) mem["marginal_bytes_per_particle"] = double(rss - base) / double(n - sizes[0]);
+        }
+        figures["memory"] = mem;
+    }
+
+    results["bars"] = bars;
+    results["figures"] = figures;
+    std::ofstream(outDir + "/results.json.tmp") << results.dump(2) << "\n";
+    std::filesystem::rename(outDir + "/results.json.tmp", outDir + "/results.json");
+
+    fmt::print("{:<26} {:>12} {:>12} {:>8} {:>8}  {}\n", "bar", "project s", "limit s", "ratio", "bar", "");
+    for (const auto& [name, b] : bars.items())
+        fmt::print("{:<26} {:>12.5f} {:>12.5f} {:>8.2f} {:>8.2f}  {}\n", name, b["project_s"].get<double>(),
+                   b["limit_s"].get<double>(), b["ratio"].get<double>(), b["limit_ratio"].get<double>(),
+                   b["ratio"].get<double>() <= b["limit_ratio"].get<double>() ? "ok" : "ABOVE");
+    fmt::print("{}\n", figures.dump(2));
+    fmt::print("results: {}/results.json, scaling: {}/scaling_particles.csv/.png, {}/scaling_resolution.csv/.png\n", outDir,
+               outDir, outDir);
+    return 0;
+}
