@@ -129,14 +129,18 @@ ParticleBvh::ParticleBvh(const EmbreeDevice& device, const GeometrySettings& set
     alpha_.omm = omm_.get();
 }
 
-ParticleBvh::~ParticleBvh() {
-    releaseBlas();
-    if (tlas_) rtcReleaseScene(tlas_);
-    if (countingTlas_) rtcReleaseScene(countingTlas_);
-}
+ParticleBvh::~ParticleBvh() { releaseBlas(); }
 
 void ParticleBvh::releaseBlas() {
-    for (RTCScene s : blas_) rtcReleaseScene(s);
+    // The TLAS first (its instances hold the BLAS), then the BLAS in
+    // parallel: freeing a frame's structures serially costs ~5 ms at 100K.
+    if (tlas_) rtcReleaseScene(tlas_);
+    tlas_ = nullptr;
+    if (countingTlas_) rtcReleaseScene(countingTlas_);
+    countingTlas_ = nullptr;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blas_.size(), 16), [&](const auto& r) {
+        for (std::size_t c = r.begin(); c != r.end(); ++c) rtcReleaseScene(blas_[c]);
+    });
     blas_.clear();
     geometry_.clear();
 }
