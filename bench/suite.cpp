@@ -162,7 +162,7 @@ RayBatch uniformShadowRays(const ParticleBvh& bvh, const Particles& p, const GBu
             const LightSample x = sampleSource<false>(L, nullptr, rng);
             LightTerm t;
             if (!L.term<ShadingModel::lambert>(sp, x.i, t)) continue;
-            const ShadowRay r = shadowRay<Primitive::billboard>(sp, t, L.radius[x.i], eps);
+            const ShadowRay r = shadowRay<Primitive::billboard>(sp, t, L.packed[x.i].radius, eps);
             if (r.tfar > 0.0f) rays.push(r.o, r.d, r.tfar);
         }
     }

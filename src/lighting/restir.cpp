@@ -130,7 +130,7 @@ StoredReservoir combine(const Offer* offers, std::uint32_t n, const LightArrays&
             if (rs.basic_visibility && d.visibilityTested && shadows) {
                 ++c.shadowRays;
                 RayCounters rc;
-                const bool seen = visible<P>(*d.bvh, d.sp, t, d.lights->radius[out.y], eps, rec.rayCounters(rc));
+                const bool seen = visible<P>(*d.bvh, d.sp, t, d.lights->packed[out.y].radius, eps, rec.rayCounters(rc));
                 rec.ray(rc);
                 if (!seen) {
                     ++c.shadowOccluded;
@@ -224,7 +224,7 @@ LightingCounters generateCandidates(const FrameContext& f, std::vector<StoredRes
             if (f.L.term<SM>(sp, r.y, t)) {
                 ++c.shadowRays;
                 RayCounters rc;
-                const bool seen = visible<P>(f.in.bvh, sp, t, f.L.radius[r.y], f.eps, rec.rayCounters(rc));
+                const bool seen = visible<P>(f.in.bvh, sp, t, f.L.packed[r.y].radius, f.eps, rec.rayCounters(rc));
                 rec.ray(rc);
                 if (!seen) {
                     ++c.shadowOccluded;
@@ -380,7 +380,7 @@ LightingCounters traceShadowRays(const FrameContext& f, std::vector<StoredReserv
             ++c.shadowRays;
             rec.trip();
             RayCounters rc;
-            seen = visible<P>(f.in.bvh, sp, t, f.L.radius[r.y], f.eps, rec.rayCounters(rc));
+            seen = visible<P>(f.in.bvh, sp, t, f.L.packed[r.y].radius, f.eps, rec.rayCounters(rc));
             rec.ray(rc);
         }
         if (!seen) {

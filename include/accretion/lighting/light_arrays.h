@@ -12,13 +12,22 @@
 
 namespace accretion {
 
+/// What a light sample reads, in one half cache line (a random light costs
+/// one miss, not four).
+struct alignas(32) PackedLight {
+    Vec3 position;
+    float dmin2;     ///< max(r_i, dmin)^2
+    Vec3 emission;
+    float radius;
+};
+
 /// The lights of a frame as the hot loops read them (views of the particle
-/// arrays plus the squared distance clamps).
+/// arrays, and the packed records the samplers read).
 struct LightArrays {
     const Vec3* position = nullptr;
     const Vec3* emission = nullptr;
     const float* radius = nullptr;
-    std::vector<float> dmin2;  ///< max(r_i, dmin)^2
+    std::vector<PackedLight> packed;
     std::uint32_t count = 0;
     float uniformPdf = 0.0f;   ///< 1 / count
 
@@ -29,18 +38,20 @@ struct LightArrays {
         radius = particles.radius.data();
         count = static_cast<std::uint32_t>(particles.size());
         uniformPdf = count ? 1.0f / float(count) : 0.0f;
-        dmin2.resize(count);
+        packed.resize(count);
         const float dmin = static_cast<float>(shading.dmin);
         for (std::uint32_t i = 0; i < count; ++i) {
             const float d = std::max(particles.radius[i], dmin);
-            dmin2[i] = d * d;
+            packed[i] = {position[i], d * d, emission[i], radius[i]};
         }
     }
 
     /// Unshadowed term of light i at the receiver (0 for its own particle).
     template <ShadingModel M>
     bool term(const ShadingPoint& sp, std::uint32_t i, LightTerm& t) const {
-        return i != sp.self && i < count && evalLight<M>(sp, position[i], emission[i], dmin2[i], t);
+        if (i == sp.self || i >= count) return false;
+        const PackedLight& l = packed[i];
+        return evalLight<M>(sp, l.position, l.emission, l.dmin2, t);
     }
     /// RIS target p_hat = luminance(f I G), no visibility.
     template <ShadingModel M>
