@@ -312,11 +312,13 @@ std::string machine() {
 int main(int argc, char** argv) {
     CLI::App app{"accretion performance suite: bars against bare Embree loops, scaling curves, memory"};
     bool quick = false;
-    std::string outDir = "bench", binary = "build/accretion", scene = "scenes/disk_100k.toml";
+    std::string outDir = "bench", binary = "build/accretion", micro = "build/bench/accretion_bench",
+                scene = "scenes/disk_100k.toml";
     app.add_flag("--quick", quick, "Skip the tree 1% reference and the 1M-particle frame (for CI smoke runs)");
     app.add_option("--out", outDir, "Directory of results.json and the scaling CSV/PNG");
     app.add_option("--accretion", binary, "The accretion binary (memory runs)");
     app.add_option("--scene", scene, "The disk scene");
+    app.add_option("--micro", micro, "The Google Benchmark micro-benchmarks binary (empty: skip)");
     CLI11_PARSE(app, argc, argv);
     const int cores = tbb::info::default_concurrency();
     std::filesystem::create_directories(outDir);
@@ -507,6 +509,22 @@ int main(int argc, char** argv) {
             else if (rss > 0 && base > 0) mem["marginal_bytes_per_particle"] = double(rss - base) / double(n - sizes[0]);
         }
         figures["memory"] = mem;
+    }
+
+    // --- Micro-benchmarks of the hot kernels (Google Benchmark, its JSON embedded).
+    if (!micro.empty()) {
+        log("micro-benchmarks");
+        const auto file = std::filesystem::temp_directory_path() / "accretion_suite_micro.json";
+        if (runChild({micro, "--benchmark_filter=BM_(Alias|LightTree|Target|Reservoir)", "--benchmark_repetitions=5",
+                      "--benchmark_report_aggregates_only=true", "--benchmark_out=" + file.string(),
+                      "--benchmark_out_format=json"})) {
+            std::ifstream in(file);
+            nlohmann::json m;
+            for (const auto& b : nlohmann::json::parse(in)["benchmarks"])
+                if (b.value("aggregate_name", "") == "median")
+                    m[b["run_name"].get<std::string>()] = {{"ns", b["real_time"]}, {"items_per_s", b["items_per_second"]}};
+            figures["micro_benchmarks_median"] = m;
+        }
     }
 
     results["bars"] = bars;
