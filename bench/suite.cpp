@@ -520,7 +520,8 @@ int main(int argc, char** argv) {
                       "--benchmark_out_format=json"})) {
             std::ifstream in(file);
             nlohmann::json m;
-            for (const auto& b : nlohmann::json::parse(in)["benchmarks"])
+            const nlohmann::json doc = nlohmann::json::parse(in);  // held: a range-for over a temporary's member dangles
+            for (const auto& b : doc["benchmarks"])
                 if (b.value("aggregate_name", "") == "median")
                     m[b["run_name"].get<std::string>()] = {{"ns", b["real_time"]}, {"items_per_s", b["items_per_second"]}};
             figures["micro_benchmarks_median"] = m;

@@ -1,9 +1,12 @@
 #include "accretion/geometry/clustering.h"
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <limits>
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 #include <tbb/parallel_sort.h>
 
 namespace accretion {
@@ -29,11 +32,18 @@ Clusters clusterParticles(std::span<const Vec3> positions, std::uint32_t target)
     if (n == 0) return out;
     target = std::max<std::uint32_t>(target, 1);
 
-    Vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-    for (const Vec3& p : positions) {
-        lo = glm::min(lo, p);
-        hi = glm::max(hi, p);
-    }
+    using Box = std::pair<Vec3, Vec3>;
+    const Box empty{Vec3(std::numeric_limits<float>::max()), Vec3(-std::numeric_limits<float>::max())};
+    const auto [lo, hi] = tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, n, 16384), empty,
+        [&](const auto& r, Box b) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                b.first = glm::min(b.first, positions[i]);
+                b.second = glm::max(b.second, positions[i]);
+            }
+            return b;
+        },
+        [](const Box& a, const Box& b) { return Box{glm::min(a.first, b.first), glm::max(a.second, b.second)}; });
     const Vec3 ext = hi - lo;
     const float size = std::max({ext.x, ext.y, ext.z, 1e-30f});
     const float scale = float((1 << kBits) - 1) / size;
@@ -50,12 +60,29 @@ Clusters clusterParticles(std::span<const Vec3> positions, std::uint32_t target)
     });
     tbb::parallel_sort(keys.begin(), keys.end());
 
-    // Finest level whose non-empty cells average >= target particles.
+    // Finest level whose non-empty cells average >= target particles. One
+    // pass: neighbours whose keys first differ at bit d are in different
+    // cells at every level l with 32 + 3 l <= d.
+    using Histogram = std::array<std::size_t, kBits + 1>;
+    const Histogram firstDiff = tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(1, std::max<std::size_t>(n, 1), 16384), Histogram{},
+        [&](const auto& r, Histogram h) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                const std::uint64_t x = (keys[i] ^ keys[i - 1]) >> 32;
+                if (x == 0) continue;
+                const int d = 63 - std::countl_zero(x);  // highest differing bit of the Morton code
+                ++h[std::min(kBits, d / 3)];
+            }
+            return h;
+        },
+        [](Histogram a, const Histogram& b) {
+            for (int l = 0; l <= kBits; ++l) a[l] += b[l];
+            return a;
+        });
     int level = kBits;  // cell = 2^level Morton units per axis; kBits = one cell
     for (int l = 0; l <= kBits; ++l) {
-        const int shift = 32 + 3 * l;
         std::size_t cells = 1;
-        for (std::size_t i = 1; i < n; ++i) cells += (keys[i] >> shift) != (keys[i - 1] >> shift);
+        for (int m = l; m <= kBits; ++m) cells += firstDiff[m];
         if (double(n) / double(cells) >= double(target)) {
             level = l;
             break;
@@ -64,7 +91,9 @@ Clusters clusterParticles(std::span<const Vec3> positions, std::uint32_t target)
     const int shift = 32 + 3 * level;
 
     out.particle.resize(n);
-    for (std::size_t i = 0; i < n; ++i) out.particle[i] = std::uint32_t(keys[i] & 0xffffffffu);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16384), [&](const auto& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) out.particle[i] = std::uint32_t(keys[i] & 0xffffffffu);
+    });
     out.offset.clear();
     out.offset.push_back(0);
     std::size_t begin = 0;
