@@ -267,11 +267,11 @@ struct FrameTiming {
 
 /// Median frame time (and its passes) of `measured` frames after `history` frames.
 FrameTiming timeFrames(const Settings& s, const ParticleSource& source, std::uint32_t first, std::uint32_t history,
-                       std::uint32_t measured) {
+                       std::uint32_t measured, bool rebuildStatic = false) {
     Settings run = s;
     run.render.frame_start = first;
     run.render.frames = history + measured;
-    FrameRenderer renderer(run, source, RenderOptions{true});
+    FrameRenderer renderer(run, source, RenderOptions{true, rebuildStatic});
     std::vector<FrameStats> stats;
     for (std::uint32_t f = 0; f < history + measured; ++f) {
         FrameStats fs;
@@ -509,6 +509,45 @@ int main(int argc, char** argv) {
             else if (rss > 0 && base > 0) mem["marginal_bytes_per_particle"] = double(rss - base) / double(n - sizes[0]);
         }
         figures["memory"] = mem;
+    }
+
+    // --- What each skip of the pass plan saves: the same frames with and without the work.
+    {
+        log("pass-plan skips, 100K particles at 640x360");
+        nlohmann::json skips;
+        Settings base = diskScene(scene, 100'000, 640, 360);
+        base.render.estimator = EstimatorKind::restir;
+        auto frame = [&](const Settings& s, bool rebuild = false) {
+            const ParticleSource src(s);
+            return timeFrames(s, src, 2, 1, 3, rebuild).frameSeconds;
+        };
+        auto primaryPass = [&](const Settings& s) {
+            const ParticleSource src(s);
+            return timeFrames(s, src, 2, 1, 3).passes.at("traceGBuffer");
+        };
+        auto pair = [&](const std::string& name, double with, double without) {
+            skips[name] = {{"with_work_s", with}, {"skipped_s", without}, {"saved_s", with - without}};
+        };
+        Settings st = base;
+        st.particles.gm = 0.0;
+        pair("static_scene_one_bvh_build", frame(st, true), frame(st));
+        Settings alpha = base;
+        alpha.geometry.alpha = AlphaMode::disc;
+        // The disc also removes coverage (less lighting work), so only the primary pass is compared.
+        pair("no_alpha_no_filter_callbacks_traceGBuffer", primaryPass(alpha), primaryPass(base));
+        Settings vis = base;
+        vis.shading.visibility = false;
+        pair("visibility_off_no_shadow_rays", frame(base), frame(vis));
+        Settings once = base;
+        once.restir.temporal = false;
+        pair("temporal_off_no_history", frame(base), frame(once));
+        Settings dark = base;
+        dark.shading.albedo = Vec3(0.0f);
+        pair("albedo_0_no_lighting", frame(base), frame(dark));
+        Settings counting = base;
+        counting.gpu.counters = true;
+        pair("counters_off_no_counting_code", frame(counting), frame(base));
+        figures["plan_skips_640x360"] = skips;
     }
 
     // --- Micro-benchmarks of the hot kernels (Google Benchmark, its JSON embedded).

@@ -62,7 +62,7 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats) {
     PassTimer& timer = stats.timer;
 
     // A static scene loads its particles and builds its BVH once for all frames.
-    const bool reuse = plan_.staticGeometry && built_;
+    const bool reuse = plan_.staticGeometry && built_ && !options_.rebuildStatic;
     Particles loaded;
     if (!reuse) {
         auto t = timer.scope(pass::loadParticles);

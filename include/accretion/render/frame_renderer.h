@@ -50,6 +50,7 @@ struct FrameStats {
 
 struct RenderOptions {
     bool quiet = false;  ///< no progress on stderr
+    bool rebuildStatic = false;  ///< benchmarks: rebuild a static scene every frame (to time the skip)
 };
 
 /// Renders frames of a scene: loadParticles, buildClusters,
