@@ -104,7 +104,6 @@ void runRender(const RenderArgs& args) {
     const std::string stem = runStem(settings);
     const std::string settingsToml = settingsToToml(settings);
     const bool withErrors = settings.render.estimator != EstimatorKind::exact;
-    writeFileAtomic(stem + ".settings.toml", settingsToml);
 
     nlohmann::json stats = {
         {"version", std::string(version())},
@@ -175,6 +174,8 @@ void runRender(const RenderArgs& args) {
     stats["total_seconds"] = total;
     stats["peak_rss_bytes"] = peakResidentBytes();
     stats["shadow_rays_per_second"] = lightingSeconds > 0 ? double(shadowRays) / lightingSeconds : 0.0;
+    // Written once every frame is out: a run stopped by bad input leaves nothing.
+    writeFileAtomic(stem + ".settings.toml", settingsToml);
     writeJson(stem + ".stats.json", stats);
     fmt::print("stats: {}.stats.json\nsettings: {}.settings.toml\ntotal: {:.2f} s\n", stem, stem, total);
 }

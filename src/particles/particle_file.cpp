@@ -26,8 +26,12 @@ void storeRecord(const std::filesystem::path& file, std::size_t index, const flo
     for (int k = 0; k < 8; ++k)
         if (!std::isfinite(f[k]))
             throw InputError(fmt::format("{}: record {}: {} is not finite ({})", file.string(), index, kFields[k], f[k]));
-    if (!(f[3] > 0.0f))
-        throw InputError(fmt::format("{}: record {}: radius must be > 0 (got {})", file.string(), index, f[3]));
+    // Beyond 1e9 squared distances leave float range (the same bound as the scene's lengths).
+    for (int k = 0; k < 3; ++k)
+        if (std::fabs(f[k]) > 1e9f)
+            throw InputError(fmt::format("{}: record {}: {} = {} is outside [-1e9, 1e9]", file.string(), index, kFields[k], f[k]));
+    if (!(f[3] > 0.0f) || f[3] > 1e9f)
+        throw InputError(fmt::format("{}: record {}: radius must be > 0 and <= 1e9 (got {})", file.string(), index, f[3]));
     for (int k = 4; k < 7; ++k)
         if (f[k] < 0.0f)
             throw InputError(fmt::format("{}: record {}: {} must be >= 0 (got {})", file.string(), index, kFields[k], f[k]));

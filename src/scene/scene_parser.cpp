@@ -206,7 +206,7 @@ public:
     void checkUnknownSections() const {
         for (auto&& [key, value] : root_)
             if (!sections_.count(std::string(key.str())))
-                throw InputError(fmt::format("{}: unknown section or key \"{}\" (sections: particles, camera, geometry, shading, render)",
+                throw InputError(fmt::format("{}: unknown section or key \"{}\" (sections: particles, camera, geometry, shading, render, restir, gpu)",
                                              where(value.source()), key.str()));
     }
 
@@ -249,6 +249,19 @@ void validate(const Settings& s, const std::map<std::string, std::string>& loc, 
                                               s.particles.count, ReservoirCodec::bitsFor(s.particles.count)));
     if (s.render.target_stderr > 0.0 && s.render.max_samples < s.render.samples)
         fail("render.max_samples", fmt::format("must be at least render.samples ({}) when target_stderr is set", s.render.samples));
+    if (s.render.memory_limit_mb > 0.0) {
+        // Peak resident estimate from bench/results.json: ~300 B per particle
+        // (particles, clusters, BVH) and ~330 B per pixel (G-buffer, images,
+        // AOVs; reservoirs and history for restir), plus ~60 MB of libraries.
+        const double particles = s.particles.file.empty() ? double(s.particles.count) : 0.0;
+        const double pixels = double(s.camera.width) * s.camera.height;
+        const double perPixel = s.render.estimator == EstimatorKind::restir ? 480.0 : 330.0;
+        const double mb = (300.0 * particles + perPixel * pixels) / 1e6 + 60.0;
+        if (mb > s.render.memory_limit_mb)
+            fail("render.memory_limit_mb",
+                 fmt::format("{} particles at {}x{} need about {:.0f} MB, more than the limit of {:.0f} MB", particles,
+                             s.camera.width, s.camera.height, mb, s.render.memory_limit_mb));
+    }
     if (s.gpu.omm != OmmMode::off && s.geometry.alpha != AlphaMode::disc)
         fail("gpu.omm", "opacity micromaps apply to disc-alpha billboards (geometry.alpha = \"disc\")");
     for (std::string_view c : std::views::split(std::string_view(s.gpu.ser_key), ',') |

@@ -20,6 +20,8 @@ inline constexpr Range kAny{};
 inline constexpr Range kPositive{0.0, std::numeric_limits<double>::infinity(), true};
 inline constexpr Range kNonNegative{0.0, std::numeric_limits<double>::infinity(), false};
 inline constexpr Range kUnit{0.0, 1.0, false};
+/// A positive length: beyond 1e9 squared distances leave float range.
+inline constexpr Range kLength{0.0, 1e9, true};
 
 /// Names of an enum's values, index = underlying value.
 template <class E> struct EnumNames;
@@ -83,10 +85,10 @@ struct ParticleSettings {
         v.field("file", file, "particle file path (raw .bin or .ply), {frame} pattern; empty: use the generator");
         v.field("count", count, "number of generated particles", Range{1, 5e7});
         v.field("seed", seed, "generator seed");
-        v.field("inner_radius", inner_radius, "disk inner radius", kPositive);
-        v.field("outer_radius", outer_radius, "disk outer radius (> inner_radius)", kPositive);
-        v.field("thickness", thickness, "height standard deviation at the outer radius", kNonNegative);
-        v.field("radius", radius, "particle radius", kPositive);
+        v.field("inner_radius", inner_radius, "disk inner radius", kLength);
+        v.field("outer_radius", outer_radius, "disk outer radius (> inner_radius)", kLength);
+        v.field("thickness", thickness, "height standard deviation at the outer radius", Range{0.0, 1e9});
+        v.field("radius", radius, "particle radius", kLength);
         v.field("radius_jitter", radius_jitter, "relative radius jitter in [0,1)", Range{0.0, 0.999});
         v.field("gm", gm, "gravitational parameter GM (Keplerian angular speed sqrt(GM/r^3))", kNonNegative);
         v.field("time_step", time_step, "simulated time between frames", kNonNegative);
@@ -178,6 +180,7 @@ struct RenderSettings {
     std::uint64_t seed = 0;                      ///< render seed
     std::string output = "out/{scene}.{frame}.exr"; ///< EXR path, {scene} and {frame} patterns
     double shadow_epsilon = 1e-4;                ///< relative far-end margin of shadow rays
+    double memory_limit_mb = 0.0;                ///< refuse runs estimated to need more (0: no limit)
     double exposure = 0.0;                       ///< preview exposure in stops, added to auto exposure
     bool auto_exposure = true;                   ///< preview: map the 99th luminance percentile to 1
 
@@ -193,6 +196,7 @@ struct RenderSettings {
         v.field("seed", seed, "render seed");
         v.field("output", output, "EXR output path; {scene} and {frame} are replaced");
         v.field("shadow_epsilon", shadow_epsilon, "shadow ray far end: t < d (1 - eps)", Range{1e-7, 0.1});
+        v.field("memory_limit_mb", memory_limit_mb, "refuse a run whose estimated peak memory exceeds this (MB; 0: no limit)", kNonNegative);
         v.field("exposure", exposure, "preview exposure (stops)", Range{-64.0, 64.0});
         v.field("auto_exposure", auto_exposure, "preview: scale the 99th luminance percentile to 1");
     }
