@@ -119,7 +119,7 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats) {
         auto t = timer.scope(pass::estimateLighting);
         if (lit && restir_) {
             RestirInputs in{*bvh_, particles, gbuffer, camera, settings_, frame, power ? &powerTable : nullptr,
-                            previousBvh_.get(), counting ? &img.counters : nullptr};
+                            plan_.previousBvh ? previousBvh_.get() : nullptr, counting ? &img.counters : nullptr};
             stats.lighting = restir_->render(in, img.lighting, img.reservoirs, timer);
             stats.reservoirBytes = restir_->reservoirBytes();
         } else if (lit) {

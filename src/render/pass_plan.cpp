@@ -30,7 +30,8 @@ PassPlan planPasses(const Settings& s) {
     plan.history = plan.lighting && restir && s.restir.temporal && manyFrames;
     plan.spatial = plan.lighting && restir && s.restir.spatial_neighbours > 0 && s.restir.spatial_iterations > 0;
     plan.upsample = plan.lighting && restir && s.restir.resolution_scale < 1.0;
-    plan.previousBvh = plan.history && plan.shadowRays && needsPreviousBvh(s);
+    // A static scene's one BVH is also last frame's.
+    plan.previousBvh = plan.history && plan.shadowRays && !plan.staticGeometry && needsPreviousBvh(s);
     plan.counting = s.gpu.counters;
 
     auto step = [&](std::string_view name, bool runs, std::string why) {

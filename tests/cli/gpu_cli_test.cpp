@@ -50,7 +50,7 @@ const std::string kRestirDisc = " -D render.estimator=\\\"restir\\\" -D geometry
 
 }  // namespace
 
-TEST_CASE("accretion cost writes every counter, SER, any-hit/OMM and BLAS memory; 4-state keeps the image", "[cli][gpu]") {
+TEST_CASE("accretion cost writes every counter, SER, any-hit/OMM and BLAS memory, and 4-state keeps the image", "[cli][gpu]") {
     const auto dir = accretion::test::scratchDir("gpu_cost");
     std::string out;
     const std::string cmd = kBin + " cost " + tinyScene() + kRestirDisc + "--overhead 0 -q -o " + (dir / "c.json").string();

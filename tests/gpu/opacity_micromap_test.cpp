@@ -61,7 +61,7 @@ TEST_CASE("OMM classification of the disc matches dense point sampling at every 
     }
 }
 
-TEST_CASE("2-state OMM has no unknown micro-triangles; memory is shared across billboards", "[gpu][omm]") {
+TEST_CASE("2-state OMM has no unknown micro-triangles, memory is shared across billboards", "[gpu][omm]") {
     const OpacityMicromap two(4, false), four(4, true);
     CHECK(two.count(OmmState::unknown) == 0);
     CHECK(four.count(OmmState::unknown) > 0);
@@ -76,7 +76,7 @@ TEST_CASE("2-state OMM has no unknown micro-triangles; memory is shared across b
 #include "accretion/particles/disk_generator.h"
 #include "accretion/render/camera.h"
 
-TEST_CASE("4-state OMM keeps every hit of alpha testing with fewer any-hits as L grows; 2-state none", "[gpu][omm][bvh]") {
+TEST_CASE("4-state OMM keeps every hit of alpha testing with fewer any-hits as L grows, 2-state none", "[gpu][omm][bvh]") {
     GeometrySettings g;
     g.alpha = AlphaMode::disc;
     g.cluster_size = 32;

@@ -74,7 +74,7 @@ Settings restirScene(bool animated) {
 
 }  // namespace
 
-TEST_CASE("restir with basic or pairwise correction agrees with exact; none (1/M) is biased", "[restir][statistical]") {
+TEST_CASE("restir with basic or pairwise correction agrees with exact, none (1/M) is biased", "[restir][statistical]") {
     struct Mode {
         const char* name;
         BiasCorrection correction;

@@ -57,7 +57,7 @@ TEST_CASE("visibility off: no shadow rays planned or traced, and more light", "[
     }
 }
 
-TEST_CASE("no alpha test: no filter callbacks; disc alpha: any-hits counted", "[plan][gpu]") {
+TEST_CASE("no alpha test: no filter callbacks, disc alpha: any-hits counted", "[plan][gpu]") {
     Settings s = small();
     s.gpu.counters = true;
     CHECK_FALSE(step(planPasses(s), "alpha filter callbacks").runs);
@@ -98,7 +98,7 @@ TEST_CASE("static particles and camera: one BVH build for all frames, the same i
     CHECK(moving[2].bvh.built);
 }
 
-TEST_CASE("restir: one frame or temporal off keeps no history; one neighbour-less frame skips spatial", "[plan][restir]") {
+TEST_CASE("restir: one frame or temporal off keeps no history, one neighbour-less frame skips spatial", "[plan][restir]") {
     Settings s = small();
     s.render.estimator = EstimatorKind::restir;
     s.render.frames = 1;
@@ -118,7 +118,7 @@ TEST_CASE("restir: one frame or temporal off keeps no history; one neighbour-les
     CHECK(render(s)[2].lighting.reuseAccepted + render(s)[2].lighting.reuseRejected == 0);
 }
 
-TEST_CASE("albedo 0: no lighting passes; exact: no reservoirs; counters off: no counting code", "[plan]") {
+TEST_CASE("albedo 0: no lighting passes, exact: no reservoirs, counters off: no counting code", "[plan]") {
     Settings s = small();
     s.shading.albedo = Vec3(0.0f);
     const PassPlan plan = planPasses(s);
