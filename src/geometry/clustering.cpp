@@ -34,7 +34,7 @@ Clusters clusterParticles(std::span<const Vec3> positions, std::uint32_t target)
 
     using Box = std::pair<Vec3, Vec3>;
     const Box empty{Vec3(std::numeric_limits<float>::max()), Vec3(-std::numeric_limits<float>::max())};
-    const auto [lo, hi] = tbb::parallel_reduce(
+    const Box box = tbb::parallel_reduce(
         tbb::blocked_range<std::size_t>(0, n, 16384), empty,
         [&](const auto& r, Box b) {
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
@@ -44,6 +44,7 @@ Clusters clusterParticles(std::span<const Vec3> positions, std::uint32_t target)
             return b;
         },
         [](const Box& a, const Box& b) { return Box{glm::min(a.first, b.first), glm::max(a.second, b.second)}; });
+    const Vec3 lo = box.first, hi = box.second;
     const Vec3 ext = hi - lo;
     const float size = std::max({ext.x, ext.y, ext.z, 1e-30f});
     const float scale = float((1 << kBits) - 1) / size;

@@ -5,7 +5,6 @@
 #include <cmath>
 #include <fstream>
 #include <map>
-#include <ranges>
 #include <set>
 #include <sstream>
 
@@ -264,10 +263,13 @@ void validate(const Settings& s, const std::map<std::string, std::string>& loc, 
     }
     if (s.gpu.omm != OmmMode::off && s.geometry.alpha != AlphaMode::disc)
         fail("gpu.omm", "opacity micromaps apply to disc-alpha billboards (geometry.alpha = \"disc\")");
-    for (std::string_view c : std::views::split(std::string_view(s.gpu.ser_key), ',') |
-                                  std::views::transform([](auto r) { return std::string_view(r.begin(), r.end()); }))
+    for (std::size_t begin = 0; begin <= s.gpu.ser_key.size();) {
+        const std::size_t end = std::min(s.gpu.ser_key.find(',', begin), s.gpu.ser_key.size());
+        const std::string_view c = std::string_view(s.gpu.ser_key).substr(begin, end - begin);
         if (c != "hit" && c != "type" && c != "cluster" && c != "hint")
             fail("gpu.ser_key", fmt::format("unknown component \"{}\" (expected hit, type, cluster, hint)", c));
+        begin = end + 1;
+    }
     if (s.geometry.primitive == Primitive::sphere && s.geometry.alpha == AlphaMode::disc)
         fail("geometry.alpha", "disc alpha applies to billboards only (primitive = \"sphere\")");
 }
