@@ -98,17 +98,35 @@ void writeChannelsExr(const std::filesystem::path& file, std::uint32_t width, st
     });
 }
 
+namespace {
+
+/// The 99.5th percentile of the positive finite values (0 if there are none).
+float percentile995(std::vector<float> v) {
+    std::erase_if(v, [](float x) { return !(x > 0.0f) || !std::isfinite(x); });
+    if (v.empty()) return 0.0f;
+    const std::size_t k = std::min(v.size() - 1, std::size_t(0.995 * double(v.size())));
+    std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(k), v.end());
+    return v[k];
+}
+
+/// An 8-bit RGB PNG, written atomically.
+void writeRgb8Png(const std::filesystem::path& file, const std::vector<std::uint8_t>& px, std::uint32_t width,
+                  std::uint32_t height) {
+    OIIO::ImageSpec spec(int(width), int(height), 3, OIIO::TypeDesc::UINT8);
+    writeAtomicWith(file, [&](const std::filesystem::path& tmp) {
+        auto out = OIIO::ImageOutput::create("png");
+        if (!out) throw InternalError("OpenImageIO has no PNG writer");
+        if (!out->open(tmp.string(), spec) || !out->write_image(OIIO::TypeDesc::UINT8, px.data()) || !out->close())
+            throw InputError(fmt::format("{}: cannot write PNG: {}", file.string(), out->geterror()));
+    });
+}
+
+}  // namespace
+
 void writeHeatmapPng(const std::filesystem::path& file, const std::vector<float>& values, std::uint32_t width,
                      std::uint32_t height) {
-    std::vector<float> nz;
-    for (float v : values)
-        if (v > 0.0f && std::isfinite(v)) nz.push_back(v);
-    float top = 1.0f;
-    if (!nz.empty()) {
-        const std::size_t k = std::min(nz.size() - 1, std::size_t(0.995 * double(nz.size())));
-        std::nth_element(nz.begin(), nz.begin() + std::ptrdiff_t(k), nz.end());
-        top = nz[k] > 0.0f ? nz[k] : 1.0f;
-    }
+    const float p = percentile995(values);
+    const float top = p > 0.0f ? p : 1.0f;
     // A viridis-like ramp: dark blue, blue, teal, green, yellow.
     static const float ramp[5][3] = {{0.27f, 0.00f, 0.33f}, {0.23f, 0.32f, 0.55f}, {0.13f, 0.57f, 0.55f},
                                      {0.37f, 0.79f, 0.38f}, {0.99f, 0.91f, 0.14f}};
@@ -121,28 +139,16 @@ void writeHeatmapPng(const std::filesystem::path& file, const std::vector<float>
         for (int c = 0; c < 3; ++c)
             px[3 * i + c] = static_cast<std::uint8_t>(std::lround(255.0f * (ramp[a][c] + f * (ramp[a + 1][c] - ramp[a][c]))));
     }
-    OIIO::ImageSpec spec(int(width), int(height), 3, OIIO::TypeDesc::UINT8);
-    writeAtomicWith(file, [&](const std::filesystem::path& tmp) {
-        auto out = OIIO::ImageOutput::create("png");
-        if (!out) throw InternalError("OpenImageIO has no PNG writer");
-        if (!out->open(tmp.string(), spec) || !out->write_image(OIIO::TypeDesc::UINT8, px.data()) || !out->close())
-            throw InputError(fmt::format("{}: cannot write PNG: {}", file.string(), out->geterror()));
-    });
+    writeRgb8Png(file, px, width, height);
 }
 
 void writePreviewPng(const std::filesystem::path& file, const std::vector<Vec3>& rgb, std::uint32_t width,
                      std::uint32_t height, bool autoExposure, double exposure) {
     double scale = std::exp2(exposure);
     if (autoExposure) {
-        std::vector<float> lum;
-        lum.reserve(rgb.size());
-        for (const Vec3& c : rgb)
-            if (const float y = luminance(c); y > 0.0f && std::isfinite(y)) lum.push_back(y);
-        if (!lum.empty()) {
-            const std::size_t k = std::min(lum.size() - 1, std::size_t(0.995 * double(lum.size())));
-            std::nth_element(lum.begin(), lum.begin() + std::ptrdiff_t(k), lum.end());
-            if (lum[k] > 0.0f) scale /= lum[k];
-        }
+        std::vector<float> lum(rgb.size());
+        for (std::size_t i = 0; i < rgb.size(); ++i) lum[i] = luminance(rgb[i]);
+        if (const float p = percentile995(std::move(lum)); p > 0.0f) scale /= p;
     }
     auto encode = [](float v) {
         v = std::clamp(v, 0.0f, 1.0f);
@@ -152,14 +158,7 @@ void writePreviewPng(const std::filesystem::path& file, const std::vector<Vec3>&
     std::vector<std::uint8_t> px(rgb.size() * 3);
     for (std::size_t i = 0; i < rgb.size(); ++i)
         for (int c = 0; c < 3; ++c) px[3 * i + c] = encode(float(scale) * rgb[i][c]);
-
-    OIIO::ImageSpec spec(int(width), int(height), 3, OIIO::TypeDesc::UINT8);
-    writeAtomicWith(file, [&](const std::filesystem::path& tmp) {
-        auto out = OIIO::ImageOutput::create("png");
-        if (!out) throw InternalError("OpenImageIO has no PNG writer");
-        if (!out->open(tmp.string(), spec) || !out->write_image(OIIO::TypeDesc::UINT8, px.data()) || !out->close())
-            throw InputError(fmt::format("{}: cannot write PNG: {}", file.string(), out->geterror()));
-    });
+    writeRgb8Png(file, px, width, height);
 }
 
 }  // namespace accretion

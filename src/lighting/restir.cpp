@@ -537,13 +537,9 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
             for (std::size_t px = 0; px < pixels; ++px) {
                 const GBufferTexel& g = full.texels[px];
                 ThreadCounters& t = pc.threads[px];
-                t.active = 1;
-                t.bytesRead = gpu_layout::kGBufferTexel;
+                recordTexel(t, g, in.particles, in.bvh, gpu_layout::kGBufferTexel);
                 t.bytesWritten = gpu_layout::kRadiance;
                 if (!g.hit()) continue;
-                t.hit = 1;
-                t.type = in.particles.type[g.particle];
-                t.cluster = in.bvh.clusterOf(g.particle);
                 t.trips = 4;
                 t.bytesRead += 4 * (gpu_layout::kGBufferTexel + gpu_layout::kRadiance);
             }

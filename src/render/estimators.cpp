@@ -155,13 +155,9 @@ LightingCounters run(const LightingInputs& in, const LightArrays& L, LightingIma
                 const auto record = [&] {
                     if constexpr (Count) {
                         ThreadCounters& t = in.counters->threads[px];
-                        t.active = 1;
-                        t.bytesRead += gpu_layout::kGBufferTexel;
+                        recordTexel(t, g, in.particles, in.bvh, gpu_layout::kGBufferTexel);
                         t.bytesWritten += gpu_layout::kRadiance;
                         if (!g.hit()) return;
-                        t.hit = 1;
-                        t.type = in.particles.type[g.particle];
-                        t.cluster = in.bvh.clusterOf(g.particle);
                         t.trips = static_cast<std::uint32_t>(c.lightTerms - before.lightTerms);
                         t.bytesRead += t.trips * gpu_layout::kParticleRecord;
                         t.addRays(raySum, static_cast<std::uint32_t>(c.shadowRays - before.shadowRays));

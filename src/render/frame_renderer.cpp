@@ -32,14 +32,9 @@ void recordCompose(const GBuffer& gbuffer, const Particles& particles, const Par
     for (std::size_t px = 0; px < gbuffer.texels.size(); ++px) {
         const GBufferTexel& g = gbuffer.texels[px];
         ThreadCounters& t = pc.threads[px];
-        t.active = 1;
-        t.bytesRead = gpu_layout::kGBufferTexel;
+        recordTexel(t, g, particles, bvh, gpu_layout::kGBufferTexel);
         t.bytesWritten = gpu_layout::kRadiance;
-        if (!g.hit()) continue;
-        t.hit = 1;
-        t.type = particles.type[g.particle];
-        t.cluster = bvh.clusterOf(g.particle);
-        t.bytesRead += gpu_layout::kRadiance + gpu_layout::kParticleRecord;
+        if (g.hit()) t.bytesRead += gpu_layout::kRadiance + gpu_layout::kParticleRecord;
     }
 }
 

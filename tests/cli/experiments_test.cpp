@@ -19,8 +19,7 @@ namespace {
 
 const std::string kBin = ACCRETION_BINARY;
 
-/// A small disk filling a 96x64 image (tests/data/small_disk.toml).
-std::string tinyScene() { return std::string(ACCRETION_SOURCE_DIR) + "/tests/data/small_disk.toml"; }
+std::string tinyScene() { return accretion::test::smallDiskScene(); }
 
 void writeConstant(const std::filesystem::path& file, float value) {
     const std::size_t pixels = 4 * 3;

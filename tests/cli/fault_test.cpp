@@ -15,13 +15,6 @@ using Catch::Matchers::Contains;
 
 namespace {
 
-std::string slurp(const fs::path& f) {
-    std::ifstream in(f, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
 std::string render(const fs::path& exr) {
     return std::string(ACCRETION_BINARY) + " render " + ACCRETION_SOURCE_DIR +
            "/scenes/quickstart.toml --quiet --frames 0:1 -D camera.width=320 -D camera.height=180 "
@@ -35,7 +28,7 @@ TEST_CASE("a full disk: a clear error, exit 1, the previous complete outputs kep
     const fs::path exr = dir / "x.exr";
     std::string out;
     REQUIRE(accretion::test::runCommand(render(exr), out) == 0);
-    const std::string before = slurp(exr);
+    const std::string before = accretion::test::readFile(exr);
     REQUIRE(before.size() > 16 * 1024);
     std::size_t filesBefore = 0;
     for (const auto& e : fs::directory_iterator(dir)) filesBefore += e.is_regular_file();
@@ -44,7 +37,7 @@ TEST_CASE("a full disk: a clear error, exit 1, the previous complete outputs kep
     INFO(out);
     CHECK(status == 1);
     CHECK_THAT(out, Contains(exr.string() + ": cannot write EXR"));
-    CHECK(slurp(exr) == before);
+    CHECK(accretion::test::readFile(exr) == before);
     std::size_t filesAfter = 0;
     for (const auto& e : fs::directory_iterator(dir)) {
         filesAfter += e.is_regular_file();

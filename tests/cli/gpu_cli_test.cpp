@@ -21,14 +21,11 @@ namespace {
 
 const std::string kBin = ACCRETION_BINARY;
 
-std::string tinyScene() { return std::string(ACCRETION_SOURCE_DIR) + "/tests/data/small_disk.toml"; }
+std::string tinyScene() { return accretion::test::smallDiskScene(); }
 
 std::string slurp(const std::filesystem::path& file) {
-    std::ifstream in(file, std::ios::binary);
-    REQUIRE(in);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
+    REQUIRE(std::filesystem::exists(file));
+    return accretion::test::readFile(file);
 }
 
 std::vector<float> readChannels(const std::filesystem::path& file, const std::vector<std::string>& names) {

@@ -1,5 +1,9 @@
 #include "support/test_scenes.h"
 
+#include <sstream>
+
+#include <fstream>
+
 #include <array>
 #include <cstdio>
 #include <sys/wait.h>
@@ -47,6 +51,15 @@ std::filesystem::path scratchDir(const std::string& name) {
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
     return dir;
+}
+
+std::string smallDiskScene() { return std::string(ACCRETION_SOURCE_DIR) + "/tests/data/small_disk.toml"; }
+
+std::string readFile(const std::filesystem::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
 }
 
 int runCommand(const std::string& command, std::string& output) {

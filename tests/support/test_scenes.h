@@ -22,6 +22,12 @@ FrameImage renderParticles(const Settings& settings, const Particles& particles,
 /// A fresh empty directory under the build tree for a test's files.
 std::filesystem::path scratchDir(const std::string& name);
 
+/// tests/data/small_disk.toml: a small disk filling a 96x64 image, for CLI runs.
+std::string smallDiskScene();
+
+/// A whole file's bytes.
+std::string readFile(const std::filesystem::path& file);
+
 /// Run a shell command; returns its exit status, stdout+stderr in `output`.
 int runCommand(const std::string& command, std::string& output);
 

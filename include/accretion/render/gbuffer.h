@@ -29,6 +29,18 @@ struct GBuffer {
     const GBufferTexel& at(std::uint32_t x, std::uint32_t y) const { return texels[std::size_t(y) * width + x]; }
 };
 
+/// Counting mode: a pixel thread that reads texel g, with its branch key
+/// (hit, particle type) and cluster.
+inline void recordTexel(ThreadCounters& t, const GBufferTexel& g, const Particles& particles, const ParticleBvh& bvh,
+                        std::uint32_t texelBytes) {
+    t.active = 1;
+    t.bytesRead += texelBytes;
+    if (!g.hit()) return;
+    t.hit = 1;
+    t.type = particles.type[g.particle];
+    t.cluster = bvh.clusterOf(g.particle);
+}
+
 /// traceGBuffer: one primary ray per pixel through its centre (MODEL.md
 /// section 3). Returns the number of rays traced. With counters (counting
 /// mode), records each pixel's thread: hit key, the ray, bytes.
