@@ -1,11 +1,9 @@
 #include "support/test_scenes.h"
 
-#include <sstream>
-
-#include <fstream>
-
 #include <array>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 #include <sys/wait.h>
 
 #include "accretion/particles/particle_source.h"
