@@ -1,5 +1,7 @@
 #include "accretion/render/estimators.h"
 
+#include <cmath>
+
 #include <tbb/blocked_range2d.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -21,7 +23,7 @@ ShadingPoint shadingPoint(const GBufferTexel& g, const Particles& particles) {
 
 /// exact: sum over every light i != j of f I G V, in double.
 template <ShadingModel M, Primitive P>
-Vec3 exactPixel(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint& sp, float eps, bool shadows,
+DVec3 exactPixel(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint& sp, float eps, bool shadows,
                 LightingCounters& c, RayCounters* rc) {
     DVec3 sum(0.0);
     for (std::uint32_t i = 0; i < L.count; ++i) {
@@ -37,113 +39,146 @@ Vec3 exactPixel(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint
         if (visible<P>(bvh, sp, t, L.packed[i].radius, eps, rc)) sum += DVec3(t.value);
         else ++c.shadowOccluded;
     }
-    return Vec3(sum);
+    return sum;
 }
 
-/// Mean and standard error of the mean of S per-sample estimates (0 counts).
-class SampleMean {
-public:
-    void add(const DVec3& x) {
-        s1_ += x;
-        s2_ += x * x;
-    }
-    void finish(std::uint32_t S, Vec3& mean, Vec3& stderr) const {
-        const DVec3 m = s1_ / double(S);
-        mean = Vec3(m);
-        const DVec3 var = S > 1 ? glm::max((s2_ - double(S) * m * m) / double(S - 1), DVec3(0.0)) : DVec3(0.0);
-        stderr = Vec3(glm::sqrt(var / double(S)));
-    }
+bool finite(const DVec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
-private:
-    DVec3 s1_{0.0}, s2_{0.0};
+/// One pixel's running sums (views into the Accumulation), with the
+/// non-finite policy applied to every sample added.
+struct PixelSums {
+    DVec3& sum;
+    DVec3& sumSq;
+    std::uint32_t& n;
+    std::uint32_t& rejected;
+    NonFinitePolicy policy;
+    LightingCounters& c;
+
+    void add(const DVec3& x) {
+        if (!finite(x)) {
+            ++rejected;
+            ++c.nonFinite;
+            if (policy == NonFinitePolicy::zero_sample) ++n;
+            return;
+        }
+        sum += x;
+        sumSq += x * x;
+        ++n;
+    }
+    void addZero() { ++n; }
 };
 
-/// uniform / power / tree: one-sample estimates f I G V / p(i) (0 when no
-/// light or i = j), in rounds of S until the relative standard error of the
-/// luminance reaches the target (or max_samples); one round when the target is 0.
+/// uniform / power / tree: `count` one-sample estimates f I G V / p(i) (a
+/// zero sample when no light or i = j).
 template <ShadingModel M, Primitive P, class Sampler>
-std::uint32_t sampledPixel(const ParticleBvh& bvh, const LightArrays& L, Sampler&& sampleOne, const ShadingPoint& sp,
-                           const RenderSettings& rs, float eps, bool shadows, Rng& rng, Vec3& mean, Vec3& stderr,
-                           LightingCounters& c, RayCounters* rc) {
-    SampleMean acc;
-    std::uint32_t n = 0;
-    for (;;) {
-        // Lights drawn 8 at a time and prefetched: their records are random
-        // accesses (a cache miss each); the RNG is consumed in the same order.
-        for (std::uint32_t k0 = 0; k0 < rs.samples; k0 += 8) {
-            const std::uint32_t batch = std::min<std::uint32_t>(8, rs.samples - k0);
-            LightSample xs[8];
-            for (std::uint32_t k = 0; k < batch; ++k) {
-                xs[k] = sampleOne(rng);
-                if (xs[k].i < L.count) __builtin_prefetch(&L.packed[xs[k].i]);
-            }
-            for (std::uint32_t k = 0; k < batch; ++k) {
-                const LightSample& x = xs[k];
-                LightTerm t;
-                ++c.lightTerms;
-                if (!L.term<M>(sp, x.i, t)) continue;
-                if (shadows) {
-                    ++c.shadowRays;
-                    if (!visible<P>(bvh, sp, t, L.packed[x.i].radius, eps, rc)) {
-                        ++c.shadowOccluded;
-                        continue;
-                    }
-                }
-                acc.add(DVec3(t.value) / double(x.pdf));
-            }
+void sampleChunk(const ParticleBvh& bvh, const LightArrays& L, Sampler&& sampleOne, const ShadingPoint& sp,
+                 std::uint32_t count, float eps, bool shadows, Rng& rng, PixelSums& acc, RayCounters* rc) {
+    LightingCounters& c = acc.c;
+    // Lights drawn 8 at a time and prefetched: their records are random
+    // accesses (a cache miss each); the RNG is consumed in the same order.
+    for (std::uint32_t k0 = 0; k0 < count; k0 += 8) {
+        const std::uint32_t batch = std::min<std::uint32_t>(8, count - k0);
+        LightSample xs[8];
+        for (std::uint32_t k = 0; k < batch; ++k) {
+            xs[k] = sampleOne(rng);
+            if (xs[k].i < L.count) __builtin_prefetch(&L.packed[xs[k].i]);
         }
-        n += rs.samples;
-        acc.finish(n, mean, stderr);
-        if (!(rs.target_stderr > 0.0) || n + rs.samples > rs.max_samples) return n;
-        if (luminance(stderr) <= rs.target_stderr * luminance(mean)) return n;
+        for (std::uint32_t k = 0; k < batch; ++k) {
+            const LightSample& x = xs[k];
+            LightTerm t;
+            ++c.lightTerms;
+            if (!L.term<M>(sp, x.i, t)) {
+                acc.addZero();
+                continue;
+            }
+            if (shadows) {
+                ++c.shadowRays;
+                if (!visible<P>(bvh, sp, t, L.packed[x.i].radius, eps, rc)) {
+                    ++c.shadowOccluded;
+                    acc.addZero();
+                    continue;
+                }
+            }
+            acc.add(DVec3(t.value) / double(x.pdf));
+        }
     }
 }
 
 /// ris (MODEL.md section 4): per sample, one reservoir streams M candidates
 /// from the source pmf with w = p_hat / p_src, p_hat = luminance(f I G)
-/// without visibility; the kept y gets one shadow ray, weighted by W.
+/// without visibility; the kept y gets one shadow ray, weighted by W. A
+/// non-finite candidate weight is rejected (zero_sample: the candidate gets
+/// weight 0; discard: the reservoir is dropped).
 template <ShadingModel M, Primitive P, bool Power>
-void risPixel(const ParticleBvh& bvh, const LightArrays& L, const AliasTable* table, const ShadingPoint& sp,
-              const RenderSettings& rs, float eps, bool shadows, Rng& rng, Vec3& mean, Vec3& stderr,
-              LightingCounters& c, RayCounters* rc) {
-    SampleMean acc;
-    for (std::uint32_t k = 0; k < rs.samples; ++k) {
+void risChunk(const ParticleBvh& bvh, const LightArrays& L, const AliasTable* table, const ShadingPoint& sp,
+              std::uint32_t count, std::uint32_t candidates, float eps, bool shadows, Rng& rng, PixelSums& acc,
+              RayCounters* rc) {
+    LightingCounters& c = acc.c;
+    for (std::uint32_t k = 0; k < count; ++k) {
         Reservoir r;
         LightTerm t_y{};
-        for (std::uint32_t m = 0; m < rs.candidates; ++m) {
+        bool discarded = false;
+        for (std::uint32_t m = 0; m < candidates; ++m) {
             const LightSample x = sampleSource<Power>(L, table, rng);
-            LightTerm t;
+            LightTerm t{};
             float p_hat = 0.0f;
             ++c.lightTerms;
             if (L.term<M>(sp, x.i, t)) p_hat = luminance(t.value);
-            if (r.update(x.i, p_hat / x.pdf, p_hat, rng.uniform())) t_y = t;
+            float w = p_hat / x.pdf;
+            if (!std::isfinite(w) || !std::isfinite(p_hat)) {
+                ++acc.rejected;
+                ++c.nonFinite;
+                discarded = discarded || acc.policy == NonFinitePolicy::discard;
+                w = p_hat = 0.0f;
+            }
+            if (r.update(x.i, w, p_hat, rng.uniform())) t_y = t;
         }
+        if (discarded) continue;
         r.finalize();
-        if (r.W <= 0.0f) continue;
+        if (r.W <= 0.0f) {
+            acc.addZero();
+            continue;
+        }
         if (shadows) {
             ++c.shadowRays;
             if (!visible<P>(bvh, sp, t_y, L.packed[r.y].radius, eps, rc)) {
                 ++c.shadowOccluded;
+                acc.addZero();
                 continue;
             }
         }
         acc.add(DVec3(t_y.value) * double(r.W));
     }
-    acc.finish(rs.samples, mean, stderr);
 }
 
-/// Counters (counting mode): per pixel, its key, the light terms as loop
-/// trips, the shadow rays with their traversal counts, and bytes.
+/// Adaptive sampling: at the end of a round, stop a pixel whose relative
+/// standard error (of the luminance) reached the target, or whose next round
+/// would pass max_samples.
+bool roundDone(const DVec3& s1, const DVec3& s2, std::uint32_t n, std::uint32_t roundsTaken, const RenderSettings& rs) {
+    if (std::uint64_t(roundsTaken + 1) * rs.samples > rs.max_samples) return true;
+    if (n < 2) return false;
+    const DVec3 m = s1 / double(n);
+    const DVec3 var = glm::max((s2 - double(n) * m * m) / double(n - 1), DVec3(0.0));
+    const DVec3 err = glm::sqrt(var / double(n));
+    return luminance(Vec3(err)) <= rs.target_stderr * luminance(Vec3(m));
+}
+
+/// Runs chunks [c0, c1) over every pixel in one parallel sweep. Counters
+/// (counting mode): per pixel, its key, the light terms as loop trips, the
+/// shadow rays with their traversal counts, and bytes.
 template <ShadingModel M, Primitive P, bool Count>
-LightingCounters run(const LightingInputs& in, const LightArrays& L, LightingImage& out, Progress* progress) {
+LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const LightingPlan& plan, Accumulation& acc,
+                       std::uint64_t c0, std::uint64_t c1, Progress* progress) {
     const GBuffer& gb = in.gbuffer;
     const float eps = static_cast<float>(in.render.shadow_epsilon);
     const EstimatorKind kind = in.render.estimator;
     const bool shadows = in.shading.visibility;  // off: V = 1, no shadow rays
-    const std::uint32_t S = in.render.samples;
     tbb::enumerable_thread_specific<LightingCounters> counters;
+    // exact: chunks are row bands; Monte Carlo: every row, chunks are samples.
+    const std::uint32_t row0 = plan.exact ? static_cast<std::uint32_t>(std::min<std::uint64_t>(c0 * LightingPlan::kChunkRows, gb.height)) : 0;
+    const std::uint32_t row1 = plan.exact ? static_cast<std::uint32_t>(std::min<std::uint64_t>(c1 * LightingPlan::kChunkRows, gb.height)) : gb.height;
 
-    tbb::parallel_for(tbb::blocked_range2d<std::uint32_t>(0, gb.height, 8, 0, gb.width, 8), [&](const auto& r) {
+    tbb::parallel_for(tbb::blocked_range2d<std::uint32_t>(row0, row1, 8, 0, gb.width, 8), [&](const auto& r) {
         LightingCounters& c = counters.local();
         for (std::uint32_t y = r.rows().begin(); y != r.rows().end(); ++y) {
             for (std::uint32_t x = r.cols().begin(); x != r.cols().end(); ++x) {
@@ -168,45 +203,85 @@ LightingCounters run(const LightingInputs& in, const LightArrays& L, LightingIma
                     continue;
                 }
                 const ShadingPoint sp = shadingPoint(g, in.particles);
+                PixelSums sums{acc.sum[px], acc.sumSq[px], acc.n[px], acc.rejected[px], in.render.nonfinite, c};
                 if (kind == EstimatorKind::exact) {
-                    out.Lr[px] = exactPixel<M, P>(in.bvh, L, sp, eps, shadows, c, rc);
+                    const DVec3 v = exactPixel<M, P>(in.bvh, L, sp, eps, shadows, c, rc);
+                    if (finite(v)) sums.sum = v;
+                    else {
+                        ++sums.rejected;
+                        ++c.nonFinite;
+                    }
+                    sums.n = 1;
                     record();
                     continue;
                 }
-                Rng rng(px, in.frame, RngPass::lightSampling, in.render.seed);
-                Vec3& mean = out.Lr[px];
-                Vec3& err = out.Lr_stderr[px];
-                std::uint32_t n = S;
-                if (kind == EstimatorKind::ris && in.render.source == LightSource::power)
-                    risPixel<M, P, true>(in.bvh, L, in.powerTable, sp, in.render, eps, shadows, rng, mean, err, c, rc);
-                else if (kind == EstimatorKind::ris)
-                    risPixel<M, P, false>(in.bvh, L, nullptr, sp, in.render, eps, shadows, rng, mean, err, c, rc);
-                else if (kind == EstimatorKind::power)
-                    n = sampledPixel<M, P>(in.bvh, L, [&](Rng& g) { return sampleSource<true>(L, in.powerTable, g); },
-                                           sp, in.render, eps, shadows, rng, mean, err, c, rc);
-                else if (kind == EstimatorKind::tree)
-                    n = sampledPixel<M, P>(in.bvh, L, [&](Rng& g) { return in.lightTree->sample(sp, g); }, sp,
-                                           in.render, eps, shadows, rng, mean, err, c, rc);
-                else
-                    n = sampledPixel<M, P>(in.bvh, L, [&](Rng& g) { return sampleSource<false>(L, nullptr, g); }, sp,
-                                           in.render, eps, shadows, rng, mean, err, c, rc);
-                out.spp[px] = float(n);
+                for (std::uint64_t chunk = c0; chunk < c1 && !acc.done[px]; ++chunk) {
+                    Rng rng(px, in.frame, RngPass::lightSampling, in.render.seed, chunk + 1);
+                    const std::uint32_t count = plan.chunkSamples(chunk);
+                    if (kind == EstimatorKind::ris && in.render.source == LightSource::power)
+                        risChunk<M, P, true>(in.bvh, L, in.powerTable, sp, count, in.render.candidates, eps, shadows, rng, sums, rc);
+                    else if (kind == EstimatorKind::ris)
+                        risChunk<M, P, false>(in.bvh, L, nullptr, sp, count, in.render.candidates, eps, shadows, rng, sums, rc);
+                    else if (kind == EstimatorKind::power)
+                        sampleChunk<M, P>(in.bvh, L, [&](Rng& g) { return sampleSource<true>(L, in.powerTable, g); },
+                                          sp, count, eps, shadows, rng, sums, rc);
+                    else if (kind == EstimatorKind::tree)
+                        sampleChunk<M, P>(in.bvh, L, [&](Rng& g) { return in.lightTree->sample(sp, g); }, sp, count,
+                                          eps, shadows, rng, sums, rc);
+                    else
+                        sampleChunk<M, P>(in.bvh, L, [&](Rng& g) { return sampleSource<false>(L, nullptr, g); }, sp,
+                                          count, eps, shadows, rng, sums, rc);
+                    if (plan.adaptive && (chunk + 1) % plan.chunksPerRound == 0)
+                        acc.done[px] = roundDone(sums.sum, sums.sumSq, sums.n,
+                                                 static_cast<std::uint32_t>((chunk + 1) / plan.chunksPerRound), in.render);
+                }
                 record();
             }
         }
-        if (progress) progress->advance(std::uint64_t(r.rows().size()) * r.cols().size());
+        if (progress) progress->advance(std::uint64_t(r.rows().size()) * r.cols().size() * (plan.exact ? 1 : c1 - c0));
     });
     LightingCounters total;
     for (const auto& c : counters) total += c;
     return total;
 }
 
+/// All chunks of acc.nextChunk.. plan.end, one sweep per chunk (counting
+/// mode: one sweep), calling afterChunk between them.
+template <ShadingModel M, Primitive P, bool Count>
+LightingCounters run(const LightingInputs& in, const LightArrays& L, const LightingPlan& plan, Accumulation& acc,
+                     const ChunkHook& afterChunk, Progress* progress) {
+    LightingCounters total;
+    if (Count) {
+        total += sweep<M, P, Count>(in, L, plan, acc, acc.nextChunk, plan.end, progress);
+        acc.nextChunk = plan.end;
+        if (afterChunk) afterChunk(acc);
+        return total;
+    }
+    while (acc.nextChunk < plan.end) {
+        const std::uint64_t c = acc.nextChunk;
+        total += sweep<M, P, Count>(in, L, plan, acc, c, c + 1, progress);
+        acc.nextChunk = c + 1;
+        // Adaptive: stop when every pixel is done at the end of a round.
+        if (plan.adaptive && acc.nextChunk % plan.chunksPerRound == 0) {
+            bool active = false;
+            for (std::size_t px = 0; px < acc.pixels() && !active; ++px)
+                active = in.gbuffer.texels[px].hit() && !acc.done[px];
+            if (!active) acc.nextChunk = plan.end;
+        }
+        if (afterChunk && !afterChunk(acc)) break;
+    }
+    return total;
+}
+
 template <ShadingModel M>
-LightingCounters dispatchPrimitive(const LightingInputs& in, const LightArrays& L, LightingImage& out, Progress* p) {
+LightingCounters dispatchPrimitive(const LightingInputs& in, const LightArrays& L, const LightingPlan& plan,
+                                   Accumulation& acc, const ChunkHook& hook, Progress* p) {
     const bool spheres = in.bvh.settings().primitive == Primitive::sphere;
     if (in.counters)
-        return spheres ? run<M, Primitive::sphere, true>(in, L, out, p) : run<M, Primitive::billboard, true>(in, L, out, p);
-    return spheres ? run<M, Primitive::sphere, false>(in, L, out, p) : run<M, Primitive::billboard, false>(in, L, out, p);
+        return spheres ? run<M, Primitive::sphere, true>(in, L, plan, acc, hook, p)
+                       : run<M, Primitive::billboard, true>(in, L, plan, acc, hook, p);
+    return spheres ? run<M, Primitive::sphere, false>(in, L, plan, acc, hook, p)
+                   : run<M, Primitive::billboard, false>(in, L, plan, acc, hook, p);
 }
 
 }  // namespace
@@ -222,23 +297,63 @@ AliasTable buildPowerTable(const Particles& particles) {
     return AliasTable(w);
 }
 
-LightingCounters estimateLighting(const LightingInputs& in, LightingImage& out, Progress* progress) {
-    const std::size_t pixels = std::size_t(in.gbuffer.width) * in.gbuffer.height;
-    out.Lr.assign(pixels, Vec3(0.0f));
-    out.Lr_stderr.assign(pixels, Vec3(0.0f));
-    out.spp.assign(pixels, 0.0f);
-    if (in.particles.empty()) return {};
+LightingCounters accumulateLighting(const LightingInputs& in, const LightingPlan& plan, Accumulation& acc,
+                                    const ChunkHook& afterChunk, Progress* progress) {
+    ACC_CHECK(acc.width == in.gbuffer.width && acc.height == in.gbuffer.height);
+    if (in.particles.empty() || acc.nextChunk >= plan.end) return {};
     ACC_CHECK(!needsPowerTable(in.render) || in.powerTable);
-
     ACC_CHECK(in.render.estimator != EstimatorKind::tree || in.lightTree);
     ACC_CHECK(in.render.estimator != EstimatorKind::restir);
     const LightArrays L(in.particles, in.shading);
     switch (in.shading.model) {
-    case ShadingModel::lambert: return dispatchPrimitive<ShadingModel::lambert>(in, L, out, progress);
-    case ShadingModel::sphere: return dispatchPrimitive<ShadingModel::sphere>(in, L, out, progress);
-    case ShadingModel::isotropic: return dispatchPrimitive<ShadingModel::isotropic>(in, L, out, progress);
+    case ShadingModel::lambert: return dispatchPrimitive<ShadingModel::lambert>(in, L, plan, acc, afterChunk, progress);
+    case ShadingModel::sphere: return dispatchPrimitive<ShadingModel::sphere>(in, L, plan, acc, afterChunk, progress);
+    case ShadingModel::isotropic: return dispatchPrimitive<ShadingModel::isotropic>(in, L, plan, acc, afterChunk, progress);
     }
     return {};
+}
+
+void resolveLighting(const Accumulation& acc, bool exact, LightingImage& out, std::uint64_t* nonFinite) {
+    const std::size_t pixels = acc.pixels();
+    out.Lr.assign(pixels, Vec3(0.0f));
+    out.Lr_stderr.assign(pixels, Vec3(0.0f));
+    out.spp.assign(pixels, 0.0f);
+    out.rejected.assign(pixels, 0.0f);
+    std::uint64_t zeroed = 0;
+    for (std::size_t px = 0; px < pixels; ++px) {
+        const std::uint32_t n = acc.n[px];
+        Vec3 mean(0.0f), err(0.0f);
+        if (exact) mean = Vec3(acc.sum[px]);
+        else if (n > 0) {
+            const DVec3 m = acc.sum[px] / double(n);
+            mean = Vec3(m);
+            if (n > 1) {
+                const DVec3 var = glm::max((acc.sumSq[px] - double(n) * m * m) / double(n - 1), DVec3(0.0));
+                err = Vec3(glm::sqrt(var / double(n)));
+            }
+            out.spp[px] = float(n);
+        }
+        std::uint32_t rejected = acc.rejected[px];
+        // Float overflow of a finite double: no Inf reaches an output.
+        if (!finite(DVec3(mean)) || !finite(DVec3(err))) {
+            mean = err = Vec3(0.0f);
+            ++rejected;
+            ++zeroed;
+        }
+        out.Lr[px] = mean;
+        out.Lr_stderr[px] = err;
+        out.rejected[px] = float(rejected);
+    }
+    if (nonFinite) *nonFinite += zeroed;
+}
+
+LightingCounters estimateLighting(const LightingInputs& in, LightingImage& out, Progress* progress) {
+    const LightingPlan plan = planLighting(in.render, in.gbuffer.height);
+    Accumulation acc;
+    acc.reset(in.gbuffer.width, in.gbuffer.height, plan.begin);
+    LightingCounters c = accumulateLighting(in, plan, acc, {}, progress);
+    resolveLighting(acc, plan.exact, out, &c.nonFinite);
+    return c;
 }
 
 }  // namespace accretion

@@ -22,19 +22,22 @@ constexpr std::uint64_t mix64(std::uint64_t x) {
     return x ^ (x >> 31);
 }
 
-/// Hash of (item, frame, pass, seed) selecting one independent stream.
-constexpr std::uint64_t streamKey(std::uint64_t item, std::uint32_t frame, RngPass pass, std::uint64_t seed) {
+/// Hash of (item, frame, pass, seed[, sub]) selecting one independent
+/// stream; `sub` != 0 splits an item's stream further (sample chunks).
+constexpr std::uint64_t streamKey(std::uint64_t item, std::uint32_t frame, RngPass pass, std::uint64_t seed,
+                                  std::uint64_t sub = 0) {
     std::uint64_t h = mix64(seed);
     h = mix64(h ^ static_cast<std::uint64_t>(pass));
     h = mix64(h ^ frame);
-    return mix64(h ^ item);
+    h = mix64(h ^ item);
+    return sub ? mix64(h ^ sub) : h;
 }
 
 /// PCG32 stream of one pixel (or particle) in one pass of one frame.
 class Rng {
 public:
-    Rng(std::uint64_t item, std::uint32_t frame, RngPass pass, std::uint64_t seed)
-        : pcg_(streamKey(item, frame, pass, seed), mix64(item ^ (std::uint64_t(frame) << 32))) {}
+    Rng(std::uint64_t item, std::uint32_t frame, RngPass pass, std::uint64_t seed, std::uint64_t sub = 0)
+        : pcg_(streamKey(item, frame, pass, seed, sub), mix64(item ^ (std::uint64_t(frame) << 32))) {}
 
     /// Uniform float in [0, 1).
     float uniform() { return static_cast<float>(pcg_() >> 8) * 0x1p-24f; }

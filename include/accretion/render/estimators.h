@@ -1,5 +1,6 @@
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "accretion/core/math.h"
@@ -7,6 +8,7 @@
 #include "accretion/geometry/particle_bvh.h"
 #include "accretion/gpu/thread_counters.h"
 #include "accretion/lighting/light_tree.h"
+#include "accretion/render/accumulation.h"
 #include "accretion/render/alias_table.h"
 #include "accretion/render/gbuffer.h"
 #include "accretion/scene/settings.h"
@@ -18,6 +20,7 @@ struct LightingImage {
     std::vector<Vec3> Lr;        ///< estimate
     std::vector<Vec3> Lr_stderr; ///< standard error of the estimate (0 for exact)
     std::vector<float> spp;      ///< light samples per pixel (N-1 terms for exact: 0 is written)
+    std::vector<float> rejected; ///< non-finite samples rejected (render.nonfinite)
 };
 
 /// Counts of the lighting pass, summed over threads (integers: deterministic).
@@ -27,7 +30,9 @@ struct LightingCounters {
     std::uint64_t shadowOccluded = 0; ///< queries that found a blocker
     std::uint64_t reuseAccepted = 0;  ///< restir: temporal/spatial neighbours resampled
     std::uint64_t reuseRejected = 0;  ///< restir: neighbours rejected (off screen, particle, normal, depth)
+    std::uint64_t nonFinite = 0;      ///< NaN/Inf samples rejected (render.nonfinite)
     LightingCounters& operator+=(const LightingCounters& o) {
+        nonFinite += o.nonFinite;
         lightTerms += o.lightTerms;
         shadowRays += o.shadowRays;
         shadowOccluded += o.shadowOccluded;
@@ -59,13 +64,29 @@ inline bool needsLightTree(const RenderSettings& render) { return render.estimat
 /// Light selection pmf over luminance(I_i), for the `power` estimator.
 AliasTable buildPowerTable(const Particles& particles);
 
+/// Called after each chunk with the sums so far; returning false stops the
+/// frame there (a checkpoint can restart it from acc.nextChunk).
+using ChunkHook = std::function<bool(const Accumulation&)>;
+
+/// Add the chunks [acc.nextChunk, plan.end) of the frame to `acc` (which
+/// must be reset() for the frame or restored from a checkpoint). Counting
+/// mode runs them in one sweep. Returns the counters of the chunks run.
+LightingCounters accumulateLighting(const LightingInputs& in, const LightingPlan& plan, Accumulation& acc,
+                                    const ChunkHook& afterChunk = {}, Progress* progress = nullptr);
+
+/// The estimate, its standard error, spp and rejected counts from the sums.
+/// A value that is not finite in float is zeroed and counted in `rejected`.
+void resolveLighting(const Accumulation& acc, bool exact, LightingImage& out, std::uint64_t* nonFinite = nullptr);
+
 /// estimateLighting (MODEL.md sections 3-4): `exact` sums every light i != j
 /// with one shadow ray each; `uniform` / `power` / `tree` average one-sample
 /// estimates f I G V / p(i) (S per round, more rounds until target_stderr);
 /// `ris` averages S one-reservoir RIS estimates of M candidates each. Monte
 /// Carlo estimators also give their standard error. (`restir` keeps history
 /// across frames: see lighting/restir.h.)
-/// Per-pixel PCG streams make the result independent of the thread count.
+/// Per-pixel, per-chunk PCG streams make the result independent of the
+/// thread count and of checkpoints. A NaN/Inf sample is rejected under
+/// render.nonfinite and counted. The whole frame in one call:
 LightingCounters estimateLighting(const LightingInputs& in, LightingImage& out, Progress* progress = nullptr);
 
 }  // namespace accretion

@@ -42,6 +42,7 @@ enum class BiasCorrection { none, basic, pairwise };
 enum class ReservoirLayout { full, packed };
 enum class LightSource { uniform, power };
 enum class OmmMode { off, two_state, four_state };
+enum class NonFinitePolicy { zero_sample, discard };
 
 ACC_ENUM_NAMES(CameraPath, "static", "orbit", "linear");
 ACC_ENUM_NAMES(Primitive, "billboard", "sphere");
@@ -54,6 +55,7 @@ ACC_ENUM_NAMES(BiasCorrection, "none", "basic", "pairwise");
 ACC_ENUM_NAMES(ReservoirLayout, "full", "packed");
 ACC_ENUM_NAMES(LightSource, "uniform", "power");
 ACC_ENUM_NAMES(OmmMode, "off", "2state", "4state");
+ACC_ENUM_NAMES(NonFinitePolicy, "zero_sample", "discard");
 
 template <class E> constexpr std::string_view enumName(E e) {
     return EnumNames<E>::names[static_cast<std::size_t>(e)];
@@ -180,6 +182,7 @@ struct RenderSettings {
     std::uint64_t seed = 0;                      ///< render seed
     std::string output = "out/{scene}.{frame}.exr"; ///< EXR path, {scene} and {frame} patterns
     double shadow_epsilon = 1e-4;                ///< relative far-end margin of shadow rays
+    NonFinitePolicy nonfinite = NonFinitePolicy::zero_sample; ///< a NaN/Inf sample counts as 0, or is discarded (restir: its reservoir)
     double memory_limit_mb = 0.0;                ///< refuse runs estimated to need more (0: no limit)
     double exposure = 0.0;                       ///< preview exposure in stops, added to auto exposure
     bool auto_exposure = true;                   ///< preview: map the 99th luminance percentile to 1
@@ -196,6 +199,7 @@ struct RenderSettings {
         v.field("seed", seed, "render seed");
         v.field("output", output, "EXR output path; {scene} and {frame} are replaced");
         v.field("shadow_epsilon", shadow_epsilon, "shadow ray far end: t < d (1 - eps)", Range{1e-7, 0.1});
+        v.field("nonfinite", nonfinite, "a NaN/Inf sample: zero_sample (counts as 0) | discard (not counted; restir: the reservoir is emptied)");
         v.field("memory_limit_mb", memory_limit_mb, "refuse a run whose estimated peak memory exceeds this (MB; 0: no limit)", kNonNegative);
         v.field("exposure", exposure, "preview exposure (stops)", Range{-64.0, 64.0});
         v.field("auto_exposure", auto_exposure, "preview: scale the 99th luminance percentile to 1");

@@ -1,0 +1,66 @@
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "accretion/core/math.h"
+#include "accretion/scene/settings.h"
+
+namespace accretion {
+
+/// A part of the work given to one process: shard `index` of `count`.
+struct Shard {
+    std::uint32_t index = 0;  ///< 0-based
+    std::uint32_t count = 1;
+    bool whole() const { return count == 1; }
+    std::string name() const;  ///< "shard1of4" (1-based in names, as people count)
+};
+
+/// Parse "i/n" (0 <= i < n). Throws InputError naming `option`.
+Shard parseShard(const std::string& text, const char* option);
+
+/// How the lighting of a frame is cut into chunks. A chunk is the unit of
+/// checkpointing and of sharding: for Monte Carlo estimators up to
+/// kChunkSamples samples (ris: reservoirs) of every pixel, drawn from the
+/// chunk's own stream, so that the image does not depend on how chunks are
+/// grouped into sweeps, processes or restarts; for `exact`, a band of
+/// kChunkRows rows. Adaptive sampling (target_stderr) runs rounds of
+/// `samples` and stops a pixel at the end of a round.
+struct LightingPlan {
+    static constexpr std::uint32_t kChunkSamples = 8;
+    static constexpr std::uint32_t kChunkRows = 8;
+    bool exact = false;
+    bool adaptive = false;
+    std::uint32_t samples = 0;          ///< samples per round (Monte Carlo)
+    std::uint32_t chunksPerRound = 0;   ///< ceil(samples / kChunkSamples); exact: row bands
+    std::uint32_t rounds = 1;           ///< adaptive: most rounds a pixel can take
+    std::uint64_t begin = 0, end = 0;   ///< chunks of this run (a shard takes a part)
+
+    std::uint64_t chunks() const { return end - begin; }
+    /// Samples of chunk c (within its round).
+    std::uint32_t chunkSamples(std::uint64_t c) const;
+};
+
+/// The chunks of a frame for `render` at `height` rows, restricted to `shard`
+/// (a contiguous range). Throws InputError when the shard cannot be cut
+/// (adaptive sampling, fewer chunks than shards).
+LightingPlan planLighting(const RenderSettings& render, std::uint32_t height, Shard shard = {});
+
+/// Per-pixel running sums of the lighting estimate: everything a restart or
+/// a merge needs. The estimate is sum / n, its standard error comes from
+/// sumSq; `exact` stores its value with n = 1.
+struct Accumulation {
+    std::uint32_t width = 0, height = 0;
+    std::vector<DVec3> sum, sumSq;
+    std::vector<std::uint32_t> n;         ///< samples taken
+    std::vector<std::uint8_t> done;       ///< adaptive: target reached or capped
+    std::vector<std::uint32_t> rejected;  ///< non-finite samples rejected (render.nonfinite)
+    std::uint64_t nextChunk = 0;          ///< the RNG position: first chunk not yet added
+
+    void reset(std::uint32_t w, std::uint32_t h, std::uint64_t firstChunk);
+    std::size_t pixels() const { return std::size_t(width) * height; }
+    /// Add a disjoint part of the same work (another shard): sums, counts.
+    void merge(const Accumulation& other);
+};
+
+}  // namespace accretion

@@ -1,0 +1,82 @@
+#include "accretion/render/accumulation.h"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+
+#include "accretion/core/error.h"
+
+namespace accretion {
+
+std::string Shard::name() const { return fmt::format("shard{}of{}", index + 1, count); }
+
+Shard parseShard(const std::string& text, const char* option) {
+    const auto slash = text.find('/');
+    auto number = [&](const std::string& s, std::uint32_t& v) {
+        if (s.empty() || s.size() > 9 || !std::all_of(s.begin(), s.end(), [](char ch) { return ch >= '0' && ch <= '9'; }))
+            return false;
+        v = static_cast<std::uint32_t>(std::stoul(s));
+        return true;
+    };
+    Shard shard;
+    if (slash == std::string::npos || !number(text.substr(0, slash), shard.index) ||
+        !number(text.substr(slash + 1), shard.count) || shard.count == 0 || shard.index >= shard.count)
+        throw InputError(fmt::format("command line {} {}: expected i/n with 0 <= i < n (e.g. 0/4)", option, text));
+    return shard;
+}
+
+std::uint32_t LightingPlan::chunkSamples(std::uint64_t c) const {
+    if (exact) return 0;
+    const std::uint32_t k = static_cast<std::uint32_t>(c % chunksPerRound);
+    return std::min(kChunkSamples, samples - k * kChunkSamples);
+}
+
+LightingPlan planLighting(const RenderSettings& render, std::uint32_t height, Shard shard) {
+    LightingPlan plan;
+    plan.exact = render.estimator == EstimatorKind::exact;
+    plan.adaptive = !plan.exact && render.target_stderr > 0.0;
+    plan.samples = render.samples;
+    plan.chunksPerRound = plan.exact ? (height + LightingPlan::kChunkRows - 1) / LightingPlan::kChunkRows
+                                     : (render.samples + LightingPlan::kChunkSamples - 1) / LightingPlan::kChunkSamples;
+    plan.chunksPerRound = std::max(plan.chunksPerRound, 1u);
+    plan.rounds = plan.adaptive ? std::max(1u, render.max_samples / render.samples) : 1u;
+    const std::uint64_t total = std::uint64_t(plan.chunksPerRound) * plan.rounds;
+    if (!shard.whole()) {
+        if (plan.adaptive)
+            throw InputError(fmt::format("--shard {}/{}: adaptive sampling (render.target_stderr) decides per pixel when "
+                                         "to stop, so its samples cannot be split; shard frames instead (--frames)",
+                                         shard.index, shard.count));
+        if (total < shard.count)
+            throw InputError(fmt::format("--shard {}/{}: the frame has only {} chunks of {} {} to split", shard.index,
+                                         shard.count, total, plan.exact ? LightingPlan::kChunkRows : LightingPlan::kChunkSamples,
+                                         plan.exact ? "rows" : "samples"));
+    }
+    plan.begin = total * shard.index / shard.count;
+    plan.end = total * (shard.index + 1) / shard.count;
+    return plan;
+}
+
+void Accumulation::reset(std::uint32_t w, std::uint32_t h, std::uint64_t firstChunk) {
+    width = w;
+    height = h;
+    const std::size_t count = pixels();
+    sum.assign(count, DVec3(0.0));
+    sumSq.assign(count, DVec3(0.0));
+    n.assign(count, 0);
+    done.assign(count, 0);
+    rejected.assign(count, 0);
+    nextChunk = firstChunk;
+}
+
+void Accumulation::merge(const Accumulation& o) {
+    ACC_CHECK(o.width == width && o.height == height);
+    for (std::size_t px = 0; px < pixels(); ++px) {
+        sum[px] += o.sum[px];
+        sumSq[px] += o.sumSq[px];
+        n[px] += o.n[px];
+        done[px] = done[px] | o.done[px];
+        rejected[px] += o.rejected[px];
+    }
+}
+
+}  // namespace accretion
