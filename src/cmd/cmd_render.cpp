@@ -13,6 +13,8 @@
 #include "accretion/core/memory.h"
 #include "accretion/core/version.h"
 #include "accretion/gpu/gpu_report.h"
+#include "accretion/core/stop_signal.h"
+#include "accretion/io/accumulation_file.h"
 #include "accretion/io/atomic_file.h"
 #include "accretion/io/exr_output.h"
 #include "accretion/io/stats_writer.h"
@@ -51,7 +53,17 @@ struct RenderArgs : SceneArgs {
     std::optional<std::uint32_t> spp;
     std::optional<std::uint64_t> seed;
     std::string targetStderr;
+    std::string shard;               ///< --shard i/n
+    bool resume = false;             ///< --resume
+    double checkpointEvery = 300.0;  ///< --checkpoint-every seconds (0: only on SIGINT/SIGTERM)
 };
+
+/// "out/x.0008.exr" -> "out/x.0008.shard2of4.exr".
+std::string shardPath(const std::string& path, const Shard& shard) {
+    if (shard.whole()) return path;
+    std::filesystem::path p(path);
+    return (p.parent_path() / (p.stem().string() + "." + shard.name() + p.extension().string())).string();
+}
 
 /// "0.5%" -> 0.005, "0.005" -> 0.005.
 double parseRelative(const std::string& text, const char* option) {
@@ -101,9 +113,33 @@ void runRender(const RenderArgs& args) {
     if (args.threads > 0) threads.emplace(tbb::global_control::max_allowed_parallelism, std::size_t(args.threads));
     const int threadCount = args.threads > 0 ? args.threads : tbb::info::default_concurrency();
 
-    const std::string stem = runStem(settings);
+    const Shard shard = args.shard.empty() ? Shard{} : parseShard(args.shard, "--shard");
+    // Accumulating estimators checkpoint and shard their samples (exact: row
+    // bands); adaptive sampling and restir shard whole frames instead.
+    const bool accumulating = settings.render.estimator != EstimatorKind::restir;
+    const bool shardSamples = !shard.whole() && accumulating && !(settings.render.target_stderr > 0.0);
+    std::uint32_t firstFrame = settings.render.frame_start, endFrame = firstFrame + settings.render.frames;
+    if (!shard.whole() && !shardSamples) {
+        const std::uint32_t F = settings.render.frames;
+        if (F < shard.count)
+            throw InputError(fmt::format("--shard {}: {} shards of {} frame(s): {} cannot split samples, so give at "
+                                         "least as many frames as shards", args.shard, shard.count, F,
+                                         accumulating ? "adaptive sampling" : "restir"));
+        firstFrame = settings.render.frame_start + std::uint32_t(std::uint64_t(F) * shard.index / shard.count);
+        endFrame = settings.render.frame_start + std::uint32_t(std::uint64_t(F) * (shard.index + 1) / shard.count);
+    }
+    if (shardSamples) planLighting(settings.render, settings.camera.height, shard);  // can it be cut? (throws)
+    if (args.resume && !accumulating)
+        throw InputError("--resume: restir keeps reservoir history across frames and is not checkpointed; "
+                         "re-run the frames (finished frames are complete on disk)");
+    if (!(args.checkpointEvery >= 0.0))
+        throw InputError(fmt::format("command line --checkpoint-every {}: expected seconds >= 0", args.checkpointEvery));
+
+    const std::string stem = shardPath(runStem(settings), shard);
+    const std::string checkpoint = stem + ".checkpoint";
     const std::string settingsToml = settingsToToml(settings);
     const bool withErrors = settings.render.estimator != EstimatorKind::exact;
+    removeStaleTemporaries(std::filesystem::path(stem).parent_path());
 
     nlohmann::json stats = {
         {"version", std::string(version())},
@@ -112,22 +148,86 @@ void runRender(const RenderArgs& args) {
         {"seed", settings.render.seed},
         {"samples", settings.render.samples},
         {"threads", threadCount},
+        {"shard", fmt::format("{}/{}", shard.index, shard.count)},
+        {"shard_by", shard.whole() ? "none" : shardSamples ? "samples" : "frames"},
         {"settings", settingsToml},
         {"frames", nlohmann::json::array()},
     };
 
+    // A checkpoint: where to start, and the sums of the frame in progress.
+    std::optional<AccumulationFile> resumed;
+    if (std::filesystem::exists(checkpoint)) {
+        if (!args.resume)
+            throw InputError(fmt::format("{}: a checkpoint of an interrupted run is here; continue it with --resume "
+                                         "or delete it to start over", checkpoint));
+        resumed = readAccumulationFile(checkpoint);
+        const nlohmann::json& h = resumed->header;
+        if (h.value("version", "") != version())
+            throw InputError(fmt::format("{}: checkpoint written by accretion {}, this is {}: its samples would not "
+                                         "continue the same streams", checkpoint, h.value("version", "?"), version()));
+        if (const std::string diff = settingsDifference(h, settingsToml); !diff.empty())
+            throw InputError(fmt::format("{}: checkpoint of other settings: {}", checkpoint, diff));
+        if (h.value("shard", "") != stats["shard"].get<std::string>())
+            throw InputError(fmt::format("{}: checkpoint of shard {}, this run is shard {}", checkpoint,
+                                         h.value("shard", "?"), stats["shard"].get<std::string>()));
+        const auto frame = h.at("frame").get<std::uint32_t>();
+        if (frame < firstFrame || frame >= endFrame)
+            throw InputError(fmt::format("{}: checkpoint of frame {}, outside this run's frames", checkpoint, frame));
+        for (const auto& f : h.at("finished_frames")) stats["frames"].push_back(f);
+        firstFrame = frame;
+        if (!args.quiet)
+            fmt::print(stderr, "accretion: resuming {} at frame {}, chunk {}\n", checkpoint, frame, resumed->acc.nextChunk);
+    } else if (args.resume && !args.quiet) {
+        fmt::print(stderr, "accretion: no checkpoint at {}: starting from the beginning\n", checkpoint);
+    }
+
     const auto start = std::chrono::steady_clock::now();
+    std::optional<StopSignal> stop;
+    if (accumulating) stop.emplace();
+    auto lastCheckpoint = start;
+    auto saveCheckpoint = [&](std::uint32_t frame, const Accumulation& acc) {
+        AccumulationFile f{{{"kind", "checkpoint"},
+                            {"version", std::string(version())},
+                            {"settings", settingsToml},
+                            {"settings_hash", fmt::format("{:016x}", fnv1a64(settingsToml))},
+                            {"shard", stats["shard"]},
+                            {"frame", frame},
+                            {"finished_frames", stats["frames"]}},
+                           acc};
+        writeAccumulationFile(checkpoint, f);
+        lastCheckpoint = std::chrono::steady_clock::now();
+    };
+    auto interrupt = [&](int signal, std::uint32_t frame, std::uint64_t chunk) {
+        fmt::print(stderr, "accretion: {}: checkpoint {} (frame {}, chunk {}); continue with --resume\n",
+                   StopSignal::name(signal), checkpoint, frame, chunk);
+        throw Interrupted{signal};
+    };
+
     FrameRenderer renderer(settings, ParticleSource(settings), RenderOptions{args.quiet});
     std::uint64_t shadowRays = 0;
     double lightingSeconds = 0.0;
-    for (std::uint32_t k = 0; k < settings.render.frames; ++k) {
-        const std::uint32_t frame = settings.render.frame_start + k;
+    for (std::uint32_t frame = firstFrame; frame < endFrame; ++frame) {
         if (!args.quiet)
-            fmt::print(stderr, "accretion: frame {} ({}/{})\n", frame, k + 1, settings.render.frames);
+            fmt::print(stderr, "accretion: frame {} ({}/{})\n", frame, frame - settings.render.frame_start + 1,
+                       settings.render.frames);
+        Accumulation sums;
+        LightingSession session;
+        session.shard = shardSamples ? shard : Shard{};
+        session.result = &sums;
+        if (resumed && resumed->header.at("frame").get<std::uint32_t>() == frame) session.resume = &resumed->acc;
+        session.afterChunk = [&](const Accumulation& acc) {
+            const int signal = stop ? stop->pending() : 0;
+            const double since = std::chrono::duration<double>(std::chrono::steady_clock::now() - lastCheckpoint).count();
+            if (signal || (args.checkpointEvery > 0.0 && since >= args.checkpointEvery)) saveCheckpoint(frame, acc);
+            if (signal) interrupt(signal, frame, acc.nextChunk);
+            return true;
+        };
         FrameStats fs;
-        const FrameImage image = renderer.render(frame, fs);
+        const FrameImage image = renderer.render(frame, fs, accumulating ? &session : nullptr);
+        resumed.reset();
 
-        const std::string exr = expandPattern(settings.render.output, settings.sceneName, frame);
+        const std::string exr = shardPath(expandPattern(settings.render.output, settings.sceneName, frame),
+                                          shardSamples ? shard : Shard{});
         const std::filesystem::path base = std::filesystem::path(exr).replace_extension();
         OutputMetadata meta = {
             {"version", std::string(version())},
@@ -136,9 +236,11 @@ void runRender(const RenderArgs& args) {
             {"estimator", std::string(enumName(settings.render.estimator))},
             {"samples", std::to_string(settings.render.samples)},
             {"seed", std::to_string(settings.render.seed)},
+            {"shard", stats["shard"].get<std::string>()},
             {"render_time_s", fmt::format("{:.6f}", fs.seconds)},
             {"settings", settingsToml},
         };
+        nlohmann::json fj = frameStatsJson(fs);
         {
             auto t = fs.timer.scope(pass::writeOutputs);
             writeFrameExr(exr, image, withErrors, meta);
@@ -146,9 +248,24 @@ void runRender(const RenderArgs& args) {
                             settings.render.exposure);
             writePreviewPng(base.string() + ".Lr.png", image.lighting.Lr, image.width, image.height,
                             settings.render.auto_exposure, settings.render.exposure);
+            fj["outputs"] = {{"exr", exr}, {"png", base.string() + ".png"}, {"lr_png", base.string() + ".Lr.png"}};
+            if (shardSamples) {  // the sums a merge needs, next to the EXR
+                const LightingPlan plan = planLighting(settings.render, image.height, shard);
+                AccumulationFile f{{{"kind", "shard"},
+                                    {"version", std::string(version())},
+                                    {"settings", settingsToml},
+                                    {"settings_hash", fmt::format("{:016x}", fnv1a64(settingsToml))},
+                                    {"shard", stats["shard"]},
+                                    {"frame", frame},
+                                    {"chunks", {plan.begin, plan.end}},
+                                    {"exact", plan.exact},
+                                    {"auto_exposure", settings.render.auto_exposure},
+                                    {"exposure", settings.render.exposure}},
+                                   sums};
+                writeAccumulationFile(base.string() + ".acc", f);
+                fj["outputs"]["accumulation"] = base.string() + ".acc";
+            }
         }
-        nlohmann::json fj = frameStatsJson(fs);
-        fj["outputs"] = {{"exr", exr}, {"png", base.string() + ".png"}, {"lr_png", base.string() + ".Lr.png"}};
         if (settings.gpu.counters) {
             // The GPU model of the frame, and a PNG of each counter heatmap.
             fj["gpu"] = toJson(makeGpuReport(image.counters, renderer.bvh(), settings, fs.reservoirBytes));
@@ -163,12 +280,23 @@ void runRender(const RenderArgs& args) {
         lightingSeconds += fs.timer.seconds(pass::estimateLighting);
         if (settings.render.target_stderr > 0.0)
             fmt::print("  adaptive: mean {:.1f}, max {:.0f} samples per hit pixel\n", fs.meanSpp, fs.maxSpp);
+        if (fs.lighting.nonFinite + fs.composeRejected > 0)
+            fmt::print("  non-finite: {} samples rejected ({}), {} pixels zeroed\n", fs.lighting.nonFinite,
+                       enumName(settings.render.nonfinite), fs.composeRejected);
         fmt::print("frame {}: {} ({:.2f} s, {} particles, {} clusters, build {:.1f} ms, {:.2f} M shadow rays/s)\n",
                    frame, exr, fs.seconds, fs.particles, fs.bvh.clusters,
                    1e3 * (fs.bvh.clusterSeconds + fs.bvh.blasSeconds + fs.bvh.tlasSeconds),
                    fs.timer.seconds(pass::estimateLighting) > 0
                        ? 1e-6 * double(fs.lighting.shadowRays) / fs.timer.seconds(pass::estimateLighting) : 0.0);
         fmt::print("  preview: {}.png, lighting only: {}.Lr.png\n", base.string(), base.string());
+        // Stopped between frames: the next frame starts from its first chunk.
+        if (const int signal = stop ? stop->pending() : 0; signal && frame + 1 < endFrame) {
+            Accumulation next;
+            next.reset(settings.camera.width, settings.camera.height,
+                       shardSamples ? planLighting(settings.render, settings.camera.height, shard).begin : 0);
+            saveCheckpoint(frame + 1, next);
+            interrupt(signal, frame + 1, next.nextChunk);
+        }
     }
     const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     stats["total_seconds"] = total;
@@ -177,6 +305,8 @@ void runRender(const RenderArgs& args) {
     // Written once every frame is out: a run stopped by bad input leaves nothing.
     writeFileAtomic(stem + ".settings.toml", settingsToml);
     writeJson(stem + ".stats.json", stats);
+    std::error_code ignored;
+    std::filesystem::remove(checkpoint, ignored);  // done: nothing left to resume
     fmt::print("stats: {}.stats.json\nsettings: {}.settings.toml\ntotal: {:.2f} s\n", stem, stem, total);
 }
 
@@ -196,6 +326,12 @@ void addRenderCommand(CLI::App& app) {
     cmd->add_option("--threads", args->threads, "Worker threads (default: all cores); never changes the image")
         ->check(CLI::Range(0, 4096));
     cmd->add_flag("-q,--quiet", args->quiet, "No progress on stderr");
+    cmd->add_option("--shard", args->shard,
+                    "Render part i/n (0 <= i < n) of the work: a sample range (exact: rows) with its own streams, "
+                    "to combine with `accretion merge`; adaptive sampling and restir split frames");
+    cmd->add_flag("--resume", args->resume, "Continue from the checkpoint of an interrupted run (same command line)");
+    cmd->add_option("--checkpoint-every", args->checkpointEvery,
+                    "Seconds between checkpoints of the lighting sums (default 300; 0: only on SIGINT/SIGTERM)");
     cmd->add_option("-D,--define", args->defines, "Override a setting: -D section.key=value (TOML value)")
         ->allow_extra_args(false);
     cmd->add_flag_callback("--help-settings", [] {

@@ -6,6 +6,7 @@
 #include <fmt/core.h>
 
 #include "accretion/core/error.h"
+#include "accretion/core/stop_signal.h"
 #include "accretion/core/version.h"
 #include "commands.h"
 
@@ -21,10 +22,13 @@ int main(int argc, char** argv) {
     accretion::cmd::addCostCommand(app);
     accretion::cmd::addCalibrateCommand(app);
     accretion::cmd::addPlanCommand(app);
+    accretion::cmd::addMergeCommand(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         return app.exit(e);
+    } catch (const accretion::Interrupted& e) {
+        return 128 + e.signal;  // checkpoint written; the shell's convention for a signal
     } catch (const accretion::InputError& e) {
         fmt::print(stderr, "accretion: error: {}\n", e.what());
         return 1;

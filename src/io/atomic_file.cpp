@@ -3,7 +3,9 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <csignal>
 #include <fcntl.h>
+#include <regex>
 #include <unistd.h>
 
 #include <fmt/format.h>
@@ -63,6 +65,21 @@ void writeFileAtomic(const std::filesystem::path& file, std::string_view bytes) 
         if (!ok || !closed)
             throw InputError(fmt::format("{}: write failed: {}", file.string(), std::strerror(ok ? errno : err)));
     });
+}
+
+std::size_t removeStaleTemporaries(const std::filesystem::path& dir) {
+    static const std::regex temporary(R"(^\..+\.tmp([0-9]+)(\.[^.]*)?$)");
+    std::error_code ec;
+    std::size_t removed = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(dir.empty() ? "." : dir, ec)) {
+        const std::string name = entry.path().filename().string();
+        std::smatch m;
+        if (!std::regex_match(name, m, temporary)) continue;
+        const long pid = std::stol(m[1].str());
+        if (pid > 0 && pid != ::getpid() && ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH)
+            removed += std::filesystem::remove(entry.path(), ec) ? 1 : 0;
+    }
+    return removed;
 }
 
 }  // namespace accretion

@@ -39,6 +39,7 @@ void writeFrameExr(const std::filesystem::path& file, const FrameImage& img, boo
     addFloat("depth.Z", img.depth);
     addVec("N", xyz, img.normal);
     channels.push_back({"particle.id", true, [&](std::size_t px) { return img.particle[px]; }});
+    if (!img.lighting.rejected.empty()) addFloat("rejected", img.lighting.rejected);
     if (withErrors) {
         addVec("Lr_stderr", dotRgb, img.lighting.Lr_stderr);
         addFloat("spp", img.lighting.spp);
@@ -159,6 +160,53 @@ void writePreviewPng(const std::filesystem::path& file, const std::vector<Vec3>&
     for (std::size_t i = 0; i < rgb.size(); ++i)
         for (int c = 0; c < 3; ++c) px[3 * i + c] = encode(float(scale) * rgb[i][c]);
     writeRgb8Png(file, px, width, height);
+}
+
+std::size_t RawExr::channel(const std::string& name) const {
+    for (std::size_t c = 0; c < channels.size(); ++c)
+        if (channels[c] == name) return c;
+    throw InputError(fmt::format("{}: no channel {}", file, name));
+}
+
+float RawExr::value(std::size_t px, std::size_t c) const { return std::bit_cast<float>(bits[px * channels.size() + c]); }
+
+void RawExr::set(std::size_t px, std::size_t c, float v) { bits[px * channels.size() + c] = std::bit_cast<std::uint32_t>(v); }
+
+RawExr readRawExr(const std::filesystem::path& file) {
+    auto in = OIIO::ImageInput::open(file.string());
+    if (!in) throw InputError(fmt::format("{}: cannot read EXR: {}", file.string(), OIIO::geterror()));
+    const OIIO::ImageSpec& spec = in->spec();
+    RawExr exr;
+    exr.file = file.string();
+    exr.width = static_cast<std::uint32_t>(spec.width);
+    exr.height = static_cast<std::uint32_t>(spec.height);
+    exr.channels = spec.channelnames;
+    for (int c = 0; c < spec.nchannels; ++c) {
+        const OIIO::TypeDesc t = spec.channelformat(c);
+        if (t.size() != 4) throw InputError(fmt::format("{}: channel {} is not 32-bit", file.string(), spec.channelnames[c]));
+        exr.uints.push_back(t == OIIO::TypeDesc::UINT);
+    }
+    for (const auto& p : spec.extra_attribs)
+        if (p.type() == OIIO::TypeDesc::STRING) exr.attributes[p.name().string()] = p.get_string();
+    exr.bits.resize(std::size_t(exr.width) * exr.height * exr.channels.size());
+    if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UNKNOWN, exr.bits.data()))
+        throw InputError(fmt::format("{}: cannot read EXR pixels: {}", file.string(), in->geterror()));
+    return exr;
+}
+
+void writeRawExr(const std::filesystem::path& file, const RawExr& exr) {
+    OIIO::ImageSpec spec(int(exr.width), int(exr.height), int(exr.channels.size()), OIIO::TypeDesc::FLOAT);
+    spec.channelnames = exr.channels;
+    spec.channelformats.clear();
+    for (const bool u : exr.uints) spec.channelformats.push_back(u ? OIIO::TypeDesc::UINT : OIIO::TypeDesc::FLOAT);
+    spec.attribute("compression", "zip");
+    for (const auto& [k, v] : exr.attributes) spec.attribute(k, v);
+    writeAtomicWith(file, [&](const std::filesystem::path& tmp) {
+        auto out = OIIO::ImageOutput::create("openexr");
+        if (!out) throw InternalError("OpenImageIO has no OpenEXR writer");
+        if (!out->open(tmp.string(), spec) || !out->write_image(OIIO::TypeDesc::UNKNOWN, exr.bits.data()) || !out->close())
+            throw InputError(fmt::format("{}: cannot write EXR: {}", file.string(), out->geterror()));
+    });
 }
 
 }  // namespace accretion

@@ -22,6 +22,8 @@ nlohmann::json frameStatsJson(const FrameStats& s) {
           {"light_terms", s.lighting.lightTerms},
           {"reuse_accepted", s.lighting.reuseAccepted},
           {"reuse_rejected", s.lighting.reuseRejected},
+          {"nonfinite_rejected", {{std::string(pass::estimateLighting), s.lighting.nonFinite},
+                                  {std::string(pass::composeImage), s.composeRejected}}},
           {"light_tree_nodes", s.lightTreeNodes},
           {"reservoir_bytes", s.reservoirBytes},
           {"mean_spp", s.meanSpp},

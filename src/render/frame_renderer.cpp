@@ -1,6 +1,7 @@
 #include "accretion/render/frame_renderer.h"
 
 #include <chrono>
+#include <cmath>
 #include <limits>
 
 #include <fmt/format.h>
@@ -50,7 +51,7 @@ FrameRenderer::FrameRenderer(const Settings& settings, ParticleSource source, Re
 
 FrameRenderer::~FrameRenderer() = default;
 
-FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats) {
+FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const LightingSession* session) {
     const auto start = std::chrono::steady_clock::now();
     stats.frame = frame;
     const Camera camera = Camera::atFrame(settings_.camera, frame);
@@ -117,16 +118,25 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats) {
                             plan_.previousBvh ? previousBvh_.get() : nullptr, counting ? &img.counters : nullptr};
             stats.lighting = restir_->render(in, img.lighting, img.reservoirs, timer);
             stats.reservoirBytes = restir_->reservoirBytes();
+            if (img.lighting.rejected.empty()) img.lighting.rejected.assign(pixels, 0.0f);
         } else if (lit) {
-            Progress progress(fmt::format("frame {} {}", frame, pass::estimateLighting), pixels, options_.quiet);
+            const LightingPlan lp = planLighting(settings_.render, camera.height, session ? session->shard : Shard{});
+            Accumulation local;
+            Accumulation& acc = session && session->result ? *session->result : local;
+            if (session && session->resume) acc = *session->resume;
+            else acc.reset(camera.width, camera.height, lp.begin);
+            Progress progress(fmt::format("frame {} {}", frame, pass::estimateLighting),
+                              std::uint64_t(pixels) * (lp.exact ? 1 : lp.chunks()), options_.quiet);
             LightingInputs in{*bvh_, particles, gbuffer, settings_.shading, settings_.render, frame,
                               power ? &powerTable : nullptr, tree ? &lightTree : nullptr,
                               counting ? &img.counters.add(pass::estimateLighting, camera.width, camera.height) : nullptr};
-            stats.lighting = estimateLighting(in, img.lighting, &progress);
+            stats.lighting = accumulateLighting(in, lp, acc, session ? session->afterChunk : ChunkHook{}, &progress);
+            resolveLighting(acc, lp.exact, img.lighting, &stats.lighting.nonFinite);
         } else {
             img.lighting.Lr.assign(pixels, Vec3(0.0f));
             img.lighting.Lr_stderr.assign(pixels, Vec3(0.0f));
             img.lighting.spp.assign(pixels, 0.0f);
+            img.lighting.rejected.assign(pixels, 0.0f);
         }
     }
     {
@@ -150,6 +160,11 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats) {
             ++hits;
             img.Le[px] = se * particles.emission[g.particle];
             img.L[px] = img.Le[px] + img.lighting.Lr[px];
+            if (!std::isfinite(img.L[px].x + img.L[px].y + img.L[px].z)) {  // float overflow: never in an output
+                img.Le[px] = img.L[px] = img.lighting.Lr[px] = img.lighting.Lr_stderr[px] = Vec3(0.0f);
+                img.lighting.rejected[px] += 1.0f;
+                ++stats.composeRejected;
+            }
             img.depth[px] = g.depth;
             img.normal[px] = g.normal;
         }

@@ -15,4 +15,9 @@ void writeFileAtomic(const std::filesystem::path& file, std::string_view bytes);
 /// temporary keeps the extension of `file`.
 void writeAtomicWith(const std::filesystem::path& file, const std::function<void(const std::filesystem::path&)>& write);
 
+/// Remove the temporary files that writers killed mid-write (kill -9, power
+/// loss) left in `dir`: ".<name>.tmp<pid>.<ext>" whose process is gone.
+/// Returns how many were removed.
+std::size_t removeStaleTemporaries(const std::filesystem::path& dir);
+
 }  // namespace accretion

@@ -2,6 +2,7 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "accretion/render/frame_renderer.h"
 
@@ -11,7 +12,8 @@ namespace accretion {
 using OutputMetadata = std::map<std::string, std::string>;
 
 /// Write a frame as a multi-layer float32 EXR (zip): R,G,B, Le.*, Lr.*,
-/// depth.Z, N.X/Y/Z, particle.id (uint32, 0xffffffff on a miss), and when
+/// depth.Z, N.X/Y/Z, particle.id (uint32, 0xffffffff on a miss), rejected
+/// (non-finite samples rejected, render.nonfinite), and when
 /// `withErrors` Lr_stderr.* and spp. Atomic: temp file + rename.
 void writeFrameExr(const std::filesystem::path& file, const FrameImage& image, bool withErrors,
                    const OutputMetadata& metadata);
@@ -31,6 +33,24 @@ void writeChannelsExr(const std::filesystem::path& file, std::uint32_t width, st
 /// non-zero values (or the maximum) bright yellow, through a perceptual ramp. Atomic.
 void writeHeatmapPng(const std::filesystem::path& file, const std::vector<float>& values, std::uint32_t width,
                      std::uint32_t height);
+
+/// An EXR's pixels in their native 4-byte channel formats, with its header:
+/// what `merge` reads from a shard and writes back with new lighting.
+struct RawExr {
+    std::uint32_t width = 0, height = 0;
+    std::vector<std::string> channels;  ///< names, in file order
+    std::vector<std::uint32_t> bits;     ///< interleaved, width x height x channels
+    std::vector<bool> uints;             ///< per channel: UINT (else FLOAT)
+    std::map<std::string, std::string> attributes;  ///< string attributes (accretion:*)
+    std::string file;                    ///< where it was read (for messages)
+
+    /// Index of a channel; throws InputError naming the file when absent.
+    std::size_t channel(const std::string& name) const;
+    float value(std::size_t px, std::size_t c) const;
+    void set(std::size_t px, std::size_t c, float v);
+};
+RawExr readRawExr(const std::filesystem::path& file);
+void writeRawExr(const std::filesystem::path& file, const RawExr& exr);
 
 void writePreviewPng(const std::filesystem::path& file, const std::vector<Vec3>& rgb, std::uint32_t width,
                      std::uint32_t height, bool autoExposure, double exposure);

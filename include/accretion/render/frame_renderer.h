@@ -44,8 +44,18 @@ struct FrameStats {
     double meanSpp = 0.0;             ///< light samples per hit pixel, mean (adaptive sampling varies it)
     double maxSpp = 0.0;              ///< and maximum
     std::size_t hitPixels = 0;
+    std::uint64_t composeRejected = 0; ///< composeImage: pixels whose Le + Lr overflowed float (zeroed)
     PassTimer timer;                  ///< wall time per pass name
     double seconds = 0.0;             ///< whole frame
+};
+
+/// Checkpointing and sharding of the lighting pass of an accumulating
+/// estimator (exact, uniform, power, tree, ris).
+struct LightingSession {
+    Shard shard;                          ///< this process's part of the chunks
+    const Accumulation* resume = nullptr; ///< continue from these sums (a checkpoint of this frame)
+    ChunkHook afterChunk;                 ///< after each chunk: may checkpoint, may throw Interrupted
+    Accumulation* result = nullptr;       ///< receives the frame's sums (a shard's output)
 };
 
 struct RenderOptions {
@@ -62,7 +72,7 @@ public:
     ~FrameRenderer();
 
     /// Render one frame; the passes' times go to stats.timer.
-    FrameImage render(std::uint32_t frame, FrameStats& stats);
+    FrameImage render(std::uint32_t frame, FrameStats& stats, const LightingSession* session = nullptr);
 
     const Settings& settings() const { return settings_; }
     /// The BVH of the last frame rendered.

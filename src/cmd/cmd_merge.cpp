@@ -1,0 +1,141 @@
+// accretion merge: shard outputs (render --shard i/n) into the image of one run.
+#include <algorithm>
+#include <filesystem>
+#include <memory>
+
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+
+#include "accretion/core/error.h"
+#include "accretion/core/version.h"
+#include "accretion/io/accumulation_file.h"
+#include "accretion/io/exr_output.h"
+#include "accretion/render/estimators.h"
+#include "commands.h"
+
+namespace accretion::cmd {
+namespace {
+
+struct MergeArgs {
+    std::vector<std::string> shards;  ///< shard EXRs (their .acc next to them)
+    std::string output;
+};
+
+struct ShardInput {
+    std::string exr;
+    AccumulationFile acc;
+    Shard shard;
+};
+
+void runMerge(const MergeArgs& args) {
+    std::vector<ShardInput> in;
+    for (const std::string& exr : args.shards) {
+        const std::string accPath = std::filesystem::path(exr).replace_extension(".acc").string();
+        if (!std::filesystem::exists(accPath))
+            throw InputError(fmt::format("{}: missing: merge needs the accumulation file a shard writes next to its EXR",
+                                         accPath));
+        ShardInput s{exr, readAccumulationFile(accPath), {}};
+        const nlohmann::json& h = s.acc.header;
+        if (h.value("kind", "") != "shard")
+            throw InputError(fmt::format("{}: a {}, not a shard's output", accPath, h.value("kind", "file")));
+        s.shard = parseShard(h.value("shard", ""), accPath.c_str());
+        in.push_back(std::move(s));
+    }
+    std::sort(in.begin(), in.end(), [](const ShardInput& a, const ShardInput& b) { return a.shard.index < b.shard.index; });
+    const nlohmann::json& first = in.front().acc.header;
+    const std::uint32_t count = in.front().shard.count;
+    for (std::size_t k = 0; k < in.size(); ++k) {
+        const nlohmann::json& h = in[k].acc.header;
+        const std::string& name = in[k].exr;
+        if (h.value("settings_hash", "") != first.value("settings_hash", ""))
+            throw InputError(fmt::format("{}: rendered with other settings than {}: {}", name, in.front().exr,
+                                         settingsDifference(first, h.value("settings", ""))));
+        if (h.value("version", "") != first.value("version", ""))
+            throw InputError(fmt::format("{}: rendered by accretion {}, {} by {}", name, h.value("version", "?"),
+                                         in.front().exr, first.value("version", "?")));
+        if (h.at("frame") != first.at("frame"))
+            throw InputError(fmt::format("{}: frame {}, but {} is frame {}", name, h.at("frame").dump(), in.front().exr,
+                                         first.at("frame").dump()));
+        if (in[k].shard.count != count)
+            throw InputError(fmt::format("{}: one of {} shards, but {} is one of {}", name, in[k].shard.count,
+                                         in.front().exr, count));
+        if (k > 0 && in[k].shard.index == in[k - 1].shard.index)
+            throw InputError(fmt::format("{}: shard {}/{} given twice ({} too)", name, in[k].shard.index, count, in[k - 1].exr));
+        if (in[k].acc.acc.nextChunk != h.at("chunks")[1].get<std::uint64_t>())
+            throw InputError(fmt::format("{}: an unfinished shard (chunk {} of {})", name, in[k].acc.acc.nextChunk,
+                                         h.at("chunks")[1].dump()));
+    }
+    if (in.size() != count) {
+        std::string missing;
+        for (std::uint32_t i = 0, k = 0; i < count; ++i) {
+            if (k < in.size() && in[k].shard.index == i) ++k;
+            else missing += fmt::format("{}{}/{}", missing.empty() ? "" : ", ", i, count);
+        }
+        throw InputError(fmt::format("merge: shard(s) {} missing: the image of one run needs all {}", missing, count));
+    }
+
+    // Sums in shard order (the same whatever order the files were given).
+    Accumulation merged = in.front().acc.acc;
+    for (std::size_t k = 1; k < in.size(); ++k) merged.merge(in[k].acc.acc);
+    const bool exact = first.value("exact", false);
+    LightingImage lighting;
+    resolveLighting(merged, exact, lighting);
+
+    RawExr exr = readRawExr(in.front().exr);
+    if (exr.width != merged.width || exr.height != merged.height)
+        throw InputError(fmt::format("{}: {}x{} pixels, its accumulation {}x{}", in.front().exr, exr.width, exr.height,
+                                     merged.width, merged.height));
+    const char* rgb[3] = {"R", "G", "B"};
+    std::size_t L[3], Le[3], Lr[3], err[3] = {0, 0, 0};
+    for (int c = 0; c < 3; ++c) {
+        L[c] = exr.channel(rgb[c]);
+        Le[c] = exr.channel(fmt::format("Le.{}", rgb[c]));
+        Lr[c] = exr.channel(fmt::format("Lr.{}", rgb[c]));
+        if (!exact) err[c] = exr.channel(fmt::format("Lr_stderr.{}", rgb[c]));
+    }
+    const std::size_t id = exr.channel("particle.id"), rejected = exr.channel("rejected");
+    const std::size_t spp = exact ? 0 : exr.channel("spp");
+    std::vector<Vec3> preview(merged.pixels());
+    for (std::size_t px = 0; px < merged.pixels(); ++px) {
+        const bool hit = exr.bits[px * exr.channels.size() + id] != 0xffffffffu;
+        for (int c = 0; c < 3; ++c) {
+            exr.set(px, Lr[c], lighting.Lr[px][c]);
+            if (!exact) exr.set(px, err[c], lighting.Lr_stderr[px][c]);
+            if (hit) exr.set(px, L[c], exr.value(px, Le[c]) + lighting.Lr[px][c]);
+            preview[px][c] = exr.value(px, L[c]);
+        }
+        if (!exact) exr.set(px, spp, lighting.spp[px]);
+        exr.set(px, rejected, lighting.rejected[px]);
+    }
+    exr.attributes["accretion:shard"] = fmt::format("merged {} shards", count);
+    exr.attributes["accretion:merge_version"] = std::string(version());
+    exr.attributes.erase("accretion:render_time_s");
+    writeRawExr(args.output, exr);
+    const std::filesystem::path base = std::filesystem::path(args.output).replace_extension();
+    writePreviewPng(base.string() + ".png", preview, exr.width, exr.height, first.value("auto_exposure", true),
+                    first.value("exposure", 0.0));
+    double meanSpp = 0.0;
+    std::size_t sampled = 0;
+    for (const std::uint32_t n : merged.n) {
+        meanSpp += n;
+        sampled += n > 0;
+    }
+    if (exact) fmt::print("merged {} shards of frame {}: {} (+ {}.png)\n", count, first.at("frame").dump(), args.output, base.string());
+    else
+        fmt::print("merged {} shards of frame {}: {} (+ {}.png), {:.1f} samples per lit pixel\n", count,
+                   first.at("frame").dump(), args.output, base.string(), sampled ? meanSpp / double(sampled) : 0.0);
+}
+
+}  // namespace
+
+void addMergeCommand(CLI::App& app) {
+    auto args = std::make_shared<MergeArgs>();
+    CLI::App* cmd = app.add_subcommand("merge", "Combine the shards of a frame (render --shard i/n) into one image");
+    cmd->add_option("shards", args->shards, "Shard EXRs of one frame (each with its .acc next to it)")->required();
+    cmd->add_option("-o,--output", args->output, "Merged EXR (a PNG preview is written next to it)")->required();
+    cmd->footer("The lighting sums of the shards are added, weighted by their sample counts, giving the image of one\n"
+                "run of the same settings and seed (exact shards: bit-identical).");
+    cmd->callback([args] { runMerge(*args); });
+}
+
+}  // namespace accretion::cmd

@@ -1,0 +1,140 @@
+#include "accretion/io/accumulation_file.h"
+
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "accretion/core/error.h"
+#include "accretion/io/atomic_file.h"
+
+namespace accretion {
+namespace {
+
+constexpr char kMagic[8] = {'A', 'C', 'C', 'R', 'A', 'C', 'C', '1'};
+
+template <class T> void put(std::string& out, const T* data, std::size_t count) {
+    out.append(reinterpret_cast<const char*>(data), sizeof(T) * count);
+}
+
+/// Reads from a byte buffer, failing with the file's name when it runs out.
+class Reader {
+public:
+    Reader(const std::string& bytes, const std::filesystem::path& file) : bytes_(bytes), file_(file) {}
+    template <class T> void get(T* data, std::size_t count) {
+        const std::size_t size = sizeof(T) * count;
+        if (bytes_.size() - pos_ < size)
+            throw InputError(fmt::format("{}: truncated accumulation file ({} bytes, more expected at byte {})",
+                                         file_.string(), bytes_.size(), pos_));
+        std::memcpy(static_cast<void*>(data), bytes_.data() + pos_, size);
+        pos_ += size;
+    }
+    std::size_t position() const { return pos_; }
+
+private:
+    const std::string& bytes_;
+    const std::filesystem::path& file_;
+    std::size_t pos_ = 0;
+};
+
+}  // namespace
+
+std::uint64_t fnv1a64(std::string_view bytes, std::uint64_t h) {
+    for (const char c : bytes) {
+        h ^= static_cast<unsigned char>(c);
+        h *= 0x100000001b3ull;
+    }
+    return h;
+}
+
+void writeAccumulationFile(const std::filesystem::path& file, const AccumulationFile& content) {
+    const Accumulation& a = content.acc;
+    nlohmann::json header = content.header;
+    header["width"] = a.width;
+    header["height"] = a.height;
+    header["next_chunk"] = a.nextChunk;
+    const std::string h = header.dump();
+    std::string out;
+    const std::size_t px = a.pixels();
+    out.reserve(8 + 8 + h.size() + px * (6 * 8 + 4 + 1 + 4) + 8);
+    out.append(kMagic, 8);
+    const std::uint64_t headerSize = h.size();
+    put(out, &headerSize, 1);
+    out += h;
+    put(out, a.sum.data(), px);
+    put(out, a.sumSq.data(), px);
+    put(out, a.n.data(), px);
+    put(out, a.done.data(), px);
+    put(out, a.rejected.data(), px);
+    const std::uint64_t check = fnv1a64(out);
+    put(out, &check, 1);
+    writeFileAtomic(file, out);
+}
+
+AccumulationFile readAccumulationFile(const std::filesystem::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw InputError(fmt::format("{}: cannot open accumulation file", file.string()));
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (bytes.size() < 8 + 8 + 8 || std::memcmp(bytes.data(), kMagic, 8) != 0)
+        throw InputError(fmt::format("{}: not an accretion accumulation file (checkpoint or shard)", file.string()));
+    std::uint64_t stored = 0;
+    std::memcpy(&stored, bytes.data() + bytes.size() - 8, 8);
+    if (fnv1a64(std::string_view(bytes.data(), bytes.size() - 8)) != stored)
+        throw InputError(fmt::format("{}: corrupted accumulation file (checksum mismatch)", file.string()));
+
+    Reader r(bytes, file);
+    char magic[8];
+    r.get(magic, 8);
+    std::uint64_t headerSize = 0;
+    r.get(&headerSize, 1);
+    if (headerSize > bytes.size()) throw InputError(fmt::format("{}: corrupted accumulation header", file.string()));
+    std::string h(headerSize, '\0');
+    r.get(h.data(), headerSize);
+    AccumulationFile f;
+    try {
+        f.header = nlohmann::json::parse(h);
+        Accumulation& a = f.acc;
+        a.width = f.header.at("width").get<std::uint32_t>();
+        a.height = f.header.at("height").get<std::uint32_t>();
+        a.nextChunk = f.header.at("next_chunk").get<std::uint64_t>();
+    } catch (const nlohmann::json::exception& e) {
+        throw InputError(fmt::format("{}: corrupted accumulation header: {}", file.string(), e.what()));
+    }
+    Accumulation& a = f.acc;
+    const std::size_t px = a.pixels();
+    if (bytes.size() != r.position() + px * (6 * 8 + 4 + 1 + 4) + 8)
+        throw InputError(fmt::format("{}: {} bytes do not hold {}x{} pixels", file.string(), bytes.size(), a.width, a.height));
+    a.sum.resize(px);
+    a.sumSq.resize(px);
+    a.n.resize(px);
+    a.done.resize(px);
+    a.rejected.resize(px);
+    r.get(a.sum.data(), px);
+    r.get(a.sumSq.data(), px);
+    r.get(a.n.data(), px);
+    r.get(a.done.data(), px);
+    r.get(a.rejected.data(), px);
+    return f;
+}
+
+std::string settingsDifference(const nlohmann::json& header, const std::string& settings) {
+    const std::string stored = header.value("settings", std::string());
+    if (stored == settings) return {};
+    std::istringstream a(stored), b(settings);
+    std::string la, lb;
+    std::string section;
+    for (;;) {
+        const bool ga = static_cast<bool>(std::getline(a, la));
+        const bool gb = static_cast<bool>(std::getline(b, lb));
+        if (!ga && !gb) return "settings differ";
+        if (ga && gb && la == lb) {
+            if (!la.empty() && la.front() == '[') section = la;
+            continue;
+        }
+        return fmt::format("{} `{}` there, `{}` here", section, ga ? la : "(end)", gb ? lb : "(end)");
+    }
+}
+
+}  // namespace accretion
