@@ -1,0 +1,233 @@
+// Batch-render robustness with real processes: checkpoints and --resume
+// (bit-identical to an uninterrupted run), refusal of foreign or corrupted
+// checkpoints, kill -9 at random moments (never a broken output), and shards
+// run with GNU parallel merged into the image of one run.
+#include <catch2/catch.hpp>
+
+#include <chrono>
+#include <csignal>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+#include <OpenImageIO/imageio.h>
+
+#include "accretion/io/accumulation_file.h"
+#include "accretion/io/exr_output.h"
+#include "support/test_scenes.h"
+
+extern char** environ;
+
+namespace fs = std::filesystem;
+using Catch::Matchers::Contains;
+using accretion::test::runCommand;
+
+namespace {
+
+/// quickstart at 160x90, 2 frames of `uniform` at `spp` samples: spp/8
+/// chunks a frame (4096 samples: about 0.8 s on 2 cores).
+std::string renderCommand(const fs::path& dir, const std::string& extra = "", int spp = 4096) {
+    return std::string(ACCRETION_BINARY) + " render " + ACCRETION_SOURCE_DIR +
+           "/scenes/quickstart.toml --quiet --frames 0:2 -D camera.width=160 -D camera.height=90 "
+           "-D particles.count=2000 --estimator uniform --spp " + std::to_string(spp) + " -o " +
+           (dir / "{scene}.{frame}.exr").string() + " " + extra;
+}
+
+/// A running process (sh -c "exec ..."): its pid is the command's.
+class Process {
+public:
+    explicit Process(const std::string& command) {
+        const std::string line = "exec " + command + " >/dev/null 2>&1";
+        char* argv[] = {const_cast<char*>("sh"), const_cast<char*>("-c"), const_cast<char*>(line.c_str()), nullptr};
+        REQUIRE(posix_spawn(&pid_, "/bin/sh", nullptr, nullptr, argv, environ) == 0);
+    }
+    void signal(int s) const { ::kill(pid_, s); }
+    /// Exit status, or 128 + signal when killed.
+    int wait() {
+        int status = 0;
+        ::waitpid(pid_, &status, 0);
+        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    }
+    bool running() const {
+        int status = 0;
+        return ::waitpid(pid_, &status, WNOHANG) == 0;
+    }
+
+private:
+    pid_t pid_ = 0;
+};
+
+/// Every pixel of every channel, bit for bit.
+bool sameImage(const fs::path& a, const fs::path& b) {
+    const accretion::RawExr x = accretion::readRawExr(a), y = accretion::readRawExr(b);
+    return x.width == y.width && x.height == y.height && x.channels == y.channels && x.bits == y.bits;
+}
+
+/// Problems of the outputs in `dir`: each file must be complete and
+/// readable (temporaries of a killed writer are not outputs).
+std::vector<std::string> brokenFiles(const fs::path& dir, std::size_t& checked) {
+    std::vector<std::string> broken;
+    for (const auto& e : fs::directory_iterator(dir)) {
+        const fs::path p = e.path();
+        const std::string name = p.filename().string();
+        if (name.front() == '.' && name.find(".tmp") != std::string::npos) continue;
+        ++checked;
+        try {
+            const std::string ext = p.extension().string();
+            if (ext == ".exr") accretion::readRawExr(p);
+            else if (ext == ".png") {
+                auto in = OIIO::ImageInput::open(p.string());
+                std::vector<unsigned char> px(in ? in->spec().image_bytes() : 0);
+                if (!in || !in->read_image(0, 0, 0, in->spec().nchannels, OIIO::TypeDesc::UINT8, px.data()))
+                    throw std::runtime_error("unreadable PNG");
+            } else if (ext == ".json") (void)nlohmann::json::parse(accretion::test::readFile(p));
+            else if (ext == ".checkpoint" || ext == ".acc") accretion::readAccumulationFile(p);
+            else if (ext == ".toml") {
+                if (accretion::test::readFile(p).find("[render]") == std::string::npos) throw std::runtime_error("truncated");
+            } else throw std::runtime_error("unexpected file");
+        } catch (const std::exception& ex) {
+            broken.push_back(name + ": " + ex.what());
+        }
+    }
+    return broken;
+}
+
+}  // namespace
+
+TEST_CASE("SIGTERM writes a checkpoint; --resume gives the uninterrupted image bit for bit", "[cli][resume]") {
+    const fs::path ref = accretion::test::scratchDir("resume_reference");
+    const fs::path dir = accretion::test::scratchDir("resume_interrupted");
+    std::string out;
+    REQUIRE(runCommand(renderCommand(ref), out) == 0);
+
+    Process p(renderCommand(dir, "--checkpoint-every 0.05"));
+    // Interrupt once a checkpoint exists (the run is part-way), before it ends.
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (!fs::exists(dir / "quickstart.checkpoint") && p.running() && std::chrono::steady_clock::now() < deadline)
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    p.signal(SIGTERM);
+    const int status = p.wait();
+    REQUIRE(status == 128 + SIGTERM);  // stopped, not finished
+    REQUIRE(fs::exists(dir / "quickstart.checkpoint"));
+    CHECK_FALSE(fs::exists(dir / "quickstart.stats.json"));
+
+    // Without --resume the checkpoint is kept and the run refused.
+    CHECK(runCommand(renderCommand(dir), out) == 1);
+    CHECK_THAT(out, Contains("quickstart.checkpoint: a checkpoint of an interrupted run is here"));
+
+    REQUIRE(runCommand(renderCommand(dir, "--resume"), out) == 0);
+    INFO(out);
+    for (const char* f : {"quickstart.0000.exr", "quickstart.0001.exr"}) {
+        INFO(f);
+        CHECK(sameImage(ref / f, dir / f));
+    }
+    CHECK_FALSE(fs::exists(dir / "quickstart.checkpoint"));  // done: removed
+    const auto stats = nlohmann::json::parse(accretion::test::readFile(dir / "quickstart.stats.json"));
+    CHECK(stats["frames"].size() == 2);
+}
+
+TEST_CASE("a checkpoint of other settings, or a corrupted one, is refused with a clear error", "[cli][resume]") {
+    const fs::path dir = accretion::test::scratchDir("resume_refused");
+    Process p(renderCommand(dir, "--checkpoint-every 0.02"));
+    while (!fs::exists(dir / "quickstart.checkpoint") && p.running())
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    p.signal(SIGINT);
+    REQUIRE(p.wait() == 128 + SIGINT);
+    const fs::path ckpt = dir / "quickstart.checkpoint";
+    const std::string good = accretion::test::readFile(ckpt);
+    std::string out;
+
+    CHECK(runCommand(renderCommand(dir, "--resume -D render.seed=5"), out) == 1);
+    CHECK_THAT(out, Contains(ckpt.string() + ": checkpoint of other settings: [render] `seed = 0` there, `seed = 5` here"));
+
+    std::string bad = good;
+    bad[bad.size() / 2] ^= 0x5a;
+    std::ofstream(ckpt, std::ios::binary) << bad;
+    CHECK(runCommand(renderCommand(dir, "--resume"), out) == 1);
+    CHECK_THAT(out, Contains(ckpt.string() + ": corrupted accumulation file (checksum mismatch)"));
+
+    std::ofstream(ckpt, std::ios::binary) << good.substr(0, good.size() / 3);
+    CHECK(runCommand(renderCommand(dir, "--resume"), out) == 1);
+    CHECK_THAT(out, Contains(ckpt.string() + ": corrupted accumulation file"));
+
+    std::ofstream(ckpt, std::ios::binary) << "not a checkpoint";
+    CHECK(runCommand(renderCommand(dir, "--resume"), out) == 1);
+    CHECK_THAT(out, Contains(ckpt.string() + ": not an accretion accumulation file"));
+    // Nothing was overwritten by the refused runs.
+    CHECK(accretion::test::readFile(ckpt) == "not a checkpoint");
+}
+
+TEST_CASE("kill -9 at random moments never leaves a broken file, and resuming still gives the same image",
+          "[cli][resume][fault]") {
+    const fs::path ref = accretion::test::scratchDir("kill_reference");
+    const fs::path dir = accretion::test::scratchDir("kill_trials");
+    std::string out;
+    constexpr int spp = 32768;  // about 6 s: room for many kills
+    REQUIRE(runCommand(renderCommand(ref, "", spp), out) == 0);
+
+    const char* env = std::getenv("ACCRETION_KILL_TRIALS");
+    const int maxTrials = env ? std::atoi(env) : 25;
+    std::mt19937 rng(2026);
+    std::uniform_int_distribution<int> delayMs(20, 700);
+    int trials = 0, killed = 0;
+    std::size_t checked = 0;
+    std::vector<std::string> broken;
+    for (bool finished = false; !finished;) {
+        Process p(renderCommand(dir, "--resume --checkpoint-every 0.03", spp));
+        if (trials < maxTrials) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(delayMs(rng)));
+            p.signal(SIGKILL);
+            ++trials;
+        }
+        const int status = p.wait();
+        killed += status == 128 + SIGKILL;
+        finished = status == 0;
+        REQUIRE((finished || status == 128 + SIGKILL));
+        for (const std::string& b : brokenFiles(dir, checked)) broken.push_back(b);
+    }
+    INFO(trials << " trials, " << killed << " killed mid-run, " << checked << " files checked");
+    WARN("kill -9 trials: " << trials << ", killed mid-run " << killed << ", files checked " << checked
+                            << ", broken " << broken.size());
+    CHECK(broken.empty());
+    CHECK(killed >= 5);
+    for (const char* f : {"quickstart.0000.exr", "quickstart.0001.exr"}) {
+        INFO(f);
+        CHECK(sameImage(ref / f, dir / f));
+    }
+}
+
+TEST_CASE("shards run with GNU parallel merge into the image of one run", "[cli][shard]") {
+    const fs::path dir = accretion::test::scratchDir("shards");
+    std::string out;
+    REQUIRE(runCommand("parallel --version", out) == 0);
+    const std::string scene = std::string(ACCRETION_SOURCE_DIR) + "/scenes/quickstart.toml";
+    for (const char* estimator : {"exact", "uniform", "ris"}) {
+        INFO(estimator);
+        const std::string common = std::string(ACCRETION_BINARY) + " render " + scene +
+                                   " --quiet --frames 1 -D camera.width=96 -D camera.height=54 -D particles.count=1500 "
+                                   "--spp 64 --estimator " + estimator;
+        const fs::path one = dir / (std::string(estimator) + ".one.exr");
+        REQUIRE(runCommand(common + " -o " + one.string(), out) == 0);
+        // -I@@: GNU parallel's {} would clash with accretion's {scene}/{frame} patterns.
+        const std::string pattern = (dir / (std::string(estimator) + ".{frame}.exr")).string();
+        REQUIRE(runCommand("parallel --will-cite -j2 -I@@ " + common + " -o '" + pattern + "' --shard @@/3 ::: 0 1 2", out) == 0);
+        const fs::path merged = dir / (std::string(estimator) + ".merged.exr");
+        // Given out of order: the merge sums in shard order.
+        const auto shard = [&](int i) { return (dir / (std::string(estimator) + ".0001.shard" + std::to_string(i) + "of3.exr")).string(); };
+        REQUIRE(runCommand(std::string(ACCRETION_BINARY) + " merge " + shard(3) + " " + shard(1) + " " + shard(2) + " -o " + merged.string(), out) == 0);
+        INFO(out);
+        CHECK(sameImage(one, merged));
+
+        // A missing or repeated shard is refused.
+        CHECK(runCommand(std::string(ACCRETION_BINARY) + " merge " + shard(1) + " " + shard(2) + " -o " + (dir / "x.exr").string(), out) == 1);
+        CHECK_THAT(out, Contains("shard(s) 2/3 missing"));
+        CHECK(runCommand(std::string(ACCRETION_BINARY) + " merge " + shard(1) + " " + shard(1) + " " + shard(2) + " -o " + (dir / "x.exr").string(), out) == 1);
+        CHECK_THAT(out, Contains("given twice"));
+        CHECK_FALSE(fs::exists(dir / "x.exr"));
+    }
+}
