@@ -240,7 +240,7 @@ void runRender(const RenderArgs& args) {
             {"render_time_s", fmt::format("{:.6f}", fs.seconds)},
             {"settings", settingsToml},
         };
-        nlohmann::json fj = frameStatsJson(fs);
+        nlohmann::json outputs;
         {
             auto t = fs.timer.scope(pass::writeOutputs);
             writeFrameExr(exr, image, withErrors, meta);
@@ -248,7 +248,7 @@ void runRender(const RenderArgs& args) {
                             settings.render.exposure);
             writePreviewPng(base.string() + ".Lr.png", image.lighting.Lr, image.width, image.height,
                             settings.render.auto_exposure, settings.render.exposure);
-            fj["outputs"] = {{"exr", exr}, {"png", base.string() + ".png"}, {"lr_png", base.string() + ".Lr.png"}};
+            outputs = {{"exr", exr}, {"png", base.string() + ".png"}, {"lr_png", base.string() + ".Lr.png"}};
             if (shardSamples) {  // the sums a merge needs, next to the EXR
                 const LightingPlan plan = planLighting(settings.render, image.height, shard);
                 AccumulationFile f{{{"kind", "shard"},
@@ -263,9 +263,11 @@ void runRender(const RenderArgs& args) {
                                     {"exposure", settings.render.exposure}},
                                    sums};
                 writeAccumulationFile(base.string() + ".acc", f);
-                fj["outputs"]["accumulation"] = base.string() + ".acc";
+                outputs["accumulation"] = base.string() + ".acc";
             }
         }
+        nlohmann::json fj = frameStatsJson(fs);
+        fj["outputs"] = outputs;
         if (settings.gpu.counters) {
             // The GPU model of the frame, and a PNG of each counter heatmap.
             fj["gpu"] = toJson(makeGpuReport(image.counters, renderer.bvh(), settings, fs.reservoirBytes));
@@ -280,9 +282,8 @@ void runRender(const RenderArgs& args) {
         lightingSeconds += fs.timer.seconds(pass::estimateLighting);
         if (settings.render.target_stderr > 0.0)
             fmt::print("  adaptive: mean {:.1f}, max {:.0f} samples per hit pixel\n", fs.meanSpp, fs.maxSpp);
-        if (fs.lighting.nonFinite + fs.composeRejected > 0)
-            fmt::print("  non-finite: {} samples rejected ({}), {} pixels zeroed\n", fs.lighting.nonFinite,
-                       enumName(settings.render.nonfinite), fs.composeRejected);
+        for (const auto& [name, count] : fs.nonFinite)
+            fmt::print("  {}: {} non-finite values rejected ({})\n", name, count, enumName(settings.render.nonfinite));
         fmt::print("frame {}: {} ({:.2f} s, {} particles, {} clusters, build {:.1f} ms, {:.2f} M shadow rays/s)\n",
                    frame, exr, fs.seconds, fs.particles, fs.bvh.clusters,
                    1e3 * (fs.bvh.clusterSeconds + fs.bvh.blasSeconds + fs.bvh.tlasSeconds),

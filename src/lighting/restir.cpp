@@ -171,6 +171,17 @@ struct FrameContext {
     float eps;
     bool shadows;               ///< shading.visibility: trace shadow rays (off: V = 1)
     FrameCounters* counters;    ///< counting mode: per-pass thread records
+    std::uint32_t* rejected;    ///< per lighting texel: non-finite values rejected (render.nonfinite)
+
+    /// A reservoir whose weights overflowed or went NaN: counted at px;
+    /// zero_sample keeps its M with W = 0, discard empties it.
+    StoredReservoir sanitize(StoredReservoir r, std::size_t px, LightingCounters& c) const {
+        if (std::isfinite(r.W) && std::isfinite(r.p_hat)) return r;
+        ++c.nonFinite;
+        ++rejected[px];
+        if (in.settings.render.nonfinite == NonFinitePolicy::discard) return StoredReservoir{};
+        return StoredReservoir{kNoLight, 0.0f, r.M, 0.0f};
+    }
 };
 
 /// The counters of a pass about to run (counting mode), else null.
@@ -211,13 +222,28 @@ LightingCounters generateCandidates(const FrameContext& f, std::vector<StoredRes
         const ShadingPoint sp = shadingPoint(g, f.in.particles);
         Rng rng(px, f.in.frame, RngPass::restirCandidates, f.in.settings.render.seed);
         Reservoir r;
+        bool discard = false;
         for (std::uint32_t m = 0; m < Mc; ++m) {
             const LightSample x = sampleSource<Power>(f.L, f.in.powerTable, rng);
-            const float p_hat = f.L.targetPdf<SM>(sp, x.i);
+            float p_hat = f.L.targetPdf<SM>(sp, x.i);
+            float w = p_hat / x.pdf;
             ++c.lightTerms;
-            r.update(x.i, p_hat / x.pdf, p_hat, rng.uniform());
+            if (!std::isfinite(w) || !std::isfinite(p_hat)) {  // render.nonfinite: a zero candidate, or no reservoir
+                ++c.nonFinite;
+                ++f.rejected[px];
+                discard = discard || f.in.settings.render.nonfinite == NonFinitePolicy::discard;
+                w = p_hat = 0.0f;
+            }
+            r.update(x.i, w, p_hat, rng.uniform());
         }
         r.finalize();
+        if (!std::isfinite(r.w_sum) || !std::isfinite(r.W)) {  // finite weights whose sum overflowed
+            ++c.nonFinite;
+            ++f.rejected[px];
+            discard = discard || f.in.settings.render.nonfinite == NonFinitePolicy::discard;
+            r.W = 0.0f;
+        }
+        if (discard) return;  // out[px] stays empty
         if (f.rs.candidate_visibility && f.shadows && r.W > 0.0f) {
             // Bitterli et al. 2020, Alg. 5: drop an occluded candidate before reuse.
             LightTerm t;
@@ -297,7 +323,7 @@ LightingCounters temporalResampling(const FrameContext& f, const std::vector<Sto
                             f.rs.candidate_visibility || f.rs.visibility_reuse,
                             f.in.previousBvh ? f.in.previousBvh : &f.in.bvh}};
         Rng rng(px, f.in.frame, RngPass::restirTemporal, f.in.settings.render.seed);
-        out[px] = f.codec.roundTrip(combine<SM, P, Count>(offers, 2, f.L, f.rs, f.eps, f.shadows, rng, c, rec));
+        out[px] = f.codec.roundTrip(f.sanitize(combine<SM, P, Count>(offers, 2, f.L, f.rs, f.eps, f.shadows, rng, c, rec), px, c));
     });
 }
 
@@ -349,7 +375,7 @@ LightingCounters spatialResampling(const FrameContext& f, std::uint32_t iteratio
             rec.read(R + gpu_layout::kParticleRecord);
             offers[n++] = {cur[q], {shadingPoint(gn, f.in.particles), &f.L, tested, &f.in.bvh}};
         }
-        out[px] = f.codec.roundTrip(combine<SM, P, Count>(offers, n, f.L, f.rs, f.eps, f.shadows, rng, c, rec));
+        out[px] = f.codec.roundTrip(f.sanitize(combine<SM, P, Count>(offers, n, f.L, f.rs, f.eps, f.shadows, rng, c, rec), px, c));
     });
 }
 
@@ -391,7 +417,13 @@ LightingCounters traceShadowRays(const FrameContext& f, std::vector<StoredReserv
             }
             return;
         }
-        Lr[px] = t.value * r.W;
+        const Vec3 value = t.value * r.W;
+        if (std::isfinite(value.x) && std::isfinite(value.y) && std::isfinite(value.z)) Lr[px] = value;
+        else {  // overflow in f I G W: a zero sample (discard: and no reservoir for reuse)
+            ++c.nonFinite;
+            ++f.rejected[px];
+            if (f.in.settings.render.nonfinite == NonFinitePolicy::discard) r = f.codec.roundTrip(StoredReservoir{});
+        }
     });
 }
 
@@ -434,41 +466,46 @@ void upsampleLighting(const GBuffer& full, const GBuffer& lg, const Particles& p
 
 template <ShadingModel SM, Primitive P, bool Count>
 LightingCounters runFrame(const FrameContext& f, std::vector<StoredReservoir>& a, std::vector<StoredReservoir>& b,
-                          std::vector<Vec3>& lowLr, PassTimer& timer) {
+                          std::vector<Vec3>& lowLr, PassTimer& timer, PassRejections& rejected) {
     LightingCounters total;
+    auto add = [&](std::string_view name, const LightingCounters& c) {
+        total += c;
+        if (c.nonFinite) rejected[std::string(name)] += c.nonFinite;
+    };
     {
         auto t = timer.scope(pass::generateCandidates);
-        total += f.in.settings.render.source == LightSource::power ? generateCandidates<SM, P, true, Count>(f, a)
-                                                                    : generateCandidates<SM, P, false, Count>(f, a);
+        add(pass::generateCandidates, f.in.settings.render.source == LightSource::power
+                                          ? generateCandidates<SM, P, true, Count>(f, a)
+                                          : generateCandidates<SM, P, false, Count>(f, a));
     }
     if (f.rs.temporal && f.prev) {
         auto t = timer.scope(pass::temporalResampling);
-        total += temporalResampling<SM, P, Count>(f, a, b);
+        add(pass::temporalResampling, temporalResampling<SM, P, Count>(f, a, b));
         std::swap(a, b);
     }
     if (f.rs.spatial_neighbours > 0) {
         auto t = timer.scope(pass::spatialResampling);
         for (std::uint32_t it = 0; it < f.rs.spatial_iterations; ++it) {
-            total += spatialResampling<SM, P, Count>(f, it, a, b);
+            add(pass::spatialResampling, spatialResampling<SM, P, Count>(f, it, a, b));
             std::swap(a, b);
         }
     }
     {
         auto t = timer.scope(pass::traceShadowRays);
-        total += traceShadowRays<SM, P, Count>(f, a, lowLr);
+        add(pass::traceShadowRays, traceShadowRays<SM, P, Count>(f, a, lowLr));
     }
     return total;
 }
 
 template <ShadingModel SM>
 LightingCounters dispatchPrimitive(const FrameContext& f, std::vector<StoredReservoir>& a, std::vector<StoredReservoir>& b,
-                                   std::vector<Vec3>& lowLr, PassTimer& timer) {
+                                   std::vector<Vec3>& lowLr, PassTimer& timer, PassRejections& rej) {
     const bool spheres = f.in.bvh.settings().primitive == Primitive::sphere;
     if (f.counters)
-        return spheres ? runFrame<SM, Primitive::sphere, true>(f, a, b, lowLr, timer)
-                       : runFrame<SM, Primitive::billboard, true>(f, a, b, lowLr, timer);
-    return spheres ? runFrame<SM, Primitive::sphere, false>(f, a, b, lowLr, timer)
-                   : runFrame<SM, Primitive::billboard, false>(f, a, b, lowLr, timer);
+        return spheres ? runFrame<SM, Primitive::sphere, true>(f, a, b, lowLr, timer, rej)
+                       : runFrame<SM, Primitive::billboard, true>(f, a, b, lowLr, timer, rej);
+    return spheres ? runFrame<SM, Primitive::sphere, false>(f, a, b, lowLr, timer, rej)
+                   : runFrame<SM, Primitive::billboard, false>(f, a, b, lowLr, timer, rej);
 }
 
 }  // namespace
@@ -483,7 +520,8 @@ bool needsPreviousBvh(const Settings& s) {
 Restir::Restir(const Settings& settings, bool keepHistory)
     : rs_(settings.restir), keepHistory_(keepHistory), codec_(settings.restir) {}
 
-LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, ReservoirImage& aov, PassTimer& timer) {
+LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, ReservoirImage& aov, PassTimer& timer,
+                                PassRejections& rejected) {
     const GBuffer& full = in.gbuffer;
     const std::size_t pixels = std::size_t(full.width) * full.height;
     out.Lr.assign(pixels, Vec3(0.0f));
@@ -512,17 +550,19 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
     const LightArrays L(in.particles, in.settings.shading);
     const History* prev = history_ && history_->gbuffer.width == lg->width && history_->gbuffer.height == lg->height
                               ? history_.get() : nullptr;
+    std::vector<std::uint32_t> lowRejected(lpixels, 0);
     FrameContext f{in, rs_, codec_, *lg, L, prev, lg == &full ? 1.0f : float(lg->width) / float(full.width),
-                   static_cast<float>(in.settings.render.shadow_epsilon), in.settings.shading.visibility, in.counters};
+                   static_cast<float>(in.settings.render.shadow_epsilon), in.settings.shading.visibility, in.counters,
+                   lowRejected.data()};
 
     std::vector<StoredReservoir> a(lpixels), b(lpixels);
     std::vector<Vec3> lowLr(lpixels);
     LightingCounters counters;
     if (!in.particles.empty()) {
         switch (in.settings.shading.model) {
-        case ShadingModel::lambert: counters = dispatchPrimitive<ShadingModel::lambert>(f, a, b, lowLr, timer); break;
-        case ShadingModel::sphere: counters = dispatchPrimitive<ShadingModel::sphere>(f, a, b, lowLr, timer); break;
-        case ShadingModel::isotropic: counters = dispatchPrimitive<ShadingModel::isotropic>(f, a, b, lowLr, timer); break;
+        case ShadingModel::lambert: counters = dispatchPrimitive<ShadingModel::lambert>(f, a, b, lowLr, timer, rejected); break;
+        case ShadingModel::sphere: counters = dispatchPrimitive<ShadingModel::sphere>(f, a, b, lowLr, timer, rejected); break;
+        case ShadingModel::isotropic: counters = dispatchPrimitive<ShadingModel::isotropic>(f, a, b, lowLr, timer, rejected); break;
         }
     }
 
@@ -549,6 +589,7 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
     aov.M.assign(pixels, 0.0f);
     aov.light.assign(pixels, kNoLight);
     aov.p_hat.assign(pixels, 0.0f);
+    out.rejected.assign(pixels, 0.0f);
     for (std::uint32_t y = 0; y < full.height; ++y)
         for (std::uint32_t x = 0; x < full.width; ++x) {
             const std::size_t px = std::size_t(y) * full.width + x;
@@ -557,6 +598,7 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
             const auto lx = std::min(lg->width - 1, std::uint32_t(float(x) * f.scale));
             const auto ly = std::min(lg->height - 1, std::uint32_t(float(y) * f.scale));
             const StoredReservoir& r = a[std::size_t(ly) * lg->width + lx];
+            out.rejected[px] = float(lowRejected[std::size_t(ly) * lg->width + lx]);
             aov.W[px] = r.W;
             aov.M[px] = float(r.M);
             aov.light[px] = r.W > 0.0f ? r.y : kNoLight;

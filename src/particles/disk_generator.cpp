@@ -43,7 +43,7 @@ Particles generateDisk(const ParticleSettings& s, std::uint32_t frame, const Bla
             const double omega = std::sqrt(s.gm / (r * r * r));
             const double theta = theta0 + omega * t;
             const double c = std::cos(theta), sn = std::sin(theta);
-            out.position[k] = Vec3(float(r * c), float(y), float(r * sn));
+            out.position[k] = Vec3(float(s.center.x + r * c), float(s.center.y + y), float(s.center.z + r * sn));
             out.velocity[k] = Vec3(float(-omega * r * sn), 0.0f, float(omega * r * c));
             out.radius[k] = float(size);
 

@@ -116,7 +116,7 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const L
         if (lit && restir_) {
             RestirInputs in{*bvh_, particles, gbuffer, camera, settings_, frame, power ? &powerTable : nullptr,
                             plan_.previousBvh ? previousBvh_.get() : nullptr, counting ? &img.counters : nullptr};
-            stats.lighting = restir_->render(in, img.lighting, img.reservoirs, timer);
+            stats.lighting = restir_->render(in, img.lighting, img.reservoirs, timer, stats.nonFinite);
             stats.reservoirBytes = restir_->reservoirBytes();
             if (img.lighting.rejected.empty()) img.lighting.rejected.assign(pixels, 0.0f);
         } else if (lit) {
@@ -132,6 +132,7 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const L
                               counting ? &img.counters.add(pass::estimateLighting, camera.width, camera.height) : nullptr};
             stats.lighting = accumulateLighting(in, lp, acc, session ? session->afterChunk : ChunkHook{}, &progress);
             resolveLighting(acc, lp.exact, img.lighting, &stats.lighting.nonFinite);
+            if (stats.lighting.nonFinite) stats.nonFinite[std::string(pass::estimateLighting)] = stats.lighting.nonFinite;
         } else {
             img.lighting.Lr.assign(pixels, Vec3(0.0f));
             img.lighting.Lr_stderr.assign(pixels, Vec3(0.0f));
@@ -163,7 +164,7 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const L
             if (!std::isfinite(img.L[px].x + img.L[px].y + img.L[px].z)) {  // float overflow: never in an output
                 img.Le[px] = img.L[px] = img.lighting.Lr[px] = img.lighting.Lr_stderr[px] = Vec3(0.0f);
                 img.lighting.rejected[px] += 1.0f;
-                ++stats.composeRejected;
+                ++stats.nonFinite[std::string(pass::composeImage)];
             }
             img.depth[px] = g.depth;
             img.normal[px] = g.normal;

@@ -358,6 +358,10 @@ Settings loadScene(const std::filesystem::path& file, const std::vector<std::str
     Settings s = parseScene(text.str(), file.string(), overrides);
     s.scenePath = file.string();
     s.sceneName = file.stem().string();
+    // A relative particle file is found next to the scene, wherever it runs from.
+    const std::filesystem::path particles(s.particles.file);
+    if (!particles.empty() && particles.is_relative() && !file.parent_path().empty())
+        s.particles.file = (file.parent_path() / particles).string();
     return s;
 }
 

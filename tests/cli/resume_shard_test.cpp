@@ -99,7 +99,7 @@ std::vector<std::string> brokenFiles(const fs::path& dir, std::size_t& checked) 
 
 }  // namespace
 
-TEST_CASE("SIGTERM writes a checkpoint; --resume gives the uninterrupted image bit for bit", "[cli][resume]") {
+TEST_CASE("SIGTERM writes a checkpoint and --resume gives the uninterrupted image bit for bit", "[cli][resume]") {
     const fs::path ref = accretion::test::scratchDir("resume_reference");
     const fs::path dir = accretion::test::scratchDir("resume_interrupted");
     std::string out;

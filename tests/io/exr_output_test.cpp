@@ -30,7 +30,7 @@ TEST_CASE("EXR: layers, formats, values and metadata read back with OpenImageIO"
     REQUIRE(spec.get_string_attribute("accretion:estimator") == "power");
 
     const std::vector<std::string> expected = {"R", "G", "B", "Le.R", "Le.G", "Le.B", "Lr.R", "Lr.G", "Lr.B", "depth.Z",
-                                               "N.X", "N.Y", "N.Z", "particle.id", "Lr_stderr.R", "Lr_stderr.G",
+                                               "N.X", "N.Y", "N.Z", "particle.id", "rejected", "Lr_stderr.R", "Lr_stderr.G",
                                                "Lr_stderr.B", "spp"};
     REQUIRE(spec.nchannels == int(expected.size()));
     auto channel = [&](const std::string& name) {
@@ -60,6 +60,7 @@ TEST_CASE("EXR: layers, formats, values and metadata read back with OpenImageIO"
         REQUIRE(v[channel("depth.Z")] == img.depth[i]);
         REQUIRE(v[channel("N.Y")] == img.normal[i].y);
         REQUIRE(v[channel("spp")] == img.lighting.spp[i]);
+        REQUIRE(v[channel("rejected")] == img.lighting.rejected[i]);
         hits += ids[i] != kNoParticle;
     }
     REQUIRE(hits > 10);

@@ -59,8 +59,11 @@ public:
     /// (false for one frame or temporal off: no history buffers or motion).
     Restir(const Settings& settings, bool keepHistory);
 
-    /// Render Lr of one frame (spp = 1, no per-pixel standard error).
-    LightingCounters render(const RestirInputs& in, LightingImage& out, ReservoirImage& aov, PassTimer& timer);
+    /// Render Lr of one frame (spp = 1, no per-pixel standard error). Values
+    /// that overflow or go NaN are rejected under render.nonfinite, counted
+    /// per pixel (out.rejected) and per pass (`rejected`).
+    LightingCounters render(const RestirInputs& in, LightingImage& out, ReservoirImage& aov, PassTimer& timer,
+                            PassRejections& rejected);
 
     /// Bytes of the stored reservoirs per lighting pixel, and of the history.
     std::size_t reservoirBytes() const { return codec_.bytes(); }

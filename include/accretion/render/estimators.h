@@ -1,6 +1,8 @@
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <map>
+#include <string>
 #include <vector>
 
 #include "accretion/core/math.h"
@@ -41,6 +43,9 @@ struct LightingCounters {
         return *this;
     }
 };
+
+/// Non-finite values rejected, per pass name (render.nonfinite).
+using PassRejections = std::map<std::string, std::uint64_t>;
 
 /// Everything the lighting estimators read.
 struct LightingInputs {

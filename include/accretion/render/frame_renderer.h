@@ -44,7 +44,7 @@ struct FrameStats {
     double meanSpp = 0.0;             ///< light samples per hit pixel, mean (adaptive sampling varies it)
     double maxSpp = 0.0;              ///< and maximum
     std::size_t hitPixels = 0;
-    std::uint64_t composeRejected = 0; ///< composeImage: pixels whose Le + Lr overflowed float (zeroed)
+    PassRejections nonFinite;         ///< NaN/Inf rejected per pass (estimateLighting or the restir passes, composeImage)
     PassTimer timer;                  ///< wall time per pass name
     double seconds = 0.0;             ///< whole frame
 };

@@ -69,6 +69,7 @@ template <class E> constexpr std::string_view enumName(E e) {
 struct ParticleSettings {
     std::string file;                  ///< particle file(s), `{frame}` pattern; empty = generator
     std::uint32_t count = 10000;       ///< number of generated particles
+    Vec3 center{0.0f, 0.0f, 0.0f};     ///< centre of the generated disk
     std::uint64_t seed = 1;            ///< generator seed
     double inner_radius = 1.0;         ///< disk inner radius
     double outer_radius = 10.0;        ///< disk outer radius
@@ -84,8 +85,9 @@ struct ParticleSettings {
     double opacity = 1.0;              ///< opacity written to the GPU buffer
 
     template <class V> void visit(V& v) {
-        v.field("file", file, "particle file path (raw .bin or .ply), {frame} pattern; empty: use the generator");
+        v.field("file", file, "particle file path (raw .bin or .ply; relative to the scene file), {frame} pattern; empty: use the generator");
         v.field("count", count, "number of generated particles", Range{1, 5e7});
+        v.field("center", center, "centre of the generated disk (|x| <= 1e9)", Range{-1e9, 1e9});
         v.field("seed", seed, "generator seed");
         v.field("inner_radius", inner_radius, "disk inner radius", kLength);
         v.field("outer_radius", outer_radius, "disk outer radius (> inner_radius)", kLength);
