@@ -15,6 +15,9 @@ struct SceneArgs {
     bool quiet = false;                  ///< --quiet: no progress on stderr
 };
 
+/// Thrown by batch when some job did not succeed (exit code 4).
+struct BatchFailed {};
+
 /// Turn `--frames A:B` into overrides of render.frame_start / render.frames.
 void appendFrameOverrides(const std::string& frames, std::vector<std::string>& overrides);
 

@@ -23,10 +23,13 @@ int main(int argc, char** argv) {
     accretion::cmd::addCalibrateCommand(app);
     accretion::cmd::addPlanCommand(app);
     accretion::cmd::addMergeCommand(app);
+    accretion::cmd::addBatchCommand(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         return app.exit(e);
+    } catch (const accretion::cmd::BatchFailed&) {
+        return 4;  // the summary says which jobs failed
     } catch (const accretion::Interrupted& e) {
         return 128 + e.signal;  // checkpoint written; the shell's convention for a signal
     } catch (const accretion::InputError& e) {

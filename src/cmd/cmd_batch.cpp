@@ -1,0 +1,396 @@
+// accretion batch: many renders (a jobs file, or scene x frame x seed from
+// the command line), each in its own process so that one failing or
+// crashing job does not stop the others; a summary JSON lists every job's
+// outcome, time and outputs, rewritten atomically after each job.
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <thread>
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+#include <nlohmann/json.hpp>
+#include <toml++/toml.h>
+
+#include "accretion/core/error.h"
+#include "accretion/core/stop_signal.h"
+#include "accretion/core/version.h"
+#include "accretion/io/atomic_file.h"
+#include "accretion/io/stats_writer.h"
+#include "commands.h"
+
+extern char** environ;
+
+namespace accretion::cmd {
+namespace {
+
+/// One render of the batch: a scene, frames, seed and render options.
+struct Job {
+    std::string name;
+    std::string scene;
+    std::string frames;               ///< "A:B" or "A"; empty: the scene's
+    std::optional<std::uint64_t> seed;
+    std::string estimator;
+    std::optional<std::uint32_t> spp;
+    std::string output;               ///< EXR pattern; default <output_dir>/<name>/{scene}.{frame}.exr
+    std::string shard;
+    std::vector<std::string> defines;
+};
+
+struct BatchArgs {
+    std::string jobsFile;
+    std::vector<std::string> scenes;
+    std::string frames, seeds, estimator, outputDir = "out/batch", summary;
+    std::optional<std::uint32_t> spp;
+    std::vector<std::string> defines;
+    int parallel = 1;
+    int threads = 0;
+    bool resume = false, quiet = false;
+};
+
+std::string where(const toml::node& n) {
+    const auto& src = n.source();
+    return fmt::format("{}:{}", src.path ? *src.path : std::string("<jobs>"), src.begin.line);
+}
+
+/// "0:4" -> 0,1,2,3; "7" -> 7.
+std::vector<std::uint64_t> parseRange(const std::string& text, const char* option) {
+    const auto colon = text.find(':');
+    auto number = [&](const std::string& s) {
+        std::size_t used = 0;
+        unsigned long long v = 0;
+        try {
+            v = std::stoull(s, &used);
+        } catch (...) {
+            used = 0;
+        }
+        if (s.empty() || used != s.size() || s[0] == '-')
+            throw InputError(fmt::format("command line {} {}: expected N or A:B (half-open)", option, text));
+        return std::uint64_t(v);
+    };
+    const std::uint64_t a = number(text.substr(0, colon));
+    const std::uint64_t b = colon == std::string::npos ? a + 1 : number(text.substr(colon + 1));
+    if (b <= a || b - a > 100000)
+        throw InputError(fmt::format("command line {} {}: expected A < B, at most 100000 values", option, text));
+    std::vector<std::uint64_t> v;
+    for (std::uint64_t x = a; x < b; ++x) v.push_back(x);
+    return v;
+}
+
+/// [[job]] tables of a jobs file; paths relative to the file. Every key is
+/// checked: an unknown or mistyped one names its line.
+std::vector<Job> readJobsFile(const std::filesystem::path& file, BatchArgs& args) {
+    toml::table root;
+    try {
+        root = toml::parse_file(file.string());
+    } catch (const toml::parse_error& e) {
+        const auto& src = e.source();
+        throw InputError(fmt::format("{}:{}: {}", file.string(), src.begin.line, e.description()));
+    }
+    const std::filesystem::path dir = file.parent_path();
+    auto path = [&](const std::string& p) { return std::filesystem::path(p).is_relative() && !dir.empty() ? (dir / p).string() : p; };
+    auto str = [&](const toml::node& n, const std::string& key) {
+        if (!n.is_string()) throw InputError(fmt::format("{}: {}: expected a string", where(n), key));
+        return n.as_string()->get();
+    };
+    auto integer = [&](const toml::node& n, const std::string& key, std::int64_t lo, std::int64_t hi) {
+        if (!n.is_integer() || n.as_integer()->get() < lo || n.as_integer()->get() > hi)
+            throw InputError(fmt::format("{}: {}: expected an integer in [{}, {}]", where(n), key, lo, hi));
+        return n.as_integer()->get();
+    };
+    for (const auto& [key, node] : root) {
+        if (key.str() == "batch") {
+            const toml::table* t = node.as_table();
+            if (!t) throw InputError(fmt::format("{}: [batch] must be a table", where(node)));
+            for (const auto& [k, v] : *t) {
+                if (k.str() == "output_dir") args.outputDir = path(str(v, "batch.output_dir"));
+                else if (k.str() == "parallel") args.parallel = int(integer(v, "batch.parallel", 1, 256));
+                else throw InputError(fmt::format("{}: batch.{}: unknown key (output_dir, parallel)", where(v), k.str()));
+            }
+        } else if (key.str() != "job") {
+            throw InputError(fmt::format("{}: {}: unknown table (expected [batch] and [[job]])", where(node), key.str()));
+        }
+    }
+    const toml::array* jobs = root["job"].as_array();
+    if (!jobs || jobs->empty())
+        throw InputError(fmt::format("{}: no [[job]] tables: nothing to run", file.string()));
+    std::vector<Job> out;
+    for (const toml::node& n : *jobs) {
+        const toml::table* t = n.as_table();
+        if (!t) throw InputError(fmt::format("{}: job must be a table ([[job]])", where(n)));
+        Job j;
+        for (const auto& [k, v] : *t) {
+            const std::string key = "job." + std::string(k.str());
+            if (k.str() == "name") j.name = str(v, key);
+            else if (k.str() == "scene") j.scene = path(str(v, key));
+            else if (k.str() == "frames") j.frames = v.is_integer() ? std::to_string(integer(v, key, 0, 1000000000)) : str(v, key);
+            else if (k.str() == "seed") j.seed = std::uint64_t(integer(v, key, 0, std::numeric_limits<std::int64_t>::max()));
+            else if (k.str() == "estimator") j.estimator = str(v, key);
+            else if (k.str() == "spp") j.spp = std::uint32_t(integer(v, key, 1, 10000000));
+            else if (k.str() == "output") j.output = path(str(v, key));
+            else if (k.str() == "shard") j.shard = str(v, key);
+            else if (k.str() == "define") {
+                const toml::array* a = v.as_array();
+                if (!a) throw InputError(fmt::format("{}: {}: expected an array of \"section.key=value\" strings", where(v), key));
+                for (const toml::node& d : *a) j.defines.push_back(str(d, key));
+            } else
+                throw InputError(fmt::format("{}: {}: unknown key (name, scene, frames, seed, estimator, spp, output, "
+                                             "shard, define)", where(v), key));
+        }
+        if (j.scene.empty()) throw InputError(fmt::format("{}: job without a scene", where(n)));
+        if (j.name.empty())
+            j.name = fmt::format("{}{}{}", std::filesystem::path(j.scene).stem().string(),
+                                 j.frames.empty() ? "" : "-f" + j.frames, j.seed ? fmt::format("-s{}", *j.seed) : "");
+        out.push_back(std::move(j));
+    }
+    return out;
+}
+
+/// Scene x frame x seed from the command line, one frame per job.
+std::vector<Job> commandLineJobs(const BatchArgs& args) {
+    if (args.scenes.empty()) throw InputError("command line: give a jobs file or --scene (with --frames, --seeds)");
+    const std::vector<std::uint64_t> frames = args.frames.empty() ? std::vector<std::uint64_t>{} : parseRange(args.frames, "--frames");
+    const std::vector<std::uint64_t> seeds = args.seeds.empty() ? std::vector<std::uint64_t>{} : parseRange(args.seeds, "--seeds");
+    std::vector<Job> jobs;
+    for (const std::string& scene : args.scenes) {
+        const std::string stem = std::filesystem::path(scene).stem().string();
+        for (std::size_t f = 0; f < std::max<std::size_t>(frames.size(), 1); ++f)
+            for (std::size_t s = 0; s < std::max<std::size_t>(seeds.size(), 1); ++s) {
+                Job j;
+                j.scene = scene;
+                if (!frames.empty()) j.frames = std::to_string(frames[f]);
+                if (!seeds.empty()) j.seed = seeds[s];
+                j.name = fmt::format("{}{}{}", stem, frames.empty() ? "" : fmt::format("-f{}", frames[f]),
+                                     seeds.empty() ? "" : fmt::format("-s{}", seeds[s]));
+                jobs.push_back(std::move(j));
+            }
+    }
+    return jobs;
+}
+
+/// The render command line of a job (this same executable).
+std::vector<std::string> renderArgv(const Job& j, const BatchArgs& args) {
+    std::vector<std::string> a = {"/proc/self/exe", "render", j.scene, "--quiet"};
+    const std::string output = j.output.empty() ? (std::filesystem::path(args.outputDir) / j.name / "{scene}.{frame}.exr").string() : j.output;
+    a.insert(a.end(), {"-o", output});
+    if (!j.frames.empty()) a.insert(a.end(), {"--frames", j.frames});
+    if (j.seed) a.insert(a.end(), {"--seed", std::to_string(*j.seed)});
+    const std::string estimator = j.estimator.empty() ? args.estimator : j.estimator;
+    if (!estimator.empty()) a.insert(a.end(), {"--estimator", estimator});
+    if (const auto spp = j.spp ? j.spp : args.spp) a.insert(a.end(), {"--spp", std::to_string(*spp)});
+    if (!j.shard.empty()) a.insert(a.end(), {"--shard", j.shard});
+    if (args.threads > 0) a.insert(a.end(), {"--threads", std::to_string(args.threads)});
+    if (args.resume) a.push_back("--resume");
+    for (const std::string& d : args.defines) a.insert(a.end(), {"-D", d});
+    for (const std::string& d : j.defines) a.insert(a.end(), {"-D", d});
+    return a;
+}
+
+/// A running job: its process, log and start time.
+struct Running {
+    std::size_t job;
+    pid_t pid;
+    std::chrono::steady_clock::time_point start;
+};
+
+pid_t spawn(const std::vector<std::string>& argv, const std::filesystem::path& log) {
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+    std::vector<char*> args;
+    for (const std::string& s : argv) args.push_back(const_cast<char*>(s.c_str()));
+    args.push_back(nullptr);
+    // Its own process group: a terminal's Ctrl-C reaches the batch only,
+    // which forwards it once (a second signal would stop a render at once).
+    posix_spawnattr_t attr;
+    posix_spawnattr_init(&attr);
+    posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP);
+    posix_spawnattr_setpgroup(&attr, 0);
+    pid_t pid = 0;
+    const int rc = posix_spawn(&pid, "/proc/self/exe", &actions, &attr, args.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    posix_spawnattr_destroy(&attr);
+    if (rc != 0) throw InternalError(fmt::format("cannot start a render process: {}", std::strerror(rc)));
+    return pid;
+}
+
+/// The last non-empty line of a log (the error of a failed job).
+std::string lastLine(const std::filesystem::path& log) {
+    std::ifstream in(log);
+    std::string line, last;
+    while (std::getline(in, line)) {
+        const auto cr = line.rfind('\r');  // progress lines
+        if (cr != std::string::npos) line = line.substr(cr + 1);
+        if (!line.empty()) last = line;
+    }
+    return last;
+}
+
+/// The outputs a job's stats.json lists (frames[].outputs), and its path.
+nlohmann::json jobOutputs(const std::filesystem::path& log) {
+    std::ifstream in(log);
+    std::string line;
+    while (std::getline(in, line))
+        if (line.rfind("stats: ", 0) == 0) {
+            const std::string stats = line.substr(7);
+            std::ifstream s(stats);
+            nlohmann::json j = nlohmann::json::parse(s, nullptr, false);
+            nlohmann::json outputs = nlohmann::json::array();
+            if (!j.is_discarded())
+                for (const auto& f : j["frames"]) outputs.push_back(f["outputs"]);
+            return {{"stats", stats}, {"frames", outputs}};
+        }
+    return nlohmann::json::object();
+}
+
+void runBatch(BatchArgs args) {
+    std::vector<Job> jobs = args.jobsFile.empty() ? commandLineJobs(args) : readJobsFile(args.jobsFile, args);
+    if (!args.jobsFile.empty() && !args.scenes.empty())
+        throw InputError("command line: give a jobs file or --scene, not both");
+    if (args.parallel < 1) throw InputError("command line --parallel: expected at least 1");
+    std::map<std::string, std::size_t> names;
+    for (std::size_t k = 0; k < jobs.size(); ++k)
+        if (!names.emplace(jobs[k].name, k).second)
+            throw InputError(fmt::format("{}: two jobs named {}: outputs would collide", args.jobsFile.empty() ? "command line" : args.jobsFile, jobs[k].name));
+    for (const Job& j : jobs)
+        if (!std::filesystem::exists(j.scene)) throw InputError(fmt::format("{}: job {}: scene file not found", j.scene, j.name));
+
+    const std::filesystem::path outDir(args.outputDir);
+    const std::string summaryPath = args.summary.empty() ? (outDir / "batch.json").string() : args.summary;
+    // --resume: jobs that finished in an earlier batch are not run again.
+    std::map<std::string, nlohmann::json> previous;
+    if (args.resume && std::filesystem::exists(summaryPath)) {
+        std::ifstream in(summaryPath);
+        const nlohmann::json old = nlohmann::json::parse(in, nullptr, false);
+        if (old.is_discarded()) throw InputError(fmt::format("{}: not a batch summary (JSON)", summaryPath));
+        for (const auto& j : old.value("jobs", nlohmann::json::array()))
+            if (j.value("outcome", "") == "ok") previous[j.value("name", "")] = j;
+    }
+
+    nlohmann::json summary = {{"version", std::string(version())},
+                              {"jobs_file", args.jobsFile},
+                              {"parallel", args.parallel},
+                              {"jobs", nlohmann::json::array()}};
+    std::vector<nlohmann::json> results(jobs.size());
+    const auto batchStart = std::chrono::steady_clock::now();
+    auto save = [&] {
+        summary["jobs"] = nlohmann::json::array();
+        std::map<std::string, int> counts;
+        for (const auto& r : results)
+            if (!r.is_null()) {
+                summary["jobs"].push_back(r);
+                ++counts[r.value("outcome", "")];
+            }
+        summary["counts"] = counts;
+        summary["total_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - batchStart).count();
+        writeJson(summaryPath, summary);
+    };
+
+    StopSignal stop;
+    std::vector<Running> running;
+    std::size_t next = 0, done = 0;
+    int forwarded = 0;
+    while (done < jobs.size()) {
+        // Start jobs up to the parallel limit (none after a stop request).
+        while (!stop.pending() && next < jobs.size() && running.size() < std::size_t(args.parallel)) {
+            const Job& j = jobs[next];
+            if (auto it = previous.find(j.name); it != previous.end()) {
+                results[next] = it->second;
+                results[next]["skipped"] = "finished in an earlier batch";
+                ++next;
+                ++done;
+                continue;
+            }
+            const std::filesystem::path log = outDir / (j.name + ".log");
+            std::error_code ec;
+            std::filesystem::create_directories(outDir, ec);
+            if (ec) throw InputError(fmt::format("{}: cannot create output directory: {}", outDir.string(), ec.message()));
+            const std::vector<std::string> argv = renderArgv(j, args);
+            results[next] = {{"name", j.name}, {"outcome", "running"}, {"log", log.string()},
+                             {"command", fmt::format("accretion {}", fmt::join(argv.begin() + 1, argv.end(), " "))}};
+            running.push_back({next, spawn(argv, log), std::chrono::steady_clock::now()});
+            if (!args.quiet) fmt::print(stderr, "accretion batch: [{}/{}] {} started\n", next + 1, jobs.size(), j.name);
+            ++next;
+        }
+        if (stop.pending() && !forwarded) {  // the renders checkpoint and stop
+            forwarded = stop.pending();
+            for (const Running& r : running) ::kill(r.pid, forwarded);
+            if (!args.quiet) fmt::print(stderr, "accretion batch: {}: stopping {} running job(s)\n", StopSignal::name(forwarded), running.size());
+        }
+        if (running.empty()) {
+            if (stop.pending()) break;
+            continue;
+        }
+        int status = 0;
+        const pid_t pid = ::waitpid(-1, &status, WNOHANG);
+        if (pid <= 0) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+            continue;
+        }
+        const auto it = std::find_if(running.begin(), running.end(), [&](const Running& r) { return r.pid == pid; });
+        if (it == running.end()) continue;
+        nlohmann::json& r = results[it->job];
+        const std::filesystem::path log = r["log"].get<std::string>();
+        r["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - it->start).count();
+        if (WIFEXITED(status)) {
+            r["exit_code"] = WEXITSTATUS(status);
+            r["outcome"] = WEXITSTATUS(status) == 0 ? "ok" : WEXITSTATUS(status) > 128 ? "interrupted" : "failed";
+        } else {
+            r["signal"] = WTERMSIG(status);
+            r["outcome"] = "crashed";
+        }
+        if (r["outcome"] == "ok") r["outputs"] = jobOutputs(log);
+        else r["error"] = lastLine(log);
+        if (!args.quiet)
+            fmt::print(stderr, "accretion batch: {} {} ({:.1f} s){}\n", r["name"].get<std::string>(), r["outcome"].get<std::string>(),
+                       r["seconds"].get<double>(), r.contains("error") ? ": " + r["error"].get<std::string>() : "");
+        running.erase(it);
+        ++done;
+        save();
+    }
+    for (std::size_t k = 0; k < jobs.size(); ++k)
+        if (results[k].is_null()) results[k] = {{"name", jobs[k].name}, {"outcome", "not started"}};
+    save();
+    const auto& counts = summary["counts"];
+    const int ok = counts.value("ok", 0);
+    fmt::print("batch: {} of {} jobs ok; summary {}\n", ok, jobs.size(), summaryPath);
+    if (forwarded) throw Interrupted{forwarded};
+    if (ok != int(jobs.size())) throw BatchFailed{};
+}
+
+}  // namespace
+
+void addBatchCommand(CLI::App& app) {
+    auto args = std::make_shared<BatchArgs>();
+    CLI::App* cmd = app.add_subcommand("batch", "Run many renders (a jobs file, or scenes x frames x seeds); one failing "
+                                                "job does not stop the others; a summary JSON lists every outcome");
+    cmd->add_option("jobs", args->jobsFile, "Jobs file (TOML): [batch] output_dir, parallel; [[job]] name, scene, frames, "
+                                            "seed, estimator, spp, output, shard, define");
+    cmd->add_option("--scene", args->scenes, "Scene file(s) (instead of a jobs file): one job per scene x frame x seed");
+    cmd->add_option("--frames", args->frames, "Frames A:B: one job per frame");
+    cmd->add_option("--seeds", args->seeds, "Seeds A:B: one job per seed");
+    cmd->add_option("--estimator", args->estimator, "Estimator of every job (a job's own wins)");
+    cmd->add_option("--spp", args->spp, "Samples per pixel of every job (a job's own wins)");
+    cmd->add_option("-D,--define", args->defines, "Setting override for every job: -D section.key=value")->allow_extra_args(false);
+    cmd->add_option("--output-dir", args->outputDir, "Where jobs write (<dir>/<job>/...), their logs and batch.json");
+    cmd->add_option("--summary", args->summary, "Summary JSON path (default <output-dir>/batch.json)");
+    cmd->add_option("-j,--parallel", args->parallel, "Jobs run at once (each render uses all cores; default 1)");
+    cmd->add_option("--threads", args->threads, "Worker threads per job");
+    cmd->add_flag("--resume", args->resume, "Skip jobs the summary lists as ok; others continue from their checkpoints");
+    cmd->add_flag("-q,--quiet", args->quiet, "No progress on stderr");
+    cmd->footer("Exit codes: 0 every job ok, 1 bad input (jobs file, command line), 4 some job failed, 128+N stopped by signal N.");
+    cmd->callback([args] { runBatch(*args); });
+}
+
+}  // namespace accretion::cmd

@@ -1,0 +1,111 @@
+// accretion batch with real processes: one failing job does not stop the
+// others, the summary lists every outcome, --resume skips finished jobs,
+// scene x frame x seed jobs from the command line, bad jobs files refused.
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "support/test_scenes.h"
+
+namespace fs = std::filesystem;
+using Catch::Matchers::Contains;
+using accretion::test::runCommand;
+
+namespace {
+
+const std::string kBin = ACCRETION_BINARY;
+
+nlohmann::json readJson(const fs::path& file) { return nlohmann::json::parse(accretion::test::readFile(file)); }
+
+}  // namespace
+
+TEST_CASE("batch: a failing job does not stop the others, the summary lists each outcome, --resume skips done jobs",
+          "[cli][batch]") {
+    const fs::path dir = accretion::test::scratchDir("batch_jobs");
+    const std::string scene = accretion::test::smallDiskScene();
+    std::ofstream(dir / "jobs.toml") << "[batch]\noutput_dir = \"out\"\n\n"
+                                     << "[[job]]\nname = \"a\"\nscene = \"" << scene << "\"\nestimator = \"uniform\"\nspp = 4\n\n"
+                                     << "[[job]]\nname = \"bad\"\nscene = \"" << scene << "\"\ndefine = [\"shading.dmin=-1\"]\n\n"
+                                     << "[[job]]\nname = \"c\"\nscene = \"" << scene << "\"\nseed = 3\nestimator = \"power\"\nspp = 4\n";
+    std::string out;
+    const std::string cmd = kBin + " batch " + (dir / "jobs.toml").string() + " --quiet";
+    REQUIRE(runCommand(cmd, out) == 4);
+    INFO(out);
+    const auto summary = readJson(dir / "out" / "batch.json");
+    REQUIRE(summary["jobs"].size() == 3);
+    CHECK(summary["counts"]["ok"] == 2);
+    CHECK(summary["counts"]["failed"] == 1);
+    for (const auto& j : summary["jobs"]) {
+        INFO(j.dump());
+        CHECK(j["seconds"].get<double>() > 0.0);
+        if (j["name"] == "bad") {
+            CHECK(j["outcome"] == "failed");
+            CHECK(j["exit_code"] == 1);
+            CHECK_THAT(j["error"].get<std::string>(), Contains("shading.dmin"));
+            continue;
+        }
+        CHECK(j["outcome"] == "ok");
+        const std::string exr = j["outputs"]["frames"][0]["exr"];
+        CHECK(fs::exists(exr));
+        CHECK(fs::exists(j["outputs"]["stats"].get<std::string>()));
+    }
+    CHECK_FALSE(fs::exists(dir / "out" / "bad"));  // the failed job wrote nothing
+
+    // Rerun with --resume: a and c are not run again, bad is (and fails again).
+    const auto before = fs::last_write_time(dir / "out" / "a" / "small_disk.0000.exr");
+    REQUIRE(runCommand(cmd + " --resume", out) == 4);
+    const auto again = readJson(dir / "out" / "batch.json");
+    for (const auto& j : again["jobs"]) {
+        INFO(j.dump());
+        if (j["name"] == "bad") CHECK(j["outcome"] == "failed");
+        else CHECK(j.contains("skipped"));
+    }
+    CHECK(fs::last_write_time(dir / "out" / "a" / "small_disk.0000.exr") == before);
+}
+
+TEST_CASE("batch: scene x frame x seed jobs from the command line", "[cli][batch]") {
+    const fs::path dir = accretion::test::scratchDir("batch_matrix");
+    std::string out;
+    REQUIRE(runCommand(kBin + " batch --quiet --scene " + accretion::test::smallDiskScene() +
+                           " --frames 0:2 --seeds 5:7 --estimator uniform --spp 2 -j 2 --output-dir " + (dir / "out").string(),
+                       out) == 0);
+    INFO(out);
+    const auto summary = readJson(dir / "out" / "batch.json");
+    REQUIRE(summary["jobs"].size() == 4);
+    for (const char* name : {"small_disk-f0-s5", "small_disk-f0-s6", "small_disk-f1-s5", "small_disk-f1-s6"}) {
+        INFO(name);
+        const fs::path stats = dir / "out" / name / "small_disk.stats.json";
+        REQUIRE(fs::exists(stats));
+        CHECK(readJson(stats)["seed"] == (std::string(name).back() == '5' ? 5 : 6));
+    }
+    // Different seeds, different images.
+    CHECK(accretion::test::readFile(dir / "out" / "small_disk-f0-s5" / "small_disk.0000.exr") !=
+          accretion::test::readFile(dir / "out" / "small_disk-f0-s6" / "small_disk.0000.exr"));
+}
+
+TEST_CASE("batch: a bad jobs file is refused with its line, nothing run", "[cli][batch]") {
+    const fs::path dir = accretion::test::scratchDir("batch_bad");
+    const std::string scene = accretion::test::smallDiskScene();
+    struct Case {
+        const char* text;
+        const char* error;
+    };
+    const Case c = GENERATE(Case{"[[job]]\nscene = \"S\"\nsped = 3\n", "jobs.toml:3: job.sped: unknown key"},
+                            Case{"[[job]]\nscene = \"S\"\nseed = -1\n", "jobs.toml:3: job.seed: expected an integer"},
+                            Case{"[[job]]\nscene = \"S\"\nspp = \"many\"\n", "jobs.toml:3: job.spp: expected an integer"},
+                            Case{"[[job]]\nname = \"x\"\nscene = \"S\"\n[[job]]\nname = \"x\"\nscene = \"S\"\n", "two jobs named x"},
+                            Case{"[[job]]\nscene = \"missing.toml\"\n", "missing.toml: job missing: scene file not found"},
+                            Case{"[jobs]\n", "jobs.toml:1: jobs: unknown table"},
+                            Case{"[batch]\n", "no [[job]] tables"},
+                            Case{"[[job]\n", "jobs.toml:1:"});
+    std::string text = c.text;
+    for (auto p = text.find("\"S\""); p != std::string::npos; p = text.find("\"S\"")) text.replace(p, 3, "\"" + scene + "\"");
+    std::ofstream(dir / "jobs.toml") << text;
+    std::string out;
+    CHECK(runCommand("cd " + dir.string() + " && " + kBin + " batch jobs.toml --output-dir out", out) == 1);
+    CHECK_THAT(out, Contains(c.error));
+    CHECK_FALSE(fs::exists(dir / "out"));
+}
