@@ -122,7 +122,7 @@ void runRender(const RenderArgs& args) {
     if (!shard.whole() && !shardSamples) {
         const std::uint32_t F = settings.render.frames;
         if (F < shard.count)
-            throw InputError(fmt::format("--shard {}: {} shards of {} frame(s): {} cannot split samples, so give at "
+            throw InputError(fmt::format("command line --shard {}: {} shards of {} frame(s): {} cannot split samples, so give at "
                                          "least as many frames as shards", args.shard, shard.count, F,
                                          accumulating ? "adaptive sampling" : "restir"));
         firstFrame = settings.render.frame_start + std::uint32_t(std::uint64_t(F) * shard.index / shard.count);
@@ -130,7 +130,7 @@ void runRender(const RenderArgs& args) {
     }
     if (shardSamples) planLighting(settings.render, settings.camera.height, shard);  // can it be cut? (throws)
     if (args.resume && !accumulating)
-        throw InputError("--resume: restir keeps reservoir history across frames and is not checkpointed; "
+        throw InputError("command line --resume: restir keeps reservoir history across frames and is not checkpointed; "
                          "re-run the frames (finished frames are complete on disk)");
     if (!(args.checkpointEvery >= 0.0))
         throw InputError(fmt::format("command line --checkpoint-every {}: expected seconds >= 0", args.checkpointEvery));

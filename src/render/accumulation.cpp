@@ -43,11 +43,11 @@ LightingPlan planLighting(const RenderSettings& render, std::uint32_t height, Sh
     const std::uint64_t total = std::uint64_t(plan.chunksPerRound) * plan.rounds;
     if (!shard.whole()) {
         if (plan.adaptive)
-            throw InputError(fmt::format("--shard {}/{}: adaptive sampling (render.target_stderr) decides per pixel when "
+            throw InputError(fmt::format("command line --shard {}/{}: adaptive sampling (render.target_stderr) decides per pixel when "
                                          "to stop, so its samples cannot be split; shard frames instead (--frames)",
                                          shard.index, shard.count));
         if (total < shard.count)
-            throw InputError(fmt::format("--shard {}/{}: the frame has only {} chunks of {} {} to split", shard.index,
+            throw InputError(fmt::format("command line --shard {}/{}: the frame has only {} chunks of {} {} to split", shard.index,
                                          shard.count, total, plan.exact ? LightingPlan::kChunkRows : LightingPlan::kChunkSamples,
                                          plan.exact ? "rows" : "samples"));
     }

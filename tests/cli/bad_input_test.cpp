@@ -37,7 +37,7 @@ TEST_CASE("the bad-input corpus: exact errors, exit 1, nothing written", "[cli][
     for (const auto& e : fs::directory_iterator(corpus))
         if (e.path().extension() == ".expected") cases.push_back(e.path());
     std::sort(cases.begin(), cases.end());
-    REQUIRE(cases.size() >= 38);
+    REQUIRE(cases.size() >= 45);
     int bad = 0, ok = 0;
     for (const fs::path& expectedFile : cases) {
         const std::string name = expectedFile.stem().string();
@@ -66,6 +66,6 @@ TEST_CASE("the bad-input corpus: exact errors, exit 1, nothing written", "[cli][
         // No output at all: no EXR, PNG, stats or settings file, no temporary.
         CHECK(fs::is_empty(out));
     }
-    CHECK(bad >= 35);  // 36 bad inputs, 2 valid ones
+    CHECK(bad >= 43);  // 43 bad inputs, 2 valid ones
     CHECK(ok >= 2);
 }
