@@ -2,8 +2,10 @@
 // the command line), each in its own process so that one failing or
 // crashing job does not stop the others; a summary JSON lists every job's
 // outcome, time and outputs, rewritten atomically after each job.
+#include <algorithm>
 #include <chrono>
 #include <csignal>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>

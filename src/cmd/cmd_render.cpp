@@ -15,6 +15,7 @@
 #include "accretion/gpu/gpu_report.h"
 #include "accretion/core/stop_signal.h"
 #include "accretion/io/accumulation_file.h"
+#include "accretion/io/checkpoint.h"
 #include "accretion/io/atomic_file.h"
 #include "accretion/io/exr_output.h"
 #include "accretion/io/stats_writer.h"
@@ -136,7 +137,6 @@ void runRender(const RenderArgs& args) {
         throw InputError(fmt::format("command line --checkpoint-every {}: expected seconds >= 0", args.checkpointEvery));
 
     const std::string stem = shardPath(runStem(settings), shard);
-    const std::string checkpoint = stem + ".checkpoint";
     const std::string settingsToml = settingsToToml(settings);
     const bool withErrors = settings.render.estimator != EstimatorKind::exact;
     removeStaleTemporaries(std::filesystem::path(stem).parent_path());
@@ -155,30 +155,16 @@ void runRender(const RenderArgs& args) {
     };
 
     // A checkpoint: where to start, and the sums of the frame in progress.
-    std::optional<AccumulationFile> resumed;
-    if (std::filesystem::exists(checkpoint)) {
-        if (!args.resume)
-            throw InputError(fmt::format("{}: a checkpoint of an interrupted run is here; continue it with --resume "
-                                         "or delete it to start over", checkpoint));
-        resumed = readAccumulationFile(checkpoint);
-        const nlohmann::json& h = resumed->header;
-        if (h.value("version", "") != version())
-            throw InputError(fmt::format("{}: checkpoint written by accretion {}, this is {}: its samples would not "
-                                         "continue the same streams", checkpoint, h.value("version", "?"), version()));
-        if (const std::string diff = settingsDifference(h, settingsToml); !diff.empty())
-            throw InputError(fmt::format("{}: checkpoint of other settings: {}", checkpoint, diff));
-        if (h.value("shard", "") != stats["shard"].get<std::string>())
-            throw InputError(fmt::format("{}: checkpoint of shard {}, this run is shard {}", checkpoint,
-                                         h.value("shard", "?"), stats["shard"].get<std::string>()));
-        const auto frame = h.at("frame").get<std::uint32_t>();
-        if (frame < firstFrame || frame >= endFrame)
-            throw InputError(fmt::format("{}: checkpoint of frame {}, outside this run's frames", checkpoint, frame));
-        for (const auto& f : h.at("finished_frames")) stats["frames"].push_back(f);
-        firstFrame = frame;
+    const Checkpoint checkpoint(stem + ".checkpoint", settingsToml, stats["shard"]);
+    std::optional<AccumulationFile> resumed = checkpoint.load(args.resume, firstFrame, endFrame);
+    if (resumed) {
+        for (const auto& f : resumed->header.at("finished_frames")) stats["frames"].push_back(f);
+        firstFrame = resumed->header.at("frame").get<std::uint32_t>();
         if (!args.quiet)
-            fmt::print(stderr, "accretion: resuming {} at frame {}, chunk {}\n", checkpoint, frame, resumed->acc.nextChunk);
+            fmt::print(stderr, "accretion: resuming {} at frame {}, chunk {}\n", checkpoint.file().string(), firstFrame,
+                       resumed->acc.nextChunk);
     } else if (args.resume && !args.quiet) {
-        fmt::print(stderr, "accretion: no checkpoint at {}: starting from the beginning\n", checkpoint);
+        fmt::print(stderr, "accretion: no checkpoint at {}: starting from the beginning\n", checkpoint.file().string());
     }
 
     const auto start = std::chrono::steady_clock::now();
@@ -186,20 +172,12 @@ void runRender(const RenderArgs& args) {
     if (accumulating) stop.emplace();
     auto lastCheckpoint = start;
     auto saveCheckpoint = [&](std::uint32_t frame, const Accumulation& acc) {
-        AccumulationFile f{{{"kind", "checkpoint"},
-                            {"version", std::string(version())},
-                            {"settings", settingsToml},
-                            {"settings_hash", fmt::format("{:016x}", fnv1a64(settingsToml))},
-                            {"shard", stats["shard"]},
-                            {"frame", frame},
-                            {"finished_frames", stats["frames"]}},
-                           acc};
-        writeAccumulationFile(checkpoint, f);
+        checkpoint.save(frame, acc, stats["frames"]);
         lastCheckpoint = std::chrono::steady_clock::now();
     };
     auto interrupt = [&](int signal, std::uint32_t frame, std::uint64_t chunk) {
         fmt::print(stderr, "accretion: {}: checkpoint {} (frame {}, chunk {}); continue with --resume\n",
-                   StopSignal::name(signal), checkpoint, frame, chunk);
+                   StopSignal::name(signal), checkpoint.file().string(), frame, chunk);
         throw Interrupted{signal};
     };
 
@@ -251,17 +229,11 @@ void runRender(const RenderArgs& args) {
             outputs = {{"exr", exr}, {"png", base.string() + ".png"}, {"lr_png", base.string() + ".Lr.png"}};
             if (shardSamples) {  // the sums a merge needs, next to the EXR
                 const LightingPlan plan = planLighting(settings.render, image.height, shard);
-                AccumulationFile f{{{"kind", "shard"},
-                                    {"version", std::string(version())},
-                                    {"settings", settingsToml},
-                                    {"settings_hash", fmt::format("{:016x}", fnv1a64(settingsToml))},
-                                    {"shard", stats["shard"]},
-                                    {"frame", frame},
-                                    {"chunks", {plan.begin, plan.end}},
-                                    {"exact", plan.exact},
-                                    {"auto_exposure", settings.render.auto_exposure},
-                                    {"exposure", settings.render.exposure}},
-                                   sums};
+                AccumulationFile f{accumulationHeader("shard", settingsToml, stats["shard"], frame), sums};
+                f.header["chunks"] = {plan.begin, plan.end};
+                f.header["exact"] = plan.exact;
+                f.header["auto_exposure"] = settings.render.auto_exposure;
+                f.header["exposure"] = settings.render.exposure;
                 writeAccumulationFile(base.string() + ".acc", f);
                 outputs["accumulation"] = base.string() + ".acc";
             }
@@ -306,8 +278,7 @@ void runRender(const RenderArgs& args) {
     // Written once every frame is out: a run stopped by bad input leaves nothing.
     writeFileAtomic(stem + ".settings.toml", settingsToml);
     writeJson(stem + ".stats.json", stats);
-    std::error_code ignored;
-    std::filesystem::remove(checkpoint, ignored);  // done: nothing left to resume
+    checkpoint.remove();  // done: nothing left to resume
     fmt::print("stats: {}.stats.json\nsettings: {}.settings.toml\ntotal: {:.2f} s\n", stem, stem, total);
 }
 
