@@ -157,8 +157,11 @@ RayBatch uniformShadowRays(const ParticleBvh& bvh, const Particles& p, const GBu
         const GBufferTexel& g = gb.texels[px];
         if (!g.hit()) continue;
         const ShadingPoint sp{g.position, g.normal, g.geomNormal, p.albedo[g.particle], g.particle};
-        Rng rng(px, 0, RngPass::lightSampling, s.render.seed);
+        Rng rng(px, 0, RngPass::lightSampling, s.render.seed, 1);
         for (std::uint32_t k = 0; k < s.render.samples; ++k) {
+            // A stream per chunk of samples (render/accumulation.h).
+            if (k > 0 && k % LightingPlan::kChunkSamples == 0)
+                rng = Rng(px, 0, RngPass::lightSampling, s.render.seed, k / LightingPlan::kChunkSamples + 1);
             const LightSample x = sampleSource<false>(L, nullptr, rng);
             LightTerm t;
             if (!L.term<ShadingModel::lambert>(sp, x.i, t)) continue;
