@@ -184,11 +184,11 @@ void runRender(const RenderArgs& args) {
     FrameRenderer renderer(settings, ParticleSource(settings), RenderOptions{args.quiet});
     std::uint64_t shadowRays = 0;
     double lightingSeconds = 0.0;
+    Accumulation sums;  // the frame's lighting sums (reused: no reallocation per frame)
     for (std::uint32_t frame = firstFrame; frame < endFrame; ++frame) {
         if (!args.quiet)
             fmt::print(stderr, "accretion: frame {} ({}/{})\n", frame, frame - settings.render.frame_start + 1,
                        settings.render.frames);
-        Accumulation sums;
         LightingSession session;
         session.shard = shardSamples ? shard : Shard{};
         session.result = &sums;

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include <tbb/blocked_range.h>
 #include <tbb/blocked_range2d.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -44,13 +45,14 @@ DVec3 exactPixel(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoin
 
 bool finite(const DVec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
-/// One pixel's running sums (views into the Accumulation), with the
-/// non-finite policy applied to every sample added.
+/// One pixel's running sums while its chunks run (loaded from and stored to
+/// the Accumulation, or resolved directly), with the non-finite policy
+/// applied to every sample added.
 struct PixelSums {
-    DVec3& sum;
-    DVec3& sumSq;
-    std::uint32_t& n;
-    std::uint32_t& rejected;
+    DVec3 sum{0.0}, sumSq{0.0};
+    std::uint32_t n = 0;
+    std::uint32_t rejected = 0;
+    std::uint8_t done = 0;
     NonFinitePolicy policy;
     LightingCounters& c;
 
@@ -66,7 +68,49 @@ struct PixelSums {
         ++n;
     }
     void addZero() { ++n; }
+    void load(const Accumulation& a, std::size_t px) {
+        sum = a.sum[px];
+        sumSq = a.sumSq[px];
+        n = a.n[px];
+        rejected = a.rejected[px];
+        done = a.done[px];
+    }
+    void store(Accumulation& a, std::size_t px) const {
+        a.sum[px] = sum;
+        a.sumSq[px] = sumSq;
+        a.n[px] = n;
+        a.rejected[px] = rejected;
+        a.done[px] = done;
+    }
 };
+
+/// Mean, standard error, spp and rejected count of one pixel's sums; a value
+/// that does not fit a float is zeroed and counted. Returns 1 if zeroed.
+std::uint32_t resolvePixel(const DVec3& sum, const DVec3& sumSq, std::uint32_t n, std::uint32_t rejected, bool exact,
+                           LightingImage& out, std::size_t px) {
+    Vec3 mean(0.0f), err(0.0f);
+    float spp = 0.0f;
+    if (exact) mean = Vec3(sum);
+    else if (n > 0) {
+        const DVec3 m = sum / double(n);
+        mean = Vec3(m);
+        if (n > 1) {
+            const DVec3 var = glm::max((sumSq - double(n) * m * m) / double(n - 1), DVec3(0.0));
+            err = Vec3(glm::sqrt(var / double(n)));
+        }
+        spp = float(n);
+    }
+    std::uint32_t zeroed = 0;
+    if (!finite(DVec3(mean)) || !finite(DVec3(err))) {  // float overflow of a finite double
+        mean = err = Vec3(0.0f);
+        zeroed = 1;
+    }
+    out.Lr[px] = mean;
+    out.Lr_stderr[px] = err;
+    out.spp[px] = spp;
+    out.rejected[px] = float(rejected + zeroed);
+    return zeroed;
+}
 
 /// uniform / power / tree: `count` one-sample estimates f I G V / p(i) (a
 /// zero sample when no light or i = j).
@@ -163,12 +207,14 @@ bool roundDone(const DVec3& s1, const DVec3& s2, std::uint32_t n, std::uint32_t 
     return luminance(Vec3(err)) <= rs.target_stderr * luminance(Vec3(m));
 }
 
-/// Runs chunks [c0, c1) over every pixel in one parallel sweep. Counters
+/// Runs chunks [c0, c1) over every pixel in one parallel sweep, each pixel's
+/// sums in registers: loaded from and stored to `acc`, or (acc null: the
+/// whole frame in one sweep) resolved straight into `out`. Counters
 /// (counting mode): per pixel, its key, the light terms as loop trips, the
 /// shadow rays with their traversal counts, and bytes.
 template <ShadingModel M, Primitive P, bool Count>
-LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const LightingPlan& plan, Accumulation& acc,
-                       std::uint64_t c0, std::uint64_t c1, Progress* progress) {
+LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const LightingPlan& plan, Accumulation* acc,
+                       LightingImage* out, std::uint64_t c0, std::uint64_t c1, Progress* progress) {
     const GBuffer& gb = in.gbuffer;
     const float eps = static_cast<float>(in.render.shadow_epsilon);
     const EstimatorKind kind = in.render.estimator;
@@ -198,12 +244,18 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
                         t.addRays(raySum, static_cast<std::uint32_t>(c.shadowRays - before.shadowRays));
                     }
                 };
-                if (!g.hit()) {
+                PixelSums sums{.policy = in.render.nonfinite, .c = c};
+                if (acc) sums.load(*acc, px);
+                const auto finish = [&] {
                     record();
+                    if (acc) sums.store(*acc, px);
+                    else c.nonFinite += resolvePixel(sums.sum, sums.sumSq, sums.n, sums.rejected, plan.exact, *out, px);
+                };
+                if (!g.hit()) {
+                    finish();
                     continue;
                 }
                 const ShadingPoint sp = shadingPoint(g, in.particles);
-                PixelSums sums{acc.sum[px], acc.sumSq[px], acc.n[px], acc.rejected[px], in.render.nonfinite, c};
                 if (kind == EstimatorKind::exact) {
                     const DVec3 v = exactPixel<M, P>(in.bvh, L, sp, eps, shadows, c, rc);
                     if (finite(v)) sums.sum = v;
@@ -212,10 +264,10 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
                         ++c.nonFinite;
                     }
                     sums.n = 1;
-                    record();
+                    finish();
                     continue;
                 }
-                for (std::uint64_t chunk = c0; chunk < c1 && !acc.done[px]; ++chunk) {
+                for (std::uint64_t chunk = c0; chunk < c1 && !sums.done; ++chunk) {
                     Rng rng(px, in.frame, RngPass::lightSampling, in.render.seed, chunk + 1);
                     const std::uint32_t count = plan.chunkSamples(chunk);
                     if (kind == EstimatorKind::ris && in.render.source == LightSource::power)
@@ -232,10 +284,10 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
                         sampleChunk<M, P>(in.bvh, L, [&](Rng& g) { return sampleSource<false>(L, nullptr, g); }, sp,
                                           count, eps, shadows, rng, sums, rc);
                     if (plan.adaptive && (chunk + 1) % plan.chunksPerRound == 0)
-                        acc.done[px] = roundDone(sums.sum, sums.sumSq, sums.n,
-                                                 static_cast<std::uint32_t>((chunk + 1) / plan.chunksPerRound), in.render);
+                        sums.done = roundDone(sums.sum, sums.sumSq, sums.n,
+                                              static_cast<std::uint32_t>((chunk + 1) / plan.chunksPerRound), in.render);
                 }
-                record();
+                finish();
             }
         }
         if (progress) progress->advance(std::uint64_t(r.rows().size()) * r.cols().size() * (plan.exact ? 1 : c1 - c0));
@@ -252,14 +304,14 @@ LightingCounters run(const LightingInputs& in, const LightArrays& L, const Light
                      const ChunkHook& afterChunk, Progress* progress) {
     LightingCounters total;
     if (Count) {
-        total += sweep<M, P, Count>(in, L, plan, acc, acc.nextChunk, plan.end, progress);
+        total += sweep<M, P, Count>(in, L, plan, &acc, nullptr, acc.nextChunk, plan.end, progress);
         acc.nextChunk = plan.end;
         if (afterChunk) afterChunk(acc);
         return total;
     }
     while (acc.nextChunk < plan.end) {
         const std::uint64_t c = acc.nextChunk;
-        total += sweep<M, P, Count>(in, L, plan, acc, c, c + 1, progress);
+        total += sweep<M, P, Count>(in, L, plan, &acc, nullptr, c, c + 1, progress);
         acc.nextChunk = c + 1;
         // Adaptive: stop when every pixel is done at the end of a round.
         if (plan.adaptive && acc.nextChunk % plan.chunksPerRound == 0) {
@@ -313,47 +365,60 @@ LightingCounters accumulateLighting(const LightingInputs& in, const LightingPlan
     return {};
 }
 
+void allocate(LightingImage& out, std::size_t pixels) {
+    out.Lr.resize(pixels);
+    out.Lr_stderr.resize(pixels);
+    out.spp.resize(pixels);
+    out.rejected.resize(pixels);
+}
+
 void resolveLighting(const Accumulation& acc, bool exact, LightingImage& out, std::uint64_t* nonFinite) {
-    const std::size_t pixels = acc.pixels();
-    out.Lr.assign(pixels, Vec3(0.0f));
-    out.Lr_stderr.assign(pixels, Vec3(0.0f));
-    out.spp.assign(pixels, 0.0f);
-    out.rejected.assign(pixels, 0.0f);
-    std::uint64_t zeroed = 0;
-    for (std::size_t px = 0; px < pixels; ++px) {
-        const std::uint32_t n = acc.n[px];
-        Vec3 mean(0.0f), err(0.0f);
-        if (exact) mean = Vec3(acc.sum[px]);
-        else if (n > 0) {
-            const DVec3 m = acc.sum[px] / double(n);
-            mean = Vec3(m);
-            if (n > 1) {
-                const DVec3 var = glm::max((acc.sumSq[px] - double(n) * m * m) / double(n - 1), DVec3(0.0));
-                err = Vec3(glm::sqrt(var / double(n)));
-            }
-            out.spp[px] = float(n);
-        }
-        std::uint32_t rejected = acc.rejected[px];
-        // Float overflow of a finite double: no Inf reaches an output.
-        if (!finite(DVec3(mean)) || !finite(DVec3(err))) {
-            mean = err = Vec3(0.0f);
-            ++rejected;
-            ++zeroed;
-        }
-        out.Lr[px] = mean;
-        out.Lr_stderr[px] = err;
-        out.rejected[px] = float(rejected);
-    }
-    if (nonFinite) *nonFinite += zeroed;
+    allocate(out, acc.pixels());
+    tbb::enumerable_thread_specific<std::uint64_t> zeroed(0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, acc.pixels(), 4096), [&](const auto& r) {
+        std::uint64_t& z = zeroed.local();
+        for (std::size_t px = r.begin(); px != r.end(); ++px)
+            z += resolvePixel(acc.sum[px], acc.sumSq[px], acc.n[px], acc.rejected[px], exact, out, px);
+    });
+    if (nonFinite)
+        for (const std::uint64_t z : zeroed) *nonFinite += z;
+}
+
+/// The whole frame in one sweep, each pixel resolved as it finishes (no
+/// Accumulation in memory): the same sums, in the same order, as chunk sweeps.
+template <ShadingModel M>
+LightingCounters directPrimitive(const LightingInputs& in, const LightArrays& L, const LightingPlan& plan,
+                                 LightingImage& out, Progress* p) {
+    const bool spheres = in.bvh.settings().primitive == Primitive::sphere;
+    const std::uint64_t c0 = plan.begin, c1 = plan.end;
+    if (in.counters)
+        return spheres ? sweep<M, Primitive::sphere, true>(in, L, plan, nullptr, &out, c0, c1, p)
+                       : sweep<M, Primitive::billboard, true>(in, L, plan, nullptr, &out, c0, c1, p);
+    return spheres ? sweep<M, Primitive::sphere, false>(in, L, plan, nullptr, &out, c0, c1, p)
+                   : sweep<M, Primitive::billboard, false>(in, L, plan, nullptr, &out, c0, c1, p);
 }
 
 LightingCounters estimateLighting(const LightingInputs& in, LightingImage& out, Progress* progress) {
+    const std::size_t pixels = std::size_t(in.gbuffer.width) * in.gbuffer.height;
+    if (in.particles.empty()) {
+        out.Lr.assign(pixels, Vec3(0.0f));
+        out.Lr_stderr.assign(pixels, Vec3(0.0f));
+        out.spp.assign(pixels, 0.0f);
+        out.rejected.assign(pixels, 0.0f);
+        return {};
+    }
+    ACC_CHECK(!needsPowerTable(in.render) || in.powerTable);
+    ACC_CHECK(in.render.estimator != EstimatorKind::tree || in.lightTree);
+    ACC_CHECK(in.render.estimator != EstimatorKind::restir);
+    allocate(out, pixels);
     const LightingPlan plan = planLighting(in.render, in.gbuffer.height);
-    Accumulation acc;
-    acc.reset(in.gbuffer.width, in.gbuffer.height, plan.begin);
-    LightingCounters c = accumulateLighting(in, plan, acc, {}, progress);
-    resolveLighting(acc, plan.exact, out, &c.nonFinite);
-    return c;
+    const LightArrays L(in.particles, in.shading);
+    switch (in.shading.model) {
+    case ShadingModel::lambert: return directPrimitive<ShadingModel::lambert>(in, L, plan, out, progress);
+    case ShadingModel::sphere: return directPrimitive<ShadingModel::sphere>(in, L, plan, out, progress);
+    case ShadingModel::isotropic: return directPrimitive<ShadingModel::isotropic>(in, L, plan, out, progress);
+    }
+    return {};
 }
 
 }  // namespace accretion

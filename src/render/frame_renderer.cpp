@@ -120,18 +120,22 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const L
             stats.reservoirBytes = restir_->reservoirBytes();
             if (img.lighting.rejected.empty()) img.lighting.rejected.assign(pixels, 0.0f);
         } else if (lit) {
-            const LightingPlan lp = planLighting(settings_.render, camera.height, session ? session->shard : Shard{});
-            Accumulation local;
-            Accumulation& acc = session && session->result ? *session->result : local;
-            if (session && session->resume) acc = *session->resume;
-            else acc.reset(camera.width, camera.height, lp.begin);
-            Progress progress(fmt::format("frame {} {}", frame, pass::estimateLighting),
-                              std::uint64_t(pixels) * (lp.exact ? 1 : lp.chunks()), options_.quiet);
             LightingInputs in{*bvh_, particles, gbuffer, settings_.shading, settings_.render, frame,
                               power ? &powerTable : nullptr, tree ? &lightTree : nullptr,
                               counting ? &img.counters.add(pass::estimateLighting, camera.width, camera.height) : nullptr};
-            stats.lighting = accumulateLighting(in, lp, acc, session ? session->afterChunk : ChunkHook{}, &progress);
-            resolveLighting(acc, lp.exact, img.lighting, &stats.lighting.nonFinite);
+            const LightingPlan lp = planLighting(settings_.render, camera.height, session ? session->shard : Shard{});
+            Progress progress(fmt::format("frame {} {}", frame, pass::estimateLighting),
+                              std::uint64_t(pixels) * (lp.exact ? 1 : lp.chunks()), options_.quiet);
+            if (!session) {
+                stats.lighting = estimateLighting(in, img.lighting, &progress);
+            } else {  // in chunks, from a checkpoint, into the session's sums
+                Accumulation local;
+                Accumulation& acc = session->result ? *session->result : local;
+                if (session->resume) acc = *session->resume;
+                else acc.reset(camera.width, camera.height, lp.begin);
+                stats.lighting = accumulateLighting(in, lp, acc, session->afterChunk, &progress);
+                resolveLighting(acc, lp.exact, img.lighting, &stats.lighting.nonFinite);
+            }
             if (stats.lighting.nonFinite) stats.nonFinite[std::string(pass::estimateLighting)] = stats.lighting.nonFinite;
         } else {
             img.lighting.Lr.assign(pixels, Vec3(0.0f));
