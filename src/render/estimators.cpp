@@ -43,7 +43,9 @@ DVec3 exactPixel(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoin
     return sum;
 }
 
-bool finite(const DVec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+/// One test for three components: a NaN or Inf component makes the sum
+/// non-finite, and float-derived doubles cannot overflow a double sum.
+inline bool finite(const DVec3& v) { return std::isfinite(v.x + v.y + v.z); }
 
 /// One pixel's running sums while its chunks run (loaded from and stored to
 /// the Accumulation, or resolved directly), with the non-finite policy
@@ -244,6 +246,14 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
                         t.addRays(raySum, static_cast<std::uint32_t>(c.shadowRays - before.shadowRays));
                     }
                 };
+                if (!g.hit()) {  // nothing to add: sums stay 0
+                    record();
+                    if (!acc) {
+                        out->Lr[px] = out->Lr_stderr[px] = Vec3(0.0f);
+                        out->spp[px] = out->rejected[px] = 0.0f;
+                    }
+                    continue;
+                }
                 PixelSums sums{.policy = in.render.nonfinite, .c = c};
                 if (acc) sums.load(*acc, px);
                 const auto finish = [&] {
@@ -251,10 +261,6 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
                     if (acc) sums.store(*acc, px);
                     else c.nonFinite += resolvePixel(sums.sum, sums.sumSq, sums.n, sums.rejected, plan.exact, *out, px);
                 };
-                if (!g.hit()) {
-                    finish();
-                    continue;
-                }
                 const ShadingPoint sp = shadingPoint(g, in.particles);
                 if (kind == EstimatorKind::exact) {
                     const DVec3 v = exactPixel<M, P>(in.bvh, L, sp, eps, shadows, c, rc);
