@@ -172,7 +172,9 @@ TEST_CASE("kill -9 at random moments never leaves a broken file, and resuming st
 
     const char* env = std::getenv("ACCRETION_KILL_TRIALS");
     const int maxTrials = env ? std::atoi(env) : 25;
-    std::mt19937 rng(2026);
+    // Longer campaigns: ACCRETION_KILL_TRIALS=N ACCRETION_KILL_SEED=S.
+    const char* seedEnv = std::getenv("ACCRETION_KILL_SEED");
+    std::mt19937 rng(seedEnv ? unsigned(std::atoi(seedEnv)) : 2026u);
     std::uniform_int_distribution<int> delayMs(20, 700);
     int trials = 0, killed = 0;
     std::size_t checked = 0;
