@@ -67,23 +67,9 @@ std::string where(const toml::node& n) {
 
 /// "0:4" -> 0,1,2,3; "7" -> 7.
 std::vector<std::uint64_t> parseRange(const std::string& text, const char* option) {
-    const auto colon = text.find(':');
-    auto number = [&](const std::string& s) {
-        std::size_t used = 0;
-        unsigned long long v = 0;
-        try {
-            v = std::stoull(s, &used);
-        } catch (...) {
-            used = 0;
-        }
-        if (s.empty() || used != s.size() || s[0] == '-')
-            throw InputError(fmt::format("command line {} {}: expected N or A:B (half-open)", option, text));
-        return std::uint64_t(v);
-    };
-    const std::uint64_t a = number(text.substr(0, colon));
-    const std::uint64_t b = colon == std::string::npos ? a + 1 : number(text.substr(colon + 1));
-    if (b <= a || b - a > 100000)
-        throw InputError(fmt::format("command line {} {}: expected A < B, at most 100000 values", option, text));
+    const auto [a, b] = parseHalfOpen(text, option);
+    if (b - a > 100000)
+        throw InputError(fmt::format("command line {} {}: at most 100000 values (one job each)", option, text));
     std::vector<std::uint64_t> v;
     for (std::uint64_t x = a; x < b; ++x) v.push_back(x);
     return v;

@@ -25,10 +25,9 @@
 
 namespace accretion::cmd {
 
-void appendFrameOverrides(const std::string& frames, std::vector<std::string>& overrides) {
-    if (frames.empty()) return;
-    const auto colon = frames.find(':');
-    auto number = [&](const std::string& s) -> unsigned long long {
+std::pair<std::uint64_t, std::uint64_t> parseHalfOpen(const std::string& text, const char* option) {
+    const auto colon = text.find(':');
+    auto number = [&](const std::string& s) -> std::uint64_t {
         std::size_t used = 0;
         unsigned long long v = 0;
         try {
@@ -37,12 +36,19 @@ void appendFrameOverrides(const std::string& frames, std::vector<std::string>& o
             used = 0;
         }
         if (s.empty() || used != s.size() || s[0] == '-')
-            throw InputError(fmt::format("command line --frames {}: expected A:B with 0 <= A < B", frames));
+            throw InputError(fmt::format("command line {} {}: expected A:B with 0 <= A < B", option, text));
         return v;
     };
-    const unsigned long long a = number(frames.substr(0, colon));
-    const unsigned long long b = colon == std::string::npos ? a + 1 : number(frames.substr(colon + 1));
-    if (b <= a) throw InputError(fmt::format("command line --frames {}: end must be greater than start (half-open A:B)", frames));
+    const std::uint64_t a = number(text.substr(0, colon));
+    const std::uint64_t b = colon == std::string::npos ? a + 1 : number(text.substr(colon + 1));
+    if (b <= a)
+        throw InputError(fmt::format("command line {} {}: end must be greater than start (half-open A:B)", option, text));
+    return {a, b};
+}
+
+void appendFrameOverrides(const std::string& frames, std::vector<std::string>& overrides) {
+    if (frames.empty()) return;
+    const auto [a, b] = parseHalfOpen(frames, "--frames");
     overrides.push_back(fmt::format("render.frame_start={}", a));
     overrides.push_back(fmt::format("render.frames={}", b - a));
 }

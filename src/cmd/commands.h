@@ -1,5 +1,7 @@
 #pragma once
+#include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -17,6 +19,10 @@ struct SceneArgs {
 
 /// Thrown by batch when some job did not succeed (exit code 4).
 struct BatchFailed {};
+
+/// Parse `A:B` (half-open, 0 <= A < B) or `A` (= A:A+1) of a command-line
+/// option; InputError names the option.
+std::pair<std::uint64_t, std::uint64_t> parseHalfOpen(const std::string& text, const char* option);
 
 /// Turn `--frames A:B` into overrides of render.frame_start / render.frames.
 void appendFrameOverrides(const std::string& frames, std::vector<std::string>& overrides);

@@ -177,10 +177,14 @@ struct FrameContext {
     /// zero_sample keeps its M with W = 0, discard empties it.
     StoredReservoir sanitize(StoredReservoir r, std::size_t px, LightingCounters& c) const {
         if (std::isfinite(r.W) && std::isfinite(r.p_hat)) return r;
+        if (reject(px, c)) return StoredReservoir{};
+        return StoredReservoir{kNoLight, 0.0f, r.M, 0.0f};
+    }
+    /// Count a non-finite value at px; true if the policy discards the reservoir.
+    bool reject(std::size_t px, LightingCounters& c) const {
         ++c.nonFinite;
         ++rejected[px];
-        if (in.settings.render.nonfinite == NonFinitePolicy::discard) return StoredReservoir{};
-        return StoredReservoir{kNoLight, 0.0f, r.M, 0.0f};
+        return in.settings.render.nonfinite == NonFinitePolicy::discard;
     }
 };
 
@@ -229,18 +233,14 @@ LightingCounters generateCandidates(const FrameContext& f, std::vector<StoredRes
             float w = p_hat / x.pdf;
             ++c.lightTerms;
             if (!std::isfinite(w) || !std::isfinite(p_hat)) {  // render.nonfinite: a zero candidate, or no reservoir
-                ++c.nonFinite;
-                ++f.rejected[px];
-                discard = discard || f.in.settings.render.nonfinite == NonFinitePolicy::discard;
+                discard = f.reject(px, c) || discard;
                 w = p_hat = 0.0f;
             }
             r.update(x.i, w, p_hat, rng.uniform());
         }
         r.finalize();
         if (!std::isfinite(r.w_sum) || !std::isfinite(r.W)) {  // finite weights whose sum overflowed
-            ++c.nonFinite;
-            ++f.rejected[px];
-            discard = discard || f.in.settings.render.nonfinite == NonFinitePolicy::discard;
+            discard = f.reject(px, c) || discard;
             r.W = 0.0f;
         }
         if (discard) return;  // out[px] stays empty
@@ -420,9 +420,7 @@ LightingCounters traceShadowRays(const FrameContext& f, std::vector<StoredReserv
         const Vec3 value = t.value * r.W;
         if (std::isfinite(value.x) && std::isfinite(value.y) && std::isfinite(value.z)) Lr[px] = value;
         else {  // overflow in f I G W: a zero sample (discard: and no reservoir for reuse)
-            ++c.nonFinite;
-            ++f.rejected[px];
-            if (f.in.settings.render.nonfinite == NonFinitePolicy::discard) r = f.codec.roundTrip(StoredReservoir{});
+            if (f.reject(px, c)) r = f.codec.roundTrip(StoredReservoir{});
         }
     });
 }

@@ -58,11 +58,15 @@ struct PixelSums {
     NonFinitePolicy policy;
     LightingCounters& c;
 
+    /// Count a non-finite value; true if the policy discards it (else it counts as 0).
+    bool reject() {
+        ++rejected;
+        ++c.nonFinite;
+        return policy == NonFinitePolicy::discard;
+    }
     void add(const DVec3& x) {
         if (!finite(x)) {
-            ++rejected;
-            ++c.nonFinite;
-            if (policy == NonFinitePolicy::zero_sample) ++n;
+            if (!reject()) ++n;
             return;
         }
         sum += x;
@@ -86,6 +90,13 @@ struct PixelSums {
     }
 };
 
+/// Mean and standard error of the mean of n samples with these sums (n > 0).
+void meanAndError(const DVec3& sum, const DVec3& sumSq, std::uint32_t n, DVec3& mean, DVec3& err) {
+    mean = sum / double(n);
+    const DVec3 var = n > 1 ? glm::max((sumSq - double(n) * mean * mean) / double(n - 1), DVec3(0.0)) : DVec3(0.0);
+    err = glm::sqrt(var / double(n));
+}
+
 /// Mean, standard error, spp and rejected count of one pixel's sums; a value
 /// that does not fit a float is zeroed and counted. Returns 1 if zeroed.
 std::uint32_t resolvePixel(const DVec3& sum, const DVec3& sumSq, std::uint32_t n, std::uint32_t rejected, bool exact,
@@ -94,12 +105,10 @@ std::uint32_t resolvePixel(const DVec3& sum, const DVec3& sumSq, std::uint32_t n
     float spp = 0.0f;
     if (exact) mean = Vec3(sum);
     else if (n > 0) {
-        const DVec3 m = sum / double(n);
+        DVec3 m, e;
+        meanAndError(sum, sumSq, n, m, e);
         mean = Vec3(m);
-        if (n > 1) {
-            const DVec3 var = glm::max((sumSq - double(n) * m * m) / double(n - 1), DVec3(0.0));
-            err = Vec3(glm::sqrt(var / double(n)));
-        }
+        err = Vec3(e);
         spp = float(n);
     }
     std::uint32_t zeroed = 0;
@@ -172,9 +181,7 @@ void risChunk(const ParticleBvh& bvh, const LightArrays& L, const AliasTable* ta
             if (L.term<M>(sp, x.i, t)) p_hat = luminance(t.value);
             float w = p_hat / x.pdf;
             if (!std::isfinite(w) || !std::isfinite(p_hat)) {
-                ++acc.rejected;
-                ++c.nonFinite;
-                discarded = discarded || acc.policy == NonFinitePolicy::discard;
+                discarded = acc.reject() || discarded;
                 w = p_hat = 0.0f;
             }
             if (r.update(x.i, w, p_hat, rng.uniform())) t_y = t;
@@ -203,9 +210,8 @@ void risChunk(const ParticleBvh& bvh, const LightArrays& L, const AliasTable* ta
 bool roundDone(const DVec3& s1, const DVec3& s2, std::uint32_t n, std::uint32_t roundsTaken, const RenderSettings& rs) {
     if (std::uint64_t(roundsTaken + 1) * rs.samples > rs.max_samples) return true;
     if (n < 2) return false;
-    const DVec3 m = s1 / double(n);
-    const DVec3 var = glm::max((s2 - double(n) * m * m) / double(n - 1), DVec3(0.0));
-    const DVec3 err = glm::sqrt(var / double(n));
+    DVec3 m, err;
+    meanAndError(s1, s2, n, m, err);
     return luminance(Vec3(err)) <= rs.target_stderr * luminance(Vec3(m));
 }
 
@@ -265,10 +271,7 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
                 if (kind == EstimatorKind::exact) {
                     const DVec3 v = exactPixel<M, P>(in.bvh, L, sp, eps, shadows, c, rc);
                     if (finite(v)) sums.sum = v;
-                    else {
-                        ++sums.rejected;
-                        ++c.nonFinite;
-                    }
+                    else sums.reject();  // exact has one value: 0 either way
                     sums.n = 1;
                     finish();
                     continue;
