@@ -17,44 +17,60 @@ double secondsSince(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-/// Every query's context: the counters of the ray (null unless counting).
+/// Every query's context: the counters of the ray (null unless counting)
+/// and, for occlusion queries, the particles excluded by identity.
 struct QueryContext {
     RTCIntersectContext base;
     RayCounters* counters;
+    Exclusion exclude;
 };
 
-QueryContext queryContext(RayCounters* counters) {
+QueryContext queryContext(RayCounters* counters, Exclusion exclude = {}) {
     QueryContext c;
     rtcInitIntersectContext(&c.base);
     c.counters = counters;
+    c.exclude = exclude;
     return c;
 }
 
-/// Any-hit of the disc alpha test: reject candidate hits outside the
-/// inscribed circle. With an opacity micromap, opaque and transparent
-/// micro-triangles are decided without the any-hit (nor its count).
+/// The disc alpha test of candidate hit i (an any-hit): false rejects it.
+/// With an opacity micromap, opaque and transparent micro-triangles are
+/// decided without the any-hit (nor its count).
+inline bool passesAlpha(const AlphaTest& alpha, const RTCFilterFunctionNArguments* args, unsigned i, RayCounters* counters) {
+    // Embree's quad parametrisation is the billboard's uv.
+    const Vec2 uv(RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i));
+    if (alpha.omm) {
+        Vec2 bary;
+        const unsigned tri = quadTriangle(uv, bary);
+        const OmmState s = alpha.omm->lookup(tri, bary.x, bary.y);
+        if (s == OmmState::opaque) return true;
+        if (s == OmmState::transparent) return false;
+    }
+    if (counters) {
+        ++counters->anyHits;
+        ++counters->candidates;
+    }
+    return insideDisc(uv);
+}
+
+/// Closest-hit queries on disc-alpha billboards: the alpha test.
 void discAlphaFilter(const RTCFilterFunctionNArguments* args) {
-    const auto* alpha = static_cast<const AlphaTest*>(args->geometryUserPtr);
+    const auto* g = static_cast<const ClusterGeometry*>(args->geometryUserPtr);
     RayCounters* counters = reinterpret_cast<const QueryContext*>(args->context)->counters;
+    for (unsigned i = 0; i < args->N; ++i)
+        if (args->valid[i] == -1 && !passesAlpha(*g->alpha, args, i, counters)) args->valid[i] = 0;
+}
+
+/// Occlusion queries: the receiver and the light are excluded by identity
+/// (MODEL.md section 3), then the alpha test of the other candidates.
+void occlusionFilter(const RTCFilterFunctionNArguments* args) {
+    const auto* g = static_cast<const ClusterGeometry*>(args->geometryUserPtr);
+    const auto* context = reinterpret_cast<const QueryContext*>(args->context);
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] != -1) continue;
-        // Embree's quad parametrisation is the billboard's uv.
-        const Vec2 uv(RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i));
-        if (alpha->omm) {
-            Vec2 bary;
-            const unsigned tri = quadTriangle(uv, bary);
-            const OmmState s = alpha->omm->lookup(tri, bary.x, bary.y);
-            if (s == OmmState::opaque) continue;
-            if (s == OmmState::transparent) {
-                args->valid[i] = 0;
-                continue;
-            }
-        }
-        if (counters) {
-            ++counters->anyHits;
-            ++counters->candidates;
-        }
-        if (!insideDisc(uv)) args->valid[i] = 0;
+        const std::uint32_t particle = g->members[RTCHitN_primID(args->hit, args->N, i)];
+        if (particle == context->exclude.receiver || particle == context->exclude.light) args->valid[i] = 0;
+        else if (g->alpha && !passesAlpha(*g->alpha, args, i, context->counters)) args->valid[i] = 0;
     }
 }
 
@@ -153,7 +169,10 @@ void ParticleBvh::buildBlas(std::size_t c, const Particles& particles, bool crea
     if (create) {
         RTCScene scene = rtcNewScene(device_.get());
         rtcSetSceneBuildQuality(scene, sceneQuality(settings_.build));
-        if (settings_.build == BuildPolicy::refit) rtcSetSceneFlags(scene, RTC_SCENE_FLAG_DYNAMIC);
+        // watertight: Embree's robust mode, so that no ray slips between a
+        // quad's two triangles along its diagonal (~30% slower shadow rays).
+        rtcSetSceneFlags(scene, (settings_.watertight ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE) |
+                                    (settings_.build == BuildPolicy::refit ? RTC_SCENE_FLAG_DYNAMIC : RTC_SCENE_FLAG_NONE));
         // Billboards are Embree quads (one primitive, builds ~1.5x faster than
         // two triangles); the GPU's two triangles are recovered from uv.
         geom = rtcNewGeometry(device_.get(), billboards ? RTC_GEOMETRY_TYPE_QUAD : RTC_GEOMETRY_TYPE_SPHERE_POINT);
@@ -163,14 +182,14 @@ void ParticleBvh::buildBlas(std::size_t c, const Particles& particles, bool crea
             auto* idx = static_cast<std::uint32_t*>(
                 rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT4, sizeof(std::uint32_t) * 4, n));
             for (std::uint32_t k = 0; k < 4 * n; ++k) idx[k] = k;
-            if (settings_.alpha == AlphaMode::disc) {
-                rtcSetGeometryUserData(geom, &alpha_);
-                rtcSetGeometryIntersectFilterFunction(geom, &discAlphaFilter);
-                rtcSetGeometryOccludedFilterFunction(geom, &discAlphaFilter);
-            }
+            if (settings_.alpha == AlphaMode::disc) rtcSetGeometryIntersectFilterFunction(geom, &discAlphaFilter);
         } else {
             rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, sizeof(float) * 4, n);
         }
+        // Every occlusion query excludes its receiver and light by identity.
+        clusterGeometry_[c] = {members.data(), billboards && settings_.alpha == AlphaMode::disc ? &alpha_ : nullptr};
+        rtcSetGeometryUserData(geom, &clusterGeometry_[c]);
+        rtcSetGeometryOccludedFilterFunction(geom, &occlusionFilter);
         rtcAttachGeometryByID(scene, geom, 0);
         rtcReleaseGeometry(geom);  // the scene keeps it
         blas_[c] = scene;
@@ -204,6 +223,7 @@ void ParticleBvh::buildTlas() {
     if (tlas_) rtcReleaseScene(tlas_);
     tlas_ = rtcNewScene(device_.get());
     rtcSetSceneBuildQuality(tlas_, sceneQuality(settings_.build));
+    if (settings_.watertight) rtcSetSceneFlags(tlas_, RTC_SCENE_FLAG_ROBUST);  // conservative box tests
     const float identity[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
     for (std::size_t c = 0; c < blas_.size(); ++c) {
         RTCGeometry inst = rtcNewGeometry(device_.get(), RTC_GEOMETRY_TYPE_INSTANCE);
@@ -263,6 +283,7 @@ void ParticleBvh::build(const Particles& particles, const Camera& camera) {
         releaseBlas();
         blas_.assign(clusters_.count(), nullptr);
         geometry_.assign(clusters_.count(), nullptr);
+        clusterGeometry_.assign(clusters_.count(), ClusterGeometry{});
     }
     // partial: a window of rebuild_fraction of the clusters, advancing round
     // robin frame by frame; the others keep last frame's (stale) geometry.
@@ -361,8 +382,9 @@ void ParticleBvh::intersect8(const Vec3& o, const Vec3* d, int n, SurfaceHit* hi
     }
 }
 
-bool ParticleBvh::occluded(const Vec3& o, const Vec3& d, float tfar, RayCounters* counters) const {
-    QueryContext context = queryContext(counters);
+bool ParticleBvh::occluded(const Vec3& o, const Vec3& d, float tnear, float tfar, Exclusion exclude,
+                           RayCounters* counters) const {
+    QueryContext context = queryContext(counters, exclude);
     RTCRay ray;
     ray.org_x = o.x;
     ray.org_y = o.y;
@@ -370,7 +392,7 @@ bool ParticleBvh::occluded(const Vec3& o, const Vec3& d, float tfar, RayCounters
     ray.dir_x = d.x;
     ray.dir_y = d.y;
     ray.dir_z = d.z;
-    ray.tnear = 0.0f;
+    ray.tnear = tnear;
     ray.tfar = tfar;
     ray.time = 0.0f;
     ray.mask = ~0u;

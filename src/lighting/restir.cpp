@@ -42,10 +42,6 @@ struct Offer {
     Domain domain;
 };
 
-ShadingPoint shadingPoint(const GBufferTexel& g, const Particles& particles) {
-    return {g.position, g.normal, g.geomNormal, particles.albedo[g.particle], g.particle};
-}
-
 /// Neighbour rejection shared by the temporal and spatial passes.
 bool similar(const GBufferTexel& a, const GBufferTexel& b, const RestirSettings& rs) {
     if (!b.hit()) return false;
@@ -61,7 +57,7 @@ bool similar(const GBufferTexel& a, const GBufferTexel& b, const RestirSettings&
 /// (weights sum to 1 for every y; equal p_hat gives M_i / M_total).
 template <ShadingModel SM, Primitive P, bool Count>
 StoredReservoir combine(const Offer* offers, std::uint32_t n, const LightArrays& L, const RestirSettings& rs,
-                        float eps, bool shadows, Rng& rng, LightingCounters& c, Recorder<Count>& rec) {
+                        const VisibilityOptions& vis, bool shadows, Rng& rng, LightingCounters& c, Recorder<Count>& rec) {
     const Offer& can = offers[0];
     const ShadingPoint& sp = can.domain.sp;
     if (n == 1) return can.r;
@@ -130,7 +126,8 @@ StoredReservoir combine(const Offer* offers, std::uint32_t n, const LightArrays&
             if (rs.basic_visibility && d.visibilityTested && shadows) {
                 ++c.shadowRays;
                 RayCounters rc;
-                const bool seen = visible<P>(*d.bvh, d.sp, t, d.lights->packed[out.y].radius, eps, rec.rayCounters(rc));
+                const PackedLight& l = d.lights->packed[out.y];
+                const bool seen = visible<P>(*d.bvh, vis, d.sp, out.y, l.position, l.radius, t, rec.rayCounters(rc));
                 rec.ray(rc);
                 if (!seen) {
                     ++c.shadowOccluded;
@@ -168,7 +165,7 @@ struct FrameContext {
     const LightArrays& L;
     const Restir::History* prev;
     float scale;                ///< lighting / image resolution
-    float eps;
+    VisibilityOptions vis;      ///< render.visibility_rule
     bool shadows;               ///< shading.visibility: trace shadow rays (off: V = 1)
     FrameCounters* counters;    ///< counting mode: per-pass thread records
     std::uint32_t* rejected;    ///< per lighting texel: non-finite values rejected (render.nonfinite)
@@ -250,7 +247,7 @@ LightingCounters generateCandidates(const FrameContext& f, std::vector<StoredRes
             if (f.L.term<SM>(sp, r.y, t)) {
                 ++c.shadowRays;
                 RayCounters rc;
-                const bool seen = visible<P>(f.in.bvh, sp, t, f.L.packed[r.y].radius, f.eps, rec.rayCounters(rc));
+                const bool seen = visible<P>(f.in.bvh, f.vis, sp, r.y, f.L.packed[r.y].position, f.L.packed[r.y].radius, t, rec.rayCounters(rc));
                 rec.ray(rc);
                 if (!seen) {
                     ++c.shadowOccluded;
@@ -292,7 +289,7 @@ LightingCounters temporalResampling(const FrameContext& f, const std::vector<Sto
             ++c.reuseRejected;
             return;
         }
-        const Vec3 xPrev = g.position - (particles.position[j] - h.particles.position[j]);
+        const Vec3 xPrev = h.particles.position[j] + g.local;  // frame-independent: relative to the particle
         float fx, fy, depth;
         bool ok = h.camera.project(xPrev, fx, fy, depth);
         const float lx = fx * f.scale, ly = fy * f.scale;
@@ -323,7 +320,7 @@ LightingCounters temporalResampling(const FrameContext& f, const std::vector<Sto
                             f.rs.candidate_visibility || f.rs.visibility_reuse,
                             f.in.previousBvh ? f.in.previousBvh : &f.in.bvh}};
         Rng rng(px, f.in.frame, RngPass::restirTemporal, f.in.settings.render.seed);
-        out[px] = f.codec.roundTrip(f.sanitize(combine<SM, P, Count>(offers, 2, f.L, f.rs, f.eps, f.shadows, rng, c, rec), px, c));
+        out[px] = f.codec.roundTrip(f.sanitize(combine<SM, P, Count>(offers, 2, f.L, f.rs, f.vis, f.shadows, rng, c, rec), px, c));
     });
 }
 
@@ -375,7 +372,7 @@ LightingCounters spatialResampling(const FrameContext& f, std::uint32_t iteratio
             rec.read(R + gpu_layout::kParticleRecord);
             offers[n++] = {cur[q], {shadingPoint(gn, f.in.particles), &f.L, tested, &f.in.bvh}};
         }
-        out[px] = f.codec.roundTrip(f.sanitize(combine<SM, P, Count>(offers, n, f.L, f.rs, f.eps, f.shadows, rng, c, rec), px, c));
+        out[px] = f.codec.roundTrip(f.sanitize(combine<SM, P, Count>(offers, n, f.L, f.rs, f.vis, f.shadows, rng, c, rec), px, c));
     });
 }
 
@@ -406,7 +403,7 @@ LightingCounters traceShadowRays(const FrameContext& f, std::vector<StoredReserv
             ++c.shadowRays;
             rec.trip();
             RayCounters rc;
-            seen = visible<P>(f.in.bvh, sp, t, f.L.packed[r.y].radius, f.eps, rec.rayCounters(rc));
+            seen = visible<P>(f.in.bvh, f.vis, sp, r.y, f.L.packed[r.y].position, f.L.packed[r.y].radius, t, rec.rayCounters(rc));
             rec.ray(rc);
         }
         if (!seen) {
@@ -550,7 +547,7 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
                               ? history_.get() : nullptr;
     std::vector<std::uint32_t> lowRejected(lpixels, 0);
     FrameContext f{in, rs_, codec_, *lg, L, prev, lg == &full ? 1.0f : float(lg->width) / float(full.width),
-                   static_cast<float>(in.settings.render.shadow_epsilon), in.settings.shading.visibility, in.counters,
+                   VisibilityOptions::from(in.settings.render), in.settings.shading.visibility, in.counters,
                    lowRejected.data()};
 
     std::vector<StoredReservoir> a(lpixels), b(lpixels);

@@ -12,6 +12,10 @@ Camera Camera::lookAt(const Vec3& eye, const Vec3& target, const Vec3& upHint, d
     c.right = glm::normalize(glm::cross(c.forward, upHint));
     c.up = glm::cross(c.right, c.forward);
     c.tanHalfFov = float(std::tan(0.5 * fovDegrees * M_PI / 180.0));
+    c.forwardD = glm::normalize(DVec3(target) - DVec3(eye));
+    c.rightD = glm::normalize(glm::cross(c.forwardD, DVec3(upHint)));
+    c.upD = glm::cross(c.rightD, c.forwardD);
+    c.tanHalfFovD = std::tan(0.5 * fovDegrees * M_PI / 180.0);
     c.width = width;
     c.height = height;
     return c;

@@ -18,13 +18,9 @@
 namespace accretion {
 namespace {
 
-ShadingPoint shadingPoint(const GBufferTexel& g, const Particles& particles) {
-    return {g.position, g.normal, g.geomNormal, particles.albedo[g.particle], g.particle};
-}
-
 /// exact: sum over every light i != j of f I G V, in double.
 template <ShadingModel M, Primitive P>
-DVec3 exactPixel(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint& sp, float eps, bool shadows,
+DVec3 exactPixel(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint& sp, const VisibilityOptions& vis, bool shadows,
                 LightingCounters& c, RayCounters* rc) {
     DVec3 sum(0.0);
     for (std::uint32_t i = 0; i < L.count; ++i) {
@@ -37,7 +33,7 @@ DVec3 exactPixel(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoin
             continue;
         }
         ++c.shadowRays;
-        if (visible<P>(bvh, sp, t, L.packed[i].radius, eps, rc)) sum += DVec3(t.value);
+        if (visible<P>(bvh, vis, sp, i, L.packed[i].position, L.packed[i].radius, t, rc)) sum += DVec3(t.value);
         else ++c.shadowOccluded;
     }
     return sum;
@@ -127,7 +123,7 @@ std::uint32_t resolvePixel(const DVec3& sum, const DVec3& sumSq, std::uint32_t n
 /// zero sample when no light or i = j).
 template <ShadingModel M, Primitive P, class Sampler>
 void sampleChunk(const ParticleBvh& bvh, const LightArrays& L, Sampler&& sampleOne, const ShadingPoint& sp,
-                 std::uint32_t count, float eps, bool shadows, Rng& rng, PixelSums& acc, RayCounters* rc) {
+                 std::uint32_t count, const VisibilityOptions& vis, bool shadows, Rng& rng, PixelSums& acc, RayCounters* rc) {
     LightingCounters& c = acc.c;
     // Lights drawn 8 at a time and prefetched: their records are random
     // accesses (a cache miss each); the RNG is consumed in the same order.
@@ -148,7 +144,7 @@ void sampleChunk(const ParticleBvh& bvh, const LightArrays& L, Sampler&& sampleO
             }
             if (shadows) {
                 ++c.shadowRays;
-                if (!visible<P>(bvh, sp, t, L.packed[x.i].radius, eps, rc)) {
+                if (!visible<P>(bvh, vis, sp, x.i, L.packed[x.i].position, L.packed[x.i].radius, t, rc)) {
                     ++c.shadowOccluded;
                     acc.addZero();
                     continue;
@@ -166,7 +162,7 @@ void sampleChunk(const ParticleBvh& bvh, const LightArrays& L, Sampler&& sampleO
 /// weight 0; discard: the reservoir is dropped).
 template <ShadingModel M, Primitive P, bool Power>
 void risChunk(const ParticleBvh& bvh, const LightArrays& L, const AliasTable* table, const ShadingPoint& sp,
-              std::uint32_t count, std::uint32_t candidates, float eps, bool shadows, Rng& rng, PixelSums& acc,
+              std::uint32_t count, std::uint32_t candidates, const VisibilityOptions& vis, bool shadows, Rng& rng, PixelSums& acc,
               RayCounters* rc) {
     LightingCounters& c = acc.c;
     for (std::uint32_t k = 0; k < count; ++k) {
@@ -194,7 +190,7 @@ void risChunk(const ParticleBvh& bvh, const LightArrays& L, const AliasTable* ta
         }
         if (shadows) {
             ++c.shadowRays;
-            if (!visible<P>(bvh, sp, t_y, L.packed[r.y].radius, eps, rc)) {
+            if (!visible<P>(bvh, vis, sp, r.y, L.packed[r.y].position, L.packed[r.y].radius, t_y, rc)) {
                 ++c.shadowOccluded;
                 acc.addZero();
                 continue;
@@ -224,7 +220,7 @@ template <ShadingModel M, Primitive P, bool Count>
 LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const LightingPlan& plan, Accumulation* acc,
                        LightingImage* out, std::uint64_t c0, std::uint64_t c1, Progress* progress) {
     const GBuffer& gb = in.gbuffer;
-    const float eps = static_cast<float>(in.render.shadow_epsilon);
+    const VisibilityOptions vis = VisibilityOptions::from(in.render);
     const EstimatorKind kind = in.render.estimator;
     const bool shadows = in.shading.visibility;  // off: V = 1, no shadow rays
     tbb::enumerable_thread_specific<LightingCounters> counters;
@@ -269,7 +265,7 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
                 };
                 const ShadingPoint sp = shadingPoint(g, in.particles);
                 if (kind == EstimatorKind::exact) {
-                    const DVec3 v = exactPixel<M, P>(in.bvh, L, sp, eps, shadows, c, rc);
+                    const DVec3 v = exactPixel<M, P>(in.bvh, L, sp, vis, shadows, c, rc);
                     if (finite(v)) sums.sum = v;
                     else sums.reject();  // exact has one value: 0 either way
                     sums.n = 1;
@@ -280,18 +276,18 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
                     Rng rng(px, in.frame, RngPass::lightSampling, in.render.seed, chunk + 1);
                     const std::uint32_t count = plan.chunkSamples(chunk);
                     if (kind == EstimatorKind::ris && in.render.source == LightSource::power)
-                        risChunk<M, P, true>(in.bvh, L, in.powerTable, sp, count, in.render.candidates, eps, shadows, rng, sums, rc);
+                        risChunk<M, P, true>(in.bvh, L, in.powerTable, sp, count, in.render.candidates, vis, shadows, rng, sums, rc);
                     else if (kind == EstimatorKind::ris)
-                        risChunk<M, P, false>(in.bvh, L, nullptr, sp, count, in.render.candidates, eps, shadows, rng, sums, rc);
+                        risChunk<M, P, false>(in.bvh, L, nullptr, sp, count, in.render.candidates, vis, shadows, rng, sums, rc);
                     else if (kind == EstimatorKind::power)
                         sampleChunk<M, P>(in.bvh, L, [&](Rng& g) { return sampleSource<true>(L, in.powerTable, g); },
-                                          sp, count, eps, shadows, rng, sums, rc);
+                                          sp, count, vis, shadows, rng, sums, rc);
                     else if (kind == EstimatorKind::tree)
                         sampleChunk<M, P>(in.bvh, L, [&](Rng& g) { return in.lightTree->sample(sp, g); }, sp, count,
-                                          eps, shadows, rng, sums, rc);
+                                          vis, shadows, rng, sums, rc);
                     else
                         sampleChunk<M, P>(in.bvh, L, [&](Rng& g) { return sampleSource<false>(L, nullptr, g); }, sp,
-                                          count, eps, shadows, rng, sums, rc);
+                                          count, vis, shadows, rng, sums, rc);
                     if (plan.adaptive && (chunk + 1) % plan.chunksPerRound == 0)
                         sums.done = roundDone(sums.sum, sums.sumSq, sums.n,
                                               static_cast<std::uint32_t>((chunk + 1) / plan.chunksPerRound), in.render);

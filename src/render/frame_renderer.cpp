@@ -54,7 +54,16 @@ FrameRenderer::~FrameRenderer() = default;
 FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const LightingSession* session) {
     const auto start = std::chrono::steady_clock::now();
     stats.frame = frame;
-    const Camera camera = Camera::atFrame(settings_.camera, frame);
+    // Frame coordinates: the world less an origin at the frame's camera, so
+    // that precision does not depend on where the scene is (MODEL.md
+    // section 3). Geometry that persists across frames (a static scene,
+    // refit and partial builds) keeps the origin of its first build.
+    const Camera world = Camera::atFrame(settings_.camera, frame);
+    const BuildPolicy policy = settings_.geometry.build;
+    const bool persistent = plan_.staticGeometry || policy == BuildPolicy::refit || policy == BuildPolicy::partial;
+    if (!built_ || !persistent) origin_ = world.position;
+    const Camera camera = world.rebased(origin_);
+    stats.origin = origin_;
     PassTimer& timer = stats.timer;
 
     // A static scene loads its particles and builds its BVH once for all frames.
@@ -63,6 +72,7 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const L
     if (!reuse) {
         auto t = timer.scope(pass::loadParticles);
         loaded = source_.frame(frame);
+        for (Vec3& p : loaded.position) p -= origin_;
         if (plan_.staticGeometry) staticParticles_ = std::move(loaded);
     }
     const Particles& particles = plan_.staticGeometry ? staticParticles_ : loaded;

@@ -15,30 +15,46 @@ void trace(const ParticleBvh& bvh, const Particles& particles, const Camera& cam
            GBuffer& gbuffer, PassCounters* counters) {
     const bool spheres = bvh.settings().primitive == Primitive::sphere;
 
-    // One G-buffer texel from a primary hit.
-    auto fill = [&](std::size_t px, const Vec3& dir, const SurfaceHit& hit) {
+    // One G-buffer texel from a primary hit: Embree decides which particle
+    // the pixel ray hits; the point on it is found again in double along the
+    // pixel ray, relative to the particle (local = x - p_j), so that its
+    // error is that of the inputs, not of the ray length or the coordinates.
+    auto fill = [&](std::size_t px, std::uint32_t x, std::uint32_t y, const Vec3& dir, const SurfaceHit& hit) {
         GBufferTexel& g = gbuffer.texels[px];
         const std::uint32_t j = hit.particle;
         const Vec3 p = particles.position[j];
         const float rj = particles.radius[j];
+        const DVec3 o = DVec3(camera.position) - DVec3(p), ray = camera.pixelRay(x, y);  // o relative to p_j
         g.particle = j;
         if (spheres) {
-            // Re-project onto the sphere: accurate to the centre's precision.
-            Vec3 n = camera.position + hit.t * dir - p;
-            const float len = glm::length(n);
-            n = len > 0.0f ? n / len : -dir;
-            g.position = p + rj * n;
-            g.normal = g.geomNormal = n;
-            g.uv = Vec2(0.5f + 0.5f * glm::dot(n, camera.right), 0.5f + 0.5f * glm::dot(n, camera.up));
+            // The near root of |o + t ray| = r, or Embree's point when the
+            // double test grazes past (then only on the silhouette).
+            const double b = glm::dot(o, ray), c = glm::dot(o, o) - double(rj) * double(rj);
+            const double disc = b * b - c;
+            DVec3 local = o + double(hit.t) * DVec3(dir);
+            if (disc >= 0.0) {
+                const double t0 = -b - std::sqrt(disc);
+                local = o + (t0 > 0.0 ? t0 : -b + std::sqrt(disc)) * ray;
+            }
+            const double len = glm::length(local);
+            const DVec3 n = len > 0.0 ? local / len : -ray;
+            g.local = Vec3(double(rj) * n);
+            g.normal = g.geomNormal = Vec3(n);
+            g.uv = Vec2(0.5f + 0.5f * glm::dot(g.normal, camera.right), 0.5f + 0.5f * glm::dot(g.normal, camera.up));
         } else {
-            // On the quad from uv: error relative to |p|, not to the ray length.
             const BillboardFrame& f = bvh.frame(j);
-            g.uv = hit.uv;
-            g.position = p + ((2.0f * hit.uv.x - 1.0f) * rj) * f.right + ((2.0f * hit.uv.y - 1.0f) * rj) * f.up;
+            const DVec3 R(f.right), U(f.up), N = glm::cross(R, U);
+            const double denom = glm::dot(N, ray);
+            DVec3 local = (2.0 * double(hit.uv.x) - 1.0) * double(rj) * R + (2.0 * double(hit.uv.y) - 1.0) * double(rj) * U;
+            if (denom != 0.0) local = o - (glm::dot(N, o) / denom) * ray;
+            g.local = Vec3(local);
+            g.uv = Vec2(glm::clamp(0.5 + 0.5 * glm::dot(local, R) / double(rj), 0.0, 1.0),
+                        glm::clamp(0.5 + 0.5 * glm::dot(local, U) / double(rj), 0.0, 1.0));
             g.geomNormal = glm::normalize(f.normal());
             if (glm::dot(g.geomNormal, dir) > 0.0f) g.geomNormal = -g.geomNormal;
-            g.normal = model == ShadingModel::sphere ? impostorNormal(f, hit.uv) : g.geomNormal;
+            g.normal = model == ShadingModel::sphere ? impostorNormal(f, g.uv) : g.geomNormal;
         }
+        g.position = p + g.local;
         g.depth = glm::dot(g.position - camera.position, camera.forward);
     };
 
@@ -58,7 +74,7 @@ void trace(const ParticleBvh& bvh, const Particles& particles, const Camera& cam
                 bvh.intersect8(camera.position, dirs, n, hits, found);
                 for (int k = 0; k < n; ++k) {
                     const std::size_t px = std::size_t(y) * camera.width + x0 + k;
-                    if (found[k]) fill(px, dirs[k], hits[k]);
+                    if (found[k]) fill(px, x0 + k, y, dirs[k], hits[k]);
                     if constexpr (Count) {
                         // The counters come from the ray a GPU thread traces: one
                         // ray through the counting TLAS (its hit is the same).

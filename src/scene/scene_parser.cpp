@@ -236,6 +236,8 @@ void validate(const Settings& s, const std::map<std::string, std::string>& loc, 
         fail("camera.up", "must be non-zero and not parallel to the view direction");
     if (s.camera.path == CameraPath::linear && glm::length(s.camera.end_look_at - s.camera.end_position) <= 0.0f)
         fail("camera.end_look_at", "must differ from camera.end_position");
+    if (s.render.offset_far == FarEnd::relative && !(s.render.offset_far_margin < 1.0))
+        fail("render.offset_far_margin", "a relative far-end margin must be below 1 (TMax = d (1 - e))");
     if (static_cast<std::uint64_t>(s.render.frame_start) + s.render.frames > 0xffffffffull)
         fail("render.frames", "frame_start + frames overflows");
     if (s.render.output.empty()) fail("render.output", "must not be empty");

@@ -109,8 +109,8 @@ TEST_CASE("Embree hits match brute force for every geometry and build policy", "
                 // Equal particle, or (edge/tie cases) an equally close hit.
                 if (!got || (hit.particle != want && std::fabs(hit.t - tWant) > 1e-4f * tWant)) ++mismatches;
                 // Occlusion of the segment up to just before the closest hit is empty.
-                if (bvh.occluded(cam.position, d, tWant * (1.0f - 1e-4f))) ++mismatches;
-                if (!bvh.occluded(cam.position, d, tWant * (1.0f + 1e-3f) + 1e-3f)) ++mismatches;
+                if (bvh.occluded(cam.position, d, 0.0f, tWant * (1.0f - 1e-4f))) ++mismatches;
+                if (!bvh.occluded(cam.position, d, 0.0f, tWant * (1.0f + 1e-3f) + 1e-3f)) ++mismatches;
             }
         REQUIRE(hits > 50);
         // Rays grazing a quad edge may legitimately differ by float rounding.
@@ -208,7 +208,7 @@ TEST_CASE("counting queries: same answers, BLAS entries bounded by the overlappe
                 anyHits += rc.anyHits;
                 RayCounters oc;
                 const float tfar = a ? plain.t * 1.01f : 1e30f;
-                REQUIRE(bvh.occluded(cam.position, d, tfar) == bvh.occluded(cam.position, d, tfar, &oc));
+                REQUIRE(bvh.occluded(cam.position, d, 0.0f, tfar) == bvh.occluded(cam.position, d, 0.0f, tfar, {}, &oc));
                 REQUIRE(oc.blasEntries <= overlappedClusters(bvh, cam.position, d, tfar));
             }
         REQUIRE(hits > 50);

@@ -43,13 +43,20 @@ inline bool insideDisc(Vec2 uv) {
 }
 
 /// Normal of the sphere impostor at quad uv: (x, y, sqrt(1-x^2-y^2)) in the
-/// billboard frame, x, y = 2 uv - 1, clamped to the rim outside the disc.
+/// billboard frame, x, y = 2 uv - 1, clamped to the rim (z = 0) outside the
+/// disc. In double: near the rim z moves fast with uv.
 inline Vec3 impostorNormal(const BillboardFrame& f, Vec2 uv) {
-    Vec2 q = 2.0f * uv - Vec2(1.0f);
-    const float q2 = glm::dot(q, q);
-    if (q2 > 1.0f) q /= std::sqrt(q2);
-    const float z = std::sqrt(std::max(0.0f, 1.0f - glm::dot(q, q)));
-    return glm::normalize(q.x * f.right + q.y * f.up + z * f.normal());
+    double x = 2.0 * double(uv.x) - 1.0, y = 2.0 * double(uv.y) - 1.0;
+    const double q2 = x * x + y * y;
+    double z = 0.0;
+    if (q2 > 1.0) {
+        const double len = std::sqrt(q2);
+        x /= len, y /= len;
+    } else {
+        z = std::sqrt(1.0 - q2);
+    }
+    const DVec3 right(f.right), up(f.up);
+    return Vec3(glm::normalize(x * right + y * up + z * glm::cross(right, up)));
 }
 
 }  // namespace accretion

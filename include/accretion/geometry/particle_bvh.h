@@ -47,6 +47,23 @@ struct AlphaTest {
     const OpacityMicromap* omm = nullptr;
 };
 
+/// What the filter callbacks of one cluster's geometry read: its particles
+/// (primID -> particle) and the alpha test (null: opaque).
+struct ClusterGeometry {
+    const std::uint32_t* members = nullptr;
+    const AlphaTest* alpha = nullptr;
+};
+
+inline constexpr std::uint32_t kNotExcluded = 0xffffffffu;
+
+/// The primitives an occlusion query ignores by identity (MODEL.md section
+/// 3): the receiver j and the light i of V(x, p_i), whatever the geometry
+/// of either crosses; no epsilon is involved.
+struct Exclusion {
+    std::uint32_t receiver = kNotExcluded;
+    std::uint32_t light = kNotExcluded;
+};
+
 /// The GPU's acceleration structure on Embree (MODEL.md section 2): one BLAS
 /// per particle cluster, instanced in a TLAS; billboards as quads (the GPU's two triangles)
 /// (optionally with the disc alpha test as a filter function) or spheres.
@@ -69,8 +86,11 @@ public:
     /// primary rays trace ~1.6x faster); found[k] says whether ray k hit.
     /// Lanes k >= n are inactive. Not for counting.
     void intersect8(const Vec3& o, const Vec3* d, int n, SurfaceHit* hit, bool* found) const;
-    /// Any hit along o + t d, t in [0, tfar): the search stops at the first.
-    bool occluded(const Vec3& o, const Vec3& d, float tfar, RayCounters* counters = nullptr) const;
+    /// Any hit along o + t d, t in [tnear, tfar], of a particle other than
+    /// the excluded ones (after its alpha test): the search stops at the
+    /// first. With counters (counting mode only), entries and any-hits are added.
+    bool occluded(const Vec3& o, const Vec3& d, float tnear, float tfar, Exclusion exclude = {},
+                  RayCounters* counters = nullptr) const;
 
     /// The TLAS (for bare Embree loops over the same BVH: benchmarks).
     RTCScene scene() const { return tlas_; }
@@ -103,6 +123,7 @@ private:
     std::vector<BillboardFrame> frames_;
     std::vector<RTCScene> blas_;
     std::vector<RTCGeometry> geometry_;  // one per BLAS, owned by its scene
+    std::vector<ClusterGeometry> clusterGeometry_;  ///< the filters' user data, one per BLAS
     RTCScene tlas_ = nullptr;
     bool counting_ = false;
     RTCScene countingTlas_ = nullptr;      ///< user-geometry instances that count entries

@@ -14,6 +14,8 @@ struct Camera {
     Vec3 up;             ///< unit, image +y
     float tanHalfFov;    ///< tan(vertical fov / 2)
     std::uint32_t width, height;
+    DVec3 forwardD, rightD, upD;  ///< the same basis computed in double (hit points are refined with it)
+    double tanHalfFovD;
 
     /// The camera of a frame along the scene's path.
     static Camera atFrame(const CameraSettings& s, std::uint32_t frame);
@@ -26,6 +28,22 @@ struct Camera {
         const float sx = ((float(x) + 0.5f) / float(width) * 2.0f - 1.0f) * tanHalfFov * aspect;
         const float sy = (1.0f - (float(y) + 0.5f) / float(height) * 2.0f) * tanHalfFov;
         return glm::normalize(forward + sx * right + sy * up);
+    }
+
+    /// The same ray in double: what primary hits are refined along.
+    DVec3 pixelRay(std::uint32_t x, std::uint32_t y) const {
+        const double aspect = double(width) / double(height);
+        const double sx = ((double(x) + 0.5) / double(width) * 2.0 - 1.0) * tanHalfFovD * aspect;
+        const double sy = (1.0 - (double(y) + 0.5) / double(height) * 2.0) * tanHalfFovD;
+        return glm::normalize(forwardD + sx * rightD + sy * upD);
+    }
+
+    /// This camera in coordinates whose origin is at `origin` (the renderer
+    /// works relative to the frame's camera: MODEL.md section 3, precision).
+    Camera rebased(const Vec3& origin) const {
+        Camera c = *this;
+        c.position = position - origin;
+        return c;
     }
 
     /// Continuous pixel coordinates (pixel centres at +0.5) and camera-space

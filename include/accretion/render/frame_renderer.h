@@ -35,6 +35,7 @@ struct FrameImage {
 /// Counts and times of one frame, for stats.json.
 struct FrameStats {
     std::uint32_t frame = 0;
+    Vec3 origin{0.0f};                ///< world position of the frame coordinates' origin (the camera)
     std::size_t particles = 0;
     BvhStats bvh;
     std::uint64_t primaryRays = 0;
@@ -85,7 +86,8 @@ private:
     PassPlan plan_;
     ParticleSource source_;
     Particles staticParticles_;  ///< static scenes: loaded once
-    bool built_ = false;         ///< static scenes: the BVH is built
+    bool built_ = false;         ///< the BVH has been built once
+    Vec3 origin_{0.0f};          ///< world position of the frame coordinates' origin
     RenderOptions options_;
     std::unique_ptr<EmbreeDevice> device_;
     std::unique_ptr<ParticleBvh> bvh_;

@@ -7,6 +7,7 @@
 #include "accretion/geometry/particle_bvh.h"
 #include "accretion/gpu/thread_counters.h"
 #include "accretion/render/camera.h"
+#include "accretion/render/shading.h"
 
 namespace accretion {
 
@@ -15,7 +16,8 @@ inline constexpr std::uint32_t kNoParticle = std::numeric_limits<std::uint32_t>:
 /// One G-buffer texel: what the primary ray through the pixel centre hit.
 struct GBufferTexel {
     std::uint32_t particle = kNoParticle; ///< hit particle, kNoParticle on a miss
-    Vec3 position{0.0f};                  ///< x on the particle's surface
+    Vec3 position{0.0f};                  ///< x on the particle's surface (frame coordinates)
+    Vec3 local{0.0f};                     ///< x - p_j, from the pixel ray intersected in double
     Vec3 normal{0.0f};                    ///< shading normal n
     Vec3 geomNormal{0.0f};                ///< geometric normal (origin offsets)
     float depth = 0.0f;                   ///< camera-space z (along the view direction)
@@ -28,6 +30,11 @@ struct GBuffer {
     std::vector<GBufferTexel> texels;
     const GBufferTexel& at(std::uint32_t x, std::uint32_t y) const { return texels[std::size_t(y) * width + x]; }
 };
+
+/// The shading point of a hit texel.
+inline ShadingPoint shadingPoint(const GBufferTexel& g, const Particles& particles) {
+    return {g.position, g.normal, g.geomNormal, particles.albedo[g.particle], g.particle, particles.position[g.particle], g.local};
+}
 
 /// Counting mode: a pixel thread that reads texel g, with its branch key
 /// (hit, particle type) and cluster.

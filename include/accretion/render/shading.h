@@ -8,12 +8,17 @@
 namespace accretion {
 
 /// The receiver of one pixel: the G-buffer texel the shading equation needs.
+/// Positions are relative to the frame's origin (the camera); the hit point
+/// is also kept relative to its particle, so that distances to the lights
+/// lose no precision to the magnitude of the coordinates.
 struct ShadingPoint {
-    Vec3 x;               ///< hit position
+    Vec3 x;               ///< hit position (shadow ray origin)
     Vec3 n;               ///< shading normal (faces the camera)
     Vec3 ng;              ///< geometric normal, for the ray origin offset
     Vec3 rho;             ///< albedo of the hit particle
     std::uint32_t self;   ///< hit particle j (excluded from its own lighting)
+    Vec3 centre;          ///< p_j
+    Vec3 local;           ///< x - p_j, computed in double
 };
 
 /// One light's unshadowed term f_j(x, w_i) I_i G_i(x) and the segment to it.
@@ -28,7 +33,7 @@ struct LightTerm {
 /// Returns false when the term is zero (so no shadow ray is needed).
 template <ShadingModel M>
 inline bool evalLight(const ShadingPoint& sp, const Vec3& p, const Vec3& I, float dmin2, LightTerm& out) {
-    const Vec3 delta = p - sp.x;
+    const Vec3 delta = (p - sp.centre) - sp.local;  // receiver-relative: exact to the inputs' rounding
     const float d2 = glm::dot(delta, delta);
     const float d = std::sqrt(d2);
     float cosTerm, f;

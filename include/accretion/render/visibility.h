@@ -6,13 +6,14 @@
 #include "accretion/core/math.h"
 #include "accretion/geometry/particle_bvh.h"
 #include "accretion/render/shading.h"
+#include "accretion/scene/settings.h"
 
 namespace accretion {
 
 /// Scale-aware ray origin offset (Waechter & Binder, "A Fast and Robust
 /// Method for Avoiding Self-Intersection", Ray Tracing Gems ch. 6): move p
 /// along n by a fixed number of float ulps, or by a fixed absolute amount
-/// near the origin where ulps are tiny.
+/// near the origin where ulps are tiny. Used only by the `offset` rule.
 inline Vec3 offsetRayOrigin(const Vec3& p, const Vec3& n) {
     constexpr float kOriginBand = 1.0f / 32.0f;
     constexpr float kFloatScale = 1.0f / 65536.0f;
@@ -26,33 +27,65 @@ inline Vec3 offsetRayOrigin(const Vec3& p, const Vec3& n) {
     return out;
 }
 
-/// The shadow ray of V(x, p_i): origin, direction (unit) and far end; tfar
-/// <= 0 when the light is too close for any ray (then V = 1).
-struct ShadowRay {
-    Vec3 o, d;
-    float tfar;
+/// The visibility rule of every shadow ray of a frame (render.visibility_rule
+/// and its offset_* parameters), read once from the settings.
+struct VisibilityOptions {
+    VisibilityRule rule = VisibilityRule::exact;
+    OffsetOrigin origin = OffsetOrigin::tmin;
+    float tmin = 1e-3f;
+    FarEnd far = FarEnd::absolute;
+    float margin = 1e-3f;
+
+    static VisibilityOptions from(const RenderSettings& r) {
+        return {r.visibility_rule, r.offset_origin, float(r.offset_tmin), r.offset_far, float(r.offset_far_margin)};
+    }
 };
 
+/// One occlusion query: o + t d, t in [tnear, tfar], ignoring `exclude`.
+struct ShadowQuery {
+    Vec3 o, d;
+    float tnear, tfar;
+    Exclusion exclude;
+};
+
+/// The query of V(x, p_i) (MODEL.md section 3) for receiver sp and light i
+/// at p (radius r), whose unshadowed term t holds w and d.
+///  - exact (the reference): the whole segment from x to p_i, with the
+///    receiver's and the light's own primitives excluded by identity.
+///  - offset (what GPU code does; a measured bias): no exclusion; the origin
+///    moves by TMin along the ray, or off the surface (Waechter-Binder) with
+///    the ray re-aimed at p_i from there; the far end stops short of the
+///    light (of its sphere's near surface for spheres) by e (TMax = D - e)
+///    or by a fraction (TMax = D (1 - e)).
 template <Primitive P>
-inline ShadowRay shadowRay(const ShadingPoint& sp, const LightTerm& light, float lightRadius, float eps) {
-    float tfar;
-    if constexpr (P == Primitive::sphere) tfar = (light.dist - lightRadius) * (1.0f - eps);
-    else tfar = light.dist * (1.0f - eps);
-    const Vec3 side = glm::dot(sp.ng, light.w) >= 0.0f ? sp.ng : -sp.ng;
-    return {offsetRayOrigin(sp.x, side), light.w, tfar > 0.0f ? tfar : 0.0f};
+inline ShadowQuery shadowQuery(const VisibilityOptions& v, const ShadingPoint& sp, std::uint32_t i, const Vec3& p,
+                               float r, const LightTerm& t) {
+    if (v.rule == VisibilityRule::exact) return {sp.x, t.w, 0.0f, t.dist, {sp.self, i}};
+    ShadowQuery q{sp.x, t.w, 0.0f, t.dist, {}};
+    if (v.origin == OffsetOrigin::tmin) {
+        q.tnear = v.tmin;
+    } else {
+        q.o = offsetRayOrigin(sp.x, glm::dot(sp.ng, t.w) >= 0.0f ? sp.ng : -sp.ng);
+        const Vec3 delta = p - q.o;
+        const float d = glm::length(delta);
+        if (d > 0.0f) q.d = delta / d;
+        q.tfar = d;
+    }
+    float D = q.tfar;
+    if constexpr (P == Primitive::sphere) D -= r;
+    q.tfar = v.far == FarEnd::absolute ? D - v.margin : D * (1.0f - v.margin);
+    return q;
 }
 
-/// V(x, p_i) of MODEL.md section 3: the segment from the (offset) receiver to
-/// the light, ending short of the light's own geometry: billboards
-/// t < d (1 - eps) (p_i lies on its own quad), spheres t < (d - r_i)(1 - eps).
-/// One occlusion query that stops at the first hit (counted into `counters`
-/// when given: counting mode).
+/// V(x, p_i): one occlusion query that stops at the first hit (counted into
+/// `counters` when given: counting mode). A query with an empty interval
+/// (a light at the receiver, or inside the offset rule's margins) sees it.
 template <Primitive P>
-inline bool visible(const ParticleBvh& bvh, const ShadingPoint& sp, const LightTerm& light, float lightRadius, float eps,
-                    RayCounters* counters = nullptr) {
-    const ShadowRay r = shadowRay<P>(sp, light, lightRadius, eps);
-    if (!(r.tfar > 0.0f)) return true;
-    return !bvh.occluded(r.o, r.d, r.tfar, counters);
+inline bool visible(const ParticleBvh& bvh, const VisibilityOptions& v, const ShadingPoint& sp, std::uint32_t i,
+                    const Vec3& p, float r, const LightTerm& t, RayCounters* counters = nullptr) {
+    const ShadowQuery q = shadowQuery<P>(v, sp, i, p, r, t);
+    if (!(q.tfar > q.tnear)) return true;
+    return !bvh.occluded(q.o, q.d, q.tnear, q.tfar, q.exclude, counters);
 }
 
 }  // namespace accretion

@@ -43,6 +43,9 @@ enum class ReservoirLayout { full, packed };
 enum class LightSource { uniform, power };
 enum class OmmMode { off, two_state, four_state };
 enum class NonFinitePolicy { zero_sample, discard };
+enum class VisibilityRule { exact, offset };
+enum class OffsetOrigin { tmin, waechter_binder };
+enum class FarEnd { absolute, relative };
 
 ACC_ENUM_NAMES(CameraPath, "static", "orbit", "linear");
 ACC_ENUM_NAMES(Primitive, "billboard", "sphere");
@@ -56,6 +59,9 @@ ACC_ENUM_NAMES(ReservoirLayout, "full", "packed");
 ACC_ENUM_NAMES(LightSource, "uniform", "power");
 ACC_ENUM_NAMES(OmmMode, "off", "2state", "4state");
 ACC_ENUM_NAMES(NonFinitePolicy, "zero_sample", "discard");
+ACC_ENUM_NAMES(VisibilityRule, "exact", "offset");
+ACC_ENUM_NAMES(OffsetOrigin, "tmin", "waechter_binder");
+ACC_ENUM_NAMES(FarEnd, "absolute", "relative");
 
 template <class E> constexpr std::string_view enumName(E e) {
     return EnumNames<E>::names[static_cast<std::size_t>(e)];
@@ -141,6 +147,7 @@ struct GeometrySettings {
     std::uint32_t cluster_size = 100;                ///< target particles per cluster (one BLAS each)
     BuildPolicy build = BuildPolicy::rebuild;        ///< per-frame BLAS policy
     double rebuild_fraction = 0.7;                   ///< partial: fraction of clusters rebuilt per frame (seed 004: 70%)
+    bool watertight = false;                         ///< Embree robust mode: watertight quads (slower)
 
     template <class V> void visit(V& v) {
         v.field("primitive", primitive, "particle geometry");
@@ -149,6 +156,7 @@ struct GeometrySettings {
         v.field("cluster_size", cluster_size, "target particles per cluster (one BLAS each)", Range{1, 1e7});
         v.field("build", build, "per-frame BLAS policy (partial: rebuild_fraction of the clusters, the rest stale)");
         v.field("rebuild_fraction", rebuild_fraction, "partial: fraction of clusters rebuilt per frame, round robin", Range{0.0, 1.0, true});
+        v.field("watertight", watertight, "Embree's robust mode: no ray slips between a quad's two triangles along the diagonal (~30% slower rays; off, a segment within float rounding of a diagonal can pass)");
     }
 };
 
@@ -183,7 +191,11 @@ struct RenderSettings {
     std::uint32_t max_samples = 65536;           ///< cap of the adaptive sampling of target_stderr
     std::uint64_t seed = 0;                      ///< render seed
     std::string output = "out/{scene}.{frame}.exr"; ///< EXR path, {scene} and {frame} patterns
-    double shadow_epsilon = 1e-4;                ///< relative far-end margin of shadow rays
+    VisibilityRule visibility_rule = VisibilityRule::exact; ///< V by identity exclusion (MODEL.md section 3), or a GPU epsilon rule
+    OffsetOrigin offset_origin = OffsetOrigin::tmin; ///< offset rule: TMin along the ray, or Waechter-Binder along the normal
+    double offset_tmin = 1e-3;                   ///< offset rule, tmin: the ray's TMin (seed 004: 0.001)
+    FarEnd offset_far = FarEnd::absolute;        ///< offset rule: TMax = d - e (seed 004) or d (1 - e)
+    double offset_far_margin = 1e-3;             ///< offset rule: the far-end margin e
     NonFinitePolicy nonfinite = NonFinitePolicy::zero_sample; ///< a NaN/Inf sample counts as 0, or is discarded (restir: its reservoir)
     double memory_limit_mb = 0.0;                ///< refuse runs estimated to need more (0: no limit)
     double exposure = 0.0;                       ///< preview exposure in stops, added to auto exposure
@@ -200,7 +212,11 @@ struct RenderSettings {
         v.field("max_samples", max_samples, "cap on samples per pixel when target_stderr is set", Range{1, 1e9});
         v.field("seed", seed, "render seed");
         v.field("output", output, "EXR output path; {scene} and {frame} are replaced");
-        v.field("shadow_epsilon", shadow_epsilon, "shadow ray far end: t < d (1 - eps)", Range{1e-7, 0.1});
+        v.field("visibility_rule", visibility_rule, "V(x, p_i): exact (the receiver and the light excluded by identity: the reference) or offset (a GPU epsilon rule, measured as a bias)");
+        v.field("offset_origin", offset_origin, "offset rule: tmin (TMin = offset_tmin along the ray) or waechter_binder (origin moved along the normal, ray re-aimed at p_i)");
+        v.field("offset_tmin", offset_tmin, "offset rule, tmin: the ray's TMin (seed 004: 0.001)", kNonNegative);
+        v.field("offset_far", offset_far, "offset rule: far end absolute (TMax = d - e, seed 004) or relative (TMax = d (1 - e))");
+        v.field("offset_far_margin", offset_far_margin, "offset rule: the far-end margin e (absolute: a length; relative: a fraction < 1)", Range{0.0, 1e9});
         v.field("nonfinite", nonfinite, "a NaN/Inf sample: zero_sample (counts as 0) | discard (not counted; restir: the reservoir is emptied)");
         v.field("memory_limit_mb", memory_limit_mb, "refuse a run whose estimated peak memory exceeds this (MB; 0: no limit)", kNonNegative);
         v.field("exposure", exposure, "preview exposure (stops)", Range{-64.0, 64.0});
