@@ -11,6 +11,7 @@ nlohmann::json frameStatsJson(const FrameStats& s) {
 
     return {
         {"frame", s.frame},
+        {"origin", {s.origin.x, s.origin.y, s.origin.z}},  // world position of the frame coordinates' origin
         {"seconds", s.seconds},
         {"passes", passes},
         {"counts",
