@@ -8,14 +8,15 @@ Camera Camera::lookAt(const Vec3& eye, const Vec3& target, const Vec3& upHint, d
                       std::uint32_t width, std::uint32_t height) {
     Camera c;
     c.position = eye;
-    c.forward = glm::normalize(target - eye);
-    c.right = glm::normalize(glm::cross(c.forward, upHint));
-    c.up = glm::cross(c.right, c.forward);
-    c.tanHalfFov = float(std::tan(0.5 * fovDegrees * M_PI / 180.0));
+    // The basis in double; the float one (Embree's rays) is its rounding.
     c.forwardD = glm::normalize(DVec3(target) - DVec3(eye));
     c.rightD = glm::normalize(glm::cross(c.forwardD, DVec3(upHint)));
     c.upD = glm::cross(c.rightD, c.forwardD);
     c.tanHalfFovD = std::tan(0.5 * fovDegrees * M_PI / 180.0);
+    c.forward = Vec3(c.forwardD);
+    c.right = Vec3(c.rightD);
+    c.up = Vec3(c.upD);
+    c.tanHalfFov = float(c.tanHalfFovD);
     c.width = width;
     c.height = height;
     return c;

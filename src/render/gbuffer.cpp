@@ -31,10 +31,12 @@ void trace(const ParticleBvh& bvh, const Particles& particles, const Camera& cam
             // double test grazes past (then only on the silhouette).
             const double b = glm::dot(o, ray), c = glm::dot(o, o) - double(rj) * double(rj);
             const double disc = b * b - c;
-            DVec3 local = o + double(hit.t) * DVec3(dir);
+            DVec3 local;
             if (disc >= 0.0) {
                 const double t0 = -b - std::sqrt(disc);
                 local = o + (t0 > 0.0 ? t0 : -b + std::sqrt(disc)) * ray;
+            } else {
+                local = o + double(hit.t) * DVec3(dir);
             }
             const double len = glm::length(local);
             const DVec3 n = len > 0.0 ? local / len : -ray;
@@ -45,8 +47,11 @@ void trace(const ParticleBvh& bvh, const Particles& particles, const Camera& cam
             const BillboardFrame& f = bvh.frame(j);
             const DVec3 R(f.right), U(f.up), N = glm::cross(R, U);
             const double denom = glm::dot(N, ray);
-            DVec3 local = (2.0 * double(hit.uv.x) - 1.0) * double(rj) * R + (2.0 * double(hit.uv.y) - 1.0) * double(rj) * U;
-            if (denom != 0.0) local = o - (glm::dot(N, o) / denom) * ray;
+            // The pixel ray meets the quad's plane; in the plane (never a hit
+            // in practice), Embree's uv.
+            const DVec3 local = denom != 0.0 ? o - (glm::dot(N, o) / denom) * ray
+                                             : (2.0 * double(hit.uv.x) - 1.0) * double(rj) * R +
+                                                   (2.0 * double(hit.uv.y) - 1.0) * double(rj) * U;
             g.local = Vec3(local);
             g.uv = Vec2(glm::clamp(0.5 + 0.5 * glm::dot(local, R) / double(rj), 0.0, 1.0),
                         glm::clamp(0.5 + 0.5 * glm::dot(local, U) / double(rj), 0.0, 1.0));
