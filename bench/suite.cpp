@@ -60,6 +60,21 @@ double timeIt(int runs, const std::function<void()>& f) {
     return median(t);
 }
 
+/// Medians of several functions timed side by side: run k times each of
+/// them in turn, so that a slow spell of the machine falls on all of them.
+std::vector<double> timeInterleaved(int runs, const std::vector<std::function<void()>>& fs) {
+    std::vector<std::vector<double>> t(fs.size());
+    for (int k = 0; k < runs; ++k)
+        for (std::size_t i = 0; i < fs.size(); ++i) {
+            const auto t0 = Clock::now();
+            fs[i]();
+            t[i].push_back(seconds(t0));
+        }
+    std::vector<double> m;
+    for (auto& ti : t) m.push_back(median(ti));
+    return m;
+}
+
 void log(const std::string& s) { fmt::print(stderr, "suite: {}\n", s); }
 
 nlohmann::json bar(double project, double limit, double limitRatio) {
@@ -407,9 +422,11 @@ int main(int argc, char** argv) {
         ParticleBvh bvh(device, disk.geometry);
         bvh.build(p0, cam);
         GBuffer gb;
-        const double primary = timeIt(5, [&] { traceGBuffer(bvh, p0, cam, disk.shading.model, gb); });
-        const double bare1 = timeIt(5, [&] { bareIntersect(bvh.scene(), cam, false); });
-        const double bare8 = timeIt(5, [&] { bareIntersect(bvh.scene(), cam, true); });
+        traceGBuffer(bvh, p0, cam, disk.shading.model, gb);
+        const std::vector<double> tp = timeInterleaved(9, {[&] { traceGBuffer(bvh, p0, cam, disk.shading.model, gb); },
+                                                           [&] { bareIntersect(bvh.scene(), cam, false); },
+                                                           [&] { bareIntersect(bvh.scene(), cam, true); }});
+        const double primary = tp[0], bare1 = tp[1], bare8 = tp[2];
         const double primaryLimit = std::min(bare1, bare8);
         bars["primary_rays"] = bar(primary, primaryLimit, 1.25);
         const double nPrimary = double(cam.width) * cam.height;
@@ -423,20 +440,21 @@ int main(int argc, char** argv) {
         const RayBatch rays = uniformShadowRays(p0, gb, u);
         LightingImage out;
         std::uint64_t traced = 0, occludedPass = 0;
-        const double shadow = timeIt(5, [&] {
-            LightingInputs in{bvh, p0, gb, u.shading, u.render, 0, nullptr, nullptr};
-            const LightingCounters c = estimateLighting(in, out);
-            traced = c.shadowRays;
-            occludedPass = c.shadowOccluded;
-        });
         // The limit: bare loops over a BVH of the same clusters without filter
         // callbacks (the project's BLAS exclude by identity in theirs).
         BareBuilder bare;
         bare.build(bvh.clusters(), p0, cam);
         std::size_t occ1 = 0, occ8 = 0, occExact = 0;
-        const double s1 = timeIt(5, [&] { occ1 = bareOccluded1(bare.tlas, rays); });
-        const double s8 = timeIt(5, [&] { occ8 = bareOccluded8(bare.tlas, rays); });
-        const double sx = timeIt(5, [&] { occExact = exactOccluded(bvh, rays); });
+        const std::vector<double> ts = timeInterleaved(9, {[&] {
+                                                               LightingInputs in{bvh, p0, gb, u.shading, u.render, 0, nullptr, nullptr};
+                                                               const LightingCounters c = estimateLighting(in, out);
+                                                               traced = c.shadowRays;
+                                                               occludedPass = c.shadowOccluded;
+                                                           },
+                                                           [&] { occ1 = bareOccluded1(bare.tlas, rays); },
+                                                           [&] { occ8 = bareOccluded8(bare.tlas, rays); },
+                                                           [&] { occExact = exactOccluded(bvh, rays); }});
+        const double shadow = ts[0], s1 = ts[1], s8 = ts[2], sx = ts[3];
         if (traced != rays.size() || occExact != occludedPass)
             log(fmt::format("warning: {} rays traced by the pass, {} rebuilt; occluded {} vs {}", traced, rays.size(),
                             occludedPass, occExact));

@@ -43,16 +43,16 @@ DVec3 exactPixel(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoin
 /// non-finite, and float-derived doubles cannot overflow a double sum.
 inline bool finite(const DVec3& v) { return std::isfinite(v.x + v.y + v.z); }
 
-/// One pixel's running sums while its chunks run (loaded from and stored to
-/// the Accumulation, or resolved directly), with the non-finite policy
-/// applied to every sample added.
+/// One pixel's running sums and counters while its chunks run (loaded from
+/// and stored to the Accumulation, or resolved directly), with the
+/// non-finite policy applied to every sample added.
 struct PixelSums {
     DVec3 sum{0.0}, sumSq{0.0};
     std::uint32_t n = 0;
     std::uint32_t rejected = 0;
     std::uint8_t done = 0;
-    NonFinitePolicy policy;
-    LightingCounters& c;
+    NonFinitePolicy policy = NonFinitePolicy::zero_sample;
+    LightingCounters c;   ///< this pixel's work (added to its thread's when it finishes)
 
     /// Count a non-finite value; true if the policy discards it (else it counts as 0).
     bool reject() {
@@ -119,39 +119,42 @@ std::uint32_t resolvePixel(const DVec3& sum, const DVec3& sumSq, std::uint32_t n
     return zeroed;
 }
 
-/// uniform / power / tree: `count` one-sample estimates f I G V / p(i) (a
-/// zero sample when no light or i = j).
-template <ShadingModel M, Primitive P, class Sampler>
-void sampleChunk(const ParticleBvh& bvh, const LightArrays& L, Sampler&& sampleOne, const ShadingPoint& sp,
-                 std::uint32_t count, const VisibilityOptions& vis, bool shadows, Rng& rng, PixelSums& acc, RayCounters* rc) {
+/// The lights of one chunk of uniform / power / tree samples, in stream
+/// order, their records prefetched (a random light is a cache miss).
+template <EstimatorKind K>
+void drawLights(const LightingInputs& in, const LightArrays& L, const ShadingPoint& sp, Rng& rng, std::uint32_t count,
+                LightSample* xs) {
+    for (std::uint32_t k = 0; k < count; ++k) {
+        if constexpr (K == EstimatorKind::power) xs[k] = sampleSource<true>(L, in.powerTable, rng);
+        else if constexpr (K == EstimatorKind::tree) xs[k] = in.lightTree->sample(sp, rng);
+        else xs[k] = sampleSource<false>(L, nullptr, rng);
+        if (xs[k].i < L.count) __builtin_prefetch(&L.packed[xs[k].i]);
+    }
+}
+
+/// uniform / power / tree: the one-sample estimates f I G V / p(i) of drawn
+/// lights (a zero sample when no light or i = j).
+template <ShadingModel M, Primitive P>
+void shadeSamples(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint& sp, const LightSample* xs,
+                  std::uint32_t count, const VisibilityOptions& vis, bool shadows, PixelSums& acc, RayCounters* rc) {
     LightingCounters& c = acc.c;
-    // Lights drawn 8 at a time and prefetched: their records are random
-    // accesses (a cache miss each); the RNG is consumed in the same order.
-    for (std::uint32_t k0 = 0; k0 < count; k0 += 8) {
-        const std::uint32_t batch = std::min<std::uint32_t>(8, count - k0);
-        LightSample xs[8];
-        for (std::uint32_t k = 0; k < batch; ++k) {
-            xs[k] = sampleOne(rng);
-            if (xs[k].i < L.count) __builtin_prefetch(&L.packed[xs[k].i]);
+    for (std::uint32_t k = 0; k < count; ++k) {
+        const LightSample& x = xs[k];
+        LightTerm t;
+        ++c.lightTerms;
+        if (!L.term<M>(sp, x.i, t)) {
+            acc.addZero();
+            continue;
         }
-        for (std::uint32_t k = 0; k < batch; ++k) {
-            const LightSample& x = xs[k];
-            LightTerm t;
-            ++c.lightTerms;
-            if (!L.term<M>(sp, x.i, t)) {
+        if (shadows) {
+            ++c.shadowRays;
+            if (!visible<P>(bvh, vis, sp, x.i, L.packed[x.i].position, L.packed[x.i].radius, t, rc)) {
+                ++c.shadowOccluded;
                 acc.addZero();
                 continue;
             }
-            if (shadows) {
-                ++c.shadowRays;
-                if (!visible<P>(bvh, vis, sp, x.i, L.packed[x.i].position, L.packed[x.i].radius, t, rc)) {
-                    ++c.shadowOccluded;
-                    acc.addZero();
-                    continue;
-                }
-            }
-            acc.add(DVec3(t.value) / double(x.pdf));
         }
+        acc.add(DVec3(t.value) / double(x.pdf));
     }
 }
 
@@ -211,11 +214,76 @@ bool roundDone(const DVec3& s1, const DVec3& s2, std::uint32_t n, std::uint32_t 
     return luminance(Vec3(err)) <= rs.target_stderr * luminance(Vec3(m));
 }
 
+/// One hit pixel of a group while its chunks run.
+struct GroupPixel {
+    std::size_t px = 0;
+    ShadingPoint sp;
+    PixelSums sums;
+    RayCounters rays;       ///< counting mode: its shadow rays' traversal
+    LightSample xs[LightingPlan::kChunkSamples];
+};
+
+/// Pixels shaded together: up to this many of a tile row.
+constexpr std::uint32_t kGroupPixels = 8;
+
+/// One chunk of every active pixel of a group. uniform / power / tree draw
+/// the lights of every pixel first (their records prefetched), then shade
+/// them, so that the random reads of eight pixels overlap; each pixel's
+/// stream, samples and sums are those it has alone.
+template <ShadingModel M, Primitive P, bool Count, EstimatorKind K>
+void runChunk(const LightingInputs& in, const LightArrays& L, const VisibilityOptions& vis, bool shadows,
+              std::uint64_t chunk, std::uint32_t count, GroupPixel* pix, std::uint32_t n) {
+    const auto stream = [&](const GroupPixel& p) {
+        return Rng(p.px, in.frame, RngPass::lightSampling, in.render.seed, chunk + 1);
+    };
+    if constexpr (K == EstimatorKind::ris) {
+        const bool power = in.render.source == LightSource::power;
+        for (std::uint32_t k = 0; k < n; ++k) {
+            GroupPixel& p = pix[k];
+            if (p.sums.done) continue;
+            Rng rng = stream(p);
+            RayCounters* rc = Count ? &p.rays : nullptr;
+            if (power) risChunk<M, P, true>(in.bvh, L, in.powerTable, p.sp, count, in.render.candidates, vis, shadows, rng, p.sums, rc);
+            else risChunk<M, P, false>(in.bvh, L, nullptr, p.sp, count, in.render.candidates, vis, shadows, rng, p.sums, rc);
+        }
+    } else {
+        ACC_CHECK(count <= LightingPlan::kChunkSamples);
+        for (std::uint32_t k = 0; k < n; ++k) {
+            if (pix[k].sums.done) continue;
+            Rng rng = stream(pix[k]);
+            drawLights<K>(in, L, pix[k].sp, rng, count, pix[k].xs);
+        }
+        for (std::uint32_t k = 0; k < n; ++k) {
+            GroupPixel& p = pix[k];
+            if (!p.sums.done) shadeSamples<M, P>(in.bvh, L, p.sp, p.xs, count, vis, shadows, p.sums, Count ? &p.rays : nullptr);
+        }
+    }
+}
+
+/// Chunks [c0, c1) of one group's hit pixels; adaptive sampling stops a
+/// pixel at the end of a round.
+template <ShadingModel M, Primitive P, bool Count, EstimatorKind K>
+void runChunks(const LightingInputs& in, const LightArrays& L, const LightingPlan& plan, const VisibilityOptions& vis,
+               bool shadows, std::uint64_t c0, std::uint64_t c1, GroupPixel* pix, std::uint32_t n) {
+    for (std::uint64_t chunk = c0; chunk < c1; ++chunk) {
+        runChunk<M, P, Count, K>(in, L, vis, shadows, chunk, plan.chunkSamples(chunk), pix, n);
+        bool active = false;
+        for (std::uint32_t k = 0; k < n; ++k) {
+            PixelSums& s = pix[k].sums;
+            if (!s.done && plan.adaptive && (chunk + 1) % plan.chunksPerRound == 0)
+                s.done = roundDone(s.sum, s.sumSq, s.n, static_cast<std::uint32_t>((chunk + 1) / plan.chunksPerRound), in.render);
+            active = active || !s.done;
+        }
+        if (!active) return;
+    }
+}
+
 /// Runs chunks [c0, c1) over every pixel in one parallel sweep, each pixel's
 /// sums in registers: loaded from and stored to `acc`, or (acc null: the
-/// whole frame in one sweep) resolved straight into `out`. Counters
-/// (counting mode): per pixel, its key, the light terms as loop trips, the
-/// shadow rays with their traversal counts, and bytes.
+/// whole frame in one sweep) resolved straight into `out`. Pixels run in
+/// groups of a tile row (runChunk). Counters (counting mode): per pixel, its
+/// key, the light terms as loop trips, the shadow rays with their traversal
+/// counts, and bytes.
 template <ShadingModel M, Primitive P, bool Count>
 LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const LightingPlan& plan, Accumulation* acc,
                        LightingImage* out, std::uint64_t c0, std::uint64_t c1, Progress* progress) {
@@ -228,71 +296,70 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
     const std::uint32_t row0 = plan.exact ? static_cast<std::uint32_t>(std::min<std::uint64_t>(c0 * LightingPlan::kChunkRows, gb.height)) : 0;
     const std::uint32_t row1 = plan.exact ? static_cast<std::uint32_t>(std::min<std::uint64_t>(c1 * LightingPlan::kChunkRows, gb.height)) : gb.height;
 
+    // Counting mode: pixel px's thread, with its work (hit pixels: `p`).
+    const auto record = [&](std::size_t px, const GroupPixel* p) {
+        if constexpr (Count) {
+            const GBufferTexel& g = gb.texels[px];
+            ThreadCounters& t = in.counters->threads[px];
+            recordTexel(t, g, in.particles, in.bvh, gpu_layout::kGBufferTexel);
+            t.bytesWritten += gpu_layout::kRadiance;
+            if (!p) return;
+            t.trips = static_cast<std::uint32_t>(p->sums.c.lightTerms);
+            t.bytesRead += t.trips * gpu_layout::kParticleRecord;
+            t.addRays(p->rays, static_cast<std::uint32_t>(p->sums.c.shadowRays));
+        }
+    };
+
     tbb::parallel_for(tbb::blocked_range2d<std::uint32_t>(row0, row1, 8, 0, gb.width, 8), [&](const auto& r) {
         LightingCounters& c = counters.local();
+        GroupPixel pix[kGroupPixels];
         for (std::uint32_t y = r.rows().begin(); y != r.rows().end(); ++y) {
-            for (std::uint32_t x = r.cols().begin(); x != r.cols().end(); ++x) {
-                const std::size_t px = std::size_t(y) * gb.width + x;
-                const GBufferTexel& g = gb.texels[px];
-                [[maybe_unused]] const LightingCounters before = c;
-                RayCounters raySum;
-                RayCounters* rc = Count ? &raySum : nullptr;
-                const auto record = [&] {
-                    if constexpr (Count) {
-                        ThreadCounters& t = in.counters->threads[px];
-                        recordTexel(t, g, in.particles, in.bvh, gpu_layout::kGBufferTexel);
-                        t.bytesWritten += gpu_layout::kRadiance;
-                        if (!g.hit()) return;
-                        t.trips = static_cast<std::uint32_t>(c.lightTerms - before.lightTerms);
-                        t.bytesRead += t.trips * gpu_layout::kParticleRecord;
-                        t.addRays(raySum, static_cast<std::uint32_t>(c.shadowRays - before.shadowRays));
+            for (std::uint32_t x0 = r.cols().begin(); x0 < r.cols().end(); x0 += kGroupPixels) {
+                const std::uint32_t x1 = std::min(r.cols().end(), x0 + kGroupPixels);
+                std::uint32_t n = 0;
+                for (std::uint32_t x = x0; x != x1; ++x) {
+                    const std::size_t px = std::size_t(y) * gb.width + x;
+                    const GBufferTexel& g = gb.texels[px];
+                    if (!g.hit()) {  // nothing to add: sums stay 0
+                        record(px, nullptr);
+                        if (!acc) {
+                            out->Lr[px] = out->Lr_stderr[px] = Vec3(0.0f);
+                            out->spp[px] = out->rejected[px] = 0.0f;
+                        }
+                        continue;
                     }
-                };
-                if (!g.hit()) {  // nothing to add: sums stay 0
-                    record();
-                    if (!acc) {
-                        out->Lr[px] = out->Lr_stderr[px] = Vec3(0.0f);
-                        out->spp[px] = out->rejected[px] = 0.0f;
-                    }
-                    continue;
+                    GroupPixel& p = pix[n++];
+                    p.px = px;
+                    p.sp = shadingPoint(g, in.particles);
+                    p.sums = PixelSums{.policy = in.render.nonfinite};
+                    p.rays = RayCounters{};
+                    if (acc) p.sums.load(*acc, px);
                 }
-                PixelSums sums{.policy = in.render.nonfinite, .c = c};
-                if (acc) sums.load(*acc, px);
-                const auto finish = [&] {
-                    record();
-                    if (acc) sums.store(*acc, px);
-                    else c.nonFinite += resolvePixel(sums.sum, sums.sumSq, sums.n, sums.rejected, plan.exact, *out, px);
-                };
-                const ShadingPoint sp = shadingPoint(g, in.particles);
+                if (n == 0) continue;
                 if (kind == EstimatorKind::exact) {
-                    const DVec3 v = exactPixel<M, P>(in.bvh, L, sp, vis, shadows, c, rc);
-                    if (finite(v)) sums.sum = v;
-                    else sums.reject();  // exact has one value: 0 either way
-                    sums.n = 1;
-                    finish();
-                    continue;
+                    for (std::uint32_t k = 0; k < n; ++k) {
+                        PixelSums& s = pix[k].sums;
+                        const DVec3 v = exactPixel<M, P>(in.bvh, L, pix[k].sp, vis, shadows, s.c, Count ? &pix[k].rays : nullptr);
+                        if (finite(v)) s.sum = v;
+                        else s.reject();  // exact has one value: 0 either way
+                        s.n = 1;
+                    }
+                } else if (kind == EstimatorKind::ris) {
+                    runChunks<M, P, Count, EstimatorKind::ris>(in, L, plan, vis, shadows, c0, c1, pix, n);
+                } else if (kind == EstimatorKind::power) {
+                    runChunks<M, P, Count, EstimatorKind::power>(in, L, plan, vis, shadows, c0, c1, pix, n);
+                } else if (kind == EstimatorKind::tree) {
+                    runChunks<M, P, Count, EstimatorKind::tree>(in, L, plan, vis, shadows, c0, c1, pix, n);
+                } else {
+                    runChunks<M, P, Count, EstimatorKind::uniform>(in, L, plan, vis, shadows, c0, c1, pix, n);
                 }
-                for (std::uint64_t chunk = c0; chunk < c1 && !sums.done; ++chunk) {
-                    Rng rng(px, in.frame, RngPass::lightSampling, in.render.seed, chunk + 1);
-                    const std::uint32_t count = plan.chunkSamples(chunk);
-                    if (kind == EstimatorKind::ris && in.render.source == LightSource::power)
-                        risChunk<M, P, true>(in.bvh, L, in.powerTable, sp, count, in.render.candidates, vis, shadows, rng, sums, rc);
-                    else if (kind == EstimatorKind::ris)
-                        risChunk<M, P, false>(in.bvh, L, nullptr, sp, count, in.render.candidates, vis, shadows, rng, sums, rc);
-                    else if (kind == EstimatorKind::power)
-                        sampleChunk<M, P>(in.bvh, L, [&](Rng& g) { return sampleSource<true>(L, in.powerTable, g); },
-                                          sp, count, vis, shadows, rng, sums, rc);
-                    else if (kind == EstimatorKind::tree)
-                        sampleChunk<M, P>(in.bvh, L, [&](Rng& g) { return in.lightTree->sample(sp, g); }, sp, count,
-                                          vis, shadows, rng, sums, rc);
-                    else
-                        sampleChunk<M, P>(in.bvh, L, [&](Rng& g) { return sampleSource<false>(L, nullptr, g); }, sp,
-                                          count, vis, shadows, rng, sums, rc);
-                    if (plan.adaptive && (chunk + 1) % plan.chunksPerRound == 0)
-                        sums.done = roundDone(sums.sum, sums.sumSq, sums.n,
-                                              static_cast<std::uint32_t>((chunk + 1) / plan.chunksPerRound), in.render);
+                for (std::uint32_t k = 0; k < n; ++k) {
+                    GroupPixel& p = pix[k];
+                    record(p.px, &p);
+                    if (acc) p.sums.store(*acc, p.px);
+                    else p.sums.c.nonFinite += resolvePixel(p.sums.sum, p.sums.sumSq, p.sums.n, p.sums.rejected, plan.exact, *out, p.px);
+                    c += p.sums.c;
                 }
-                finish();
             }
         }
         if (progress) progress->advance(std::uint64_t(r.rows().size()) * r.cols().size() * (plan.exact ? 1 : c1 - c0));

@@ -42,7 +42,6 @@ void trace(const ParticleBvh& bvh, const Particles& particles, const Camera& cam
             const DVec3 n = len > 0.0 ? local / len : -ray;
             g.local = Vec3(double(rj) * n);
             g.normal = g.geomNormal = Vec3(n);
-            g.uv = Vec2(0.5f + 0.5f * glm::dot(g.normal, camera.right), 0.5f + 0.5f * glm::dot(g.normal, camera.up));
         } else {
             const BillboardFrame& f = bvh.frame(j);
             const DVec3 R(f.right), U(f.up), N = glm::cross(R, U);
@@ -53,14 +52,17 @@ void trace(const ParticleBvh& bvh, const Particles& particles, const Camera& cam
                                              : (2.0 * double(hit.uv.x) - 1.0) * double(rj) * R +
                                                    (2.0 * double(hit.uv.y) - 1.0) * double(rj) * U;
             g.local = Vec3(local);
-            g.uv = Vec2(glm::clamp(0.5 + 0.5 * glm::dot(local, R) / double(rj), 0.0, 1.0),
-                        glm::clamp(0.5 + 0.5 * glm::dot(local, U) / double(rj), 0.0, 1.0));
             g.geomNormal = glm::normalize(f.normal());
             if (glm::dot(g.geomNormal, dir) > 0.0f) g.geomNormal = -g.geomNormal;
-            g.normal = model == ShadingModel::sphere ? impostorNormal(f, g.uv) : g.geomNormal;
+            if (model == ShadingModel::sphere) {
+                const Vec2 uv(glm::clamp(0.5 + 0.5 * glm::dot(local, R) / double(rj), 0.0, 1.0),
+                              glm::clamp(0.5 + 0.5 * glm::dot(local, U) / double(rj), 0.0, 1.0));
+                g.normal = impostorNormal(f, uv);
+            } else {
+                g.normal = g.geomNormal;
+            }
         }
-        g.position = p + g.local;
-        g.depth = glm::dot(g.position - camera.position, camera.forward);
+        g.depth = glm::dot((p + g.local) - camera.position, camera.forward);
     };
 
     // 8x8 tiles at fixed positions, so that the packets (tile rows) do not
@@ -80,6 +82,7 @@ void trace(const ParticleBvh& bvh, const Particles& particles, const Camera& cam
                 for (int k = 0; k < n; ++k) {
                     const std::size_t px = std::size_t(y) * camera.width + x0 + k;
                     if (found[k]) fill(px, x0 + k, y, dirs[k], hits[k]);
+                    else gbuffer.texels[px] = GBufferTexel{};
                     if constexpr (Count) {
                         // The counters come from the ray a GPU thread traces: one
                         // ray through the counting TLAS (its hit is the same).
@@ -105,7 +108,7 @@ std::uint64_t traceGBuffer(const ParticleBvh& bvh, const Particles& particles, c
                            ShadingModel model, GBuffer& gbuffer, PassCounters* counters) {
     gbuffer.width = camera.width;
     gbuffer.height = camera.height;
-    gbuffer.texels.assign(std::size_t(camera.width) * camera.height, GBufferTexel{});
+    gbuffer.texels.resize(std::size_t(camera.width) * camera.height);  // every texel is written by the trace
     if (counters) trace<true>(bvh, particles, camera, model, gbuffer, counters);
     else trace<false>(bvh, particles, camera, model, gbuffer, nullptr);
     return std::uint64_t(camera.width) * camera.height;

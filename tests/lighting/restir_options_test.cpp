@@ -141,7 +141,7 @@ TEST_CASE("partial BVH rebuild: a round-robin fraction of clusters, identical im
     std::size_t hits = 0;
     for (std::size_t px = 0; px < a.texels.size(); ++px) {
         REQUIRE(a.texels[px].particle == b.texels[px].particle);
-        REQUIRE(a.texels[px].position == b.texels[px].position);
+        REQUIRE(a.texels[px].local == b.texels[px].local);
         hits += a.texels[px].hit();
     }
     CHECK(hits > 100);

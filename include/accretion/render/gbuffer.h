@@ -13,17 +13,21 @@ namespace accretion {
 
 inline constexpr std::uint32_t kNoParticle = std::numeric_limits<std::uint32_t>::max();
 
-/// One G-buffer texel: what the primary ray through the pixel centre hit.
+/// One G-buffer texel: what the primary ray through the pixel centre hit
+/// (44 bytes: the lighting passes stream it for every pixel). The hit point
+/// x is p_j + local, rounded once.
 struct GBufferTexel {
     std::uint32_t particle = kNoParticle; ///< hit particle, kNoParticle on a miss
-    Vec3 position{0.0f};                  ///< x on the particle's surface (frame coordinates)
     Vec3 local{0.0f};                     ///< x - p_j, from the pixel ray intersected in double
     Vec3 normal{0.0f};                    ///< shading normal n
     Vec3 geomNormal{0.0f};                ///< geometric normal (origin offsets)
     float depth = 0.0f;                   ///< camera-space z (along the view direction)
-    Vec2 uv{0.0f};                        ///< quad uv
     bool hit() const { return particle != kNoParticle; }
+    /// x in frame coordinates.
+    Vec3 position(const Particles& particles) const { return particles.position[particle] + local; }
 };
+
+static_assert(sizeof(GBufferTexel) == 44, "the texel the lighting passes stream");
 
 struct GBuffer {
     std::uint32_t width = 0, height = 0;
@@ -33,7 +37,8 @@ struct GBuffer {
 
 /// The shading point of a hit texel.
 inline ShadingPoint shadingPoint(const GBufferTexel& g, const Particles& particles) {
-    return {g.position, g.normal, g.geomNormal, particles.albedo[g.particle], g.particle, particles.position[g.particle], g.local};
+    const Vec3 centre = particles.position[g.particle];
+    return {centre + g.local, g.normal, g.geomNormal, particles.albedo[g.particle], g.particle, centre, g.local};
 }
 
 /// Counting mode: a pixel thread that reads texel g, with its branch key
