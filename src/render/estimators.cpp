@@ -18,6 +18,18 @@
 namespace accretion {
 namespace {
 
+/// V(x, p_i) of a light with a non-zero term t: one shadow ray, counted
+/// (visibility off: 1, no ray).
+template <Primitive P>
+inline bool seen(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint& sp, std::uint32_t i, const LightTerm& t,
+                 const VisibilityOptions& vis, bool shadows, LightingCounters& c, RayCounters* rc) {
+    if (!shadows) return true;
+    ++c.shadowRays;
+    if (visible<P>(bvh, vis, sp, i, L.packed[i].position, L.packed[i].radius, t, rc)) return true;
+    ++c.shadowOccluded;
+    return false;
+}
+
 /// exact: sum over every light i != j of f I G V, in double.
 template <ShadingModel M, Primitive P>
 DVec3 exactPixel(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint& sp, const VisibilityOptions& vis, bool shadows,
@@ -28,13 +40,7 @@ DVec3 exactPixel(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoin
         LightTerm t;
         ++c.lightTerms;
         if (!evalLight<M>(sp, L.position[i], L.emission[i], L.packed[i].dmin2, t)) continue;
-        if (!shadows) {
-            sum += DVec3(t.value);
-            continue;
-        }
-        ++c.shadowRays;
-        if (visible<P>(bvh, vis, sp, i, L.packed[i].position, L.packed[i].radius, t, rc)) sum += DVec3(t.value);
-        else ++c.shadowOccluded;
+        if (seen<P>(bvh, L, sp, i, t, vis, shadows, c, rc)) sum += DVec3(t.value);
     }
     return sum;
 }
@@ -142,19 +148,8 @@ void shadeSamples(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoi
         const LightSample& x = xs[k];
         LightTerm t;
         ++c.lightTerms;
-        if (!L.term<M>(sp, x.i, t)) {
-            acc.addZero();
-            continue;
-        }
-        if (shadows) {
-            ++c.shadowRays;
-            if (!visible<P>(bvh, vis, sp, x.i, L.packed[x.i].position, L.packed[x.i].radius, t, rc)) {
-                ++c.shadowOccluded;
-                acc.addZero();
-                continue;
-            }
-        }
-        acc.add(DVec3(t.value) / double(x.pdf));
+        if (L.term<M>(sp, x.i, t) && seen<P>(bvh, L, sp, x.i, t, vis, shadows, c, rc)) acc.add(DVec3(t.value) / double(x.pdf));
+        else acc.addZero();
     }
 }
 
@@ -191,15 +186,8 @@ void risChunk(const ParticleBvh& bvh, const LightArrays& L, const AliasTable* ta
             acc.addZero();
             continue;
         }
-        if (shadows) {
-            ++c.shadowRays;
-            if (!visible<P>(bvh, vis, sp, r.y, L.packed[r.y].position, L.packed[r.y].radius, t_y, rc)) {
-                ++c.shadowOccluded;
-                acc.addZero();
-                continue;
-            }
-        }
-        acc.add(DVec3(t_y.value) * double(r.W));
+        if (seen<P>(bvh, L, sp, r.y, t_y, vis, shadows, c, rc)) acc.add(DVec3(t_y.value) * double(r.W));
+        else acc.addZero();
     }
 }
 
@@ -220,7 +208,7 @@ struct GroupPixel {
     ShadingPoint sp;
     PixelSums sums;
     RayCounters rays;       ///< counting mode: its shadow rays' traversal
-    LightSample xs[LightingPlan::kChunkSamples];
+    LightSample xs[LightingPlan::kChunkSamples];  ///< a chunk's lights (chunkSamples() <= kChunkSamples)
 };
 
 /// Pixels shaded together: up to this many of a tile row.
@@ -247,7 +235,6 @@ void runChunk(const LightingInputs& in, const LightArrays& L, const VisibilityOp
             else risChunk<M, P, false>(in.bvh, L, nullptr, p.sp, count, in.render.candidates, vis, shadows, rng, p.sums, rc);
         }
     } else {
-        ACC_CHECK(count <= LightingPlan::kChunkSamples);
         for (std::uint32_t k = 0; k < n; ++k) {
             if (pix[k].sums.done) continue;
             Rng rng = stream(pix[k]);

@@ -15,7 +15,7 @@ inline constexpr std::uint32_t kNoParticle = std::numeric_limits<std::uint32_t>:
 
 /// One G-buffer texel: what the primary ray through the pixel centre hit
 /// (44 bytes: the lighting passes stream it for every pixel). The hit point
-/// x is p_j + local, rounded once.
+/// is not stored: shadingPoint() forms x = p_j + local.
 struct GBufferTexel {
     std::uint32_t particle = kNoParticle; ///< hit particle, kNoParticle on a miss
     Vec3 local{0.0f};                     ///< x - p_j, from the pixel ray intersected in double
@@ -23,8 +23,6 @@ struct GBufferTexel {
     Vec3 geomNormal{0.0f};                ///< geometric normal (origin offsets)
     float depth = 0.0f;                   ///< camera-space z (along the view direction)
     bool hit() const { return particle != kNoParticle; }
-    /// x in frame coordinates.
-    Vec3 position(const Particles& particles) const { return particles.position[particle] + local; }
 };
 
 static_assert(sizeof(GBufferTexel) == 44, "the texel the lighting passes stream");
