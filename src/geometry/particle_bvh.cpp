@@ -17,19 +17,23 @@ double secondsSince(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+inline constexpr std::uint64_t kNoKey = ~std::uint64_t(0);
+
 /// Every query's context: the counters of the ray (null unless counting)
-/// and, for occlusion queries, the particles excluded by identity.
+/// and, for occlusion queries, the keys (cluster << 32 | primitive) of the
+/// particles excluded by identity.
 struct QueryContext {
     RTCIntersectContext base;
     RayCounters* counters;
-    Exclusion exclude;
+    std::uint64_t exclude[2];
 };
 
-QueryContext queryContext(RayCounters* counters, Exclusion exclude = {}) {
+QueryContext queryContext(RayCounters* counters, std::uint64_t receiver = kNoKey, std::uint64_t light = kNoKey) {
     QueryContext c;
     rtcInitIntersectContext(&c.base);
     c.counters = counters;
-    c.exclude = exclude;
+    c.exclude[0] = receiver;
+    c.exclude[1] = light;
     return c;
 }
 
@@ -55,22 +59,28 @@ inline bool passesAlpha(const AlphaTest& alpha, const RTCFilterFunctionNArgument
 
 /// Closest-hit queries on disc-alpha billboards: the alpha test.
 void discAlphaFilter(const RTCFilterFunctionNArguments* args) {
-    const auto* g = static_cast<const ClusterGeometry*>(args->geometryUserPtr);
+    const auto* alpha = static_cast<const AlphaTest*>(args->geometryUserPtr);
     RayCounters* counters = reinterpret_cast<const QueryContext*>(args->context)->counters;
     for (unsigned i = 0; i < args->N; ++i)
-        if (args->valid[i] == -1 && !passesAlpha(*g->alpha, args, i, counters)) args->valid[i] = 0;
+        if (args->valid[i] == -1 && !passesAlpha(*alpha, args, i, counters)) args->valid[i] = 0;
 }
 
 /// Occlusion queries: the receiver and the light are excluded by identity
-/// (MODEL.md section 3), then the alpha test of the other candidates.
+/// (MODEL.md section 3), then (Alpha) the alpha test of the other candidates.
+/// The identity is the hit's (instance, primitive) key, so that the filter
+/// reads nothing but its arguments (a particle-index lookup here was a cache
+/// miss on most calls).
+template <bool Alpha>
 void occlusionFilter(const RTCFilterFunctionNArguments* args) {
-    const auto* g = static_cast<const ClusterGeometry*>(args->geometryUserPtr);
     const auto* context = reinterpret_cast<const QueryContext*>(args->context);
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] != -1) continue;
-        const std::uint32_t particle = g->members[RTCHitN_primID(args->hit, args->N, i)];
-        if (particle == context->exclude.receiver || particle == context->exclude.light) args->valid[i] = 0;
-        else if (g->alpha && !passesAlpha(*g->alpha, args, i, context->counters)) args->valid[i] = 0;
+        const std::uint64_t key = std::uint64_t(RTCHitN_instID(args->hit, args->N, i, 0)) << 32 |
+                                  RTCHitN_primID(args->hit, args->N, i);
+        if (key == context->exclude[0] || key == context->exclude[1]) args->valid[i] = 0;
+        else if constexpr (Alpha) {
+            if (!passesAlpha(*static_cast<const AlphaTest*>(args->geometryUserPtr), args, i, context->counters)) args->valid[i] = 0;
+        }
     }
 }
 
@@ -182,14 +192,16 @@ void ParticleBvh::buildBlas(std::size_t c, const Particles& particles, bool crea
             auto* idx = static_cast<std::uint32_t*>(
                 rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT4, sizeof(std::uint32_t) * 4, n));
             for (std::uint32_t k = 0; k < 4 * n; ++k) idx[k] = k;
-            if (settings_.alpha == AlphaMode::disc) rtcSetGeometryIntersectFilterFunction(geom, &discAlphaFilter);
         } else {
             rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, sizeof(float) * 4, n);
         }
         // Every occlusion query excludes its receiver and light by identity.
-        clusterGeometry_[c] = {members.data(), billboards && settings_.alpha == AlphaMode::disc ? &alpha_ : nullptr};
-        rtcSetGeometryUserData(geom, &clusterGeometry_[c]);
-        rtcSetGeometryOccludedFilterFunction(geom, &occlusionFilter);
+        const bool alpha = billboards && settings_.alpha == AlphaMode::disc;
+        if (alpha) {
+            rtcSetGeometryUserData(geom, const_cast<AlphaTest*>(&alpha_));
+            rtcSetGeometryIntersectFilterFunction(geom, &discAlphaFilter);
+        }
+        rtcSetGeometryOccludedFilterFunction(geom, alpha ? &occlusionFilter<true> : &occlusionFilter<false>);
         rtcAttachGeometryByID(scene, geom, 0);
         rtcReleaseGeometry(geom);  // the scene keeps it
         blas_[c] = scene;
@@ -199,6 +211,7 @@ void ParticleBvh::buildBlas(std::size_t c, const Particles& particles, bool crea
     auto* vtx = static_cast<float*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, 0));
     for (std::size_t k = 0; k < n; ++k) {
         const std::uint32_t i = members[k];
+        if (create) where_[i] = std::uint64_t(c) << 32 | k;
         const Vec3 p = particles.position[i];
         const float r = particles.radius[i];
         if (billboards) {
@@ -283,7 +296,7 @@ void ParticleBvh::build(const Particles& particles, const Camera& camera) {
         releaseBlas();
         blas_.assign(clusters_.count(), nullptr);
         geometry_.assign(clusters_.count(), nullptr);
-        clusterGeometry_.assign(clusters_.count(), ClusterGeometry{});
+        where_.resize(n);
     }
     // partial: a window of rebuild_fraction of the clusters, advancing round
     // robin frame by frame; the others keep last frame's (stale) geometry.
@@ -303,12 +316,7 @@ void ParticleBvh::build(const Particles& particles, const Camera& camera) {
 
     t0 = std::chrono::steady_clock::now();
     buildTlas();
-    if (counting_) {
-        buildCountingTlas();
-        clusterOf_.assign(n, 0);
-        for (std::size_t c = 0; c < clusters_.count(); ++c)
-            for (std::uint32_t i : clusters_.members(c)) clusterOf_[i] = static_cast<std::uint32_t>(c);
-    }
+    if (counting_) buildCountingTlas();
     device_.check("buildClusters (TLAS)");
     stats_.tlasSeconds = secondsSince(t0);
 
@@ -384,7 +392,8 @@ void ParticleBvh::intersect8(const Vec3& o, const Vec3* d, int n, SurfaceHit* hi
 
 bool ParticleBvh::occluded(const Vec3& o, const Vec3& d, float tnear, float tfar, Exclusion exclude,
                            RayCounters* counters) const {
-    QueryContext context = queryContext(counters, exclude);
+    QueryContext context = queryContext(counters, exclude.receiver == kNotExcluded ? kNoKey : where_[exclude.receiver],
+                                        exclude.light == kNotExcluded ? kNoKey : where_[exclude.light]);
     RTCRay ray;
     ray.org_x = o.x;
     ray.org_y = o.y;

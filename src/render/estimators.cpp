@@ -134,7 +134,10 @@ void drawLights(const LightingInputs& in, const LightArrays& L, const ShadingPoi
         if constexpr (K == EstimatorKind::power) xs[k] = sampleSource<true>(L, in.powerTable, rng);
         else if constexpr (K == EstimatorKind::tree) xs[k] = in.lightTree->sample(sp, rng);
         else xs[k] = sampleSource<false>(L, nullptr, rng);
-        if (xs[k].i < L.count) __builtin_prefetch(&L.packed[xs[k].i]);
+        if (xs[k].i < L.count) {
+            __builtin_prefetch(&L.packed[xs[k].i]);
+            in.bvh.prefetchExclusion(xs[k].i);
+        }
     }
 }
 
@@ -303,11 +306,19 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
         for (std::uint32_t y = r.rows().begin(); y != r.rows().end(); ++y) {
             for (std::uint32_t x0 = r.cols().begin(); x0 < r.cols().end(); x0 += kGroupPixels) {
                 const std::uint32_t x1 = std::min(r.cols().end(), x0 + kGroupPixels);
+                const std::size_t row = std::size_t(y) * gb.width;
+                // The next group's texels (the next row's at a row's end) are
+                // read soon: a range's rows are short runs of the G-buffer.
+                const std::size_t next = x1 < r.cols().end() ? row + x1 : row + gb.width + r.cols().begin();
+                if (next + kGroupPixels <= gb.texels.size())
+                    for (std::size_t b = 0; b < kGroupPixels * sizeof(GBufferTexel); b += 64)
+                        __builtin_prefetch(reinterpret_cast<const char*>(&gb.texels[next]) + b);
+                // The group's hits first, their particles' records prefetched.
                 std::uint32_t n = 0;
                 for (std::uint32_t x = x0; x != x1; ++x) {
-                    const std::size_t px = std::size_t(y) * gb.width + x;
-                    const GBufferTexel& g = gb.texels[px];
-                    if (!g.hit()) {  // nothing to add: sums stay 0
+                    const std::size_t px = row + x;
+                    const std::uint32_t j = gb.texels[px].particle;
+                    if (j == kNoParticle) {  // nothing to add: sums stay 0
                         record(px, nullptr);
                         if (!acc) {
                             out->Lr[px] = out->Lr_stderr[px] = Vec3(0.0f);
@@ -315,12 +326,17 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
                         }
                         continue;
                     }
-                    GroupPixel& p = pix[n++];
-                    p.px = px;
-                    p.sp = shadingPoint(g, in.particles);
-                    p.sums = PixelSums{.policy = in.render.nonfinite};
+                    __builtin_prefetch(&in.particles.position[j]);
+                    __builtin_prefetch(&in.particles.albedo[j]);
+                    pix[n++].px = px;
+                }
+                for (std::uint32_t k = 0; k < n; ++k) {
+                    GroupPixel& p = pix[k];
+                    p.sp = shadingPoint(gb.texels[p.px], in.particles);
+                    p.sums = PixelSums{};
+                    p.sums.policy = in.render.nonfinite;
                     p.rays = RayCounters{};
-                    if (acc) p.sums.load(*acc, px);
+                    if (acc) p.sums.load(*acc, p.px);
                 }
                 if (n == 0) continue;
                 if (kind == EstimatorKind::exact) {

@@ -27,3 +27,26 @@ TEST_CASE("uniform() is uniform on the unit interval (chi-square, 64 bins)", "[r
     }
     CHECK(accretion::test::chiSquarePValue(observed, expected) > 1e-4);
 }
+
+TEST_CASE("uniformInt(IntBound) draws the numbers of pcg's bounded_rand", "[rng]") {
+    // The remainder by multiplication against %, on the bounds and draws
+    // where it could go wrong (1, powers of two and their neighbours, the
+    // largest bounds and draws) and on random ones.
+    std::vector<std::uint32_t> bounds = {1, 2, 3, 5, 7, 1000, 100'000, 999'983, 0x7fffffffu, 0x80000000u, 0x80000001u,
+                                         0xfffffffeu, 0xffffffffu};
+    for (int k = 2; k < 32; ++k) bounds.insert(bounds.end(), {(1u << k) - 1, 1u << k, (1u << k) + 1});
+    Rng pick(7, 0, RngPass::particles, 1);
+    for (int k = 0; k < 2000; ++k) bounds.push_back(std::max(1u, pick.next() >> (pick.next() % 32)));
+    for (const std::uint32_t n : bounds) {
+        const IntBound b(n);
+        REQUIRE(b.threshold == (0u - n) % n);
+        for (const std::uint32_t r : {0u, 1u, n - 1, n, n + 1, 0xffffffffu, 0xfffffffeu, 0x80000000u})
+            REQUIRE(b.mod(r) == r % n);
+        for (int i = 0; i < 200; ++i) {
+            const std::uint32_t r = pick.next();
+            REQUIRE(b.mod(r) == r % n);
+        }
+        Rng x(n, 1, RngPass::lightSampling, 2), y(n, 1, RngPass::lightSampling, 2);
+        for (int i = 0; i < 20; ++i) REQUIRE(x.uniformInt(b) == y.uniformInt(n));
+    }
+}

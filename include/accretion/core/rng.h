@@ -33,6 +33,25 @@ constexpr std::uint64_t streamKey(std::uint64_t item, std::uint32_t frame, RngPa
     return sub ? mix64(h ^ sub) : h;
 }
 
+/// A bound n of uniform integers in [0, n), with the two divisions of
+/// pcg's bounded_rand done once: Rng::uniformInt(IntBound) draws the same
+/// numbers as Rng::uniformInt(n) (the same rejection threshold, then r mod n
+/// by Lemire, Kaser & Kurz's exact 32-bit remainder: two multiplications).
+struct IntBound {
+    std::uint32_t n = 1;
+    std::uint32_t threshold = 0;  ///< 2^32 mod n: draws below it are rejected
+    std::uint64_t m = 0;          ///< ceil(2^64 / n) (0 for n = 1)
+
+    IntBound() = default;
+    explicit IntBound(std::uint32_t bound)
+        : n(bound), threshold((0u - bound) % bound), m(~std::uint64_t(0) / bound + 1) {}
+    /// r mod n, exact for every 32-bit r.
+    std::uint32_t mod(std::uint32_t r) const {
+        const std::uint64_t low = m * r;
+        return static_cast<std::uint32_t>((static_cast<unsigned __int128>(low) * n) >> 64);
+    }
+};
+
 /// PCG32 stream of one pixel (or particle) in one pass of one frame.
 class Rng {
 public:
@@ -43,6 +62,13 @@ public:
     float uniform() { return static_cast<float>(pcg_() >> 8) * 0x1p-24f; }
     /// Uniform integer in [0, n).
     std::uint32_t uniformInt(std::uint32_t n) { return pcg_(n); }
+    /// The same number as uniformInt(b.n), without divisions.
+    std::uint32_t uniformInt(const IntBound& b) {
+        for (;;) {
+            const std::uint32_t r = pcg_();
+            if (r >= b.threshold) return b.mod(r);
+        }
+    }
     std::uint32_t next() { return pcg_(); }
 
 private:

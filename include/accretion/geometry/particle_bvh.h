@@ -47,13 +47,6 @@ struct AlphaTest {
     const OpacityMicromap* omm = nullptr;
 };
 
-/// What the filter callbacks of one cluster's geometry read: its particles
-/// (primID -> particle) and the alpha test (null: opaque).
-struct ClusterGeometry {
-    const std::uint32_t* members = nullptr;
-    const AlphaTest* alpha = nullptr;
-};
-
 inline constexpr std::uint32_t kNotExcluded = 0xffffffffu;
 
 /// The primitives an occlusion query ignores by identity (MODEL.md section
@@ -98,8 +91,11 @@ public:
     bool counting() const { return counting_; }
     /// The opacity micromap in use (null without one).
     const OpacityMicromap* micromap() const { return omm_.get(); }
-    /// Cluster of particle i (counting mode only).
-    std::uint32_t clusterOf(std::uint32_t i) const { return clusterOf_[i]; }
+    /// Hint that occlusion queries excluding particle i will follow (its
+    /// identity key is a random read).
+    void prefetchExclusion(std::uint32_t i) const { __builtin_prefetch(&where_[i]); }
+    /// Cluster of particle i.
+    std::uint32_t clusterOf(std::uint32_t i) const { return static_cast<std::uint32_t>(where_[i] >> 32); }
     /// BLAS of cluster c (for the counting instances).
     RTCScene blas(std::size_t c) const { return blas_[c]; }
     /// World bounds of cluster c's BLAS in the current build.
@@ -123,12 +119,13 @@ private:
     std::vector<BillboardFrame> frames_;
     std::vector<RTCScene> blas_;
     std::vector<RTCGeometry> geometry_;  // one per BLAS, owned by its scene
-    std::vector<ClusterGeometry> clusterGeometry_;  ///< the filters' user data, one per BLAS
     RTCScene tlas_ = nullptr;
     bool counting_ = false;
     RTCScene countingTlas_ = nullptr;      ///< user-geometry instances that count entries
     std::vector<RTCBounds> blasBounds_;
-    std::vector<std::uint32_t> clusterOf_;  ///< counting: particle -> cluster
+    /// particle -> (cluster << 32 | its primitive in the cluster's BLAS): the
+    /// key an occlusion query's filter compares with Embree's (instID, primID)
+    std::vector<std::uint64_t> where_;
     std::unique_ptr<OpacityMicromap> omm_;
     AlphaTest alpha_;
     std::size_t partialCursor_ = 0;  ///< partial: first cluster of the next window

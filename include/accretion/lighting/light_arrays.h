@@ -29,6 +29,7 @@ struct LightArrays {
     const float* radius = nullptr;
     std::vector<PackedLight> packed;
     std::uint32_t count = 0;
+    IntBound countBound;       ///< [0, count) without divisions
     float uniformPdf = 0.0f;   ///< 1 / count
 
     LightArrays() = default;
@@ -38,6 +39,7 @@ struct LightArrays {
         radius = particles.radius.data();
         count = static_cast<std::uint32_t>(particles.size());
         uniformPdf = count ? 1.0f / float(count) : 0.0f;
+        if (count) countBound = IntBound(count);
         packed.resize(count);
         const float dmin = static_cast<float>(shading.dmin);
         for (std::uint32_t i = 0; i < count; ++i) {
@@ -66,11 +68,11 @@ struct LightArrays {
 template <bool Power>
 LightSample sampleSource(const LightArrays& L, const AliasTable* table, Rng& rng) {
     if constexpr (Power) {
-        const std::uint32_t bucket = rng.uniformInt(L.count);
+        const std::uint32_t bucket = rng.uniformInt(L.countBound);
         const std::uint32_t i = table->sample(bucket, rng.uniform());
         return {i, table->pmf(i)};
     } else {
-        return {rng.uniformInt(L.count), L.uniformPdf};
+        return {rng.uniformInt(L.countBound), L.uniformPdf};
     }
 }
 
