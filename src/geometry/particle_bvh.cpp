@@ -211,6 +211,13 @@ void ParticleBvh::buildBlas(std::size_t c, const Particles& particles, bool crea
     auto* vtx = static_cast<float*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, 0));
     for (std::size_t k = 0; k < n; ++k) {
         const std::uint32_t i = members[k];
+        if (k + 8 < n) {  // members are scattered over the particle arrays
+            const std::uint32_t ahead = members[k + 8];
+            __builtin_prefetch(&particles.position[ahead]);
+            __builtin_prefetch(&particles.radius[ahead]);
+            if (billboards) __builtin_prefetch(&frames_[ahead]);
+            if (create) __builtin_prefetch(&where_[ahead], 1);
+        }
         if (create) where_[i] = std::uint64_t(c) << 32 | k;
         const Vec3 p = particles.position[i];
         const float r = particles.radius[i];
