@@ -72,7 +72,7 @@ void BM_TargetPdf(benchmark::State& state) {
     Rng rng(3, 0, RngPass::lightSampling, 0);
     const ShadingPoint sp = l.receiver(12345);
     float sum = 0.0f;
-    for (auto _ : state) sum += l.L.targetPdf<ShadingModel::lambert>(sp, rng.uniformInt(l.L.count));
+    for (auto _ : state) sum += l.L.targetPdf<ShadingModel::lambert>(sp, rng.uniformInt(l.L.countBound));
     benchmark::DoNotOptimize(sum);
     state.SetItemsProcessed(state.iterations());
 }
