@@ -2,7 +2,7 @@
 # Regenerates the issue-3 experiments (CSV, JSON, PNG plots, bias maps) under
 # out/experiments. Nothing here is committed output: run it to get the plots.
 #   scripts/run_experiments.sh [all|reference|converge|table|bias|sequence]
-# Times on the project's 2-core AMD EPYC VM at commit 8bd5a6c: all ~19 min
+# Times on the project's 2-core AMD EPYC VM at commits 8bd5a6c and 171b6fd: all ~19 min
 # (references ~8 min, converge ~7 min, table ~2 min, bias ~2 min, sequence ~20 s).
 set -euo pipefail
 cd "$(dirname "$0")/.."

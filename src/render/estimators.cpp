@@ -330,6 +330,7 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
                     __builtin_prefetch(&in.particles.albedo[j]);
                     pix[n++].px = px;
                 }
+                if (n == 0) continue;
                 for (std::uint32_t k = 0; k < n; ++k) {
                     GroupPixel& p = pix[k];
                     p.sp = shadingPoint(gb.texels[p.px], in.particles);
@@ -338,7 +339,6 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
                     p.rays = RayCounters{};
                     if (acc) p.sums.load(*acc, p.px);
                 }
-                if (n == 0) continue;
                 if (kind == EstimatorKind::exact) {
                     for (std::uint32_t k = 0; k < n; ++k) {
                         PixelSums& s = pix[k].sums;
