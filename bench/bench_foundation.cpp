@@ -6,7 +6,7 @@
 
 #include "accretion/geometry/particle_bvh.h"
 #include "accretion/particles/particle_source.h"
-#include "accretion/render/camera.h"
+#include "accretion/geometry/camera.h"
 #include "accretion/render/estimators.h"
 #include "accretion/render/gbuffer.h"
 

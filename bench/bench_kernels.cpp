@@ -10,6 +10,7 @@
 
 #include "accretion/core/rng.h"
 #include "accretion/lighting/light_arrays.h"
+#include "accretion/lighting/light_sampler.h"
 #include "accretion/lighting/light_tree.h"
 #include "accretion/lighting/reservoir.h"
 #include "accretion/particles/particle_source.h"

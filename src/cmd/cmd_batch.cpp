@@ -27,7 +27,7 @@
 #include "accretion/core/error.h"
 #include "accretion/core/stop_signal.h"
 #include "accretion/core/version.h"
-#include "accretion/io/atomic_file.h"
+#include "accretion/core/atomic_file.h"
 #include "accretion/io/stats_writer.h"
 #include "commands.h"
 

@@ -14,7 +14,7 @@
 #include "accretion/analysis/image_metrics.h"
 #include "accretion/core/error.h"
 #include "accretion/core/version.h"
-#include "accretion/io/atomic_file.h"
+#include "accretion/core/atomic_file.h"
 #include "accretion/io/exr_output.h"
 #include "accretion/io/plot.h"
 #include "accretion/io/stats_writer.h"

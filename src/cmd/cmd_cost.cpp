@@ -15,7 +15,7 @@
 #include "accretion/core/version.h"
 #include "accretion/geometry/particle_bvh.h"
 #include "accretion/gpu/cost_model.h"
-#include "accretion/io/atomic_file.h"
+#include "accretion/core/atomic_file.h"
 #include "accretion/io/exr_output.h"
 #include "accretion/io/stats_writer.h"
 #include "accretion/render/frame_renderer.h"
@@ -73,7 +73,7 @@ CountedFrame renderCounted(const Settings& s, const ParticleSource& source, std:
         out.stats = FrameStats{};
         out.image = renderer.render(f, out.stats);
     }
-    if (s.gpu.counters) out.report = makeGpuReport(out.image.counters, renderer.bvh(), s, out.stats.reservoirBytes);
+    if (s.gpu.counters) out.report = makeGpuReport(out.image.counters, s, out.stats.reservoirBytes);
     return out;
 }
 

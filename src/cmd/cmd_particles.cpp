@@ -5,7 +5,7 @@
 #include <fmt/core.h>
 
 #include "accretion/core/error.h"
-#include "accretion/io/atomic_file.h"
+#include "accretion/core/atomic_file.h"
 #include "accretion/particles/particle_file.h"
 #include "accretion/particles/particle_source.h"
 #include "accretion/scene/scene_parser.h"

@@ -16,7 +16,7 @@
 #include "accretion/core/stop_signal.h"
 #include "accretion/io/accumulation_file.h"
 #include "accretion/io/checkpoint.h"
-#include "accretion/io/atomic_file.h"
+#include "accretion/core/atomic_file.h"
 #include "accretion/io/exr_output.h"
 #include "accretion/io/stats_writer.h"
 #include "accretion/render/frame_renderer.h"
@@ -248,7 +248,7 @@ void runRender(const RenderArgs& args) {
         fj["outputs"] = outputs;
         if (settings.gpu.counters) {
             // The GPU model of the frame, and a PNG of each counter heatmap.
-            fj["gpu"] = toJson(makeGpuReport(image.counters, renderer.bvh(), settings, fs.reservoirBytes));
+            fj["gpu"] = toJson(makeGpuReport(image.counters, settings, fs.reservoirBytes));
             for (const Heatmap& h : image.heatmaps) {
                 const std::string png = base.string() + "." + h.name + ".png";
                 writeHeatmapPng(png, h.values, image.width, image.height);

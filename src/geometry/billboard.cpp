@@ -1,6 +1,6 @@
 #include "accretion/geometry/billboard.h"
 
-#include "accretion/render/camera.h"
+#include "accretion/geometry/camera.h"
 
 namespace accretion {
 namespace {

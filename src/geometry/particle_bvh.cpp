@@ -8,7 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include "accretion/core/error.h"
-#include "accretion/render/camera.h"
+#include "accretion/geometry/camera.h"
 
 namespace accretion {
 namespace {
@@ -416,6 +416,27 @@ bool ParticleBvh::occluded(const Vec3& o, const Vec3& d, float tnear, float tfar
     ray.flags = 0;
     rtcOccluded1(counters && countingTlas_ ? countingTlas_ : tlas_, &context.base, &ray);
     return ray.tfar < 0.0f;
+}
+
+AccelCounters ParticleBvh::accelCounters() const {
+    AccelCounters a;
+    const bool billboards = settings().primitive == Primitive::billboard;
+    a.blasPrimitives.resize(clusters_.count());
+    for (std::size_t c = 0; c < clusters_.count(); ++c)
+        a.blasPrimitives[c] = static_cast<std::uint32_t>(clusters_.members(c).size()) * (billboards ? 2u : 1u);
+    a.embreeBytes = stats_.embreeBytes;
+    if (omm_) {
+        a.omm = true;
+        a.ommLevel = omm_->level();
+        a.ommFourState = omm_->fourState();
+        a.ommOpaque = omm_->count(OmmState::opaque);
+        a.ommTransparent = omm_->count(OmmState::transparent);
+        a.ommUnknown = omm_->count(OmmState::unknown);
+        const OmmMemory m = ommMemory(*omm_, stats_.primitives / 2);
+        a.ommSharedBytes = m.sharedBytes;
+        a.ommPerTriangleBytes = m.perTriangleBytes;
+    }
+    return a;
 }
 
 }  // namespace accretion

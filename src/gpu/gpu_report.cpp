@@ -5,8 +5,7 @@
 #include <fmt/format.h>
 
 #include "accretion/core/pass_timer.h"
-#include "accretion/geometry/particle_bvh.h"
-#include "accretion/gpu/gpu_layouts.h"
+#include "accretion/counters/gpu_layouts.h"
 
 namespace accretion {
 namespace {
@@ -45,7 +44,7 @@ void adviseRayModel(PassReport& p) {
 
 PassReport summarise(const PassCounters& pc, const GpuSettings& gpu, const SerKey& key) {
     PassReport p;
-    p.pass = pc.pass;
+    p.pass = pc.label();
     p.width = pc.width;
     p.height = pc.height;
     for (const ThreadCounters& t : pc.threads) {
@@ -71,7 +70,7 @@ SerReport serOf(const PassCounters& pass, const GpuSettings& gpu, const SerKey& 
     return serReport(pass, warpLayout(gpu), key, gpu.ser_window, gpu.ser_reorder_cost);
 }
 
-GpuReport makeGpuReport(const FrameCounters& counters, const ParticleBvh& bvh, const Settings& settings,
+GpuReport makeGpuReport(const FrameCounters& counters, const Settings& settings,
                         std::size_t reservoirBytes) {
     const GpuSettings& gpu = settings.gpu;
     GpuReport r;
@@ -79,20 +78,14 @@ GpuReport makeGpuReport(const FrameCounters& counters, const ParticleBvh& bvh, c
     const SerKey key = SerKey::parse(gpu.ser_key, gpu.ser_hint_bits, "gpu.ser_key");
     r.serKey = key.label();
     r.serWindow = gpu.ser_window;
-    std::map<std::string, int> seen;
     for (const PassCounters& pc : counters.passes) {
         PassReport p = summarise(pc, gpu, key);
-        if (int n = ++seen[pc.pass]; n > 1) p.pass = fmt::format("{}[{}]", pc.pass, n);
         r.passes.push_back(std::move(p));
         r.layouts.bytesPerFrame += r.passes.back().bytesRead + r.passes.back().bytesWritten;
     }
 
-    const Clusters& clusters = bvh.clusters();
-    std::vector<std::uint32_t> tris(clusters.count());
-    const bool billboards = bvh.settings().primitive == Primitive::billboard;
-    for (std::size_t c = 0; c < clusters.count(); ++c)
-        tris[c] = static_cast<std::uint32_t>(clusters.members(c).size()) * (billboards ? 2u : 1u);
-    r.blas = blasMemory(tris, gpu, bvh.stats().embreeBytes);
+    const AccelCounters& accel = counters.accel;
+    r.blas = blasMemory(accel.blasPrimitives, gpu, accel.embreeBytes);
 
     const std::uint64_t pixels = std::uint64_t(settings.camera.width) * settings.camera.height;
     const double s = settings.render.estimator == EstimatorKind::restir ? settings.restir.resolution_scale : 1.0;
@@ -105,17 +98,14 @@ GpuReport makeGpuReport(const FrameCounters& counters, const ParticleBvh& bvh, c
     r.layouts.reservoirBufferBytes = reservoirBytes * lightingPixels * (temporal ? 2 : 1);
     r.layouts.gbufferBufferBytes = gpu_layout::kGBufferTexel * pixels * (temporal ? 2 : 1);
 
-    if (const OpacityMicromap* omm = bvh.micromap()) {
-        r.omm.enabled = true;
-        r.omm.level = omm->level();
-        r.omm.fourState = omm->fourState();
-        r.omm.opaque = omm->count(OmmState::opaque);
-        r.omm.transparent = omm->count(OmmState::transparent);
-        r.omm.unknown = omm->count(OmmState::unknown);
-        const OmmMemory m = ommMemory(*omm, bvh.stats().primitives / 2);
-        r.omm.sharedBytes = m.sharedBytes;
-        r.omm.perTriangleBytes = m.perTriangleBytes;
-    }
+    r.omm.enabled = accel.omm;
+    r.omm.level = accel.ommLevel;
+    r.omm.fourState = accel.ommFourState;
+    r.omm.opaque = accel.ommOpaque;
+    r.omm.transparent = accel.ommTransparent;
+    r.omm.unknown = accel.ommUnknown;
+    r.omm.sharedBytes = accel.ommSharedBytes;
+    r.omm.perTriangleBytes = accel.ommPerTriangleBytes;
     return r;
 }
 

@@ -8,7 +8,7 @@
 #include <fmt/format.h>
 
 #include "accretion/core/error.h"
-#include "accretion/io/atomic_file.h"
+#include "accretion/core/atomic_file.h"
 
 namespace accretion {
 namespace {

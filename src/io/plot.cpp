@@ -5,7 +5,7 @@
 
 #include <fmt/format.h>
 
-#include "accretion/io/atomic_file.h"
+#include "accretion/core/atomic_file.h"
 
 namespace accretion {
 

@@ -1,6 +1,6 @@
 #include "accretion/io/stats_writer.h"
 
-#include "accretion/io/atomic_file.h"
+#include "accretion/core/atomic_file.h"
 
 namespace accretion {
 

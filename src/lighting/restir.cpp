@@ -8,9 +8,9 @@
 
 #include "accretion/core/error.h"
 #include "accretion/core/rng.h"
-#include "accretion/gpu/gpu_layouts.h"
+#include "accretion/counters/gpu_layouts.h"
 #include "accretion/lighting/reservoir.h"
-#include "accretion/render/shading.h"
+#include "accretion/lighting/shading.h"
 #include "accretion/render/visibility.h"
 
 namespace accretion {

@@ -9,10 +9,11 @@
 
 #include "accretion/core/error.h"
 #include "accretion/core/rng.h"
-#include "accretion/gpu/gpu_layouts.h"
+#include "accretion/counters/gpu_layouts.h"
 #include "accretion/lighting/light_arrays.h"
+#include "accretion/lighting/light_sampler.h"
 #include "accretion/lighting/reservoir.h"
-#include "accretion/render/shading.h"
+#include "accretion/lighting/shading.h"
 #include "accretion/render/visibility.h"
 
 namespace accretion {
@@ -418,11 +419,6 @@ bool needsPowerTable(const RenderSettings& r) {
     return r.estimator == EstimatorKind::power || (resampling && r.source == LightSource::power);
 }
 
-AliasTable buildPowerTable(const Particles& particles) {
-    std::vector<float> w(particles.size());
-    for (std::size_t i = 0; i < w.size(); ++i) w[i] = luminance(particles.emission[i]);
-    return AliasTable(w);
-}
 
 LightingCounters accumulateLighting(const LightingInputs& in, const LightingPlan& plan, Accumulation& acc,
                                     const ChunkHook& afterChunk, Progress* progress) {

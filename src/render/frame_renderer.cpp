@@ -6,7 +6,7 @@
 
 #include <fmt/format.h>
 
-#include "accretion/gpu/gpu_layouts.h"
+#include "accretion/counters/gpu_layouts.h"
 
 namespace accretion {
 namespace {
@@ -193,7 +193,10 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const L
             }
         stats.meanSpp = hits ? sppSum / double(hits) : 0.0;
     }
-    if (counting) img.heatmaps = counterHeatmaps(img.counters, img.width, img.height);
+    if (counting) {
+        img.counters.accel = bvh_->accelCounters();
+        img.heatmaps = counterHeatmaps(img.counters, img.width, img.height);
+    }
     stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return img;
 }

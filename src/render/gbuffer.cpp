@@ -4,7 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include "accretion/geometry/billboard.h"
-#include "accretion/gpu/gpu_layouts.h"
+#include "accretion/counters/gpu_layouts.h"
 
 namespace accretion {
 

@@ -6,7 +6,7 @@
 
 #include "accretion/geometry/particle_bvh.h"
 #include "accretion/particles/disk_generator.h"
-#include "accretion/render/camera.h"
+#include "accretion/geometry/camera.h"
 
 using namespace accretion;
 

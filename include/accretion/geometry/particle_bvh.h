@@ -8,8 +8,8 @@
 #include "accretion/geometry/billboard.h"
 #include "accretion/geometry/clustering.h"
 #include "accretion/geometry/embree_device.h"
-#include "accretion/gpu/opacity_micromap.h"
-#include "accretion/gpu/thread_counters.h"
+#include "accretion/geometry/opacity_micromap.h"
+#include "accretion/counters/thread_counters.h"
 #include "accretion/particles/particles.h"
 #include "accretion/scene/settings.h"
 
@@ -91,6 +91,8 @@ public:
     bool counting() const { return counting_; }
     /// The opacity micromap in use (null without one).
     const OpacityMicromap* micromap() const { return omm_.get(); }
+    /// What the GPU memory model reads of this BVH: primitives per BLAS, Embree bytes, the micromap.
+    AccelCounters accelCounters() const;
     /// Hint that occlusion queries excluding particle i will follow (its
     /// identity key is a random read).
     void prefetchExclusion(std::uint32_t i) const { __builtin_prefetch(&where_[i]); }

@@ -6,13 +6,11 @@
 #include <nlohmann/json.hpp>
 
 #include "accretion/gpu/gpu_memory.h"
-#include "accretion/gpu/thread_counters.h"
+#include "accretion/counters/thread_counters.h"
 #include "accretion/gpu/warp_model.h"
 #include "accretion/scene/settings.h"
 
 namespace accretion {
-
-class ParticleBvh;
 
 /// One pass's counters, summed, with its SIMT/SER statistics and the
 /// inline-RayQuery vs pipeline-TraceRay advice of seed 003.
@@ -60,8 +58,8 @@ struct GpuReport {
     OmmReport omm;
 };
 
-/// Summarise a frame's counters (the BVH gives cluster sizes, Embree memory and the OMM).
-GpuReport makeGpuReport(const FrameCounters& counters, const ParticleBvh& bvh, const Settings& settings,
+/// Summarise a frame's counters (counters.accel gives cluster sizes, Embree memory and the OMM).
+GpuReport makeGpuReport(const FrameCounters& counters, const Settings& settings,
                         std::size_t reservoirBytes);
 
 /// SIMT / SER of one pass under another key or window (the cost command's key sweep).

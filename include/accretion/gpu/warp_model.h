@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "accretion/gpu/thread_counters.h"
+#include "accretion/counters/thread_counters.h"
 
 namespace accretion {
 

@@ -4,10 +4,8 @@
 
 #include "accretion/core/math.h"
 #include "accretion/core/rng.h"
-#include "accretion/lighting/light_tree.h"
 #include "accretion/particles/particles.h"
-#include "accretion/render/alias_table.h"
-#include "accretion/render/shading.h"
+#include "accretion/lighting/shading.h"
 #include "accretion/scene/settings.h"
 
 namespace accretion {
@@ -62,18 +60,5 @@ struct LightArrays {
         return term<M>(sp, i, t) ? luminance(t.value) : 0.0f;
     }
 };
-
-/// One light from a receiver-independent source pmf: uniform, or in
-/// proportion to power (alias table). Bucket then coin, in that order.
-template <bool Power>
-LightSample sampleSource(const LightArrays& L, const AliasTable* table, Rng& rng) {
-    if constexpr (Power) {
-        const std::uint32_t bucket = rng.uniformInt(L.countBound);
-        const std::uint32_t i = table->sample(bucket, rng.uniform());
-        return {i, table->pmf(i)};
-    } else {
-        return {rng.uniformInt(L.countBound), L.uniformPdf};
-    }
-}
 
 }  // namespace accretion

@@ -4,18 +4,12 @@
 
 #include "accretion/core/math.h"
 #include "accretion/core/rng.h"
+#include "accretion/lighting/light_sample.h"
 #include "accretion/particles/particles.h"
-#include "accretion/render/shading.h"
+#include "accretion/lighting/shading.h"
 #include "accretion/scene/settings.h"
 
 namespace accretion {
-
-/// A light drawn by a light sampler, with its probability.
-struct LightSample {
-    std::uint32_t i;  ///< light index, kNoLightSample when every light has zero importance
-    float pdf;        ///< probability of i (0 with kNoLightSample)
-};
-inline constexpr std::uint32_t kNoLightSample = 0xffffffffu;
 
 /// Light-tree importance sampling over point emitters (a binary BVH over the
 /// particles with power and spatial bounds, after pbrt-v4's BVHLightSampler

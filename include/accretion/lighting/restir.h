@@ -5,10 +5,10 @@
 
 #include "accretion/core/pass_timer.h"
 #include "accretion/geometry/particle_bvh.h"
-#include "accretion/gpu/thread_counters.h"
+#include "accretion/counters/thread_counters.h"
 #include "accretion/lighting/light_arrays.h"
 #include "accretion/lighting/reservoir_codec.h"
-#include "accretion/render/camera.h"
+#include "accretion/geometry/camera.h"
 #include "accretion/render/estimators.h"
 #include "accretion/render/gbuffer.h"
 #include "accretion/scene/settings.h"

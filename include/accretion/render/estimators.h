@@ -8,10 +8,9 @@
 #include "accretion/core/math.h"
 #include "accretion/core/progress.h"
 #include "accretion/geometry/particle_bvh.h"
-#include "accretion/gpu/thread_counters.h"
-#include "accretion/lighting/light_tree.h"
+#include "accretion/counters/thread_counters.h"
+#include "accretion/lighting/light_sampler.h"
 #include "accretion/render/accumulation.h"
-#include "accretion/render/alias_table.h"
 #include "accretion/render/gbuffer.h"
 #include "accretion/scene/settings.h"
 
@@ -66,8 +65,6 @@ bool needsPowerTable(const RenderSettings& render);
 /// True if the estimator samples lights with the light tree.
 inline bool needsLightTree(const RenderSettings& render) { return render.estimator == EstimatorKind::tree; }
 
-/// Light selection pmf over luminance(I_i), for the `power` estimator.
-AliasTable buildPowerTable(const Particles& particles);
 
 /// Called after each chunk with the sums so far; returning false stops the
 /// frame there (a checkpoint can restart it from acc.nextChunk).

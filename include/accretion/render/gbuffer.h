@@ -5,9 +5,9 @@
 
 #include "accretion/core/math.h"
 #include "accretion/geometry/particle_bvh.h"
-#include "accretion/gpu/thread_counters.h"
-#include "accretion/render/camera.h"
-#include "accretion/render/shading.h"
+#include "accretion/counters/thread_counters.h"
+#include "accretion/geometry/camera.h"
+#include "accretion/lighting/shading.h"
 
 namespace accretion {
 

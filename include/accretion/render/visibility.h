@@ -5,7 +5,7 @@
 
 #include "accretion/core/math.h"
 #include "accretion/geometry/particle_bvh.h"
-#include "accretion/render/shading.h"
+#include "accretion/lighting/shading.h"
 #include "accretion/scene/settings.h"
 
 namespace accretion {

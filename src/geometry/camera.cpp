@@ -1,4 +1,4 @@
-#include "accretion/render/camera.h"
+#include "accretion/geometry/camera.h"
 
 #include <cmath>
 

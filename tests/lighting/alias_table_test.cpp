@@ -1,7 +1,7 @@
 #include <catch2/catch.hpp>
 
 #include "accretion/core/rng.h"
-#include "accretion/render/alias_table.h"
+#include "accretion/lighting/alias_table.h"
 #include "support/statistics.h"
 
 using namespace accretion;

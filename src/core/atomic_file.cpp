@@ -1,4 +1,4 @@
-#include "accretion/io/atomic_file.h"
+#include "accretion/core/atomic_file.h"
 
 #include <cerrno>
 #include <cstdio>

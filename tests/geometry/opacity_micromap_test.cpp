@@ -5,7 +5,7 @@
 #include <set>
 
 #include "accretion/geometry/billboard.h"
-#include "accretion/gpu/opacity_micromap.h"
+#include "accretion/geometry/opacity_micromap.h"
 
 using namespace accretion;
 
@@ -74,7 +74,7 @@ TEST_CASE("2-state OMM has no unknown micro-triangles, memory is shared across b
 
 #include "accretion/geometry/particle_bvh.h"
 #include "accretion/particles/disk_generator.h"
-#include "accretion/render/camera.h"
+#include "accretion/geometry/camera.h"
 
 TEST_CASE("4-state OMM keeps every hit of alpha testing with fewer any-hits as L grows, 2-state none", "[gpu][omm][bvh]") {
     GeometrySettings g;

@@ -50,27 +50,41 @@ struct ThreadCounters {
 /// buildClusters one thread per cluster, height 1).
 struct PassCounters {
     std::string pass;
+    std::uint32_t run = 1;  ///< 1 for a pass's first run in the frame, 2 for its second (spatial iterations)...
     std::uint32_t width = 0, height = 0;
     std::vector<ThreadCounters> threads;
 
     PassCounters() = default;
     PassCounters(std::string_view name, std::uint32_t w, std::uint32_t h)
         : pass(name), width(w), height(h), threads(std::size_t(w) * h) {}
+    /// The pass name, with "[n]" for its n-th run when n > 1: spatialResampling[2].
+    std::string label() const { return run > 1 ? pass + "[" + std::to_string(run) + "]" : pass; }
 };
 
-/// Counters of every pass of a frame, in execution order.
+/// The acceleration structures of a frame as the GPU memory model reads
+/// them: triangles (or spheres) per BLAS, Embree's bytes, the micromap.
+struct AccelCounters {
+    std::vector<std::uint32_t> blasPrimitives;  ///< per cluster: triangles (2 per billboard) or spheres
+    std::int64_t embreeBytes = 0;
+    bool omm = false;                ///< an opacity micromap is attached
+    std::uint32_t ommLevel = 0;
+    bool ommFourState = false;
+    std::uint64_t ommOpaque = 0, ommTransparent = 0, ommUnknown = 0;  ///< micro-triangles of the two uv triangles
+    std::uint64_t ommSharedBytes = 0, ommPerTriangleBytes = 0;
+};
+
+/// Counters of every pass of a frame, in execution order. Each run of a
+/// pass is its own record (see PassCounters::run).
 struct FrameCounters {
     std::vector<PassCounters> passes;
+    AccelCounters accel;  ///< the frame's BVH, for the memory model
 
-    /// A new pass record; a pass that runs twice (spatial iterations) is merged on `find`.
+    /// The record of a pass about to run.
     PassCounters& add(std::string_view name, std::uint32_t w, std::uint32_t h) {
-        passes.emplace_back(name, w, h);
+        std::uint32_t run = 1;
+        for (const PassCounters& p : passes) run += p.pass == name;
+        passes.emplace_back(name, w, h).run = run;
         return passes.back();
-    }
-    const PassCounters* find(std::string_view name) const {
-        for (const PassCounters& p : passes)
-            if (p.pass == name) return &p;
-        return nullptr;
     }
     bool empty() const { return passes.empty(); }
 };

@@ -1,4 +1,4 @@
-#include "accretion/gpu/opacity_micromap.h"
+#include "accretion/geometry/opacity_micromap.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "accretion/render/alias_table.h"
+#include "accretion/lighting/alias_table.h"
 
 #include <cmath>
 

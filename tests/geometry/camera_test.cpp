@@ -1,6 +1,6 @@
 #include <catch2/catch.hpp>
 
-#include "accretion/render/camera.h"
+#include "accretion/geometry/camera.h"
 
 using namespace accretion;
 
