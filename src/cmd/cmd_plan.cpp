@@ -3,7 +3,8 @@
 
 #include <fmt/core.h>
 
-#include "accretion/render/pass_plan.h"
+#include "accretion/particles/particle_source.h"
+#include "accretion/render/frame_plan.h"
 #include "accretion/scene/scene_parser.h"
 #include "commands.h"
 
@@ -14,10 +15,26 @@ void runPlan(const SceneArgs& a) {
     std::vector<std::string> overrides = a.defines;
     appendFrameOverrides(a.frames, overrides);
     const Settings s = loadScene(a.scene, overrides);
-    const PassPlan plan = planPasses(s);
+    // The plan needs to know whether the particles emit: load the first frame's.
+    FrameFacts facts;
+    facts.emissive = emissive(ParticleSource(s).frame(s.render.frame_start));
+    const FramePlan first = planFrame(s, facts);
     fmt::print("{}: {} frame{} from {}, estimator {}, {}x{}\n", s.scenePath, s.render.frames, s.render.frames > 1 ? "s" : "",
                s.render.frame_start, enumName(s.render.estimator), s.camera.width, s.camera.height);
-    fmt::print("{}", formatPlan(plan));
+    if (s.render.frames == 1) {
+        fmt::print("{}", formatPlan(first));
+        return;
+    }
+    // Later frames find the static geometry built and the history kept.
+    facts.geometryBuilt = true;
+    facts.historyAvailable = first.keepHistory;
+    const FramePlan later = planFrame(s, facts);
+    const std::uint32_t begin = s.render.frame_start, end = begin + s.render.frames;
+    if (later.passes() == first.passes()) {
+        fmt::print("frames {}:{}\n{}", begin, end, formatPlan(first));
+        return;
+    }
+    fmt::print("frame {}\n{}frames {}:{}\n{}", begin, formatPlan(first), begin + 1, end, formatPlan(later));
 }
 
 }  // namespace

@@ -229,7 +229,7 @@ void runChunk(const LightingInputs& in, const LightArrays& L, const VisibilityOp
         return Rng(p.px, in.frame, RngPass::lightSampling, in.render.seed, chunk + 1);
     };
     if constexpr (K == EstimatorKind::ris) {
-        const bool power = in.render.source == LightSource::power;
+        const bool power = in.powerTable != nullptr;  // the plan built one: candidates in proportion to power
         for (std::uint32_t k = 0; k < n; ++k) {
             GroupPixel& p = pix[k];
             if (p.sums.done) continue;
@@ -414,17 +414,11 @@ LightingCounters dispatchPrimitive(const LightingInputs& in, const LightArrays& 
 
 }  // namespace
 
-bool needsPowerTable(const RenderSettings& r) {
-    const bool resampling = r.estimator == EstimatorKind::ris || r.estimator == EstimatorKind::restir;
-    return r.estimator == EstimatorKind::power || (resampling && r.source == LightSource::power);
-}
-
-
 LightingCounters accumulateLighting(const LightingInputs& in, const LightingPlan& plan, Accumulation& acc,
                                     const ChunkHook& afterChunk, Progress* progress) {
     ACC_CHECK(acc.width == in.gbuffer.width && acc.height == in.gbuffer.height);
     if (in.particles.empty() || acc.nextChunk >= plan.end) return {};
-    ACC_CHECK(!needsPowerTable(in.render) || in.powerTable);
+    ACC_CHECK(in.render.estimator != EstimatorKind::power || in.powerTable);
     ACC_CHECK(in.render.estimator != EstimatorKind::tree || in.lightTree);
     ACC_CHECK(in.render.estimator != EstimatorKind::restir);
     const LightArrays L(in.particles, in.shading);
@@ -478,7 +472,7 @@ LightingCounters estimateLighting(const LightingInputs& in, LightingImage& out, 
         out.rejected.assign(pixels, 0.0f);
         return {};
     }
-    ACC_CHECK(!needsPowerTable(in.render) || in.powerTable);
+    ACC_CHECK(in.render.estimator != EstimatorKind::power || in.powerTable);
     ACC_CHECK(in.render.estimator != EstimatorKind::tree || in.lightTree);
     ACC_CHECK(in.render.estimator != EstimatorKind::restir);
     allocate(out, pixels);

@@ -42,11 +42,10 @@ void recordCompose(const GBuffer& gbuffer, const Particles& particles, const Par
 }  // namespace
 
 FrameRenderer::FrameRenderer(const Settings& settings, ParticleSource source, RenderOptions options)
-    : settings_(settings), plan_(planPasses(settings)), source_(std::move(source)), options_(options),
+    : settings_(settings), plan_(planFrame(settings, FrameFacts{})), source_(std::move(source)), options_(options),
       device_(std::make_unique<EmbreeDevice>()),
       bvh_(std::make_unique<ParticleBvh>(*device_, settings.geometry, settings.gpu)) {
-    if (settings_.render.estimator == EstimatorKind::restir && plan_.lighting)
-        restir_ = std::make_unique<Restir>(settings_, plan_.history);
+    if (settings_.render.estimator == EstimatorKind::restir) restir_ = std::make_unique<Restir>(settings_, plan_.keepHistory);
 }
 
 FrameRenderer::~FrameRenderer() = default;
@@ -66,20 +65,27 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const L
     stats.origin = origin_;
     PassTimer& timer = stats.timer;
 
-    // A static scene loads its particles and builds its BVH once for all frames.
-    const bool reuse = plan_.staticGeometry && built_ && !options_.rebuildStatic;
+    // A static scene loads its particles and builds its BVH once for all
+    // frames; the plan of this frame needs the particles (do they emit?).
+    FrameFacts facts;
+    facts.geometryBuilt = built_ && !options_.rebuildStatic;
+    facts.historyAvailable = restir_ && restir_->hasHistory();
+    const bool load = planFrame(settings_, facts).loadParticles;
     Particles loaded;
-    if (!reuse) {
+    if (load) {
         auto t = timer.scope(pass::loadParticles);
         loaded = source_.frame(frame);
         for (Vec3& p : loaded.position) p -= origin_;
         if (plan_.staticGeometry) staticParticles_ = std::move(loaded);
     }
     const Particles& particles = plan_.staticGeometry ? staticParticles_ : loaded;
+    facts.emissive = emissive(particles);
+    plan_ = planFrame(settings_, facts);
+    const FramePlan& plan = plan_;
     stats.particles = particles.size();
-    if (!reuse) {
+    if (plan.buildClusters) {
         auto t = timer.scope(pass::buildClusters);
-        if (plan_.previousBvh) {  // double buffer: last frame's BVH stays valid
+        if (plan.previousBvh) {  // double buffer: last frame's BVH stays valid
             std::swap(bvh_, previousBvh_);
             if (!bvh_) bvh_ = std::make_unique<ParticleBvh>(*device_, settings_.geometry, settings_.gpu);
         }
@@ -87,24 +93,19 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const L
         built_ = true;
     }
     stats.bvh = bvh_->stats();
-    if (reuse) {
+    if (!plan.buildClusters) {
         stats.bvh.built = false;
         stats.bvh.rebuiltClusters = 0;
         stats.bvh.clusterSeconds = stats.bvh.blasSeconds = stats.bvh.tlasSeconds = 0.0;
     }
     FrameImage img;
-    const bool counting = settings_.gpu.counters;
+    const bool counting = plan.counting;
     if (counting) recordClusterBuild(*bvh_, particles, img.counters);
 
-    // Light sampler: only the power and tree estimators need one, and only with light.
     AliasTable powerTable;
     LightTree lightTree;
-    double totalLuminance = 0.0;
-    for (const Vec3& I : particles.emission) totalLuminance += luminance(I);
-    const bool lit = totalLuminance > 0.0 && glm::length(settings_.shading.albedo) > 0.0f;
-    const bool power = lit && needsPowerTable(settings_.render);
-    const bool tree = lit && needsLightTree(settings_.render);
-    if (power || tree) {
+    const bool power = plan.sampler == LightSamplerKind::power, tree = plan.sampler == LightSamplerKind::tree;
+    if (plan.sampler != LightSamplerKind::none) {
         auto t = timer.scope(pass::buildLightSampler);
         if (power) powerTable = buildPowerTable(particles);
         if (tree) lightTree = LightTree(particles, settings_.shading);
@@ -121,15 +122,15 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const L
     img.width = camera.width;
     img.height = camera.height;
     const std::size_t pixels = std::size_t(img.width) * img.height;
-    {
+    if (plan.lighting) {
         auto t = timer.scope(pass::estimateLighting);
-        if (lit && restir_) {
-            RestirInputs in{*bvh_, particles, gbuffer, camera, settings_, frame, power ? &powerTable : nullptr,
-                            plan_.previousBvh ? previousBvh_.get() : nullptr, counting ? &img.counters : nullptr};
+        if (plan.restir) {
+            RestirInputs in{*bvh_, particles, gbuffer, camera, settings_, plan, frame, power ? &powerTable : nullptr,
+                            plan.previousBvh ? previousBvh_.get() : nullptr, counting ? &img.counters : nullptr};
             stats.lighting = restir_->render(in, img.lighting, img.reservoirs, timer, stats.nonFinite);
             stats.reservoirBytes = restir_->reservoirBytes();
             if (img.lighting.rejected.empty()) img.lighting.rejected.assign(pixels, 0.0f);
-        } else if (lit) {
+        } else {
             LightingInputs in{*bvh_, particles, gbuffer, settings_.shading, settings_.render, frame,
                               power ? &powerTable : nullptr, tree ? &lightTree : nullptr,
                               counting ? &img.counters.add(pass::estimateLighting, camera.width, camera.height) : nullptr};
@@ -147,12 +148,12 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const L
                 resolveLighting(acc, lp.exact, img.lighting, &stats.lighting.nonFinite);
             }
             if (stats.lighting.nonFinite) stats.nonFinite[std::string(pass::estimateLighting)] = stats.lighting.nonFinite;
-        } else {
-            img.lighting.Lr.assign(pixels, Vec3(0.0f));
-            img.lighting.Lr_stderr.assign(pixels, Vec3(0.0f));
-            img.lighting.spp.assign(pixels, 0.0f);
-            img.lighting.rejected.assign(pixels, 0.0f);
         }
+    } else {  // nothing lights the scene: Lr = 0
+        img.lighting.Lr.assign(pixels, Vec3(0.0f));
+        img.lighting.Lr_stderr.assign(pixels, Vec3(0.0f));
+        img.lighting.spp.assign(pixels, 0.0f);
+        img.lighting.rejected.assign(pixels, 0.0f);
     }
     {
         auto t = timer.scope(pass::composeImage);

@@ -54,17 +54,10 @@ struct LightingInputs {
     const ShadingSettings& shading;
     const RenderSettings& render;
     std::uint32_t frame = 0;
-    const AliasTable* powerTable = nullptr;  ///< required when needsPowerTable()
+    const AliasTable* powerTable = nullptr;  ///< power (required); ris: candidates in proportion to power when given
     const LightTree* lightTree = nullptr;    ///< required by `tree`
     PassCounters* counters = nullptr;        ///< counting mode: one thread record per pixel (the BVH must count)
 };
-
-/// True if the estimator samples lights in proportion to their power.
-bool needsPowerTable(const RenderSettings& render);
-
-/// True if the estimator samples lights with the light tree.
-inline bool needsLightTree(const RenderSettings& render) { return render.estimator == EstimatorKind::tree; }
-
 
 /// Called after each chunk with the sums so far; returning false stops the
 /// frame there (a checkpoint can restart it from acc.nextChunk).

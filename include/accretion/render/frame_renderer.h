@@ -8,12 +8,13 @@
 #include "accretion/geometry/particle_bvh.h"
 #include "accretion/gpu/gpu_report.h"
 #include "accretion/counters/thread_counters.h"
-#include "accretion/lighting/restir.h"
+#include "accretion/render/restir.h"
 #include "accretion/particles/particle_source.h"
 #include "accretion/geometry/camera.h"
 #include "accretion/render/estimators.h"
 #include "accretion/render/gbuffer.h"
-#include "accretion/render/pass_plan.h"
+#include "accretion/render/frame_plan.h"
+#include "accretion/render/restir.h"
 #include "accretion/scene/settings.h"
 
 namespace accretion {
@@ -64,9 +65,10 @@ struct RenderOptions {
     bool rebuildStatic = false;  ///< benchmarks: rebuild a static scene every frame (to time the skip)
 };
 
-/// Renders frames of a scene: loadParticles, buildClusters,
-/// buildLightSampler, traceGBuffer, estimateLighting, composeImage.
-/// Keeps the Embree device and BVH across frames (refit needs them).
+/// Renders frames of a scene: each frame executes its FramePlan
+/// (loadParticles, buildClusters, buildLightSampler, traceGBuffer,
+/// estimateLighting or the restir passes, composeImage) and decides nothing
+/// else. Keeps the Embree device and BVH across frames (refit needs them).
 class FrameRenderer {
 public:
     FrameRenderer(const Settings& settings, ParticleSource source, RenderOptions options = {});
@@ -78,12 +80,12 @@ public:
     const Settings& settings() const { return settings_; }
     /// The BVH of the last frame rendered.
     const ParticleBvh& bvh() const { return *bvh_; }
-    /// The passes every frame runs (and those it skips).
-    const PassPlan& plan() const { return plan_; }
+    /// The plan of the last frame rendered (before the first: of the first frame, as far as the settings tell).
+    const FramePlan& plan() const { return plan_; }
 
 private:
     Settings settings_;
-    PassPlan plan_;
+    FramePlan plan_;             ///< the last frame's
     ParticleSource source_;
     Particles staticParticles_;  ///< static scenes: loaded once
     bool built_ = false;         ///< the BVH has been built once

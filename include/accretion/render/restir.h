@@ -4,12 +4,14 @@
 #include <vector>
 
 #include "accretion/core/pass_timer.h"
+#include "accretion/geometry/camera.h"
 #include "accretion/geometry/particle_bvh.h"
 #include "accretion/counters/thread_counters.h"
-#include "accretion/lighting/light_arrays.h"
+#include "accretion/lighting/alias_table.h"
 #include "accretion/lighting/reservoir_codec.h"
 #include "accretion/geometry/camera.h"
 #include "accretion/render/estimators.h"
+#include "accretion/render/frame_plan.h"
 #include "accretion/render/gbuffer.h"
 #include "accretion/scene/settings.h"
 
@@ -31,18 +33,14 @@ struct RestirInputs {
     const GBuffer& gbuffer;      ///< full resolution
     const Camera& camera;
     const Settings& settings;
+    const FramePlan& plan;       ///< the passes to run (temporal, spatial iterations, upsample)
     std::uint32_t frame = 0;
-    const AliasTable* powerTable = nullptr;  ///< render.source = power
+    const AliasTable* powerTable = nullptr;  ///< candidates in proportion to power (the plan built it), else uniform
     const ParticleBvh* previousBvh = nullptr; ///< last frame's BVH (see needsPreviousBvh), else the current one is used
     FrameCounters* counters = nullptr;        ///< counting mode: each pass adds its thread records (the BVH must count)
 };
 
-/// basic_visibility tests the previous frame's samples against the previous
-/// frame's geometry: the frame renderer keeps that BVH (for rebuild and
-/// fast_trace policies; refit and partial update one BVH in place).
-bool needsPreviousBvh(const Settings& settings);
-
-/// ReSTIR DI (MODEL.md section 4; Bitterli et al. 2020): generateCandidates
+/// ReSTIR DI (docs/MODEL.md section 4; Bitterli et al. 2020): generateCandidates
 /// (RIS, M candidates, target p_hat without visibility), temporalResampling
 /// (reprojection through particle motion and the previous camera, rejection
 /// on particle / normal / depth, history M capped at C x M), k-neighbour
@@ -51,8 +49,9 @@ bool needsPreviousBvh(const Settings& settings);
 /// stored), and upsampleLighting when lighting runs at reduced resolution.
 /// Reusing a sample y of reservoir i at pixel q weighs it by
 /// p_hat_q(y) W_i M_i (bias correction none / basic) or by the pairwise MIS
-/// weight. Keeps the previous frame's G-buffer, particles, camera and
-/// reservoirs: the history starts with the first frame rendered.
+/// weight (lighting/resampling.h). Keeps the previous frame's G-buffer,
+/// particles, camera and reservoirs: the history starts with the first
+/// frame rendered. One file per pass in src/render/restir/, named like it.
 class Restir {
 public:
     /// keepHistory: keep this frame for the next one's temporal reuse
@@ -65,11 +64,14 @@ public:
     LightingCounters render(const RestirInputs& in, LightingImage& out, ReservoirImage& aov, PassTimer& timer,
                             PassRejections& rejected);
 
+    /// A previous frame is kept for temporal reuse (FrameFacts::historyAvailable).
+    bool hasHistory() const { return history_ != nullptr; }
+
     /// Bytes of the stored reservoirs per lighting pixel, and of the history.
     std::size_t reservoirBytes() const { return codec_.bytes(); }
     const ReservoirCodec& codec() const { return codec_; }
 
-    struct History;  ///< previous frame (defined in restir.cpp)
+    struct History;  ///< previous frame (src/render/restir/restir_pass.h)
 
 private:
     RestirSettings rs_;

@@ -1,17 +1,19 @@
 // Only the work a scene needs: the pass plan, and the counters that show the
 // skipped work really is not done (no shadow rays, no any-hit calls, one BVH
 // build for a static scene, no history for one frame, no lighting for albedo 0).
+#include <algorithm>
+
 #include <catch2/catch.hpp>
 
 #include "accretion/render/frame_renderer.h"
-#include "accretion/render/pass_plan.h"
+#include "accretion/render/frame_plan.h"
 #include "support/test_scenes.h"
 
 using namespace accretion;
 
 namespace {
 
-const PlannedStep& step(const PassPlan& plan, const std::string& name) {
+const PlannedStep& step(const FramePlan& plan, const std::string& name) {
     for (const PlannedStep& s : plan.steps)
         if (s.name == name) return s;
     FAIL("no step " << name);
@@ -30,6 +32,9 @@ std::vector<FrameStats> render(const Settings& s, std::vector<FrameImage>* image
     return stats;
 }
 
+/// The plan of a run's first frame (its particles emit).
+FramePlan planPasses(const Settings& s) { return planFrame(s, FrameFacts{}); }
+
 Settings small() {
     Settings s = accretion::test::smallDiskSettings();
     s.render.estimator = EstimatorKind::uniform;
@@ -43,7 +48,7 @@ TEST_CASE("visibility off: no shadow rays planned or traced, and more light", "[
     Settings s = small();
     const auto with = render(s);
     s.shading.visibility = false;
-    const PassPlan plan = planPasses(s);
+    const FramePlan plan = planPasses(s);
     CHECK_FALSE(step(plan, "shadow rays").runs);
     CHECK_THAT(step(plan, "shadow rays").why, Catch::Contains("visibility off"));
     std::vector<FrameImage> img;
@@ -81,7 +86,7 @@ TEST_CASE("static particles and camera: one BVH build for all frames, the same i
     s.particles.gm = 0.0;
     s.render.estimator = EstimatorKind::exact;
     s.render.frames = 3;
-    const PassPlan plan = planPasses(s);
+    const FramePlan plan = planPasses(s);
     CHECK(plan.staticGeometry);
     CHECK_THAT(step(plan, "buildClusters").why, Catch::Contains("once for all frames"));
     std::vector<FrameImage> img;
@@ -102,10 +107,10 @@ TEST_CASE("restir: one frame or temporal off keeps no history, one neighbour-les
     Settings s = small();
     s.render.estimator = EstimatorKind::restir;
     s.render.frames = 1;
-    CHECK_FALSE(planPasses(s).history);
+    CHECK_FALSE(planPasses(s).keepHistory);
     CHECK_THAT(step(planPasses(s), "temporalResampling").why, Catch::Contains("one frame"));
     s.render.frames = 3;
-    CHECK(planPasses(s).history);
+    CHECK(planPasses(s).keepHistory);
     const auto kept = render(s);
     CHECK(kept[2].timer.seconds(pass::temporalResampling) > 0.0);
     s.restir.temporal = false;
@@ -121,7 +126,7 @@ TEST_CASE("restir: one frame or temporal off keeps no history, one neighbour-les
 TEST_CASE("albedo 0: no lighting passes, exact: no reservoirs, counters off: no counting code", "[plan]") {
     Settings s = small();
     s.shading.albedo = Vec3(0.0f);
-    const PassPlan plan = planPasses(s);
+    const FramePlan plan = planPasses(s);
     CHECK_FALSE(plan.lighting);
     CHECK_FALSE(step(plan, "estimateLighting").runs);
     CHECK_FALSE(step(plan, "buildLightSampler").runs);
@@ -134,4 +139,53 @@ TEST_CASE("albedo 0: no lighting passes, exact: no reservoirs, counters off: no 
     CHECK_THAT(step(planPasses(s), "counters").why, Catch::Contains("no counting code"));
     s.gpu.counters = true;
     CHECK(step(planPasses(s), "counters").runs);
+}
+
+TEST_CASE("the plan is the frame: every frame's timed passes are exactly the plan's, for every skip", "[plan]") {
+    // Each variant skips something (or runs something more); every frame of
+    // it must time exactly the passes its plan lists, in the plan's names.
+    struct Variant {
+        const char* name;
+        void (*apply)(Settings&);
+    };
+    const Variant variants[] = {
+        {"uniform", [](Settings&) {}},
+        {"visibility off", [](Settings& s) { s.shading.visibility = false; }},
+        {"albedo 0", [](Settings& s) { s.shading.albedo = Vec3(0.0f); }},
+        {"no emission", [](Settings& s) { s.particles.luminosity = 0.0; }},
+        {"static", [](Settings& s) { s.particles.gm = 0.0; }},
+        {"power", [](Settings& s) { s.render.estimator = EstimatorKind::power; }},
+        {"tree", [](Settings& s) { s.render.estimator = EstimatorKind::tree; }},
+        {"ris power", [](Settings& s) { s.render.estimator = EstimatorKind::ris; s.render.source = LightSource::power; }},
+        {"restir", [](Settings& s) { s.render.estimator = EstimatorKind::restir; }},
+        {"restir temporal off", [](Settings& s) { s.render.estimator = EstimatorKind::restir; s.restir.temporal = false; }},
+        {"restir no neighbours", [](Settings& s) { s.render.estimator = EstimatorKind::restir; s.restir.spatial_neighbours = 0; }},
+        {"restir no iterations", [](Settings& s) { s.render.estimator = EstimatorKind::restir; s.restir.spatial_iterations = 0; }},
+        {"restir half scale", [](Settings& s) { s.render.estimator = EstimatorKind::restir; s.restir.resolution_scale = 0.5; }},
+        {"restir visibility off", [](Settings& s) { s.render.estimator = EstimatorKind::restir; s.shading.visibility = false; }},
+        {"restir static", [](Settings& s) { s.render.estimator = EstimatorKind::restir; s.particles.gm = 0.0; }},
+    };
+    for (const Variant& v : variants) {
+        Settings s = small();
+        s.render.frames = 3;
+        v.apply(s);
+        FrameRenderer r(s, ParticleSource(s), RenderOptions{true});
+        for (std::uint32_t f = 0; f < s.render.frames; ++f) {
+            FrameStats fs;
+            r.render(f, fs);
+            std::vector<std::string> timed;
+            for (const auto& [name, seconds] : fs.timer.all()) timed.push_back(name);
+            std::vector<std::string> planned = r.plan().passes();
+            std::sort(planned.begin(), planned.end());
+            INFO(v.name << ", frame " << f << "\n" << formatPlan(r.plan()));
+            CHECK(timed == planned);
+        }
+    }
+    // And the plan says what it skips: frame 0 of restir has no history yet, frame 1 does.
+    Settings s = small();
+    s.render.estimator = EstimatorKind::restir;
+    s.render.frames = 3;
+    CHECK_FALSE(planFrame(s, FrameFacts{}).temporal);
+    CHECK(planFrame(s, FrameFacts{false, true, true}).temporal);
+    CHECK_FALSE(planFrame(s, FrameFacts{false, true, false}).lighting);
 }

@@ -1,0 +1,77 @@
+#pragma once
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "accretion/particles/particles.h"
+#include "accretion/scene/settings.h"
+
+namespace accretion {
+
+/// One line of a frame's plan: a pass (or the work inside one) and whether
+/// it runs, with what it does or why it is skipped.
+struct PlannedStep {
+    std::string name;
+    bool runs = true;
+    std::string why;
+    bool isPass = true;  ///< a timed pass (stats' "passes"), else work inside one
+    bool nested = false; ///< a restir pass, inside estimateLighting
+};
+
+/// What the frame renderer knows of a frame before it plans it.
+struct FrameFacts {
+    bool geometryBuilt = false;     ///< a static scene's particles and BVH are already built
+    bool historyAvailable = false;  ///< restir: a previous frame's reservoirs are kept
+    bool emissive = true;           ///< some particle emits (luminance > 0)
+};
+
+/// The light sampler buildLightSampler builds.
+enum class LightSamplerKind { none, power, tree };
+
+/// Everything a frame runs, decided once from the settings and the facts;
+/// FrameRenderer and Restir execute it and decide nothing themselves.
+/// `accretion plan` prints it, and stats.json's "passes" of a frame are
+/// exactly passes() (plus writeOutputs, which the command runs).
+struct FramePlan {
+    // Run-wide decisions (the same every frame).
+    bool staticGeometry = false;  ///< static particles and camera: one BVH build for all frames
+    bool alphaFilter = false;     ///< disc alpha: filter (any-hit) callbacks attached
+    bool keepHistory = false;     ///< restir temporal reuse over several frames: history buffers and motion kept
+    bool previousBvh = false;     ///< a second BVH kept for basic_visibility
+    bool counting = false;        ///< counter code compiled into the loops
+    // This frame.
+    bool loadParticles = true;    ///< load (or generate) the particles
+    bool buildClusters = true;    ///< build (or refit) the BVH
+    bool lighting = true;         ///< any lighting pass at all
+    LightSamplerKind sampler = LightSamplerKind::none;  ///< buildLightSampler
+    bool shadowRays = true;       ///< visibility by shadow rays (off: V = 1)
+    bool restir = false;          ///< the restir passes instead of estimateLighting's accumulation
+    bool temporal = false;        ///< temporalResampling
+    std::uint32_t spatialIterations = 0;  ///< spatialResampling runs
+    bool upsample = false;        ///< upsampleLighting (restir at reduced resolution)
+    std::vector<PlannedStep> steps;
+
+    /// Names of the passes that run, in order (restir's inside estimateLighting).
+    std::vector<std::string> passes() const;
+    const PlannedStep* find(std::string_view name) const;
+};
+
+/// The plan of one frame.
+FramePlan planFrame(const Settings& settings, const FrameFacts& facts);
+
+/// Some particle emits.
+bool emissive(const Particles& particles);
+
+/// basic_visibility tests the previous frame's samples against the previous
+/// frame's geometry: the frame renderer keeps that BVH (for rebuild and
+/// fast_trace policies; refit and partial update one BVH in place).
+bool needsPreviousBvh(const Settings& settings);
+
+/// Particles identical in every frame (generator without motion, or one file without {frame}).
+bool staticParticles(const ParticleSettings& particles);
+
+/// "name   runs/skipped  why" lines.
+std::string formatPlan(const FramePlan& plan);
+
+}  // namespace accretion

@@ -1,0 +1,150 @@
+#include "accretion/render/frame_plan.h"
+
+#include <fmt/format.h>
+
+#include "accretion/core/math.h"
+#include "accretion/core/pass_timer.h"
+#include "accretion/lighting/reservoir_codec.h"
+
+namespace accretion {
+namespace {
+
+/// The run-wide part of the plan: the same for every frame.
+void planRun(const Settings& s, FramePlan& plan) {
+    const bool staticCamera = s.camera.path == CameraPath::static_pose ||
+                              (s.camera.path == CameraPath::orbit && s.camera.orbit_speed == 0.0);
+    const bool restir = s.render.estimator == EstimatorKind::restir;
+    plan.staticGeometry = staticParticles(s.particles) && staticCamera;
+    plan.alphaFilter = s.geometry.primitive == Primitive::billboard && s.geometry.alpha == AlphaMode::disc;
+    plan.keepHistory = restir && s.restir.temporal && s.render.frames > 1;
+    // A static scene's one BVH is also last frame's.
+    plan.previousBvh = plan.keepHistory && s.shading.visibility && !plan.staticGeometry && needsPreviousBvh(s);
+    plan.counting = s.gpu.counters;
+}
+
+/// This frame's passes.
+void planPasses(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
+    const EstimatorKind est = s.render.estimator;
+    const bool resampling = est == EstimatorKind::ris || est == EstimatorKind::restir;
+    plan.loadParticles = plan.buildClusters = !(plan.staticGeometry && facts.geometryBuilt);
+    plan.lighting = facts.emissive && glm::length(s.shading.albedo) > 0.0f;
+    plan.shadowRays = plan.lighting && s.shading.visibility;
+    if (plan.lighting && est == EstimatorKind::tree) plan.sampler = LightSamplerKind::tree;
+    if (plan.lighting && (est == EstimatorKind::power || (resampling && s.render.source == LightSource::power)))
+        plan.sampler = LightSamplerKind::power;
+    plan.restir = plan.lighting && est == EstimatorKind::restir;
+    plan.temporal = plan.restir && plan.keepHistory && facts.historyAvailable;
+    plan.spatialIterations = plan.restir && s.restir.spatial_neighbours > 0 ? s.restir.spatial_iterations : 0;
+    plan.upsample = plan.restir && float(s.restir.resolution_scale) < 1.0f;
+}
+
+/// The plan as lines, with what each step does or why it is skipped.
+void describe(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
+    const EstimatorKind est = s.render.estimator;
+    const bool restir = est == EstimatorKind::restir;
+    const bool manyFrames = s.render.frames > 1;
+    auto step = [&](std::string_view name, bool runs, std::string why, bool isPass = true, bool nested = false) {
+        plan.steps.push_back({std::string(name), runs, std::move(why), isPass, nested});
+    };
+    const std::string once = "static particles and camera: built at the first frame";
+    step(pass::loadParticles, plan.loadParticles,
+         !plan.loadParticles ? once : plan.staticGeometry && manyFrames ? "once: the particles do not move" : "every frame");
+    step(pass::buildClusters, plan.buildClusters,
+         !plan.buildClusters ? once
+         : plan.staticGeometry ? (manyFrames ? "once for all frames: static particles and camera" : "one frame")
+                               : fmt::format("every frame ({})", enumName(s.geometry.build)));
+    step("alpha filter callbacks", plan.alphaFilter,
+         plan.alphaFilter ? (s.gpu.omm == OmmMode::off ? "disc alpha: any-hit on every candidate"
+                                                       : fmt::format("disc alpha with {} OMM level {}", enumName(s.gpu.omm), s.gpu.omm_level))
+                          : "no alpha test (opaque quads or spheres)", false);
+    step("previous-frame BVH", plan.previousBvh,
+         plan.previousBvh ? "basic_visibility tests history samples against last frame's geometry"
+                          : "not needed (no basic_visibility with history and visibility reuse)", false);
+    const bool dark = !plan.lighting;
+    const std::string noLight = !facts.emissive ? "no lighting passes: no particle emits"
+                                                : "no lighting passes: albedo 0";
+    step(pass::buildLightSampler, plan.sampler != LightSamplerKind::none,
+         plan.sampler == LightSamplerKind::tree    ? "light tree"
+         : plan.sampler == LightSamplerKind::power ? "alias table over light power"
+         : dark ? noLight : fmt::format("{} samples lights uniformly", enumName(est)));
+    step(pass::traceGBuffer, true, "one primary ray per pixel");
+    step(pass::estimateLighting, plan.lighting,
+         dark ? noLight : restir ? "the restir passes below" : std::string(enumName(est)));
+    if (restir) {
+        step(pass::generateCandidates, plan.restir, dark ? noLight : fmt::format("{} candidates", s.render.candidates), true, true);
+        step(pass::temporalResampling, plan.temporal,
+             plan.temporal ? "reprojection through particle motion"
+             : dark ? noLight : !s.restir.temporal ? "temporal off: no history buffers or motion"
+             : !manyFrames ? "one frame: no history buffers or motion" : "first frame: no history yet", true, true);
+        step(pass::spatialResampling, plan.spatialIterations > 0,
+             plan.spatialIterations ? fmt::format("{} neighbours x {}", s.restir.spatial_neighbours, s.restir.spatial_iterations)
+                                    : (dark ? noLight : "no neighbours"), true, true);
+        step(pass::traceShadowRays, plan.restir,
+             plan.shadowRays ? "one shadow ray per pixel"
+             : dark ? noLight : "visibility off: the kept sample shaded with V = 1, no shadow rays", true, true);
+        step(pass::upsampleLighting, plan.upsample,
+             plan.upsample ? fmt::format("lighting at scale {}", s.restir.resolution_scale) : "full-resolution lighting", true, true);
+    } else {
+        step("shadow rays", plan.shadowRays,
+             plan.shadowRays ? "V by occlusion queries" : (dark ? noLight : "visibility off: no shadow rays"), false);
+    }
+    const bool reservoirs = plan.lighting && (est == EstimatorKind::ris || restir);
+    step("reservoirs", reservoirs,
+         reservoirs ? fmt::format("{} B each", restir ? ReservoirCodec(s.restir).bytes() : 16)
+                    : fmt::format("estimator {}: no reservoirs", enumName(est)), false);
+    step("counters", plan.counting,
+         plan.counting ? "counting variants of every pass" : "counters off: no counting code in the loops", false);
+    step(pass::composeImage, true, "Le + Lr");
+    step(pass::writeOutputs, true, "EXR, PNG previews, stats (by the command)");
+}
+
+}  // namespace
+
+bool staticParticles(const ParticleSettings& p) {
+    if (!p.file.empty()) return p.file.find("{frame}") == std::string::npos;
+    return p.gm == 0.0 || p.time_step == 0.0;
+}
+
+bool emissive(const Particles& particles) {
+    double total = 0.0;
+    for (const Vec3& I : particles.emission) total += luminance(I);
+    return total > 0.0;
+}
+
+bool needsPreviousBvh(const Settings& s) {
+    return s.render.estimator == EstimatorKind::restir && s.restir.temporal &&
+           s.restir.bias_correction == BiasCorrection::basic && s.restir.basic_visibility &&
+           (s.restir.visibility_reuse || s.restir.candidate_visibility) &&
+           (s.geometry.build == BuildPolicy::rebuild || s.geometry.build == BuildPolicy::fast_trace);
+}
+
+FramePlan planFrame(const Settings& settings, const FrameFacts& facts) {
+    FramePlan plan;
+    planRun(settings, plan);
+    planPasses(settings, facts, plan);
+    describe(settings, facts, plan);
+    return plan;
+}
+
+std::vector<std::string> FramePlan::passes() const {
+    std::vector<std::string> out;
+    for (const PlannedStep& s : steps)
+        if (s.isPass && s.runs && s.name != pass::writeOutputs) out.push_back(s.name);
+    return out;
+}
+
+const PlannedStep* FramePlan::find(std::string_view name) const {
+    for (const PlannedStep& s : steps)
+        if (s.name == name) return &s;
+    return nullptr;
+}
+
+std::string formatPlan(const FramePlan& plan) {
+    std::string out;
+    for (const PlannedStep& s : plan.steps)
+        out += fmt::format("  {}{:<{}} {:<8} {}\n", s.nested ? "  " : "", s.name, s.nested ? 22 : 24,
+                           s.runs ? "runs" : "skipped", s.why);
+    return out;
+}
+
+}  // namespace accretion

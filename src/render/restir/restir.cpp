@@ -1,0 +1,128 @@
+// Restir: one frame of ReSTIR DI, the passes in the order the plan gives.
+#include "accretion/render/restir.h"
+
+#include "accretion/core/error.h"
+#include "restir_pass.h"
+
+namespace accretion {
+namespace {
+
+/// The plan's restir passes: generateCandidates, temporalResampling,
+/// spatialResampling (plan.spatialIterations times), traceShadowRays.
+LightingCounters runPasses(const restir::FrameContext& f, std::vector<StoredReservoir>& a, std::vector<StoredReservoir>& b,
+                           std::vector<Vec3>& lowLr, PassTimer& timer, PassRejections& rejected) {
+    const FramePlan& plan = f.in.plan;
+    LightingCounters total;
+    auto add = [&](std::string_view name, const LightingCounters& c) {
+        total += c;
+        if (c.nonFinite) rejected[std::string(name)] += c.nonFinite;
+    };
+    {
+        auto t = timer.scope(pass::generateCandidates);
+        add(pass::generateCandidates, restir::generateCandidates(f, a));
+    }
+    if (plan.temporal) {
+        auto t = timer.scope(pass::temporalResampling);
+        add(pass::temporalResampling, restir::temporalResampling(f, a, b));
+        std::swap(a, b);
+    }
+    if (plan.spatialIterations > 0) {
+        auto t = timer.scope(pass::spatialResampling);
+        for (std::uint32_t it = 0; it < plan.spatialIterations; ++it) {
+            add(pass::spatialResampling, restir::spatialResampling(f, it, a, b));
+            std::swap(a, b);
+        }
+    }
+    {
+        auto t = timer.scope(pass::traceShadowRays);
+        add(pass::traceShadowRays, restir::traceShadowRays(f, a, lowLr));
+    }
+    return total;
+}
+
+}  // namespace
+
+Restir::Restir(const Settings& settings, bool keepHistory)
+    : rs_(settings.restir), keepHistory_(keepHistory), codec_(settings.restir) {}
+
+LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, ReservoirImage& aov, PassTimer& timer,
+                                PassRejections& rejected) {
+    const GBuffer& full = in.gbuffer;
+    const std::size_t pixels = std::size_t(full.width) * full.height;
+    out.Lr.assign(pixels, Vec3(0.0f));
+    out.Lr_stderr.assign(pixels, Vec3(0.0f));
+    out.spp.assign(pixels, 0.0f);
+    codec_.checkCapacity(in.particles.size(), in.settings.scenePath.empty() ? "restir" : in.settings.scenePath);
+
+    // The lighting grid: the image at resolution_scale, each texel the
+    // G-buffer texel of the image pixel that contains its centre.
+    const float scale = static_cast<float>(rs_.resolution_scale);
+    GBuffer reduced;
+    const GBuffer* lg = &full;
+    if (in.plan.upsample) {
+        reduced.width = std::max(1u, std::uint32_t(std::lround(full.width * scale)));
+        reduced.height = std::max(1u, std::uint32_t(std::lround(full.height * scale)));
+        reduced.texels.resize(std::size_t(reduced.width) * reduced.height);
+        for (std::uint32_t y = 0; y < reduced.height; ++y)
+            for (std::uint32_t x = 0; x < reduced.width; ++x) {
+                const auto fx = std::min(full.width - 1, std::uint32_t((float(x) + 0.5f) / scale));
+                const auto fy = std::min(full.height - 1, std::uint32_t((float(y) + 0.5f) / scale));
+                reduced.texels[std::size_t(y) * reduced.width + x] = full.at(fx, fy);
+            }
+        lg = &reduced;
+    }
+    const std::size_t lpixels = std::size_t(lg->width) * lg->height;
+    const LightArrays L(in.particles, in.settings.shading);
+    const FramePlan& plan = in.plan;
+    ACC_CHECK(plan.restir);
+    ACC_CHECK(!plan.temporal || (history_ && history_->gbuffer.width == lg->width && history_->gbuffer.height == lg->height));
+    const History* prev = plan.temporal ? history_.get() : nullptr;
+    std::vector<std::uint32_t> lowRejected(lpixels, 0);
+    restir::FrameContext f{in, rs_, codec_, *lg, L, prev, lg == &full ? 1.0f : float(lg->width) / float(full.width),
+                   VisibilityOptions::from(in.settings.render), in.settings.shading.visibility, in.counters,
+                   lowRejected.data()};
+
+    std::vector<StoredReservoir> a(lpixels), b(lpixels);
+    std::vector<Vec3> lowLr(lpixels);
+    LightingCounters counters = runPasses(f, a, b, lowLr, timer, rejected);
+
+    if (!plan.upsample) {
+        out.Lr = lowLr;
+    } else {
+        auto t = timer.scope(pass::upsampleLighting);
+        restir::upsampleLighting(full, *lg, in.particles, lowLr, f.scale, rs_, out.Lr);
+        if (in.counters) restir::recordUpsample(in, in.counters->add(pass::upsampleLighting, full.width, full.height));
+    }
+    aov.W.assign(pixels, 0.0f);
+    aov.M.assign(pixels, 0.0f);
+    aov.light.assign(pixels, kNoLight);
+    aov.p_hat.assign(pixels, 0.0f);
+    out.rejected.assign(pixels, 0.0f);
+    for (std::uint32_t y = 0; y < full.height; ++y)
+        for (std::uint32_t x = 0; x < full.width; ++x) {
+            const std::size_t px = std::size_t(y) * full.width + x;
+            if (!full.texels[px].hit()) continue;
+            out.spp[px] = 1.0f;
+            const auto lx = std::min(lg->width - 1, std::uint32_t(float(x) * f.scale));
+            const auto ly = std::min(lg->height - 1, std::uint32_t(float(y) * f.scale));
+            const StoredReservoir& r = a[std::size_t(ly) * lg->width + lx];
+            out.rejected[px] = float(lowRejected[std::size_t(ly) * lg->width + lx]);
+            aov.W[px] = r.W;
+            aov.M[px] = float(r.M);
+            aov.light[px] = r.W > 0.0f ? r.y : kNoLight;
+            aov.p_hat[px] = r.p_hat;
+        }
+
+    // History for the next frame.
+    if (!keepHistory_) return counters;
+    auto h = std::make_shared<History>();
+    h->gbuffer = *lg;
+    h->particles = in.particles;
+    h->lights = LightArrays(h->particles, in.settings.shading);
+    h->camera = in.camera;
+    h->reservoirs = std::move(a);
+    history_ = std::move(h);
+    return counters;
+}
+
+}  // namespace accretion

@@ -1,0 +1,166 @@
+#pragma once
+// What the restir passes share (internal to src/render/restir/): the frame
+// context, the offers a pass resamples, pixel loops and counting helpers.
+#include <cmath>
+#include <cstdint>
+#include <type_traits>
+#include <vector>
+
+#include <tbb/blocked_range2d.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include "accretion/core/rng.h"
+#include "accretion/counters/gpu_layouts.h"
+#include "accretion/lighting/light_arrays.h"
+#include "accretion/lighting/reservoir.h"
+#include "accretion/lighting/shading.h"
+#include "accretion/render/restir.h"
+#include "accretion/render/visibility.h"
+
+namespace accretion {
+
+/// The previous frame as temporal reuse sees it.
+struct Restir::History {
+    GBuffer gbuffer;                        ///< lighting-resolution G-buffer
+    Particles particles;                    ///< previous positions / emission / albedo
+    LightArrays lights;                     ///< views of `particles`
+    Camera camera;
+    std::vector<StoredReservoir> reservoirs;
+};
+
+namespace restir {
+
+/// The domain of a reservoir: the receiver and the lights its p_hat used,
+/// and whether its samples passed a visibility test (then its support is
+/// that of p_hat x V, and basic_visibility must test V to count it).
+struct Domain {
+    ShadingPoint sp;
+    const LightArrays* lights;
+    bool visibilityTested = false;
+    const ParticleBvh* bvh = nullptr;  ///< the geometry of the domain's frame (visibility tests)
+};
+
+/// A reservoir offered for resampling at the current pixel.
+struct Offer {
+    StoredReservoir r;
+    Domain domain;
+};
+
+/// Per-thread buffers of a resampling pass, sized by the neighbours asked for.
+struct Scratch {
+    std::vector<Offer> offers;
+    std::vector<float> pc;              ///< p_hat at the current pixel of each offered sample
+    std::vector<std::uint32_t> M;
+    std::vector<std::uint8_t> counts;   ///< basic: the domain counts in Z
+};
+
+
+/// Runs body(px, x, y, counters) or body(px, x, y, counters, scratch) over
+/// the pixels of a w x h grid in 8x8 tiles; counters and scratch are the
+/// running thread's.
+template <class Body>
+LightingCounters forEachPixel(std::uint32_t w, std::uint32_t h, Body&& body) {
+    struct ThreadState {
+        LightingCounters counters;
+        Scratch scratch;
+    };
+    tbb::enumerable_thread_specific<ThreadState> state;
+    tbb::parallel_for(tbb::blocked_range2d<std::uint32_t>(0, h, 8, 0, w, 8), [&](const auto& r) {
+        ThreadState& ts = state.local();
+        for (std::uint32_t y = r.rows().begin(); y != r.rows().end(); ++y)
+            for (std::uint32_t x = r.cols().begin(); x != r.cols().end(); ++x) {
+                if constexpr (std::is_invocable_v<Body&, std::size_t, std::uint32_t, std::uint32_t, LightingCounters&, Scratch&>)
+                    body(std::size_t(y) * w + x, x, y, ts.counters, ts.scratch);
+                else
+                    body(std::size_t(y) * w + x, x, y, ts.counters);
+            }
+    });
+    LightingCounters total;
+    for (const auto& ts : state) total += ts.counters;
+    return total;
+}
+
+struct FrameContext {
+    const RestirInputs& in;
+    const RestirSettings& rs;
+    const ReservoirCodec& codec;
+    const GBuffer& lg;          ///< lighting-resolution G-buffer
+    const LightArrays& L;
+    const Restir::History* prev;
+    float scale;                ///< lighting / image resolution
+    VisibilityOptions vis;      ///< render.visibility_rule
+    bool shadows;               ///< shading.visibility: trace shadow rays (off: V = 1)
+    FrameCounters* counters;    ///< counting mode: per-pass thread records
+    std::uint32_t* rejected;    ///< per lighting texel: non-finite values rejected (render.nonfinite)
+
+    /// A reservoir whose weights overflowed or went NaN: counted at px;
+    /// zero_sample keeps its M with W = 0, discard empties it.
+    StoredReservoir sanitize(StoredReservoir r, std::size_t px, LightingCounters& c) const {
+        if (std::isfinite(r.W) && std::isfinite(r.p_hat)) return r;
+        if (reject(px, c)) return StoredReservoir{};
+        return StoredReservoir{kNoLight, 0.0f, r.M, 0.0f};
+    }
+    /// Count a non-finite value at px; true if the policy discards the reservoir.
+    bool reject(std::size_t px, LightingCounters& c) const {
+        ++c.nonFinite;
+        ++rejected[px];
+        return in.settings.render.nonfinite == NonFinitePolicy::discard;
+    }
+};
+
+/// The counters of a pass about to run (counting mode), else null.
+template <bool Count>
+PassCounters* passCounters(const FrameContext& f, std::string_view name) {
+    if constexpr (Count) return &f.counters->add(name, f.lg.width, f.lg.height);
+    return nullptr;
+}
+
+template <bool Count>
+Recorder<Count> recorder(PassCounters* pc, std::size_t px) {
+    if constexpr (Count) return Recorder<true>(&pc->threads[px]);
+    else return Recorder<false>(nullptr);
+}
+
+/// The branch key of a lighting-grid texel (counting mode).
+template <bool Count>
+void recordHit(Recorder<Count>& rec, const FrameContext& f, const GBufferTexel& g) {
+    rec.read(gpu_layout::kGBufferTexel);
+    if constexpr (Count)
+        if (g.hit()) rec.shade(true, f.in.particles.type[g.particle], f.in.bvh.clusterOf(g.particle));
+}
+
+/// Calls fn.template operator()<SM, P, Count>() with the frame's shading
+/// model, primitive and counting mode (each pass compiles every variant).
+template <class Fn>
+LightingCounters dispatchKernel(const FrameContext& f, Fn&& fn) {
+    auto byPrimitive = [&]<ShadingModel SM>() {
+        const bool spheres = f.in.bvh.settings().primitive == Primitive::sphere;
+        if (f.counters)
+            return spheres ? fn.template operator()<SM, Primitive::sphere, true>()
+                           : fn.template operator()<SM, Primitive::billboard, true>();
+        return spheres ? fn.template operator()<SM, Primitive::sphere, false>()
+                       : fn.template operator()<SM, Primitive::billboard, false>();
+    };
+    switch (f.in.settings.shading.model) {
+    case ShadingModel::lambert: return byPrimitive.template operator()<ShadingModel::lambert>();
+    case ShadingModel::sphere: return byPrimitive.template operator()<ShadingModel::sphere>();
+    case ShadingModel::isotropic: return byPrimitive.template operator()<ShadingModel::isotropic>();
+    }
+    return {};
+}
+
+// The passes, in the order a frame runs them (one file each).
+LightingCounters generateCandidates(const FrameContext& f, std::vector<StoredReservoir>& out);
+LightingCounters temporalResampling(const FrameContext& f, const std::vector<StoredReservoir>& cur,
+                                    std::vector<StoredReservoir>& out);
+LightingCounters spatialResampling(const FrameContext& f, std::uint32_t iteration, const std::vector<StoredReservoir>& cur,
+                                   std::vector<StoredReservoir>& out);
+LightingCounters traceShadowRays(const FrameContext& f, std::vector<StoredReservoir>& res, std::vector<Vec3>& Lr);
+void upsampleLighting(const GBuffer& full, const GBuffer& lg, const Particles& particles, const std::vector<Vec3>& lowLr,
+                      float scale, const RestirSettings& rs, std::vector<Vec3>& Lr);
+/// Counting mode: upsampleLighting's per-pixel work.
+void recordUpsample(const RestirInputs& in, PassCounters& pc);
+
+}  // namespace restir
+}  // namespace accretion

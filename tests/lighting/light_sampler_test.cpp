@@ -1,0 +1,85 @@
+// One chi-square harness over every light sampler: each draws lights with
+// exactly the probabilities its pdf reports, the pdf sums to 1 (up to the
+// mass of an empty draw), and a light with a non-zero term can be drawn.
+#include <functional>
+
+#include <catch2/catch.hpp>
+
+#include "accretion/lighting/light_sampler.h"
+#include "accretion/particles/particle_source.h"
+#include "support/statistics.h"
+#include "support/test_scenes.h"
+
+using namespace accretion;
+
+namespace {
+
+/// A sampler under test: draw (with its stream) and pdf, at one receiver.
+struct SamplerUnderTest {
+    const char* name;
+    std::function<LightSample(Rng&)> sample;
+    std::function<float(std::uint32_t)> pdf;
+};
+
+/// Draws N lights; the chi-square p-value of the counts against N pdf(i)
+/// must exceed 1e-4 (a correct sampler fails one run in 10^4).
+void checkSampler(const SamplerUnderTest& s, std::uint32_t lights, const std::vector<bool>& lit) {
+    INFO("sampler " << s.name);
+    const std::uint32_t N = 400000;
+    std::vector<double> observed(lights + 1, 0.0), expected(lights + 1, 0.0);
+    Rng rng(7, 0, RngPass::lightSampling, 11);
+    std::uint32_t pdfMismatches = 0, outOfRange = 0;
+    for (std::uint32_t n = 0; n < N; ++n) {
+        const LightSample x = s.sample(rng);
+        if (x.i == kNoLightSample) {
+            observed[lights] += 1.0;
+            continue;
+        }
+        if (x.i >= lights) {
+            ++outOfRange;
+            continue;
+        }
+        if (std::abs(x.pdf - s.pdf(x.i)) > 1e-6f * x.pdf) ++pdfMismatches;  // sample reports the pdf that pdf() gives
+        observed[x.i] += 1.0;
+    }
+    CHECK(outOfRange == 0);
+    CHECK(pdfMismatches == 0);
+    double sum = 0.0;
+    for (std::uint32_t i = 0; i < lights; ++i) {
+        const double p = s.pdf(i);
+        if (lit[i]) CHECK(p > 0.0);
+        expected[i] = N * p;
+        sum += p;
+    }
+    CHECK(sum <= 1.0 + 1e-5);
+    expected[lights] = N * std::max(0.0, 1.0 - sum);  // an empty draw (tree: every light below the horizon)
+    CHECK(accretion::test::chiSquarePValue(observed, expected) > 1e-4);
+}
+
+}  // namespace
+
+TEST_CASE("every light sampler draws in proportion to its pdf (one chi-square harness)", "[lighting][sampler][statistical]") {
+    Settings s = accretion::test::smallDiskSettings();
+    s.particles.count = 300;
+    Particles particles = ParticleSource(s).frame(0);
+    const auto N = static_cast<std::uint32_t>(particles.size());
+    const LightArrays L(particles, s.shading);
+    const AliasTable power = buildPowerTable(particles);
+    const LightTree tree(particles, s.shading);
+    const ShadingPoint sp{particles.position[3], glm::normalize(Vec3(0.3f, 1.0f, 0.2f)), Vec3(0, 1, 0), Vec3(0.8f), 3,
+                          particles.position[3], Vec3(0.0f)};
+    std::vector<bool> lit(N), emits(N);
+    for (std::uint32_t i = 0; i < N; ++i) {
+        LightTerm t;
+        lit[i] = L.term<ShadingModel::lambert>(sp, i, t);
+        emits[i] = luminance(particles.emission[i]) > 0.0f;
+    }
+    checkSampler({"uniform", [&](Rng& rng) { return sampleSource<false>(L, nullptr, rng); },
+                  [&](std::uint32_t i) { return sourcePdf<false>(L, nullptr, i); }},
+                 N, emits);
+    checkSampler({"power", [&](Rng& rng) { return sampleSource<true>(L, &power, rng); },
+                  [&](std::uint32_t i) { return sourcePdf<true>(L, &power, i); }},
+                 N, emits);
+    checkSampler({"tree", [&](Rng& rng) { return tree.sample(sp, rng); }, [&](std::uint32_t i) { return tree.pdf(sp, i); }},
+                 N, lit);
+}
