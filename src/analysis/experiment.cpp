@@ -5,48 +5,25 @@
 #include <fmt/format.h>
 
 #include "accretion/core/error.h"
+#include "accretion/core/parse.h"
 #include "accretion/scene/scene_parser.h"
 
 namespace accretion {
-namespace {
-
-template <class E>
-bool parseEnum(const std::string& text, E& out) {
-    const auto& names = EnumNames<E>::names;
-    for (std::size_t i = 0; i < names.size(); ++i)
-        if (names[i] == text) {
-            out = static_cast<E>(i);
-            return true;
-        }
-    return false;
-}
-
-std::vector<std::string> split(const std::string& s, char sep) {
-    std::vector<std::string> out;
-    std::size_t start = 0;
-    for (;;) {
-        const auto k = s.find(sep, start);
-        out.push_back(s.substr(start, k == std::string::npos ? std::string::npos : k - start));
-        if (k == std::string::npos) return out;
-        start = k + 1;
-    }
-}
-
-}  // namespace
 
 std::vector<EstimatorSpec> parseEstimatorSpecs(const std::string& list, const std::string& option) {
     std::vector<EstimatorSpec> specs;
-    for (const std::string& entry : split(list, ',')) {
+    for (const std::string& entry : splitList(list, ',')) {
         auto fail = [&](const std::string& why) {
             throw InputError(fmt::format("command line {} '{}': {}", option, entry, why));
         };
         if (entry.empty()) fail("empty estimator");
-        const auto parts = split(entry, ':');
+        const auto parts = splitList(entry, ':');
         EstimatorSpec spec;
         spec.label = entry;
         if (!parseEnum(parts[0], spec.kind))
             fail("unknown estimator (exact, uniform, power, tree, ris, restir)");
-        spec.overrides.push_back("render.estimator=\"" + parts[0] + "\"");
+        const std::string flag = fmt::format("{} {}", option, entry);
+        spec.settings.push_back({"render.estimator", flag, [k = spec.kind](Settings& s) { s.render.estimator = k; }});
         for (std::size_t k = 1; k < parts.size(); ++k) {
             const std::string& o = parts[k];
             BiasCorrection bc;
@@ -54,13 +31,13 @@ std::vector<EstimatorSpec> parseEstimatorSpecs(const std::string& list, const st
             if (o.find('=') != std::string::npos) {
                 spec.overrides.push_back(o);
             } else if (o == "basic+vis") {
-                spec.overrides.push_back("restir.bias_correction=\"basic\"");
-                spec.overrides.push_back("restir.basic_visibility=true");
+                spec.settings.push_back({"restir.bias_correction", flag, [](Settings& s) { s.restir.bias_correction = BiasCorrection::basic; }});
+                spec.settings.push_back({"restir.basic_visibility", flag, [](Settings& s) { s.restir.basic_visibility = true; }});
             } else if (parseEnum(o, bc)) {
                 if (spec.kind != EstimatorKind::restir) fail("a bias correction applies to restir only");
-                spec.overrides.push_back("restir.bias_correction=\"" + o + "\"");
+                spec.settings.push_back({"restir.bias_correction", flag, [bc](Settings& s) { s.restir.bias_correction = bc; }});
             } else if (parseEnum(o, src)) {
-                spec.overrides.push_back("render.source=\"" + o + "\"");
+                spec.settings.push_back({"render.source", flag, [src](Settings& s) { s.render.source = src; }});
             } else {
                 fail(fmt::format("unknown option '{}' (none, basic, basic+vis, pairwise, uniform, power or key=value)", o));
             }
@@ -70,10 +47,13 @@ std::vector<EstimatorSpec> parseEstimatorSpecs(const std::string& list, const st
     return specs;
 }
 
-Settings specSettings(const std::filesystem::path& scene, const std::vector<std::string>& base, const EstimatorSpec& spec) {
-    std::vector<std::string> overrides = base;
+Settings specSettings(const std::filesystem::path& scene, const std::vector<std::string>& defines,
+                      const std::vector<FlagSetting>& base, const EstimatorSpec& spec) {
+    std::vector<std::string> overrides = defines;
     overrides.insert(overrides.end(), spec.overrides.begin(), spec.overrides.end());
-    return loadScene(scene, overrides);
+    std::vector<FlagSetting> flags = base;
+    flags.insert(flags.end(), spec.settings.begin(), spec.settings.end());
+    return loadScene(scene, overrides, flags);
 }
 
 ExperimentRender renderForExperiment(const Settings& settings, const ParticleSource& source, std::uint32_t frame,

@@ -43,14 +43,12 @@ struct BiasRow {
 };
 
 void runBias(const BiasArgs& a) {
-    std::vector<std::string> base = a.defines;
-    appendFrameOverrides(a.frames, base);
-    const Settings sceneSettings = loadScene(a.scene, base);
+    const std::vector<FlagSetting> base = frameFlags(a.frames);
+    const Settings sceneSettings = loadSceneArgs(a);
     const auto specs = parseEstimatorSpecs(a.estimators, "--estimators");
     if (a.seeds < 2) throw InputError("command line --seeds: at least 2 seeds are needed for a standard error");
     const std::uint32_t frame = a.frame.value_or(sceneSettings.render.frame_start);
-    std::optional<tbb::global_control> threads;
-    if (a.threads > 0) threads.emplace(tbb::global_control::max_allowed_parallelism, std::size_t(a.threads));
+    const auto threads = limitThreads(a.threads);
     const std::string prefix = a.out.empty() ? "out/" + sceneSettings.sceneName + ".bias" : a.out;
     if (auto dir = std::filesystem::path(prefix).parent_path(); !dir.empty()) std::filesystem::create_directories(dir);
 
@@ -75,7 +73,7 @@ void runBias(const BiasArgs& a) {
     const ParticleSource source(sceneSettings);
     std::vector<BiasRow> rows;
     for (const EstimatorSpec& spec : specs) {
-        const Settings specBase = specSettings(a.scene, base, spec);
+        const Settings specBase = specSettings(a.scene, a.defines, base, spec);
         std::vector<DVec3> s1(pixels, DVec3(0.0)), s2(pixels, DVec3(0.0));
         double e1 = 0.0, e2 = 0.0, seconds = 0.0;
         for (std::uint32_t k = 0; k < a.seeds; ++k) {
@@ -171,18 +169,14 @@ void runBias(const BiasArgs& a) {
 void addBiasCommand(CLI::App& app) {
     auto args = std::make_shared<BiasArgs>();
     CLI::App* cmd = app.add_subcommand("bias", "Mean signed error over many seeds per estimator, with its standard error");
-    cmd->add_option("scene", args->scene, "Scene file (TOML)")->required();
+    addSceneOptions(cmd, *args, "Frames A:B (= render.frame_start, render.frames); the first is measured");
     cmd->add_option("--reference", args->reference, "Reference EXR with an Lr layer (and Lr_stderr if noisy)")->required();
     cmd->add_option("--estimators", args->estimators, "Comma-separated specs, as for converge");
     cmd->add_option("--seeds", args->seeds, "Independent renders per estimator")->check(CLI::Range(2u, 1000000u));
     cmd->add_option("--frame", args->frame, "Frame measured (default render.frame_start)");
-    cmd->add_option("--frames", args->frames, "Frames A:B (= render.frame_start, render.frames); the first is measured");
     cmd->add_option("--history", args->history, "restir: frames rendered before the measured one");
     cmd->add_option("--z", args->zCritical, "Two-sided critical |z| for the verdict (3.29: 99.9%)");
     cmd->add_option("-o,--out", args->out, "Output prefix (default out/<scene>.bias): .csv, .png, .json, bias-map EXRs");
-    cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")->check(CLI::Range(0, 4096));
-    cmd->add_flag("-q,--quiet", args->quiet, "No progress on stderr");
-    cmd->add_option("-D,--define", args->defines, "Override a setting: -D section.key=value")->allow_extra_args(false);
     cmd->callback([args] { runBias(*args); });
 }
 

@@ -14,6 +14,7 @@
 #include "accretion/analysis/experiment.h"
 #include "accretion/analysis/image_metrics.h"
 #include "accretion/core/error.h"
+#include "accretion/core/parse.h"
 #include "accretion/core/version.h"
 #include "accretion/core/atomic_file.h"
 #include "accretion/io/plot.h"
@@ -38,16 +39,9 @@ double parseSeconds(const std::string& text) {
         t.pop_back();
         scale = 60.0;
     }
-    std::size_t used = 0;
-    double v = 0.0;
-    try {
-        v = std::stod(t, &used);
-    } catch (const std::exception&) {
-        used = 0;
-    }
-    if (used == 0 || used != t.size() || !(v > 0.0) || !std::isfinite(v))
-        throw InputError(fmt::format("command line --budget {}: expected a duration such as 60s or 2m", text));
-    return v * scale;
+    const std::optional<double> v = parseNumber(t);
+    if (!v || !(*v > 0.0)) throw InputError(fmt::format("command line --budget {}: expected a duration such as 60s or 2m", text));
+    return *v * scale;
 }
 
 struct Point {
@@ -77,14 +71,12 @@ double timeAtError(const std::vector<Point>& curve, double relMSE) {
 }
 
 void runConverge(const ConvergeArgs& a) {
-    std::vector<std::string> base = a.defines;
-    appendFrameOverrides(a.frames, base);
-    const Settings sceneSettings = loadScene(a.scene, base);
+    const std::vector<FlagSetting> base = frameFlags(a.frames);
+    const Settings sceneSettings = loadSceneArgs(a);
     const auto specs = parseEstimatorSpecs(a.estimators, "--estimators");
     const double budget = parseSeconds(a.budget);
     const std::uint32_t frame = a.frame.value_or(sceneSettings.render.frame_start);
-    std::optional<tbb::global_control> threads;
-    if (a.threads > 0) threads.emplace(tbb::global_control::max_allowed_parallelism, std::size_t(a.threads));
+    const auto threads = limitThreads(a.threads);
 
     const std::string prefix = a.out.empty() ? "out/" + sceneSettings.sceneName + ".converge" : a.out;
     if (auto dir = std::filesystem::path(prefix).parent_path(); !dir.empty()) std::filesystem::create_directories(dir);
@@ -116,7 +108,7 @@ void runConverge(const ConvergeArgs& a) {
         for (std::uint32_t k = 0; k < a.sequence; ++k) refs.push_back(loadRef(frame + k));
         for (const EstimatorSpec& spec : specs) {
             // One history per seed; each frame's metrics are means over the seeds, its time their median.
-            Settings s = specSettings(a.scene, base, spec);
+            Settings s = specSettings(a.scene, a.defines, base, spec);
             s.render.frame_start = frame;
             s.render.frames = a.sequence;
             const std::uint64_t seed0 = s.render.seed;
@@ -162,12 +154,13 @@ void runConverge(const ConvergeArgs& a) {
             double spent = 0.0, last = 0.0;
             for (std::uint32_t effort = a.minEffort; effort <= a.maxEffort; effort *= 2) {
                 if (spent > 0.0 && spent + 2.2 * last > budget) break;  // the next level would overrun the budget
-                std::vector<std::string> extra = spec.overrides;
-                if (spec.kind == EstimatorKind::restir) extra.push_back(fmt::format("render.candidates={}", effort));
-                else extra.push_back(fmt::format("render.samples={}", effort));
                 EstimatorSpec level = spec;
-                level.overrides = extra;
-                Settings s = specSettings(a.scene, base, level);
+                const std::string flag = fmt::format("--min-effort/--max-effort (level {})", effort);
+                if (spec.kind == EstimatorKind::restir)
+                    level.settings.push_back({"render.candidates", flag, [effort](Settings& st) { st.render.candidates = effort; }});
+                else
+                    level.settings.push_back({"render.samples", flag, [effort](Settings& st) { st.render.samples = effort; }});
+                Settings s = specSettings(a.scene, a.defines, base, level);
                 // Metrics are means over --seeds independent renders; time per frame is their median.
                 Point p{spec.label, frame, effort, 0.0, 0.0, 0, 0, {}};
                 std::vector<double> frameSeconds;
@@ -295,14 +288,13 @@ void runConverge(const ConvergeArgs& a) {
 void addConvergeCommand(CLI::App& app) {
     auto args = std::make_shared<ConvergeArgs>();
     CLI::App* cmd = app.add_subcommand("converge", "Error against time and rays per estimator, against a reference EXR");
-    cmd->add_option("scene", args->scene, "Scene file (TOML)")->required();
+    addSceneOptions(cmd, *args, "Frames A:B (= render.frame_start, render.frames); the first is measured");
     cmd->add_option("--reference", args->reference, "Reference EXR with an Lr layer ({frame} pattern with --sequence)")->required();
     cmd->add_option("--estimators", args->estimators,
                     "Comma-separated specs name[:option...]: uniform, power, tree, ris[:power], restir[:none|basic|basic+vis|pairwise], "
                     "options key=value override settings");
     cmd->add_option("--budget", args->budget, "Time budget per estimator (e.g. 60s, 2m)");
     cmd->add_option("--frame", args->frame, "Frame measured (default render.frame_start)");
-    cmd->add_option("--frames", args->frames, "Frames A:B (= render.frame_start, render.frames); the first is measured");
     cmd->add_option("--history", args->history, "restir: frames rendered before the measured one");
     cmd->add_option("--sequence", args->sequence, "Error per frame over N frames from --frame (one history per estimator)");
     cmd->add_option("--min-effort", args->minEffort, "First spp (restir: candidates) tried; doubled from there")
@@ -311,9 +303,6 @@ void addConvergeCommand(CLI::App& app) {
     cmd->add_option("--seeds", args->seeds, "Renders per point: errors are their means, time their median")
         ->check(CLI::Range(1u, 100000u));
     cmd->add_option("-o,--out", args->out, "Output prefix (default out/<scene>.converge): .csv, .png, .json");
-    cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")->check(CLI::Range(0, 4096));
-    cmd->add_flag("-q,--quiet", args->quiet, "No progress on stderr");
-    cmd->add_option("-D,--define", args->defines, "Override a setting: -D section.key=value")->allow_extra_args(false);
     cmd->footer("Effort doubles from --min-effort (spp; ris reservoirs; restir candidates) until the budget is spent.\n"
                 "relMSE_corrected subtracts the reference's own noise (its Lr_stderr layer) in expectation.");
     cmd->callback([args] { runConverge(*args); });

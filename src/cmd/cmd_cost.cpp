@@ -12,6 +12,7 @@
 
 #include "accretion/analysis/image_metrics.h"
 #include "accretion/core/error.h"
+#include "accretion/core/parse.h"
 #include "accretion/core/version.h"
 #include "accretion/geometry/particle_bvh.h"
 #include "accretion/gpu/cost_model.h"
@@ -38,19 +39,11 @@ struct CostArgs : SceneArgs {
 std::vector<std::uint32_t> parseList(const std::string& text, const char* option, std::uint32_t lo, std::uint32_t hi) {
     std::vector<std::uint32_t> out;
     if (text.empty()) return out;
-    std::stringstream ss(text);
-    std::string part;
-    while (std::getline(ss, part, ',')) {
-        std::size_t used = 0;
-        unsigned long v = 0;
-        try {
-            v = std::stoul(part, &used);
-        } catch (...) {
-            used = 0;
-        }
-        if (used == 0 || used != part.size() || v < lo || v > hi)
+    for (const std::string& part : splitList(text, ',')) {
+        const std::optional<std::uint64_t> v = parseUnsigned(part, hi);
+        if (!v || *v < lo)
             throw InputError(fmt::format("command line {} {}: expected integers in [{}, {}] separated by commas", option, text, lo, hi));
-        out.push_back(static_cast<std::uint32_t>(v));
+        out.push_back(static_cast<std::uint32_t>(*v));
     }
     return out;
 }
@@ -83,18 +76,15 @@ double median(std::vector<double> v) {
 }
 
 void runCost(const CostArgs& a) {
-    std::vector<std::string> overrides = a.defines;
-    appendFrameOverrides(a.frames, overrides);
-    overrides.push_back("gpu.counters=true");
-    const Settings settings = loadScene(a.scene, overrides);
+    const Settings settings =
+        loadSceneArgs(a, {{"gpu.counters", "cost (counts every pass)", [](Settings& s) { s.gpu.counters = true; }}});
     const std::vector<std::uint32_t> clusterSizes = parseList(a.clusterSizes, "--cluster-sizes", 1, 10000000);
     const std::vector<std::uint32_t> ommLevels = parseList(a.ommLevels, "--omm-levels", 0, 6);
     std::vector<SerKey> serKeys;
     for (const std::string& k : a.serKeys) serKeys.push_back(SerKey::parse(k, std::max(settings.gpu.ser_hint_bits, 4u), "--ser-keys " + k));
     const CostCoefficients coef = settings.gpu.coefficients.empty() ? CostCoefficients::defaults()
                                                                     : CostCoefficients::load(settings.gpu.coefficients);
-    std::optional<tbb::global_control> threads;
-    if (a.threads > 0) threads.emplace(tbb::global_control::max_allowed_parallelism, std::size_t(a.threads));
+    const auto threads = limitThreads(a.threads);
     const std::string prefix = a.output.empty() ? "out/" + settings.sceneName + ".cost" : std::filesystem::path(a.output).replace_extension().string();
     const std::string config = a.config.empty() ? settings.sceneName : a.config;
     const std::uint32_t frame = settings.render.frame_start;
@@ -323,19 +313,14 @@ void runCost(const CostArgs& a) {
 void addCostCommand(CLI::App& app) {
     auto args = std::make_shared<CostArgs>();
     CLI::App* cmd = app.add_subcommand("cost", "GPU model of a frame: counters, SIMT/SER, any-hit/OMM, memory, predicted time");
-    cmd->add_option("scene", args->scene, "Scene file (TOML)")->required();
+    addSceneOptions(cmd, *args, "Frame A (or A:B, the first is measured)");
     cmd->add_option("-o,--output", args->output, "Output JSON (the CSV, heatmap EXR and PNGs go beside it); default out/<scene>.cost.json");
-    cmd->add_option("--frames", args->frames, "Frame A (or A:B, the first is measured)");
     cmd->add_option("--history", args->history, "restir: frames rendered before the measured one");
     cmd->add_option("--config", args->config, "Configuration label of the CSV rows (default: the scene name)");
     cmd->add_option("--overhead", args->overhead, "Measure the counting overhead: renders with counters off and on, median of N (0: skip)");
     cmd->add_option("--cluster-sizes", args->clusterSizes, "BLAS memory table at these cluster sizes (empty: skip)");
     cmd->add_option("--omm-levels", args->ommLevels, "Disc alpha: OMM levels compared with alpha testing (empty: skip)");
     cmd->add_option("--ser-keys", args->serKeys, "SER sort keys compared (each comma-separated hit,type,cluster,hint)");
-    cmd->add_option("--threads", args->threads, "Worker threads (default: all cores); never changes the counters")
-        ->check(CLI::Range(0, 4096));
-    cmd->add_flag("-q,--quiet", args->quiet, "No progress on stderr");
-    cmd->add_option("-D,--define", args->defines, "Override a setting: -D section.key=value (TOML value)")->allow_extra_args(false);
     cmd->callback([args] { runCost(*args); });
 }
 

@@ -20,9 +20,7 @@ struct ParticlesArgs : SceneArgs {
 };
 
 void runParticles(const ParticlesArgs& args) {
-    std::vector<std::string> overrides = args.defines;
-    appendFrameOverrides(args.frames, overrides);
-    const Settings settings = loadScene(args.scene, overrides);
+    const Settings settings = loadSceneArgs(args);
     const ParticleFormat format = args.format == "ply" ? ParticleFormat::ply : ParticleFormat::raw;
     const ParticleSource source(settings);
     const std::filesystem::path dir(args.out);
@@ -41,12 +39,10 @@ void runParticles(const ParticlesArgs& args) {
 void addParticlesCommand(CLI::App& app) {
     auto args = std::make_shared<ParticlesArgs>();
     CLI::App* cmd = app.add_subcommand("particles", "Write a scene's particles in the GPU buffer format (32-byte records) or PLY");
-    cmd->add_option("scene", args->scene, "Scene file (TOML)")->required();
-    cmd->add_option("--frames", args->frames, "Frames A:B, half-open (default: the scene's render frames)");
+    addSceneOptions(cmd, *args, "Frames A:B, half-open (default: the scene's render frames)", false);
     cmd->add_option("--out", args->out, "Output directory (files <scene>.<frame>.bin|ply)");
     cmd->add_option("--format", args->format, "raw (GPU buffer, little-endian) | ply (binary)")
         ->check(CLI::IsMember({"raw", "ply"}));
-    cmd->add_option("-D,--define", args->defines, "Override a setting: -D section.key=value")->allow_extra_args(false);
     cmd->callback([args] { runParticles(*args); });
 }
 

@@ -12,9 +12,7 @@ namespace accretion::cmd {
 namespace {
 
 void runPlan(const SceneArgs& a) {
-    std::vector<std::string> overrides = a.defines;
-    appendFrameOverrides(a.frames, overrides);
-    const Settings s = loadScene(a.scene, overrides);
+    const Settings s = loadSceneArgs(a);
     // The plan needs to know whether the particles emit: load the first frame's.
     FrameFacts facts;
     facts.emissive = emissive(ParticleSource(s).frame(s.render.frame_start));
@@ -42,9 +40,7 @@ void runPlan(const SceneArgs& a) {
 void addPlanCommand(CLI::App& app) {
     auto args = std::make_shared<SceneArgs>();
     CLI::App* cmd = app.add_subcommand("plan", "Print the passes a scene's frames run, with the reason for every pass skipped");
-    cmd->add_option("scene", args->scene, "Scene file (TOML)")->required();
-    cmd->add_option("--frames", args->frames, "Frames A:B (= render.frame_start, render.frames)");
-    cmd->add_option("-D,--define", args->defines, "Override a setting: -D section.key=value (TOML value)")->allow_extra_args(false);
+    addSceneOptions(cmd, *args, "Frames A:B (= render.frame_start, render.frames)", false);
     cmd->callback([args] { runPlan(*args); });
 }
 

@@ -10,6 +10,7 @@
 #include <tbb/info.h>
 
 #include "accretion/core/error.h"
+#include "accretion/core/parse.h"
 #include "accretion/core/memory.h"
 #include "accretion/core/version.h"
 #include "accretion/gpu/gpu_report.h"
@@ -24,34 +25,6 @@
 #include "commands.h"
 
 namespace accretion::cmd {
-
-std::pair<std::uint64_t, std::uint64_t> parseHalfOpen(const std::string& text, const char* option) {
-    const auto colon = text.find(':');
-    auto number = [&](const std::string& s) -> std::uint64_t {
-        std::size_t used = 0;
-        unsigned long long v = 0;
-        try {
-            v = std::stoull(s, &used);
-        } catch (...) {
-            used = 0;
-        }
-        if (s.empty() || used != s.size() || s[0] == '-')
-            throw InputError(fmt::format("command line {} {}: expected A:B with 0 <= A < B", option, text));
-        return v;
-    };
-    const std::uint64_t a = number(text.substr(0, colon));
-    const std::uint64_t b = colon == std::string::npos ? a + 1 : number(text.substr(colon + 1));
-    if (b <= a)
-        throw InputError(fmt::format("command line {} {}: end must be greater than start (half-open A:B)", option, text));
-    return {a, b};
-}
-
-void appendFrameOverrides(const std::string& frames, std::vector<std::string>& overrides) {
-    if (frames.empty()) return;
-    const auto [a, b] = parseHalfOpen(frames, "--frames");
-    overrides.push_back(fmt::format("render.frame_start={}", a));
-    overrides.push_back(fmt::format("render.frames={}", b - a));
-}
 
 namespace {
 
@@ -80,16 +53,10 @@ double parseRelative(const std::string& text, const char* option) {
         t.pop_back();
         scale = 0.01;
     }
-    std::size_t used = 0;
-    double v = 0.0;
-    try {
-        v = std::stod(t, &used);
-    } catch (const std::exception&) {
-        used = 0;
-    }
-    if (used == 0 || used != t.size() || !(v >= 0.0) || !std::isfinite(v))
+    const std::optional<double> v = parseNumber(t);
+    if (!v || !(*v >= 0.0))
         throw InputError(fmt::format("command line {} {}: expected a non-negative number or percentage", option, text));
-    return v * scale;
+    return *v * scale;
 }
 
 /// "out/{scene}.{frame}.exr" -> "out/<scene>" (the {frame} part and extension dropped).
@@ -105,19 +72,33 @@ std::string runStem(const Settings& s) {
     return (p.parent_path() / p.stem()).string();
 }
 
-void runRender(const RenderArgs& args) {
-    std::vector<std::string> overrides = args.defines;
-    if (!args.output.empty()) overrides.push_back("render.output=" + args.output);
-    if (!args.estimator.empty()) overrides.push_back("render.estimator=" + args.estimator);
-    if (args.spp) overrides.push_back(fmt::format("render.samples={}", *args.spp));
-    if (args.seed) overrides.push_back(fmt::format("render.seed={}", *args.seed));
-    if (!args.targetStderr.empty())
-        overrides.push_back(fmt::format("render.target_stderr={}", parseRelative(args.targetStderr, "--target-stderr")));
-    appendFrameOverrides(args.frames, overrides);
-    const Settings settings = loadScene(args.scene, overrides);
+/// The render flags as the settings they set (typed, and errors name the flag).
+std::vector<FlagSetting> renderFlags(const RenderArgs& args) {
+    std::vector<FlagSetting> flags;
+    if (!args.output.empty())
+        flags.push_back({"render.output", "-o " + args.output, [o = args.output](Settings& s) { s.render.output = o; }});
+    if (!args.estimator.empty()) {
+        EstimatorKind e;
+        if (!parseEnum(args.estimator, e))
+            throw InputError(fmt::format("command line --estimator {}: unknown estimator (expected {})", args.estimator,
+                                         enumChoices<EstimatorKind>()));
+        flags.push_back({"render.estimator", "--estimator " + args.estimator, [e](Settings& s) { s.render.estimator = e; }});
+    }
+    if (args.spp)
+        flags.push_back({"render.samples", fmt::format("--spp {}", *args.spp), [n = *args.spp](Settings& s) { s.render.samples = n; }});
+    if (args.seed)
+        flags.push_back({"render.seed", fmt::format("--seed {}", *args.seed), [n = *args.seed](Settings& s) { s.render.seed = n; }});
+    if (!args.targetStderr.empty()) {
+        const double t = parseRelative(args.targetStderr, "--target-stderr");
+        flags.push_back({"render.target_stderr", "--target-stderr " + args.targetStderr,
+                         [t](Settings& s) { s.render.target_stderr = t; }});
+    }
+    return flags;
+}
 
-    std::optional<tbb::global_control> threads;
-    if (args.threads > 0) threads.emplace(tbb::global_control::max_allowed_parallelism, std::size_t(args.threads));
+void runRender(const RenderArgs& args) {
+    const Settings settings = loadSceneArgs(args, renderFlags(args));
+    const auto threads = limitThreads(args.threads);
     const int threadCount = args.threads > 0 ? args.threads : tbb::info::default_concurrency();
 
     const Shard shard = args.shard.empty() ? Shard{} : parseShard(args.shard, "--shard");
@@ -293,25 +274,19 @@ void runRender(const RenderArgs& args) {
 void addRenderCommand(CLI::App& app) {
     auto args = std::make_shared<RenderArgs>();
     CLI::App* cmd = app.add_subcommand("render", "Render frames of a scene to EXR (+ PNG preview, stats.json)");
-    cmd->add_option("scene", args->scene, "Scene file (TOML)")->required();
+    addSceneOptions(cmd, *args, "Frames A:B, half-open (= render.frame_start, render.frames)");
     cmd->add_option("-o,--output", args->output, "EXR output path ({scene}, {frame} patterns) = render.output");
     cmd->add_option("--estimator", args->estimator, "exact | uniform | power | tree | ris | restir  (= render.estimator)");
     cmd->add_option("--target-stderr", args->targetStderr,
                     "Sample each pixel until its relative standard error is below this (e.g. 0.5%; = render.target_stderr)");
     cmd->add_option("--spp", args->spp, "Light samples per pixel (= render.samples)");
     cmd->add_option("--seed", args->seed, "Render seed (= render.seed)");
-    cmd->add_option("--frames", args->frames, "Frames A:B, half-open (= render.frame_start, render.frames)");
-    cmd->add_option("--threads", args->threads, "Worker threads (default: all cores); never changes the image")
-        ->check(CLI::Range(0, 4096));
-    cmd->add_flag("-q,--quiet", args->quiet, "No progress on stderr");
     cmd->add_option("--shard", args->shard,
                     "Render part i/n (0 <= i < n) of the work: a sample range (exact: rows) with its own streams, "
                     "to combine with `accretion merge`; adaptive sampling and restir split frames");
     cmd->add_flag("--resume", args->resume, "Continue from the checkpoint of an interrupted run (same command line)");
     cmd->add_option("--checkpoint-every", args->checkpointEvery,
                     "Seconds between checkpoints of the lighting sums (default 300; 0: only on SIGINT/SIGTERM)");
-    cmd->add_option("-D,--define", args->defines, "Override a setting: -D section.key=value (TOML value)")
-        ->allow_extra_args(false);
     cmd->add_flag_callback("--help-settings", [] {
         fmt::print("Scene settings (section.key = default  # meaning):\n{}", settingsReference());
         throw CLI::Success();

@@ -1,10 +1,14 @@
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include <CLI/CLI.hpp>
+#include <tbb/global_control.h>
+
+#include "accretion/scene/scene_parser.h"
 
 namespace accretion::cmd {
 
@@ -24,8 +28,19 @@ struct BatchFailed {};
 /// option; InputError names the option.
 std::pair<std::uint64_t, std::uint64_t> parseHalfOpen(const std::string& text, const char* option);
 
-/// Turn `--frames A:B` into overrides of render.frame_start / render.frames.
-void appendFrameOverrides(const std::string& frames, std::vector<std::string>& overrides);
+/// `--frames A:B` as the settings it sets (render.frame_start, render.frames).
+std::vector<FlagSetting> frameFlags(const std::string& frames);
+
+/// The command's scene: the file, its -D overrides, --frames, then `flags`.
+Settings loadSceneArgs(const SceneArgs& args, const std::vector<FlagSetting>& flags = {});
+
+/// --threads N as a TBB limit for the life of the result (none for 0).
+std::unique_ptr<tbb::global_control> limitThreads(int threads);
+
+/// The options of SceneArgs: scene, --frames (with its help), -D, and
+/// optionally --threads and --quiet.
+void addSceneOptions(CLI::App* cmd, SceneArgs& args, const std::string& framesHelp, bool threadsAndQuiet = true);
+
 
 void addRenderCommand(CLI::App& app);
 void addParticlesCommand(CLI::App& app);

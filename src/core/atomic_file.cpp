@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "accretion/core/error.h"
+#include "accretion/core/parse.h"
 
 namespace accretion {
 namespace {
@@ -75,7 +76,9 @@ std::size_t removeStaleTemporaries(const std::filesystem::path& dir) {
         const std::string name = entry.path().filename().string();
         std::smatch m;
         if (!std::regex_match(name, m, temporary)) continue;
-        const long pid = std::stol(m[1].str());
+        const std::optional<std::uint64_t> id = parseUnsigned(m[1].str(), 0x7fffffff);  // a pid_t, else not ours
+        if (!id) continue;
+        const long pid = long(*id);
         if (pid > 0 && pid != ::getpid() && ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH)
             removed += std::filesystem::remove(entry.path(), ec) ? 1 : 0;
     }

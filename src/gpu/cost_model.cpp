@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "accretion/core/error.h"
+#include "accretion/core/parse.h"
 
 namespace accretion {
 
@@ -126,16 +127,9 @@ std::vector<std::string> splitCsv(const std::string& line) {
 }
 
 double parseNumber(const std::string& s, const std::string& where) {
-    std::size_t used = 0;
-    double v = 0.0;
-    try {
-        v = std::stod(s, &used);
-    } catch (const std::exception&) {
-        used = 0;
-    }
-    if (used != s.size() || s.empty() || !std::isfinite(v) || v < 0.0)
-        throw InputError(fmt::format("{}: '{}' is not a finite non-negative number", where, s));
-    return v;
+    const std::optional<double> v = accretion::parseNumber(s);
+    if (!v || *v < 0.0) throw InputError(fmt::format("{}: '{}' is not a finite non-negative number", where, s));
+    return *v;
 }
 
 /// Rows of a CSV with a header; each row mapped by column name.

@@ -75,7 +75,7 @@ GpuReport makeGpuReport(const FrameCounters& counters, const Settings& settings,
     const GpuSettings& gpu = settings.gpu;
     GpuReport r;
     r.layout = warpLayout(gpu);
-    const SerKey key = SerKey::parse(gpu.ser_key, gpu.ser_hint_bits, "gpu.ser_key");
+    const SerKey key(gpu.ser_key, gpu.ser_hint_bits);
     r.serKey = key.label();
     r.serWindow = gpu.ser_window;
     for (const PassCounters& pc : counters.passes) {

@@ -81,34 +81,32 @@ std::vector<std::uint32_t> serReorder(std::span<const std::uint32_t> order, std:
 }
 
 SerKey SerKey::parse(const std::string& spec, std::uint32_t hintBits, const std::string& where) {
-    SerKey k;
-    k.hintBits = hintBits;
-    std::stringstream ss(spec);
-    std::string part;
-    while (std::getline(ss, part, ',')) {
-        if (part != "hit" && part != "type" && part != "cluster" && part != "hint")
-            throw InputError(fmt::format("{}: unknown SER key component '{}' (expected hit, type, cluster, hint)", where, part));
-        k.components.push_back(part);
-    }
-    if (k.components.empty()) throw InputError(fmt::format("{}: empty SER key", where));
-    return k;
+    std::string bad;
+    const std::optional<SerKeySpec> key = parseSerKey(spec, bad);
+    if (!key)
+        throw InputError(fmt::format("{}: unknown SER key component '{}' (expected hit, type, cluster, hint)", where, bad));
+    return SerKey(*key, hintBits);
 }
 
 std::uint64_t SerKey::of(const ThreadCounters& t) const {
     std::uint64_t key = 0;
-    for (const std::string& c : components) {
-        if (c == "hit") key = (key << 1) | t.hit;
-        else if (c == "type") key = (key << 8) | t.type;
-        else if (c == "cluster") key = (key << 24) | (t.cluster & 0xffffffu);
-        else if (hintBits > 0) key = (key << hintBits) | (t.hint & ((1u << hintBits) - 1u));
+    for (const SerComponent c : components) {
+        switch (c) {
+        case SerComponent::hit: key = (key << 1) | t.hit; break;
+        case SerComponent::type: key = (key << 8) | t.type; break;
+        case SerComponent::cluster: key = (key << 24) | (t.cluster & 0xffffffu); break;
+        case SerComponent::hint:
+            if (hintBits > 0) key = (key << hintBits) | (t.hint & ((1u << hintBits) - 1u));
+            break;
+        }
     }
     return key;
 }
 
 std::string SerKey::label() const {
     std::string s;
-    for (const std::string& c : components) s += (s.empty() ? "" : "+") + c;
-    if (hintBits > 0 && std::find(components.begin(), components.end(), "hint") != components.end())
+    for (const SerComponent c : components) s += (s.empty() ? "" : "+") + std::string(enumName(c));
+    if (hintBits > 0 && std::find(components.begin(), components.end(), SerComponent::hint) != components.end())
         s += fmt::format("({} bits)", hintBits);
     return s;
 }

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "accretion/core/error.h"
+#include "accretion/core/parse.h"
 
 namespace accretion {
 
@@ -13,10 +14,9 @@ std::string Shard::name() const { return fmt::format("shard{}of{}", index + 1, c
 Shard parseShard(const std::string& text, const char* option) {
     const auto slash = text.find('/');
     auto number = [&](const std::string& s, std::uint32_t& v) {
-        if (s.empty() || s.size() > 9 || !std::all_of(s.begin(), s.end(), [](char ch) { return ch >= '0' && ch <= '9'; }))
-            return false;
-        v = static_cast<std::uint32_t>(std::stoul(s));
-        return true;
+        const std::optional<std::uint64_t> n = parseUnsigned(s, 999999999);
+        if (n) v = static_cast<std::uint32_t>(*n);
+        return n.has_value();
     };
     Shard shard;
     if (slash == std::string::npos || !number(text.substr(0, slash), shard.index) ||

@@ -77,6 +77,40 @@ Overrides parseOverrides(const std::vector<std::string>& items) {
 }
 
 
+/// Why x is outside the range, or empty.
+std::string rangeError(double x, Range range) {
+    if (!std::isfinite(x)) return fmt::format("must be finite (got {})", x);
+    const bool below = range.loOpen ? !(x > range.lo) : !(x >= range.lo);
+    if (!below && !(x > range.hi)) return {};
+    const std::string lo = range.loOpen ? fmt::format("> {}", range.lo) : fmt::format(">= {}", range.lo);
+    return std::isinf(range.hi) ? fmt::format("must be {} (got {})", lo, x)
+                                : fmt::format("must be {} and <= {} (got {})", lo, range.hi, x);
+}
+
+/// The ranges of the settings that command-line flags set, checked as a
+/// scene file's are; errors name the flag.
+class FlagRangeCheck {
+public:
+    explicit FlagRangeCheck(const std::map<std::string, std::string>& flags) : flags_(flags) {}
+    template <class S> void section(std::string_view name, S& s) {
+        section_ = name;
+        s.visit(*this);
+    }
+    template <class T> void field(std::string_view key, const T& value, std::string_view, Range range = kAny) {
+        if constexpr (std::is_arithmetic_v<T> && !std::is_same_v<T, bool>) {
+            const std::string dotted = fmt::format("{}.{}", section_, key);
+            const auto it = flags_.find(dotted);
+            if (it == flags_.end()) return;
+            if (const std::string msg = rangeError(double(value), range); !msg.empty())
+                throw InputError(fmt::format("{}: {}: {}", it->second, dotted, msg));
+        }
+    }
+
+private:
+    const std::map<std::string, std::string>& flags_;
+    std::string section_;
+};
+
 /// Reads one section's fields from its table (and the overrides), checking
 /// types and ranges; remembers which keys it consumed.
 class SectionReader {
@@ -114,16 +148,17 @@ private:
     }
 
     void checkRange(const toml::node& n, const std::string& dotted, double x, Range range) const {
-        if (!std::isfinite(x)) fail(n, dotted, fmt::format("must be finite (got {})", x));
-        const bool below = range.loOpen ? !(x > range.lo) : !(x >= range.lo);
-        if (below || x > range.hi) {
-            std::string lo = range.loOpen ? fmt::format("> {}", range.lo) : fmt::format(">= {}", range.lo);
-            std::string msg = std::isinf(range.hi) ? fmt::format("must be {} (got {})", lo, x)
-                                                   : fmt::format("must be {} and <= {} (got {})", lo, range.hi, x);
-            fail(n, dotted, msg);
-        }
+        if (const std::string msg = rangeError(x, range); !msg.empty()) fail(n, dotted, msg);
     }
 
+    void read(const toml::node& n, const std::string& dotted, SerKeySpec& v, Range) const {
+        auto* str = n.as_string();
+        if (!str) fail(n, dotted, fmt::format("expected a string, got {}", typeName(n)));
+        std::string bad;
+        const std::optional<SerKeySpec> key = parseSerKey(str->get(), bad);
+        if (!key) fail(n, dotted, fmt::format("unknown component \"{}\" (expected hit, type, cluster, hint)", bad));
+        v = *key;
+    }
     void read(const toml::node& n, const std::string& dotted, bool& v, Range) const {
         auto* b = n.as_boolean();
         if (!b) fail(n, dotted, fmt::format("expected a boolean, got {}", typeName(n)));
@@ -163,14 +198,9 @@ private:
     template <class E>
         requires std::is_enum_v<E>
     void read(const toml::node& n, const std::string& dotted, E& v, Range) const {
-        constexpr auto& names = EnumNames<E>::names;
-        std::string choices;
-        for (auto nm : names) choices += (choices.empty() ? "" : " | ") + std::string(nm);
         auto* s = n.as_string();
-        if (!s) fail(n, dotted, fmt::format("expected one of {}, got {}", choices, typeName(n)));
-        for (std::size_t k = 0; k < names.size(); ++k)
-            if (names[k] == s->get()) { v = static_cast<E>(k); return; }
-        fail(n, dotted, fmt::format("unknown value \"{}\" (expected {})", s->get(), choices));
+        if (!s) fail(n, dotted, fmt::format("expected one of {}, got {}", enumChoices<E>(), typeName(n)));
+        if (!parseEnum(s->get(), v)) fail(n, dotted, fmt::format("unknown value \"{}\" (expected {})", s->get(), enumChoices<E>()));
     }
 
     std::string section_;
@@ -265,13 +295,6 @@ void validate(const Settings& s, const std::map<std::string, std::string>& loc, 
     }
     if (s.gpu.omm != OmmMode::off && s.geometry.alpha != AlphaMode::disc)
         fail("gpu.omm", "opacity micromaps apply to disc-alpha billboards (geometry.alpha = \"disc\")");
-    for (std::size_t begin = 0; begin <= s.gpu.ser_key.size();) {
-        const std::size_t end = std::min(s.gpu.ser_key.find(',', begin), s.gpu.ser_key.size());
-        const std::string_view c = std::string_view(s.gpu.ser_key).substr(begin, end - begin);
-        if (c != "hit" && c != "type" && c != "cluster" && c != "hint")
-            fail("gpu.ser_key", fmt::format("unknown component \"{}\" (expected hit, type, cluster, hint)", c));
-        begin = end + 1;
-    }
     if (s.geometry.primitive == Primitive::sphere && s.geometry.alpha == AlphaMode::disc)
         fail("geometry.alpha", "disc alpha applies to billboards only (primitive = \"sphere\")");
 }
@@ -291,6 +314,7 @@ std::string tomlValue(F v) {
 template <class Int>
     requires(std::is_integral_v<Int> && !std::is_same_v<Int, bool>)
 std::string tomlValue(Int v) { return std::to_string(v); }
+std::string tomlValue(const SerKeySpec& k) { return tomlQuote(formatSerKey(k)); }
 std::string tomlValue(const Vec3& v) {
     return fmt::format("[{}, {}, {}]", tomlValue(v.x), tomlValue(v.y), tomlValue(v.z));
 }
@@ -320,11 +344,7 @@ public:
 
 private:
     template <class T> static std::string choices() {
-        if constexpr (std::is_enum_v<T>) {
-            std::string c;
-            for (auto nm : EnumNames<T>::names) c += (c.empty() ? "" : " | ") + std::string(nm);
-            return " (" + c + ")";
-        }
+        if constexpr (std::is_enum_v<T>) return " (" + enumChoices<T>() + ")";
         return "";
     }
     bool withDocs_;
@@ -332,7 +352,8 @@ private:
 
 }  // namespace
 
-Settings parseScene(std::string_view text, std::string_view sourceName, const std::vector<std::string>& overrideItems) {
+Settings parseScene(std::string_view text, std::string_view sourceName, const std::vector<std::string>& overrideItems,
+                    const std::vector<FlagSetting>& flags) {
     toml::table root;
     try {
         root = toml::parse(text, sourceName);
@@ -347,17 +368,25 @@ Settings parseScene(std::string_view text, std::string_view sourceName, const st
     for (const auto& [key, doc] : overrides.docs)
         if (!overrides.used.count(key))
             throw InputError(fmt::format("command line -D {}: unknown setting (see accretion render --help-settings)", key));
+    std::map<std::string, std::string> flagged;  // "section.key" -> "command line --flag value"
+    for (const FlagSetting& f : flags) {
+        f.apply(settings);
+        flagged[f.key] = reader.locations[f.key] = "command line " + f.flag;
+    }
+    FlagRangeCheck check(flagged);
+    settings.visit(check);
     validate(settings, reader.locations, sourceName);
     return settings;
 }
 
-Settings loadScene(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+Settings loadScene(const std::filesystem::path& file, const std::vector<std::string>& overrides,
+                   const std::vector<FlagSetting>& flags) {
     std::ifstream in(file, std::ios::binary);
     if (!in) throw InputError(fmt::format("{}: cannot open scene file", file.string()));
     std::ostringstream text;
     text << in.rdbuf();
     if (in.bad()) throw InputError(fmt::format("{}: cannot read scene file", file.string()));
-    Settings s = parseScene(text.str(), file.string(), overrides);
+    Settings s = parseScene(text.str(), file.string(), overrides, flags);
     s.scenePath = file.string();
     s.sceneName = file.stem().string();
     // A relative particle file is found next to the scene, wherever it runs from.

@@ -1,5 +1,7 @@
 #include "accretion/scene/settings.h"
 
+#include <algorithm>
+
 #include <fmt/format.h>
 
 namespace accretion {
@@ -19,6 +21,29 @@ std::string expandPattern(std::string_view pattern, std::string_view scene, std:
         }
     }
     return out;
+}
+
+std::optional<SerKeySpec> parseSerKey(std::string_view text, std::string& bad) {
+    SerKeySpec key;
+    key.components.clear();
+    for (std::size_t begin = 0; begin <= text.size();) {
+        const std::size_t end = std::min(text.find(',', begin), text.size());
+        const std::string_view c = text.substr(begin, end - begin);
+        SerComponent component;
+        if (!parseEnum(c, component)) {
+            bad = std::string(c);
+            return std::nullopt;
+        }
+        key.components.push_back(component);
+        begin = end + 1;
+    }
+    return key;
+}
+
+std::string formatSerKey(const SerKeySpec& key) {
+    std::string s;
+    for (SerComponent c : key.components) s += (s.empty() ? "" : ",") + std::string(enumName(c));
+    return s;
 }
 
 }  // namespace accretion

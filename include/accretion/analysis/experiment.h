@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "accretion/render/frame_renderer.h"
+#include "accretion/scene/scene_parser.h"
 #include "accretion/scene/settings.h"
 
 namespace accretion {
@@ -17,14 +18,17 @@ namespace accretion {
 struct EstimatorSpec {
     std::string label;                   ///< the spec as written
     EstimatorKind kind = EstimatorKind::uniform;
-    std::vector<std::string> overrides;  ///< -D style overrides it implies
+    std::vector<FlagSetting> settings;   ///< the estimator, bias correction, source it sets
+    std::vector<std::string> overrides;  ///< its key=value options, as -D
 };
 
 /// Parse a comma-separated list; errors name `option` and the bad entry.
 std::vector<EstimatorSpec> parseEstimatorSpecs(const std::string& list, const std::string& option);
 
-/// The scene's settings for one spec (base overrides, then the spec's).
-Settings specSettings(const std::filesystem::path& scene, const std::vector<std::string>& base, const EstimatorSpec& spec);
+/// The scene's settings for one spec: the scene's -D overrides and the
+/// spec's key=value options, then the base flags (--frames), then the spec's settings.
+Settings specSettings(const std::filesystem::path& scene, const std::vector<std::string>& defines,
+                      const std::vector<FlagSetting>& base, const EstimatorSpec& spec);
 
 /// The result of rendering one frame for an experiment.
 struct ExperimentRender {

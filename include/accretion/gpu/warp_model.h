@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "accretion/counters/thread_counters.h"
+#include "accretion/scene/settings.h"
 
 namespace accretion {
 
@@ -50,9 +51,11 @@ std::vector<std::uint32_t> serReorder(std::span<const std::uint32_t> order, std:
 /// The components of an SER sort key, most significant first: "hit", "type",
 /// "cluster" and "hint" (the low hintBits bits of the thread's hint).
 struct SerKey {
-    std::vector<std::string> components;
+    std::vector<SerComponent> components;
     std::uint32_t hintBits = 0;
-    /// Parses "hit,type,cluster,hint"; throws InputError naming `where` on an unknown component.
+    SerKey() = default;
+    SerKey(const SerKeySpec& spec, std::uint32_t hintBits) : components(spec.components), hintBits(hintBits) {}
+    /// Parses "hit,type,cluster,hint" (parseSerKey); throws InputError naming `where` on an unknown component.
     static SerKey parse(const std::string& spec, std::uint32_t hintBits, const std::string& where);
     std::uint64_t of(const ThreadCounters& t) const;
     std::string label() const;

@@ -1,5 +1,6 @@
 #pragma once
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -8,13 +9,22 @@
 
 namespace accretion {
 
-/// Load a TOML scene and apply `-D section.key=value` overrides.
-/// Throws InputError naming file:line (or the -D flag) and the key.
-Settings loadScene(const std::filesystem::path& file, const std::vector<std::string>& overrides = {});
+/// A setting a typed command-line flag sets (after the file and the -D
+/// overrides, before the range and cross-field checks, which then name the flag).
+struct FlagSetting {
+    std::string key;                      ///< "render.estimator"
+    std::string flag;                     ///< "--estimator restir"
+    std::function<void(Settings&)> apply;
+};
+
+/// Load a TOML scene, apply `-D section.key=value` overrides, then the flags.
+/// Throws InputError naming file:line (or the -D or other flag) and the key.
+Settings loadScene(const std::filesystem::path& file, const std::vector<std::string>& overrides = {},
+                   const std::vector<FlagSetting>& flags = {});
 
 /// Same, from text; `sourceName` is used in error messages.
 Settings parseScene(std::string_view text, std::string_view sourceName,
-                    const std::vector<std::string>& overrides = {});
+                    const std::vector<std::string>& overrides = {}, const std::vector<FlagSetting>& flags = {});
 
 /// The effective settings as a TOML document (every key, defaults included).
 std::string settingsToToml(const Settings& settings);

@@ -2,6 +2,7 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -32,6 +33,7 @@ template <class E> struct EnumNames;
     }
 
 enum class CameraPath { static_pose, orbit, linear };
+enum class SerComponent : std::uint8_t { hit, type, cluster, hint };
 enum class Primitive { billboard, sphere };
 enum class Orientation { view_plane, view_point, velocity };
 enum class AlphaMode { opaque, disc };
@@ -48,6 +50,7 @@ enum class OffsetOrigin { tmin, waechter_binder };
 enum class FarEnd { absolute, relative };
 
 ACC_ENUM_NAMES(CameraPath, "static", "orbit", "linear");
+ACC_ENUM_NAMES(SerComponent, "hit", "type", "cluster", "hint");
 ACC_ENUM_NAMES(Primitive, "billboard", "sphere");
 ACC_ENUM_NAMES(Orientation, "view_plane", "view_point", "velocity");
 ACC_ENUM_NAMES(AlphaMode, "opaque", "disc");
@@ -65,6 +68,24 @@ ACC_ENUM_NAMES(FarEnd, "absolute", "relative");
 
 template <class E> constexpr std::string_view enumName(E e) {
     return EnumNames<E>::names[static_cast<std::size_t>(e)];
+}
+
+/// The value named `text` (the inverse of enumName); false if none is.
+template <class E> constexpr bool parseEnum(std::string_view text, E& out) {
+    const auto& names = EnumNames<E>::names;
+    for (std::size_t i = 0; i < names.size(); ++i)
+        if (names[i] == text) {
+            out = static_cast<E>(i);
+            return true;
+        }
+    return false;
+}
+
+/// "a | b | c": every name of an enum, for messages.
+template <class E> std::string enumChoices() {
+    std::string c;
+    for (auto nm : EnumNames<E>::names) c += (c.empty() ? "" : " | ") + std::string(nm);
+    return c;
 }
 
 // Each settings struct lists its fields once, in visit(): the same table
@@ -262,6 +283,20 @@ struct RestirSettings {
     }
 };
 
+/// An SER sort key as the settings hold it: its components, most
+/// significant first ("hit,type" in a scene file).
+struct SerKeySpec {
+    std::vector<SerComponent> components{SerComponent::hit, SerComponent::type};
+    bool operator==(const SerKeySpec&) const = default;
+};
+
+/// The one parser of SER key text ("hit,type,cluster,hint", comma-separated,
+/// no empty component): scene files, -D and `cost --ser-keys`. On an unknown
+/// or empty component returns nothing and sets `bad` to it.
+std::optional<SerKeySpec> parseSerKey(std::string_view text, std::string& bad);
+/// "hit,type".
+std::string formatSerKey(const SerKeySpec& key);
+
 /// [gpu]: the GPU model (MODEL.md section 6): counters, warps, SER, opacity
 /// micromaps, memory estimates and the cost model's coefficients.
 struct GpuSettings {
@@ -269,7 +304,7 @@ struct GpuSettings {
     std::uint32_t group_width = 8;            ///< thread group width
     std::uint32_t group_height = 8;           ///< thread group height
     std::uint32_t warp_size = 32;             ///< lanes per warp
-    std::string ser_key = "hit,type";         ///< SER sort key components, most significant first
+    SerKeySpec ser_key;                       ///< SER sort key components, most significant first
     std::uint32_t ser_hint_bits = 0;          ///< coherence-hint bits appended to the SER key
     std::uint32_t ser_window = 2048;          ///< threads regrouped together (those an SM holds)
     double ser_reorder_cost = 0.25;           ///< reorder cost per thread, in lane-steps

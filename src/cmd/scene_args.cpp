@@ -1,0 +1,55 @@
+// What the commands that load a scene share: its options, the flags that
+// set typed settings, the thread limit.
+#include <fmt/format.h>
+
+#include "accretion/core/error.h"
+#include "accretion/core/parse.h"
+#include "commands.h"
+
+namespace accretion::cmd {
+
+std::pair<std::uint64_t, std::uint64_t> parseHalfOpen(const std::string& text, const char* option) {
+    const auto colon = text.find(':');
+    auto number = [&](const std::string& s) -> std::uint64_t {
+        const std::optional<std::uint64_t> v = parseUnsigned(s);
+        if (!v) throw InputError(fmt::format("command line {} {}: expected A:B with 0 <= A < B", option, text));
+        return *v;
+    };
+    const std::uint64_t a = number(text.substr(0, colon));
+    const std::uint64_t b = colon == std::string::npos ? a + 1 : number(text.substr(colon + 1));
+    if (b <= a)
+        throw InputError(fmt::format("command line {} {}: end must be greater than start (half-open A:B)", option, text));
+    return {a, b};
+}
+
+std::vector<FlagSetting> frameFlags(const std::string& frames) {
+    if (frames.empty()) return {};
+    const auto [a, b] = parseHalfOpen(frames, "--frames");
+    if (b > 0xffffffffull) throw InputError(fmt::format("command line --frames {}: frames are 32-bit numbers", frames));
+    const std::string flag = "--frames " + frames;
+    return {{"render.frame_start", flag, [a = a](Settings& s) { s.render.frame_start = std::uint32_t(a); }},
+            {"render.frames", flag, [n = b - a](Settings& s) { s.render.frames = std::uint32_t(n); }}};
+}
+
+Settings loadSceneArgs(const SceneArgs& a, const std::vector<FlagSetting>& flags) {
+    std::vector<FlagSetting> all = frameFlags(a.frames);
+    all.insert(all.end(), flags.begin(), flags.end());
+    return loadScene(a.scene, a.defines, all);
+}
+
+std::unique_ptr<tbb::global_control> limitThreads(int threads) {
+    if (threads <= 0) return nullptr;
+    return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+}
+
+void addSceneOptions(CLI::App* cmd, SceneArgs& args, const std::string& framesHelp, bool threadsAndQuiet) {
+    cmd->add_option("scene", args.scene, "Scene file (TOML)")->required();
+    cmd->add_option("--frames", args.frames, framesHelp);
+    cmd->add_option("-D,--define", args.defines, "Override a setting: -D section.key=value (TOML value)")->allow_extra_args(false);
+    if (!threadsAndQuiet) return;
+    cmd->add_option("--threads", args.threads, "Worker threads (default: all cores); never changes the results")
+        ->check(CLI::Range(0, 4096));
+    cmd->add_flag("-q,--quiet", args.quiet, "No progress on stderr");
+}
+
+}  // namespace accretion::cmd
