@@ -166,9 +166,14 @@ std::vector<Job> commandLineJobs(const BatchArgs& args) {
     return jobs;
 }
 
+/// Where a job lists the files it wrote (render --outputs-file).
+std::filesystem::path outputsFile(const BatchArgs& args, const Job& j) {
+    return std::filesystem::path(args.outputDir) / (j.name + ".outputs.json");
+}
+
 /// The render command line of a job (this same executable).
 std::vector<std::string> renderArgv(const Job& j, const BatchArgs& args) {
-    std::vector<std::string> a = {"/proc/self/exe", "render", j.scene, "--quiet"};
+    std::vector<std::string> a = {"/proc/self/exe", "render", j.scene, "--quiet", "--outputs-file", outputsFile(args, j).string()};
     const std::string output = j.output.empty() ? (std::filesystem::path(args.outputDir) / j.name / "{scene}.{frame}.exr").string() : j.output;
     a.insert(a.end(), {"-o", output});
     if (!j.frames.empty()) a.insert(a.end(), {"--frames", j.frames});
@@ -225,21 +230,12 @@ std::string lastLine(const std::filesystem::path& log) {
     return last;
 }
 
-/// The outputs a job's stats.json lists (frames[].outputs), and its path.
-nlohmann::json jobOutputs(const std::filesystem::path& log) {
-    std::ifstream in(log);
-    std::string line;
-    while (std::getline(in, line))
-        if (line.rfind("stats: ", 0) == 0) {
-            const std::string stats = line.substr(7);
-            std::ifstream s(stats);
-            nlohmann::json j = nlohmann::json::parse(s, nullptr, false);
-            nlohmann::json outputs = nlohmann::json::array();
-            if (!j.is_discarded())
-                for (const auto& f : j["frames"]) outputs.push_back(f["outputs"]);
-            return {{"stats", stats}, {"frames", outputs}};
-        }
-    return nlohmann::json::object();
+/// The files a finished job wrote, as its render listed them (--outputs-file).
+nlohmann::json jobOutputs(const std::filesystem::path& manifest) {
+    std::ifstream in(manifest);
+    nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+    if (j.is_discarded() || !j.is_object()) return nlohmann::json::object();
+    return {{"stats", j.value("stats", "")}, {"frames", j.value("frames", nlohmann::json::array())}};
 }
 
 void runBatch(BatchArgs args) {
@@ -338,7 +334,7 @@ void runBatch(BatchArgs args) {
             r["signal"] = WTERMSIG(status);
             r["outcome"] = "crashed";
         }
-        if (r["outcome"] == "ok") r["outputs"] = jobOutputs(log);
+        if (r["outcome"] == "ok") r["outputs"] = jobOutputs(outputsFile(args, jobs[it->job]));
         else r["error"] = lastLine(log);
         if (!args.quiet)
             fmt::print(stderr, "accretion batch: {} {} ({:.1f} s){}\n", r["name"].get<std::string>(), r["outcome"].get<std::string>(),

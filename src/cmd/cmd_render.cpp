@@ -36,6 +36,7 @@ struct RenderArgs : SceneArgs {
     std::string shard;               ///< --shard i/n
     bool resume = false;             ///< --resume
     double checkpointEvery = 300.0;  ///< --checkpoint-every seconds (0: only on SIGINT/SIGTERM)
+    std::string outputsFile;         ///< --outputs-file: a JSON list of every file written (for batch)
 };
 
 /// "out/x.0008.exr" -> "out/x.0008.shard2of4.exr".
@@ -265,6 +266,12 @@ void runRender(const RenderArgs& args) {
     // Written once every frame is out: a run stopped by bad input leaves nothing.
     writeFileAtomic(stem + ".settings.toml", settingsToml);
     writeJson(stem + ".stats.json", stats);
+    if (!args.outputsFile.empty()) {  // what this run wrote, for a program (batch) to read
+        nlohmann::json manifest = {{"stats", stem + ".stats.json"}, {"settings", stem + ".settings.toml"},
+                                   {"frames", nlohmann::json::array()}};
+        for (const auto& f : stats["frames"]) manifest["frames"].push_back(f["outputs"]);
+        writeJson(args.outputsFile, manifest);
+    }
     checkpoint.remove();  // done: nothing left to resume
     fmt::print("stats: {}.stats.json\nsettings: {}.settings.toml\ntotal: {:.2f} s\n", stem, stem, total);
 }
@@ -285,6 +292,8 @@ void addRenderCommand(CLI::App& app) {
                     "Render part i/n (0 <= i < n) of the work: a sample range (exact: rows) with its own streams, "
                     "to combine with `accretion merge`; adaptive sampling and restir split frames");
     cmd->add_flag("--resume", args->resume, "Continue from the checkpoint of an interrupted run (same command line)");
+    cmd->add_option("--outputs-file", args->outputsFile,
+                    "Write a JSON list of the files this run wrote (stats, settings, each frame's outputs) here at the end");
     cmd->add_option("--checkpoint-every", args->checkpointEvery,
                     "Seconds between checkpoints of the lighting sums (default 300; 0: only on SIGINT/SIGTERM)");
     cmd->add_flag_callback("--help-settings", [] {
