@@ -1,4 +1,4 @@
-// accretion_suite: the performance bars of issue 5, each measured side by
+// accretion_suite: the performance bars, each measured side by
 // side with the limit that matters (a bare Embree loop over the same data),
 // plus scaling curves, per-pass breakdowns and peak memory. Writes
 // bench/results.json, bench/scaling_particles.csv, bench/scaling_resolution.csv

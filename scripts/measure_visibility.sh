@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 12's figures: the error of seed 004's GPU visibility rule (TMin = 0.001,
+# The error of the GPU pipeline's visibility rule (TMin = 0.001,
 # TMax = d - 0.001) against the exact rule, and the equal-error times of
 # exact / tree / power, on the quickstart and the 100K disk at 320x180.
 # Writes under out/visibility; prints the figures. About 10 minutes on 2 cores.

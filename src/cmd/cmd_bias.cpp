@@ -1,6 +1,6 @@
 // accretion bias: per estimator, the mean signed error over many seeds with
 // its standard error, the energy loss, and a per-pixel bias map, so a bias
-// can be told apart from noise (MODEL.md section 5).
+// can be told apart from noise (docs/MODEL.md section 5).
 #include <cmath>
 #include <filesystem>
 #include <memory>

@@ -1,4 +1,4 @@
-// accretion cost: the GPU model of one frame (MODEL.md section 6): every
+// accretion cost: the GPU model of one frame (docs/MODEL.md section 6): every
 // pass's counters, SIMT and SER, any-hits with opacity micromaps, BLAS
 // memory, layouts, ray-model advice, the counting overhead, and the
 // predicted time per pass; JSON + CSV (the counters calibrate reads).

@@ -66,7 +66,7 @@ void discAlphaFilter(const RTCFilterFunctionNArguments* args) {
 }
 
 /// Occlusion queries: the receiver and the light are excluded by identity
-/// (MODEL.md section 3), then (Alpha) the alpha test of the other candidates.
+/// (docs/MODEL.md section 3), then (Alpha) the alpha test of the other candidates.
 /// The identity is the hit's (instance, primitive) key, so that the filter
 /// reads nothing but its arguments (a particle-index lookup here was a cache
 /// miss on most calls).

@@ -157,7 +157,7 @@ void shadeSamples(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoi
     }
 }
 
-/// ris (MODEL.md section 4): per sample, one reservoir streams M candidates
+/// ris (docs/MODEL.md section 4): per sample, one reservoir streams M candidates
 /// from the source pmf with w = p_hat / p_src, p_hat = luminance(f I G)
 /// without visibility; the kept y gets one shadow ray, weighted by W. A
 /// non-finite candidate weight is rejected (zero_sample: the candidate gets

@@ -54,7 +54,7 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const L
     const auto start = std::chrono::steady_clock::now();
     stats.frame = frame;
     // Frame coordinates: the world less an origin at the frame's camera, so
-    // that precision does not depend on where the scene is (MODEL.md
+    // that precision does not depend on where the scene is (docs/MODEL.md
     // section 3). Geometry that persists across frames (a static scene,
     // refit and partial builds) keeps the origin of its first build.
     const Camera world = Camera::atFrame(settings_.camera, frame);

@@ -75,7 +75,7 @@ TEST_CASE("Embree hits match brute force for every geometry and build policy", "
         std::vector<BillboardFrame> frames(p.size());
         for (std::uint32_t i = 0; i < p.size(); ++i) frames[i] = bvh.frame(i);
         // The frames the brute force reuses are checked on their own: orthonormal,
-        // facing the camera as MODEL.md section 2 defines for each mode.
+        // facing the camera as docs/MODEL.md section 2 defines for each mode.
         if (g.primitive == Primitive::billboard)
             for (std::uint32_t i = 0; i < p.size(); ++i) {
                 const BillboardFrame& f = frames[i];

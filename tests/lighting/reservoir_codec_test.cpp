@@ -10,7 +10,7 @@ TEST_CASE("light index bits needed for N lights", "[reservoir][codec]") {
     CHECK(ReservoirCodec::bitsFor(2) == 1);
     CHECK(ReservoirCodec::bitsFor(65536) == 16);
     CHECK(ReservoirCodec::bitsFor(65537) == 17);
-    CHECK(ReservoirCodec::bitsFor(100000) == 17);  // MODEL.md: 100K particles need 17 bits, not 16
+    CHECK(ReservoirCodec::bitsFor(100000) == 17);  // docs/MODEL.md: 100K particles need 17 bits, not 16
 }
 
 TEST_CASE("a packed layout that cannot address every particle is rejected with the bits it needs", "[reservoir][codec]") {

@@ -1,5 +1,5 @@
 // Analytic scenes with closed-form answers for the shading equation
-// (MODEL.md section 3): one emitter over a receiver, occluders, dmin, i != j.
+// (docs/MODEL.md section 3): one emitter over a receiver, occluders, dmin, i != j.
 #include <catch2/catch.hpp>
 
 #include <cmath>

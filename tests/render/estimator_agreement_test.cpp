@@ -1,6 +1,6 @@
 // Monte Carlo estimators agree with the brute-force oracle's image
 // (tests/support/oracle.h: no code shared with the renderer) and with
-// `exact` (MODEL.md section 4), as a statistical test with a stated
+// `exact` (docs/MODEL.md section 4), as a statistical test with a stated
 // confidence, and the test itself catches a deliberately injected bias (3%).
 #include <catch2/catch.hpp>
 

@@ -149,7 +149,7 @@ TEST_CASE("exact equals the brute-force oracle for every geometry and shading mo
 }
 
 TEST_CASE("two particles 10 units from the origin: rho/pi I cos/d^2, as at the origin", "[oracle][closed_form]") {
-    // The reproduction of issue 12: a receiver (r = 1) at z = 10 facing a
+    // The reproduction of the shadow-ray defect (docs/MODEL.md section 7): a receiver (r = 1) at z = 10 facing a
     // camera 10 units away on the z axis, a light at (4, 0, 12), nothing in
     // between; before the fix, Lr was 0 on every pixel at z = 10.
     const double zOffset = GENERATE(0.0, 10.0, 1000.0, 100000.0);

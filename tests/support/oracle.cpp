@@ -15,7 +15,7 @@ D3 d3(const glm::vec3& v) { return D3(double(v.x), double(v.y), double(v.z)); }
 
 constexpr double kPi = 3.14159265358979323846;
 
-/// The pinhole camera of MODEL.md section 1, in double.
+/// The pinhole camera of docs/MODEL.md section 1, in double.
 struct OracleCamera {
     D3 eye, forward, right, up;
     double tanHalf = 0.0, aspect = 1.0;
@@ -57,7 +57,7 @@ Axes facingEye(const OracleCamera& cam, const D3& p) {
     return {right, glm::cross(n, right), n};
 }
 
-/// MODEL.md section 2: view_plane (image plane), view_point (facing the
+/// docs/MODEL.md section 2: view_plane (image plane), view_point (facing the
 /// eye, right perpendicular to the camera's up), velocity (facing the eye,
 /// right along the velocity projected onto the facing plane).
 Axes billboardAxes(Orientation mode, const OracleCamera& cam, const D3& p, const D3& v) {
@@ -185,7 +185,7 @@ OracleImage oracleRender(const Settings& s, const Particles& particles, double m
             const Body& rb = bodies[j];
             const D3 x = cam.eye + tj * dir;
 
-            // Shading normal (MODEL.md section 3).
+            // Shading normal (docs/MODEL.md section 3).
             D3 nrm;
             if (spheres) {
                 nrm = glm::normalize(x - rb.p);

@@ -1,5 +1,5 @@
 #pragma once
-// A brute-force, double-precision reference of MODEL.md section 3 that
+// A brute-force, double-precision reference of docs/MODEL.md section 3 that
 // shares no code with the renderer: its own camera rays, billboard frames,
 // ray-quad / ray-disc / ray-sphere tests and shading sum; no Embree, no
 // render/ headers. It reads only the inputs (settings and particle arrays).

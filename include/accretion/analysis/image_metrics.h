@@ -8,7 +8,7 @@
 
 namespace accretion {
 
-/// MODEL.md section 5, averaged over pixels and RGB channels:
+/// docs/MODEL.md section 5, averaged over pixels and RGB channels:
 /// relMSE = (x - ref)^2 / (ref^2 + eps), MSE = (x - ref)^2,
 /// MAPE = |x - ref| / (|ref| + eps), eps = 1e-2.
 struct ErrorMetrics {

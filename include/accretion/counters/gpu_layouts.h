@@ -3,7 +3,7 @@
 
 namespace accretion::gpu_layout {
 
-/// Bytes of the GPU's buffers as the counters charge them (MODEL.md section 6).
+/// Bytes of the GPU's buffers as the counters charge them (docs/MODEL.md section 6).
 /// G-buffer texel: position float3 (12) + octahedral normal (4) + depth (4) + particle id (4).
 inline constexpr std::uint32_t kGBufferTexel = 24;
 /// Particle record: the raw 32-byte GPU record (position, radius, emission, opacity, type).

@@ -6,14 +6,14 @@
 
 namespace accretion {
 
-/// What one ray query did, as a GPU would count it (MODEL.md section 6).
+/// What one ray query did, as a GPU would count it (docs/MODEL.md section 6).
 struct RayCounters {
     std::uint32_t blasEntries = 0;  ///< TLAS leaves entered (BLAS traversals started)
     std::uint32_t anyHits = 0;      ///< any-hit invocations (alpha-tested candidates)
     std::uint32_t candidates = 0;   ///< non-opaque candidates seen (RayQuery Proceed() returning true)
 };
 
-/// The work of one pixel's thread in one pass (MODEL.md section 6). The
+/// The work of one pixel's thread in one pass (docs/MODEL.md section 6). The
 /// branch key of a thread is (hit, type): a miss is key 0, a hit on a
 /// particle of type t is key 1 + t. cluster and hint feed SER sort keys.
 struct ThreadCounters {

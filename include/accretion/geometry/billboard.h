@@ -14,7 +14,7 @@ struct BillboardFrame {
     Vec3 normal() const { return glm::cross(right, up); }
 };
 
-/// The frame of a billboard at p moving with v (MODEL.md section 2):
+/// The frame of a billboard at p moving with v (docs/MODEL.md section 2):
 /// view_plane: the image plane; view_point: facing the eye; velocity: facing
 /// the eye with `right` along the projected velocity (view_point if v is 0).
 BillboardFrame billboardFrame(Orientation mode, const Camera& camera, const Vec3& p, const Vec3& v);

@@ -39,7 +39,7 @@ struct Camera {
     }
 
     /// This camera in coordinates whose origin is at `origin` (the renderer
-    /// works relative to the frame's camera: MODEL.md section 3, precision).
+    /// works relative to the frame's camera: docs/MODEL.md section 3, precision).
     Camera rebased(const Vec3& origin) const {
         Camera c = *this;
         c.position = position - origin;

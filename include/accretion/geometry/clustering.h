@@ -7,7 +7,7 @@
 
 namespace accretion {
 
-/// Particles grouped into clusters, one BLAS each (MODEL.md section 2).
+/// Particles grouped into clusters, one BLAS each (docs/MODEL.md section 2).
 struct Clusters {
     std::vector<std::uint32_t> particle;  ///< particle indices, cluster by cluster
     std::vector<std::uint32_t> offset;    ///< cluster c is particle[offset[c] .. offset[c+1])

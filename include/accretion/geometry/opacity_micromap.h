@@ -9,7 +9,7 @@ namespace accretion {
 
 enum class OmmState : std::uint8_t { transparent = 0, opaque = 1, unknown = 2 };
 
-/// Opacity micromap of the billboard's disc alpha (MODEL.md section 6): each
+/// Opacity micromap of the billboard's disc alpha (docs/MODEL.md section 6): each
 /// of the quad's two uv triangles, (0,0),(1,0),(1,1) and (0,0),(1,1),(0,1),
 /// is split into 4^L micro-triangles on its barycentric grid, each classified
 /// exactly against the inscribed disc as opaque (inside), transparent

@@ -49,7 +49,7 @@ struct AlphaTest {
 
 inline constexpr std::uint32_t kNotExcluded = 0xffffffffu;
 
-/// The primitives an occlusion query ignores by identity (MODEL.md section
+/// The primitives an occlusion query ignores by identity (docs/MODEL.md section
 /// 3): the receiver j and the light i of V(x, p_i), whatever the geometry
 /// of either crosses; no epsilon is involved.
 struct Exclusion {
@@ -57,7 +57,7 @@ struct Exclusion {
     std::uint32_t light = kNotExcluded;
 };
 
-/// The GPU's acceleration structure on Embree (MODEL.md section 2): one BLAS
+/// The GPU's acceleration structure on Embree (docs/MODEL.md section 2): one BLAS
 /// per particle cluster, instanced in a TLAS; billboards as quads (the GPU's two triangles)
 /// (optionally with the disc alpha test as a filter function) or spheres.
 class ParticleBvh {

@@ -10,7 +10,7 @@
 
 namespace accretion {
 
-/// The counters a pass's predicted time is linear in (MODEL.md section 6).
+/// The counters a pass's predicted time is linear in (docs/MODEL.md section 6).
 inline constexpr std::array<std::string_view, 6> kCostFeatures = {"threads", "warp_steps", "rays",
                                                                    "blas_entries", "any_hits", "bytes"};
 using CostFeatures = std::array<double, kCostFeatures.size()>;

@@ -6,7 +6,7 @@
 
 namespace accretion {
 
-/// BLAS memory of a frame's clusters (MODEL.md section 6): a GPU estimate
+/// BLAS memory of a frame's clusters (docs/MODEL.md section 6): a GPU estimate
 /// from bytes per triangle and per internal node, under one allocation per
 /// BLAS (blas_alignment) against a pooled buffer (pool_alignment), and
 /// after compaction; Embree's own figure for comparison.

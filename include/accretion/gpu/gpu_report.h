@@ -13,7 +13,7 @@
 namespace accretion {
 
 /// One pass's counters, summed, with its SIMT/SER statistics and the
-/// inline-RayQuery vs pipeline-TraceRay advice of seed 003.
+/// inline-RayQuery vs pipeline-TraceRay advice (docs/MODEL.md section 6).
 struct PassReport {
     std::string pass;
     std::uint32_t width = 0, height = 0;
@@ -47,7 +47,7 @@ struct OmmReport {
     std::uint64_t sharedBytes = 0, perTriangleBytes = 0;
 };
 
-/// The GPU model of one frame (MODEL.md section 6).
+/// The GPU model of one frame (docs/MODEL.md section 6).
 struct GpuReport {
     WarpLayout layout;
     std::string serKey;

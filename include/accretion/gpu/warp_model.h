@@ -12,7 +12,7 @@ namespace accretion {
 
 inline constexpr std::uint32_t kIdleLane = std::numeric_limits<std::uint32_t>::max();
 
-/// Thread groups of a 2D dispatch and the warps cut from them (MODEL.md section 6).
+/// Thread groups of a 2D dispatch and the warps cut from them (docs/MODEL.md section 6).
 struct WarpLayout {
     std::uint32_t groupWidth = 8;
     std::uint32_t groupHeight = 8;

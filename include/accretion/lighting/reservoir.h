@@ -8,8 +8,8 @@ inline constexpr std::uint32_t kNoLight = std::numeric_limits<std::uint32_t>::ma
 
 /// Weighted reservoir of one light sample (Bitterli et al. 2020, Alg. 2):
 /// streams candidates, keeps y with probability w_y / w_sum.
-/// W = w_sum / (M p_hat(y)) is the contribution weight (MODEL.md section 4;
-/// not seed 004's w_sum / M).
+/// W = w_sum / (M p_hat(y)) is the contribution weight (docs/MODEL.md section 4;
+/// not w_sum / M: docs/MODEL.md section 7).
 struct Reservoir {
     std::uint32_t y = kNoLight;  ///< selected light
     float w_sum = 0.0f;          ///< sum of resampling weights
@@ -30,7 +30,7 @@ struct Reservoir {
     }
 
     /// Merge a reservoir of M_other candidates whose sample x carries
-    /// resampling weight w (p_hat(x) W M_other for a finalized one, MODEL.md
+    /// resampling weight w (p_hat(x) W M_other for a finalized one, docs/MODEL.md
     /// section 4): keeps x with probability w / w_sum.
     bool merge(std::uint32_t x, float w, float p_hat_x, std::uint32_t M_other, float u) {
         const bool kept = update(x, w, p_hat_x, u);

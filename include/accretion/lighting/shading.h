@@ -15,7 +15,7 @@ struct LightTerm {
     float dist;   ///< d_i = |p_i - x|
 };
 
-/// MODEL.md section 3: G_i = cos_i / max(d_i^2, dmin_i^2); lambert and sphere:
+/// docs/MODEL.md section 3: G_i = cos_i / max(d_i^2, dmin_i^2); lambert and sphere:
 /// f = rho / pi, cos_i = max(0, n . w_i); isotropic: f = rho / (4 pi), cos_i = 1.
 /// Returns false when the term is zero (so no shadow ray is needed).
 template <ShadingModel M>

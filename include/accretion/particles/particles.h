@@ -6,7 +6,7 @@
 
 namespace accretion {
 
-/// The particle buffer of one frame, struct-of-arrays (MODEL.md section 1).
+/// The particle buffer of one frame, struct-of-arrays (docs/MODEL.md section 1).
 struct Particles {
     std::vector<Vec3> position;      ///< p_i, centre
     std::vector<float> radius;       ///< r_i > 0

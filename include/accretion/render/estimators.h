@@ -73,7 +73,7 @@ LightingCounters accumulateLighting(const LightingInputs& in, const LightingPlan
 /// A value that is not finite in float is zeroed and counted in `rejected`.
 void resolveLighting(const Accumulation& acc, bool exact, LightingImage& out, std::uint64_t* nonFinite = nullptr);
 
-/// estimateLighting (MODEL.md sections 3-4): `exact` sums every light i != j
+/// estimateLighting (docs/MODEL.md sections 3-4): `exact` sums every light i != j
 /// with one shadow ray each; `uniform` / `power` / `tree` average one-sample
 /// estimates f I G V / p(i) (S per round, more rounds until target_stderr);
 /// `ris` averages S one-reservoir RIS estimates of M candidates each. Monte

@@ -51,7 +51,7 @@ inline void recordTexel(ThreadCounters& t, const GBufferTexel& g, const Particle
     t.cluster = bvh.clusterOf(g.particle);
 }
 
-/// traceGBuffer: one primary ray per pixel through its centre (MODEL.md
+/// traceGBuffer: one primary ray per pixel through its centre (docs/MODEL.md
 /// section 3). Returns the number of rays traced. With counters (counting
 /// mode), records each pixel's thread: hit key, the ray, bytes.
 std::uint64_t traceGBuffer(const ParticleBvh& bvh, const Particles& particles, const Camera& camera,

@@ -48,7 +48,7 @@ struct ShadowQuery {
     Exclusion exclude;
 };
 
-/// The query of V(x, p_i) (MODEL.md section 3) for receiver sp and light i
+/// The query of V(x, p_i) (docs/MODEL.md section 3) for receiver sp and light i
 /// at p (radius r), whose unshadowed term t holds w and d.
 ///  - exact (the reference): the whole segment from x to p_i, with the
 ///    receiver's and the light's own primitives excluded by identity.

@@ -92,7 +92,7 @@ template <class E> std::string enumChoices() {
 // drives parsing (with validation), writing the effective settings, and help.
 // v.field(key, member, doc, range).
 
-/// [particles]: the accretion-disk generator (MODEL.md section 1) or a file.
+/// [particles]: the accretion-disk generator (docs/MODEL.md section 1) or a file.
 struct ParticleSettings {
     std::string file;                  ///< particle file(s), `{frame}` pattern; empty = generator
     std::uint32_t count = 10000;       ///< number of generated particles
@@ -160,14 +160,14 @@ struct CameraSettings {
     }
 };
 
-/// [geometry]: what the GPU's BLAS/TLAS hold (MODEL.md section 2).
+/// [geometry]: what the GPU's BLAS/TLAS hold (docs/MODEL.md section 2).
 struct GeometrySettings {
     Primitive primitive = Primitive::billboard;      ///< billboard quads or procedural spheres
     Orientation orientation = Orientation::view_plane; ///< billboard facing
     AlphaMode alpha = AlphaMode::opaque;             ///< billboard alpha test
     std::uint32_t cluster_size = 100;                ///< target particles per cluster (one BLAS each)
     BuildPolicy build = BuildPolicy::rebuild;        ///< per-frame BLAS policy
-    double rebuild_fraction = 0.7;                   ///< partial: fraction of clusters rebuilt per frame (seed 004: 70%)
+    double rebuild_fraction = 0.7;                   ///< partial: fraction of clusters rebuilt per frame (the GPU pipeline's: 70%)
     bool watertight = false;                         ///< Embree robust mode: watertight quads (slower)
 
     template <class V> void visit(V& v) {
@@ -181,7 +181,7 @@ struct GeometrySettings {
     }
 };
 
-/// [shading]: the shading equation (MODEL.md section 3).
+/// [shading]: the shading equation (docs/MODEL.md section 3).
 struct ShadingSettings {
     ShadingModel model = ShadingModel::lambert; ///< BRDF and cosine
     Vec3 albedo{0.8f, 0.8f, 0.8f};              ///< particle albedo rho
@@ -206,16 +206,16 @@ struct RenderSettings {
     std::uint32_t frames = 1;                    ///< number of frames rendered
     EstimatorKind estimator = EstimatorKind::exact; ///< estimator of Lr
     std::uint32_t samples = 16;                  ///< light samples per pixel (Monte Carlo estimators)
-    std::uint32_t candidates = 16;               ///< ris, restir: candidates M per reservoir (seed 004: 16)
+    std::uint32_t candidates = 16;               ///< ris, restir: candidates M per reservoir (the GPU pipeline's: 16)
     LightSource source = LightSource::uniform;   ///< ris, restir: source pdf of the candidates
     double target_stderr = 0.0;                  ///< tree, uniform, power: relative standard error to reach per pixel (0: fixed samples)
     std::uint32_t max_samples = 65536;           ///< cap of the adaptive sampling of target_stderr
     std::uint64_t seed = 0;                      ///< render seed
     std::string output = "out/{scene}.{frame}.exr"; ///< EXR path, {scene} and {frame} patterns
-    VisibilityRule visibility_rule = VisibilityRule::exact; ///< V by identity exclusion (MODEL.md section 3), or a GPU epsilon rule
+    VisibilityRule visibility_rule = VisibilityRule::exact; ///< V by identity exclusion (docs/MODEL.md section 3), or a GPU epsilon rule
     OffsetOrigin offset_origin = OffsetOrigin::tmin; ///< offset rule: TMin along the ray, or Waechter-Binder along the normal
-    double offset_tmin = 1e-3;                   ///< offset rule, tmin: the ray's TMin (seed 004: 0.001)
-    FarEnd offset_far = FarEnd::absolute;        ///< offset rule: TMax = d - e (seed 004) or d (1 - e)
+    double offset_tmin = 1e-3;                   ///< offset rule, tmin: the ray's TMin (the GPU pipeline's: 0.001)
+    FarEnd offset_far = FarEnd::absolute;        ///< offset rule: TMax = d - e (the GPU pipeline's) or d (1 - e)
     double offset_far_margin = 1e-3;             ///< offset rule: the far-end margin e
     NonFinitePolicy nonfinite = NonFinitePolicy::zero_sample; ///< a NaN/Inf sample counts as 0, or is discarded (restir: its reservoir)
     double memory_limit_mb = 0.0;                ///< refuse runs estimated to need more (0: no limit)
@@ -235,8 +235,8 @@ struct RenderSettings {
         v.field("output", output, "EXR output path; {scene} and {frame} are replaced");
         v.field("visibility_rule", visibility_rule, "V(x, p_i): exact (the receiver and the light excluded by identity: the reference) or offset (a GPU epsilon rule, measured as a bias)");
         v.field("offset_origin", offset_origin, "offset rule: tmin (TMin = offset_tmin along the ray) or waechter_binder (origin moved along the normal, ray re-aimed at p_i)");
-        v.field("offset_tmin", offset_tmin, "offset rule, tmin: the ray's TMin (seed 004: 0.001)", kNonNegative);
-        v.field("offset_far", offset_far, "offset rule: far end absolute (TMax = d - e, seed 004) or relative (TMax = d (1 - e))");
+        v.field("offset_tmin", offset_tmin, "offset rule, tmin: the ray's TMin (the GPU pipeline's: 0.001)", kNonNegative);
+        v.field("offset_far", offset_far, "offset rule: far end absolute (TMax = d - e, the GPU pipeline's) or relative (TMax = d (1 - e))");
         v.field("offset_far_margin", offset_far_margin, "offset rule: the far-end margin e (absolute: a length; relative: a fraction < 1)", Range{0.0, 1e9});
         v.field("nonfinite", nonfinite, "a NaN/Inf sample: zero_sample (counts as 0) | discard (not counted; restir: the reservoir is emptied)");
         v.field("memory_limit_mb", memory_limit_mb, "refuse a run whose estimated peak memory exceeds this (MB; 0: no limit)", kNonNegative);
@@ -245,7 +245,7 @@ struct RenderSettings {
     }
 };
 
-/// [restir]: ReSTIR DI reuse (MODEL.md section 4; seed 004's tuning
+/// [restir]: ReSTIR DI reuse (docs/MODEL.md section 4; the GPU pipeline's tuning
 /// checklist gives the defaults: M cap 20, 5 neighbours, 30 px, 1 iteration).
 struct RestirSettings {
     bool temporal = true;                    ///< temporal reuse
@@ -297,7 +297,7 @@ std::optional<SerKeySpec> parseSerKey(std::string_view text, std::string& bad);
 /// "hit,type".
 std::string formatSerKey(const SerKeySpec& key);
 
-/// [gpu]: the GPU model (MODEL.md section 6): counters, warps, SER, opacity
+/// [gpu]: the GPU model (docs/MODEL.md section 6): counters, warps, SER, opacity
 /// micromaps, memory estimates and the cost model's coefficients.
 struct GpuSettings {
     bool counters = false;                    ///< record per-pass, per-pixel counters (costs time)
