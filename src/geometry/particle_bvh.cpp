@@ -426,15 +426,9 @@ AccelCounters ParticleBvh::accelCounters() const {
         a.blasPrimitives[c] = static_cast<std::uint32_t>(clusters_.members(c).size()) * (billboards ? 2u : 1u);
     a.embreeBytes = stats_.embreeBytes;
     if (omm_) {
-        a.omm = true;
-        a.ommLevel = omm_->level();
-        a.ommFourState = omm_->fourState();
-        a.ommOpaque = omm_->count(OmmState::opaque);
-        a.ommTransparent = omm_->count(OmmState::transparent);
-        a.ommUnknown = omm_->count(OmmState::unknown);
         const OmmMemory m = ommMemory(*omm_, stats_.primitives / 2);
-        a.ommSharedBytes = m.sharedBytes;
-        a.ommPerTriangleBytes = m.perTriangleBytes;
+        a.omm = {true, omm_->level(), omm_->fourState(), omm_->count(OmmState::opaque),
+                 omm_->count(OmmState::transparent), omm_->count(OmmState::unknown), m.sharedBytes, m.perTriangleBytes};
     }
     return a;
 }

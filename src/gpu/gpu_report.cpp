@@ -98,14 +98,7 @@ GpuReport makeGpuReport(const FrameCounters& counters, const Settings& settings,
     r.layouts.reservoirBufferBytes = reservoirBytes * lightingPixels * (temporal ? 2 : 1);
     r.layouts.gbufferBufferBytes = gpu_layout::kGBufferTexel * pixels * (temporal ? 2 : 1);
 
-    r.omm.enabled = accel.omm;
-    r.omm.level = accel.ommLevel;
-    r.omm.fourState = accel.ommFourState;
-    r.omm.opaque = accel.ommOpaque;
-    r.omm.transparent = accel.ommTransparent;
-    r.omm.unknown = accel.ommUnknown;
-    r.omm.sharedBytes = accel.ommSharedBytes;
-    r.omm.perTriangleBytes = accel.ommPerTriangleBytes;
+    r.omm = accel.omm;
     return r;
 }
 

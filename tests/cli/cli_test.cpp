@@ -7,17 +7,13 @@
 #include <OpenImageIO/imageio.h>
 #include <nlohmann/json.hpp>
 
-#include "support/test_scenes.h"
+#include "support/cli.h"
 
 using namespace accretion;
-using accretion::test::runCommand;
-using Catch::Matchers::Contains;
-namespace OIIO = OIIO_NAMESPACE;
+using namespace accretion::test;
 
 namespace {
 
-const std::string kBin = ACCRETION_BINARY;
-const std::string kScenes = std::string(ACCRETION_SOURCE_DIR) + "/scenes";
 
 /// A small version of the quickstart scene.
 std::string smallQuickstart() {

@@ -8,18 +8,13 @@
 #include <OpenImageIO/imageio.h>
 
 #include "accretion/io/exr_output.h"
-#include "support/test_scenes.h"
+#include "support/cli.h"
 
 using namespace accretion;
-using accretion::test::runCommand;
-using Catch::Matchers::Contains;
-namespace OIIO = OIIO_NAMESPACE;
+using namespace accretion::test;
 
 namespace {
 
-const std::string kBin = ACCRETION_BINARY;
-
-std::string tinyScene() { return accretion::test::smallDiskScene(); }
 
 void writeConstant(const std::filesystem::path& file, float value) {
     const std::size_t pixels = 4 * 3;

@@ -10,18 +10,13 @@
 #include <nlohmann/json.hpp>
 
 #include "accretion/gpu/cost_model.h"
-#include "support/test_scenes.h"
+#include "support/cli.h"
 
 using namespace accretion;
-using accretion::test::runCommand;
-using Catch::Matchers::Contains;
-namespace OIIO = OIIO_NAMESPACE;
+using namespace accretion::test;
 
 namespace {
 
-const std::string kBin = ACCRETION_BINARY;
-
-std::string tinyScene() { return accretion::test::smallDiskScene(); }
 
 std::string slurp(const std::filesystem::path& file) {
     REQUIRE(std::filesystem::exists(file));

@@ -63,14 +63,19 @@ struct PassCounters {
 
 /// The acceleration structures of a frame as the GPU memory model reads
 /// them: triangles (or spheres) per BLAS, Embree's bytes, the micromap.
+/// The opacity micromap of a frame, when disc alpha has one.
+struct OmmCounters {
+    bool enabled = false;
+    std::uint32_t level = 0;
+    bool fourState = false;
+    std::uint64_t opaque = 0, transparent = 0, unknown = 0;  ///< micro-triangles of the two uv triangles
+    std::uint64_t sharedBytes = 0, perTriangleBytes = 0;
+};
+
 struct AccelCounters {
     std::vector<std::uint32_t> blasPrimitives;  ///< per cluster: triangles (2 per billboard) or spheres
     std::int64_t embreeBytes = 0;
-    bool omm = false;                ///< an opacity micromap is attached
-    std::uint32_t ommLevel = 0;
-    bool ommFourState = false;
-    std::uint64_t ommOpaque = 0, ommTransparent = 0, ommUnknown = 0;  ///< micro-triangles of the two uv triangles
-    std::uint64_t ommSharedBytes = 0, ommPerTriangleBytes = 0;
+    OmmCounters omm;
 };
 
 /// Counters of every pass of a frame, in execution order. Each run of a

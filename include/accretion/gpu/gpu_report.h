@@ -39,13 +39,8 @@ struct LayoutReport {
     std::uint64_t bytesPerFrame = 0;         ///< read + written by every pass
 };
 
-struct OmmReport {
-    bool enabled = false;
-    std::uint32_t level = 0;
-    bool fourState = false;
-    std::uint64_t opaque = 0, transparent = 0, unknown = 0;  ///< micro-triangles of the two uv triangles
-    std::uint64_t sharedBytes = 0, perTriangleBytes = 0;
-};
+/// The micromap as the report gives it: its counters.
+using OmmReport = OmmCounters;
 
 /// The GPU model of one frame (docs/MODEL.md section 6).
 struct GpuReport {
