@@ -18,6 +18,7 @@
 #include "accretion/core/version.h"
 #include "accretion/core/atomic_file.h"
 #include "accretion/io/plot.h"
+#include "accretion/io/report_table.h"
 #include "accretion/io/stats_writer.h"
 #include "accretion/scene/scene_parser.h"
 #include "commands.h"
@@ -70,141 +71,158 @@ double timeAtError(const std::vector<Point>& curve, double relMSE) {
     return std::exp(logC / double(n)) / relMSE;
 }
 
-void runConverge(const ConvergeArgs& a) {
-    const std::vector<FlagSetting> base = frameFlags(a.frames);
-    const Settings sceneSettings = loadSceneArgs(a);
-    const auto specs = parseEstimatorSpecs(a.estimators, "--estimators");
-    const double budget = parseSeconds(a.budget);
-    const std::uint32_t frame = a.frame.value_or(sceneSettings.render.frame_start);
-    const auto threads = limitThreads(a.threads);
+/// A reference image: Lr and, when it has one, its per-pixel standard error.
+struct Reference {
+    std::vector<Vec3> Lr, stderr;
+    bool hasStderr = false;
+};
 
-    const std::string prefix = a.out.empty() ? "out/" + sceneSettings.sceneName + ".converge" : a.out;
-    if (auto dir = std::filesystem::path(prefix).parent_path(); !dir.empty()) std::filesystem::create_directories(dir);
+/// The reference of `frame` (a {frame} pattern for --sequence), checked against the scene's resolution.
+Reference loadReference(const std::string& pattern, const Settings& scene, std::uint32_t frame) {
+    const std::string file = expandPattern(pattern, scene.sceneName, frame);
+    const RgbLayer L = readExrLayer(file, "Lr");
+    if (L.width != scene.camera.width || L.height != scene.camera.height)
+        throw InputError(fmt::format("{}: reference is {}x{}, the scene renders {}x{}", file, L.width, L.height,
+                                     scene.camera.width, scene.camera.height));
+    Reference r;
+    r.Lr = L.rgb;
+    if (exrHasLayer(file, "Lr_stderr")) {
+        r.stderr = readExrLayer(file, "Lr_stderr").rgb;
+        r.hasStderr = true;
+    }
+    return r;
+}
 
-    // References: one file, or a {frame} pattern for --sequence.
-    struct Ref {
-        std::vector<Vec3> Lr, stderr;
-        bool hasStderr = false;
-    };
-    auto loadRef = [&](std::uint32_t f) {
-        const std::string file = expandPattern(a.reference, sceneSettings.sceneName, f);
-        Ref r;
-        const RgbLayer L = readExrLayer(file, "Lr");
-        if (L.width != sceneSettings.camera.width || L.height != sceneSettings.camera.height)
-            throw InputError(fmt::format("{}: reference is {}x{}, the scene renders {}x{}", file, L.width, L.height,
-                                         sceneSettings.camera.width, sceneSettings.camera.height));
-        r.Lr = L.rgb;
-        if (exrHasLayer(file, "Lr_stderr")) {
-            r.stderr = readExrLayer(file, "Lr_stderr").rgb;
-            r.hasStderr = true;
-        }
-        return r;
-    };
-
-    std::vector<Point> points;
-    const ParticleSource source(sceneSettings);
-    if (a.sequence > 0) {
-        std::vector<Ref> refs;
-        for (std::uint32_t k = 0; k < a.sequence; ++k) refs.push_back(loadRef(frame + k));
-        for (const EstimatorSpec& spec : specs) {
-            // One history per seed; each frame's metrics are means over the seeds, its time their median.
-            Settings s = specSettings(a.scene, a.defines, base, spec);
-            s.render.frame_start = frame;
-            s.render.frames = a.sequence;
-            const std::uint64_t seed0 = s.render.seed;
-            std::vector<Point> perFrame(a.sequence);
-            std::vector<std::vector<double>> frameSeconds(a.sequence);
-            for (std::uint32_t seed = 0; seed < a.seeds; ++seed) {
-                s.render.seed = seed0 + seed;
-                FrameRenderer renderer(s, source, RenderOptions{true});
-                for (std::uint32_t k = 0; k < a.sequence; ++k) {
-                    FrameStats stats;
-                    const FrameImage img = renderer.render(frame + k, stats);
-                    const ErrorMetrics e =
-                        computeErrors(img.lighting.Lr, refs[k].Lr, refs[k].hasStderr ? &refs[k].stderr : nullptr);
-                    Point& p = perFrame[k];
-                    p.label = spec.label;
-                    p.frame = frame + k;
-                    p.totalSeconds += stats.seconds;
-                    p.shadowRays += stats.lighting.shadowRays;
-                    p.lightTerms += stats.lighting.lightTerms;
-                    p.err.relMSE += e.relMSE / a.seeds;
-                    p.err.MSE += e.MSE / a.seeds;
-                    p.err.MAPE += e.MAPE / a.seeds;
-                    p.err.relMSEFloor = e.relMSEFloor;
-                    p.err.pixels = e.pixels;
-                    frameSeconds[k].push_back(stats.seconds);
-                }
-            }
-            for (std::uint32_t k = 0; k < a.sequence; ++k) {
-                Point& p = perFrame[k];
-                std::sort(frameSeconds[k].begin(), frameSeconds[k].end());
-                p.seconds = frameSeconds[k][frameSeconds[k].size() / 2];
-                p.shadowRays /= a.seeds;
-                p.lightTerms /= a.seeds;
-                if (!a.quiet)
-                    fmt::print(stderr, "converge: {} frame {}: {:.3f} s, relMSE {:.4g}, MAPE {:.4g}\n", spec.label, p.frame,
-                               p.seconds, p.err.relMSE, p.err.MAPE);
-                points.push_back(p);
-            }
-        }
-    } else {
-        const Ref ref = loadRef(frame);
-        for (const EstimatorSpec& spec : specs) {
-            double spent = 0.0, last = 0.0;
-            for (std::uint32_t effort = a.minEffort; effort <= a.maxEffort; effort *= 2) {
-                if (spent > 0.0 && spent + 2.2 * last > budget) break;  // the next level would overrun the budget
-                EstimatorSpec level = spec;
-                const std::string flag = fmt::format("--min-effort/--max-effort (level {})", effort);
-                if (spec.kind == EstimatorKind::restir)
-                    level.settings.push_back({"render.candidates", flag, [effort](Settings& st) { st.render.candidates = effort; }});
-                else
-                    level.settings.push_back({"render.samples", flag, [effort](Settings& st) { st.render.samples = effort; }});
-                Settings s = specSettings(a.scene, a.defines, base, level);
-                // Metrics are means over --seeds independent renders; time per frame is their median.
-                Point p{spec.label, frame, effort, 0.0, 0.0, 0, 0, {}};
-                std::vector<double> frameSeconds;
-                const std::uint64_t seed0 = s.render.seed;
-                for (std::uint32_t k = 0; k < a.seeds; ++k) {
-                    s.render.seed = seed0 + k;
-                    const ExperimentRender r = renderForExperiment(s, source, frame, a.history);
-                    const ErrorMetrics e = computeErrors(r.image.lighting.Lr, ref.Lr, ref.hasStderr ? &ref.stderr : nullptr);
-                    frameSeconds.push_back(r.frameSeconds);
-                    p.totalSeconds += r.totalSeconds;
-                    p.shadowRays += r.stats.lighting.shadowRays;
-                    p.lightTerms += r.stats.lighting.lightTerms;
-                    p.err.relMSE += e.relMSE / a.seeds;
-                    p.err.MSE += e.MSE / a.seeds;
-                    p.err.MAPE += e.MAPE / a.seeds;
-                    p.err.relMSEFloor = e.relMSEFloor;
-                    p.err.pixels = e.pixels;
-                }
-                std::sort(frameSeconds.begin(), frameSeconds.end());
-                p.seconds = frameSeconds[frameSeconds.size() / 2];
-                p.shadowRays /= a.seeds;
-                p.lightTerms /= a.seeds;
-                if (!a.quiet)
-                    fmt::print(stderr, "converge: {} x{}: {:.3f} s, relMSE {:.4g} (reference noise {:.3g})\n", spec.label,
-                               effort, p.seconds, p.err.relMSE, p.err.relMSEFloor);
-                points.push_back(p);
-                spent += p.totalSeconds;
-                last = p.totalSeconds;
-                if (spec.kind == EstimatorKind::exact) break;
-            }
-        }
+/// One point's renders over the seeds: errors are their means, time per frame their median.
+class SeedAverage {
+public:
+    SeedAverage(std::string label, std::uint32_t frame, std::uint32_t effort, std::uint32_t seeds)
+        : seeds_(seeds) {
+        p_.label = std::move(label);
+        p_.frame = frame;
+        p_.effort = effort;
+    }
+    void add(const std::vector<Vec3>& Lr, const Reference& ref, const FrameStats& stats, double frameSeconds,
+             double totalSeconds) {
+        const ErrorMetrics e = computeErrors(Lr, ref.Lr, ref.hasStderr ? &ref.stderr : nullptr);
+        frameSeconds_.push_back(frameSeconds);
+        p_.totalSeconds += totalSeconds;
+        p_.shadowRays += stats.lighting.shadowRays;
+        p_.lightTerms += stats.lighting.lightTerms;
+        p_.err.relMSE += e.relMSE / seeds_;
+        p_.err.MSE += e.MSE / seeds_;
+        p_.err.MAPE += e.MAPE / seeds_;
+        p_.err.relMSEFloor = e.relMSEFloor;
+        p_.err.pixels = e.pixels;
+    }
+    Point finish() {
+        std::sort(frameSeconds_.begin(), frameSeconds_.end());
+        p_.seconds = frameSeconds_[frameSeconds_.size() / 2];
+        p_.shadowRays /= seeds_;
+        p_.lightTerms /= seeds_;
+        return p_;
     }
 
-    // CSV, one row per point.
-    std::string csv = "estimator,frame,effort,seconds,total_seconds,shadow_rays,light_terms,relMSE,MSE,MAPE,relMSE_reference_noise,relMSE_corrected\n";
-    for (const Point& p : points)
-        csv += fmt::format("{},{},{},{:.6g},{:.6g},{},{},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g}\n", p.label, p.frame, p.effort,
-                           p.seconds, p.totalSeconds, p.shadowRays, p.lightTerms, p.err.relMSE, p.err.MSE, p.err.MAPE,
-                           p.err.relMSEFloor, p.err.relMSE - p.err.relMSEFloor);
-    writeFileAtomic(prefix + ".csv", csv);
+private:
+    Point p_;
+    std::uint32_t seeds_;
+    std::vector<double> frameSeconds_;
+};
 
-    // Summary: each estimator's last point, and for every other estimator the
-    // time the baseline (first Monte Carlo estimator listed) needs for the same error.
-    nlohmann::json summary = nlohmann::json::array();
+/// What every measurement reads.
+struct ConvergeRun {
+    const ConvergeArgs& a;
+    const Settings& scene;
+    const std::vector<FlagSetting>& base;  ///< --frames
+    const ParticleSource& source;
+    std::uint32_t frame;
+    double budget;
+};
+
+/// --sequence: each estimator over N frames from one history per seed.
+std::vector<Point> measureSequence(const ConvergeRun& run, const std::vector<EstimatorSpec>& specs) {
+    const ConvergeArgs& a = run.a;
+    std::vector<Reference> refs;
+    for (std::uint32_t k = 0; k < a.sequence; ++k) refs.push_back(loadReference(a.reference, run.scene, run.frame + k));
+    std::vector<Point> points;
+    for (const EstimatorSpec& spec : specs) {
+        Settings s = specSettings(a.scene, a.defines, run.base, spec);
+        s.render.frame_start = run.frame;
+        s.render.frames = a.sequence;
+        const std::uint64_t seed0 = s.render.seed;
+        std::vector<SeedAverage> perFrame;
+        for (std::uint32_t k = 0; k < a.sequence; ++k) perFrame.emplace_back(spec.label, run.frame + k, 0, a.seeds);
+        for (std::uint32_t seed = 0; seed < a.seeds; ++seed) {
+            s.render.seed = seed0 + seed;
+            FrameRenderer renderer(s, run.source, RenderOptions{true});
+            for (std::uint32_t k = 0; k < a.sequence; ++k) {
+                FrameStats stats;
+                const FrameImage img = renderer.render(run.frame + k, stats);
+                perFrame[k].add(img.lighting.Lr, refs[k], stats, stats.seconds, stats.seconds);
+            }
+        }
+        for (SeedAverage& avg : perFrame) {
+            const Point p = avg.finish();
+            if (!a.quiet)
+                fmt::print(stderr, "converge: {} frame {}: {:.3f} s, relMSE {:.4g}, MAPE {:.4g}\n", spec.label, p.frame,
+                           p.seconds, p.err.relMSE, p.err.MAPE);
+            points.push_back(p);
+        }
+    }
+    return points;
+}
+
+/// One frame: each estimator at doubling effort until its share of the budget is spent.
+std::vector<Point> measureLevels(const ConvergeRun& run, const std::vector<EstimatorSpec>& specs) {
+    const ConvergeArgs& a = run.a;
+    const Reference ref = loadReference(a.reference, run.scene, run.frame);
+    std::vector<Point> points;
+    for (const EstimatorSpec& spec : specs) {
+        double spent = 0.0, last = 0.0;
+        for (std::uint32_t effort = a.minEffort; effort <= a.maxEffort; effort *= 2) {
+            if (spent > 0.0 && spent + 2.2 * last > run.budget) break;  // the next level would overrun the budget
+            EstimatorSpec level = spec;
+            const std::string flag = fmt::format("--min-effort/--max-effort (level {})", effort);
+            if (spec.kind == EstimatorKind::restir)
+                level.settings.push_back({"render.candidates", flag, [effort](Settings& st) { st.render.candidates = effort; }});
+            else
+                level.settings.push_back({"render.samples", flag, [effort](Settings& st) { st.render.samples = effort; }});
+            Settings s = specSettings(a.scene, a.defines, run.base, level);
+            SeedAverage avg(spec.label, run.frame, effort, a.seeds);
+            const std::uint64_t seed0 = s.render.seed;
+            for (std::uint32_t k = 0; k < a.seeds; ++k) {
+                s.render.seed = seed0 + k;
+                const ExperimentRender r = renderForExperiment(s, run.source, run.frame, a.history);
+                avg.add(r.image.lighting.Lr, ref, r.stats, r.frameSeconds, r.totalSeconds);
+            }
+            const Point p = avg.finish();
+            if (!a.quiet)
+                fmt::print(stderr, "converge: {} x{}: {:.3f} s, relMSE {:.4g} (reference noise {:.3g})\n", spec.label,
+                           effort, p.seconds, p.err.relMSE, p.err.relMSEFloor);
+            points.push_back(p);
+            spent += p.totalSeconds;
+            last = p.totalSeconds;
+            if (spec.kind == EstimatorKind::exact) break;
+        }
+    }
+    return points;
+}
+
+/// Every point (the CSV).
+Table pointsTable(const std::vector<Point>& points) {
+    Table t({{"estimator"}, {"frame"}, {"effort"}, {"seconds", "", 0, "{}", "{:.6g}"}, {"total_seconds", "", 0, "{}", "{:.6g}"},
+             {"shadow_rays"}, {"light_terms"}, {"relMSE", "", 0, "{}", "{:.8g}"}, {"MSE", "", 0, "{}", "{:.8g}"},
+             {"MAPE", "", 0, "{}", "{:.8g}"}, {"relMSE_reference_noise", "", 0, "{}", "{:.8g}"},
+             {"relMSE_corrected", "", 0, "{}", "{:.8g}"}});
+    for (const Point& p : points)
+        t.add({p.label, std::uint64_t(p.frame), std::uint64_t(p.effort), p.seconds, p.totalSeconds, p.shadowRays,
+               p.lightTerms, p.err.relMSE, p.err.MSE, p.err.MAPE, p.err.relMSEFloor, p.err.relMSE - p.err.relMSEFloor});
+    return t;
+}
+
+/// Each point with the time the baseline (the first Monte Carlo estimator
+/// listed) needs for the same error (the console table and the JSON).
+Table summaryTable(const std::vector<Point>& points, const std::vector<EstimatorSpec>& specs) {
     std::vector<Point> baseline;
     std::string baselineLabel;
     for (const EstimatorSpec& spec : specs)
@@ -214,38 +232,45 @@ void runConverge(const ConvergeArgs& a) {
                 if (p.label == spec.label) baseline.push_back(p);
             break;
         }
-    if (a.sequence == 0) {
-        fmt::print("{:<28} {:>7} {:>10} {:>12} {:>12} {:>14}\n", "estimator", "effort", "s/frame", "relMSE",
-                   "relMSE-noise", baselineLabel.empty() ? "" : "speed-up vs " + baselineLabel);
-        for (const EstimatorSpec& spec : specs) {
-            for (const Point& p : points) {
-                if (p.label != spec.label) continue;
-                const double corrected = p.err.relMSE - p.err.relMSEFloor;
-                const double tBase = baseline.empty() || corrected <= 0.0 ? NAN : timeAtError(baseline, corrected);
-                fmt::print("{:<28} {:>7} {:>10.4f} {:>12.5g} {:>12.5g} {:>14.3g}\n", p.label, p.effort, p.seconds,
-                           p.err.relMSE, corrected, tBase / p.seconds);
-                summary.push_back({{"estimator", p.label}, {"effort", p.effort}, {"seconds", p.seconds},
-                                   {"relMSE", p.err.relMSE}, {"relMSE_corrected", corrected}, {"MSE", p.err.MSE},
-                                   {"MAPE", p.err.MAPE}, {"baseline", baselineLabel},
-                                   {"baseline_seconds_at_equal_error", std::isfinite(tBase) ? nlohmann::json(tBase) : nlohmann::json()},
-                                   {"speedup_at_equal_error", std::isfinite(tBase) ? nlohmann::json(tBase / p.seconds) : nlohmann::json()}});
-            }
+    auto hidden = [](const char* key) { return Column{key, "", 0, "{}", "{}", false}; };
+    Table t({{"estimator", "estimator", -28}, {"effort", "effort", 7}, {"seconds", "s/frame", 10, "{:.4f}"},
+             {"relMSE", "relMSE", 12, "{:.5g}"},
+             {"relMSE_corrected", "relMSE-noise", 12, "{:.5g}"}, hidden("MSE"), hidden("MAPE"), hidden("baseline"),
+             hidden("baseline_seconds_at_equal_error"),
+             {"speedup_at_equal_error", baselineLabel.empty() ? "" : "speed-up vs " + baselineLabel, 14, "{:.3g}"}});
+    for (const EstimatorSpec& spec : specs)
+        for (const Point& p : points) {
+            if (p.label != spec.label) continue;
+            const double corrected = p.err.relMSE - p.err.relMSEFloor;
+            const double tBase = baseline.empty() || corrected <= 0.0 ? NAN : timeAtError(baseline, corrected);
+            t.add({p.label, std::uint64_t(p.effort), p.seconds, p.err.relMSE, corrected, p.err.MSE, p.err.MAPE, baselineLabel,
+                   tBase, tBase / p.seconds});
         }
-    }
-    writeJson(prefix + ".json", {{"version", std::string(version())},
-                                 {"command", "converge"},
-                                 {"scene", sceneSettings.scenePath},
-                                 {"reference", a.reference},
-                                 {"frame", frame},
-                                 {"budget_seconds", budget},
-                                 {"history_frames", a.history},
-                                 {"seeds_per_point", a.seeds},
-                                 {"speedup_model", "baseline relMSE = c / seconds, c fitted over its curve"},
-                                 {"estimators", a.estimators},
-                                 {"settings", settingsToToml(sceneSettings)},
-                                 {"points", summary}});
+    return t;
+}
 
-    // Plot: relMSE against time and against shadow rays (or against frame).
+/// --sequence: relMSE (MAPE) at frames 0, 1, 3, 7, 15, ... of the sequence.
+Table sequenceTable(const std::vector<Point>& points, const std::vector<EstimatorSpec>& specs, std::uint32_t frame,
+                    std::uint32_t sequence) {
+    std::vector<std::uint32_t> shown;
+    for (std::uint32_t k = 1; k <= sequence; k *= 2) shown.push_back(k - 1);
+    if (shown.back() != sequence - 1) shown.push_back(sequence - 1);
+    std::vector<Column> columns{{"", "relMSE (MAPE) at sequence frame", -44}};
+    for (std::uint32_t k : shown) columns.push_back({"", std::to_string(k), 15});
+    Table t(columns);
+    for (const EstimatorSpec& spec : specs) {
+        std::vector<Cell> row{spec.label};
+        for (std::uint32_t k : shown)
+            for (const Point& p : points)
+                if (p.label == spec.label && p.frame == frame + k)
+                    row.push_back(fmt::format("{:.3g} ({:.3f})", p.err.relMSE, p.err.MAPE));
+        t.add(row);
+    }
+    return t;
+}
+
+/// relMSE against time and against shadow rays (or against frame).
+void plotConverge(const std::string& prefix, const std::vector<EstimatorSpec>& specs, bool sequence) {
     std::string plots;
     for (const EstimatorSpec& spec : specs)
         plots += fmt::format("{}{} skip 1 using XCOL:(strcol(1) eq {} ? $8 : NaN) with linespoints title {}",
@@ -257,29 +282,50 @@ void runConverge(const ConvergeArgs& a) {
         return s;
     };
     std::string script = "set datafile separator ','\nset key outside right\nset grid\nset ylabel 'relMSE'\nset logscale y\n";
-    if (a.sequence > 0) {
-        // Table: relMSE (MAPE) at frames 0, 1, 3, 7, 15, 31, ... of the sequence.
-        std::vector<std::uint32_t> shown;
-        for (std::uint32_t k = 1; k <= a.sequence; k *= 2) shown.push_back(k - 1);
-        if (shown.back() != a.sequence - 1) shown.push_back(a.sequence - 1);
-        fmt::print("{:<44}", "relMSE (MAPE) at sequence frame");
-        for (std::uint32_t k : shown) fmt::print(" {:>15}", k);
-        fmt::print("\n");
-        for (const EstimatorSpec& spec : specs) {
-            fmt::print("{:<44}", spec.label);
-            for (std::uint32_t k : shown)
-                for (const Point& p : points)
-                    if (p.label == spec.label && p.frame == frame + k)
-                        fmt::print(" {:>15}", fmt::format("{:.3g} ({:.3f})", p.err.relMSE, p.err.MAPE));
-            fmt::print("\n");
-        }
+    if (sequence) {
         script += "set xlabel 'frame'\nplot " + withColumn("2") + "\n";
         plotPng(prefix + ".png", script);
-    } else {
-        script += "set multiplot layout 1,2\nset logscale x\nset xlabel 'seconds per frame'\nplot " + withColumn("4") +
-                  "\nset xlabel 'shadow rays'\nplot " + withColumn("6") + "\nunset multiplot\n";
-        plotPng(prefix + ".png", script, 1400, 600);
+        return;
     }
+    script += "set multiplot layout 1,2\nset logscale x\nset xlabel 'seconds per frame'\nplot " + withColumn("4") +
+              "\nset xlabel 'shadow rays'\nplot " + withColumn("6") + "\nunset multiplot\n";
+    plotPng(prefix + ".png", script, 1400, 600);
+}
+
+void runConverge(const ConvergeArgs& a) {
+    const std::vector<FlagSetting> base = frameFlags(a.frames);
+    const Settings scene = loadSceneArgs(a);
+    const auto specs = parseEstimatorSpecs(a.estimators, "--estimators");
+    const double budget = parseSeconds(a.budget);
+    const std::uint32_t frame = a.frame.value_or(scene.render.frame_start);
+    const auto threads = limitThreads(a.threads);
+    const std::string prefix = a.out.empty() ? "out/" + scene.sceneName + ".converge" : a.out;
+    if (auto dir = std::filesystem::path(prefix).parent_path(); !dir.empty()) std::filesystem::create_directories(dir);
+
+    const ParticleSource source(scene);
+    const ConvergeRun run{a, scene, base, source, frame, budget};
+    const std::vector<Point> points = a.sequence > 0 ? measureSequence(run, specs) : measureLevels(run, specs);
+    writeFileAtomic(prefix + ".csv", pointsTable(points).csv());
+    nlohmann::json summary = nlohmann::json::array();
+    if (a.sequence == 0) {
+        const Table t = summaryTable(points, specs);
+        fmt::print("{}", t.console());
+        summary = t.json();
+    }
+    writeJson(prefix + ".json", {{"version", std::string(version())},
+                                 {"command", "converge"},
+                                 {"scene", scene.scenePath},
+                                 {"reference", a.reference},
+                                 {"frame", frame},
+                                 {"budget_seconds", budget},
+                                 {"history_frames", a.history},
+                                 {"seeds_per_point", a.seeds},
+                                 {"speedup_model", "baseline relMSE = c / seconds, c fitted over its curve"},
+                                 {"estimators", a.estimators},
+                                 {"settings", settingsToToml(scene)},
+                                 {"points", summary}});
+    if (a.sequence > 0) fmt::print("{}", sequenceTable(points, specs, frame, a.sequence).console());
+    plotConverge(prefix, specs, a.sequence > 0);
     fmt::print("converge: {}.csv, {}.png, {}.json\n", prefix, prefix, prefix);
 }
 
