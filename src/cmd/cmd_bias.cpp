@@ -17,6 +17,7 @@
 #include "accretion/core/atomic_file.h"
 #include "accretion/io/exr_output.h"
 #include "accretion/io/plot.h"
+#include "accretion/io/report_table.h"
 #include "accretion/io/stats_writer.h"
 #include "accretion/scene/scene_parser.h"
 #include "commands.h"
@@ -42,119 +43,142 @@ struct BiasRow {
     bool biased = false;
 };
 
-void runBias(const BiasArgs& a) {
-    const std::vector<FlagSetting> base = frameFlags(a.frames);
-    const Settings sceneSettings = loadSceneArgs(a);
-    const auto specs = parseEstimatorSpecs(a.estimators, "--estimators");
-    if (a.seeds < 2) throw InputError("command line --seeds: at least 2 seeds are needed for a standard error");
-    const std::uint32_t frame = a.frame.value_or(sceneSettings.render.frame_start);
-    const auto threads = limitThreads(a.threads);
-    const std::string prefix = a.out.empty() ? "out/" + sceneSettings.sceneName + ".bias" : a.out;
-    if (auto dir = std::filesystem::path(prefix).parent_path(); !dir.empty()) std::filesystem::create_directories(dir);
+/// The reference: Lr, its per-pixel standard error when it has one, and its image mean.
+struct BiasReference {
+    RgbLayer image;
+    std::vector<Vec3> stderr;  ///< empty without an Lr_stderr layer
+    double mean = 0.0, meanStderr = 0.0;
+};
 
-    const RgbLayer ref = readExrLayer(a.reference, "Lr");
-    const std::uint32_t W = ref.width, H = ref.height;
-    if (W != sceneSettings.camera.width || H != sceneSettings.camera.height)
-        throw InputError(fmt::format("{}: reference is {}x{}, the scene renders {}x{}", a.reference, W, H,
-                                     sceneSettings.camera.width, sceneSettings.camera.height));
-    const std::size_t pixels = std::size_t(W) * H;
+BiasReference loadBiasReference(const std::string& file, const Settings& scene) {
+    BiasReference r;
+    r.image = readExrLayer(file, "Lr");
+    if (r.image.width != scene.camera.width || r.image.height != scene.camera.height)
+        throw InputError(fmt::format("{}: reference is {}x{}, the scene renders {}x{}", file, r.image.width, r.image.height,
+                                     scene.camera.width, scene.camera.height));
+    if (exrHasLayer(file, "Lr_stderr")) r.stderr = readExrLayer(file, "Lr_stderr").rgb;
+    const std::size_t pixels = r.image.rgb.size();
     const double n = 3.0 * double(pixels);
-    double refMean = 0.0, refVar = 0.0;
-    const bool refHasStderr = exrHasLayer(a.reference, "Lr_stderr");
-    const std::vector<Vec3> refErr = refHasStderr ? readExrLayer(a.reference, "Lr_stderr").rgb : std::vector<Vec3>();
+    double var = 0.0;
     for (std::size_t p = 0; p < pixels; ++p)
         for (int c = 0; c < 3; ++c) {
-            refMean += ref.rgb[p][c];
-            if (refHasStderr) refVar += double(refErr[p][c]) * refErr[p][c];
+            r.mean += r.image.rgb[p][c];
+            if (!r.stderr.empty()) var += double(r.stderr[p][c]) * r.stderr[p][c];
         }
-    refMean /= n;
-    const double refMeanStderr = std::sqrt(refVar) / n;  // independent pixels
+    r.mean /= n;
+    r.meanStderr = std::sqrt(var) / n;  // independent pixels
+    return r;
+}
 
-    const ParticleSource source(sceneSettings);
-    std::vector<BiasRow> rows;
-    for (const EstimatorSpec& spec : specs) {
-        const Settings specBase = specSettings(a.scene, a.defines, base, spec);
-        std::vector<DVec3> s1(pixels, DVec3(0.0)), s2(pixels, DVec3(0.0));
-        double e1 = 0.0, e2 = 0.0, seconds = 0.0;
-        for (std::uint32_t k = 0; k < a.seeds; ++k) {
-            Settings s = specBase;
-            s.render.seed = specBase.render.seed + k;
-            const ExperimentRender r = renderForExperiment(s, source, frame, a.history);
-            seconds += r.totalSeconds;
-            double e = 0.0;
-            for (std::size_t p = 0; p < pixels; ++p) {
-                const DVec3 d = DVec3(r.image.lighting.Lr[p]) - DVec3(ref.rgb[p]);
-                s1[p] += d;
-                s2[p] += d * d;
-                e += d.x + d.y + d.z;
-            }
-            e /= n;
-            e1 += e;
-            e2 += e * e;
-            if (!a.quiet)
-                fmt::print(stderr, "\rbias: {} seed {}/{} ({:.2f} s)", spec.label, k + 1, a.seeds, r.totalSeconds);
+/// Per-pixel signed errors over the seeds: the bias map (mean signed error,
+/// its standard error with the reference's, z of the luminance).
+void writeBiasMap(const std::string& file, const std::vector<DVec3>& s1, const std::vector<DVec3>& s2, double S,
+                  const BiasReference& ref, const OutputMetadata& meta) {
+    const std::size_t pixels = s1.size();
+    std::vector<FloatChannel> ch = {{"bias.R", {}}, {"bias.G", {}}, {"bias.B", {}},
+                                    {"bias_stderr.R", {}}, {"bias_stderr.G", {}}, {"bias_stderr.B", {}}, {"bias_z.Y", {}}};
+    for (auto& c : ch) c.values.resize(pixels);
+    for (std::size_t p = 0; p < pixels; ++p) {
+        const DVec3 m = s1[p] / S;
+        const DVec3 var = glm::max((s2[p] / S - m * m) * (S / (S - 1.0)), DVec3(0.0));
+        DVec3 se = glm::sqrt(var / S);
+        if (!ref.stderr.empty()) se = glm::sqrt(se * se + DVec3(ref.stderr[p]) * DVec3(ref.stderr[p]));
+        for (int c = 0; c < 3; ++c) {
+            ch[c].values[p] = float(m[c]);
+            ch[3 + c].values[p] = float(se[c]);
         }
-        if (!a.quiet) fmt::print(stderr, "\n");
-        const double S = a.seeds;
-        BiasRow row;
-        row.label = spec.label;
-        row.seeds = a.seeds;
-        row.meanError = e1 / S;
-        const double seedVar = std::max(0.0, (e2 / S - row.meanError * row.meanError) * S / (S - 1.0));
-        row.stderr = std::sqrt(seedVar / S + refMeanStderr * refMeanStderr);
-        row.z = row.stderr > 0.0 ? row.meanError / row.stderr : 0.0;
-        row.energyLossPct = refMean > 0.0 ? -100.0 * row.meanError / refMean : 0.0;
-        row.secondsPerRender = seconds / S;
-        row.biased = std::fabs(row.z) > a.zCritical;
-        rows.push_back(row);
-
-        // Per-pixel bias map: mean signed error, its standard error, z (luminance).
-        std::vector<FloatChannel> ch = {{"bias.R", {}}, {"bias.G", {}}, {"bias.B", {}},
-                                        {"bias_stderr.R", {}}, {"bias_stderr.G", {}}, {"bias_stderr.B", {}}, {"bias_z.Y", {}}};
-        for (auto& c : ch) c.values.resize(pixels);
-        for (std::size_t p = 0; p < pixels; ++p) {
-            const DVec3 m = s1[p] / S;
-            const DVec3 var = glm::max((s2[p] / S - m * m) * (S / (S - 1.0)), DVec3(0.0));
-            DVec3 se = glm::sqrt(var / S);
-            if (refHasStderr) se = glm::sqrt(se * se + DVec3(refErr[p]) * DVec3(refErr[p]));
-            for (int c = 0; c < 3; ++c) {
-                ch[c].values[p] = float(m[c]);
-                ch[3 + c].values[p] = float(se[c]);
-            }
-            const double mY = luminance(Vec3(m)), seY = luminance(Vec3(se));
-            ch[6].values[p] = seY > 0.0 ? float(mY / seY) : 0.0f;
-        }
-        std::string safe = spec.label;
-        for (char& c : safe)
-            if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
-        writeChannelsExr(prefix + "." + safe + ".exr", W, H, ch,
-                         {{"version", std::string(version())}, {"estimator", spec.label},
-                          {"seeds", std::to_string(a.seeds)}, {"reference", a.reference},
-                          {"settings", settingsToToml(specBase)}});
+        const double mY = luminance(Vec3(m)), seY = luminance(Vec3(se));
+        ch[6].values[p] = seY > 0.0 ? float(mY / seY) : 0.0f;
     }
+    writeChannelsExr(file, ref.image.width, ref.image.height, ch, meta);
+}
 
-    std::string csv = "estimator,seeds,mean_signed_error,stderr,z,energy_loss_pct,energy_loss_stderr_pct,biased,seconds_per_render\n";
-    fmt::print("{:<28} {:>6} {:>13} {:>11} {:>8} {:>15} {:>9}  verdict (|z| > {:.2f}: 99.9%)\n", "estimator", "seeds",
-               "mean error", "stderr", "z", "energy loss %", "s/render", a.zCritical);
-    nlohmann::json jrows = nlohmann::json::array();
+/// One estimator over the seeds: its row, and its bias map at prefix.<estimator>.exr.
+BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vector<FlagSetting>& base,
+                    const ParticleSource& source, std::uint32_t frame, const BiasReference& ref, const std::string& prefix) {
+    const Settings specBase = specSettings(a.scene, a.defines, base, spec);
+    const std::size_t pixels = ref.image.rgb.size();
+    const double n = 3.0 * double(pixels);
+    std::vector<DVec3> s1(pixels, DVec3(0.0)), s2(pixels, DVec3(0.0));
+    double e1 = 0.0, e2 = 0.0, seconds = 0.0;
+    for (std::uint32_t k = 0; k < a.seeds; ++k) {
+        Settings s = specBase;
+        s.render.seed = specBase.render.seed + k;
+        const ExperimentRender r = renderForExperiment(s, source, frame, a.history);
+        seconds += r.totalSeconds;
+        double e = 0.0;
+        for (std::size_t p = 0; p < pixels; ++p) {
+            const DVec3 d = DVec3(r.image.lighting.Lr[p]) - DVec3(ref.image.rgb[p]);
+            s1[p] += d;
+            s2[p] += d * d;
+            e += d.x + d.y + d.z;
+        }
+        e /= n;
+        e1 += e;
+        e2 += e * e;
+        if (!a.quiet) fmt::print(stderr, "\rbias: {} seed {}/{} ({:.2f} s)", spec.label, k + 1, a.seeds, r.totalSeconds);
+    }
+    if (!a.quiet) fmt::print(stderr, "\n");
+    const double S = a.seeds;
+    BiasRow row;
+    row.label = spec.label;
+    row.seeds = a.seeds;
+    row.meanError = e1 / S;
+    const double seedVar = std::max(0.0, (e2 / S - row.meanError * row.meanError) * S / (S - 1.0));
+    row.stderr = std::sqrt(seedVar / S + ref.meanStderr * ref.meanStderr);
+    row.z = row.stderr > 0.0 ? row.meanError / row.stderr : 0.0;
+    row.energyLossPct = ref.mean > 0.0 ? -100.0 * row.meanError / ref.mean : 0.0;
+    row.secondsPerRender = seconds / S;
+    row.biased = std::fabs(row.z) > a.zCritical;
+    std::string safe = spec.label;
+    for (char& c : safe)
+        if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
+    writeBiasMap(prefix + "." + safe + ".exr", s1, s2, S, ref,
+                 {{"version", std::string(version())}, {"estimator", spec.label}, {"seeds", std::to_string(a.seeds)},
+                  {"reference", a.reference}, {"settings", settingsToToml(specBase)}});
+    return row;
+}
+
+/// The rows as the console, CSV and JSON give them.
+Table biasTable(const std::vector<BiasRow>& rows, double refMean, double zCritical) {
+    auto hidden = [](const char* key, const char* csv) { return Column{key, "", 0, "{}", csv, false}; };
+    Table t({{"estimator", "estimator", -28}, {"seeds", "seeds", 6}, {"mean_signed_error", "mean error", 13, "{:.5g}", "{:.8g}"},
+             {"stderr", "stderr", 11, "{:.3g}", "{:.8g}"}, {"z", "z", 8, "{:.2f}", "{:.5g}"},
+             hidden("energy_loss_pct", "{:.6g}"), hidden("energy_loss_stderr_pct", "{:.6g}"), {"", "energy loss %", 15},
+             hidden("biased", "{}"), {"seconds_per_render", "s/render", 9, "{:.3f}", "{:.6g}"},
+             {"", fmt::format("verdict (|z| > {:.2f}: 99.9%)", zCritical), 0, "{}", "{}", true, "  "}});
     for (const BiasRow& r : rows) {
         const double lossSe = refMean > 0.0 ? 100.0 * r.stderr / refMean : 0.0;
-        csv += fmt::format("{},{},{:.8g},{:.8g},{:.5g},{:.6g},{:.6g},{},{:.6g}\n", r.label, r.seeds, r.meanError, r.stderr,
-                           r.z, r.energyLossPct, lossSe, r.biased ? 1 : 0, r.secondsPerRender);
-        fmt::print("{:<28} {:>6} {:>13.5g} {:>11.3g} {:>8.2f} {:>8.3f} +- {:<5.3f} {:>9.3f}  {}\n", r.label, r.seeds,
-                   r.meanError, r.stderr, r.z, r.energyLossPct, lossSe, r.secondsPerRender,
-                   r.biased ? "BIASED" : fmt::format("no bias detected (|bias| < {:.2g}%)", a.zCritical * lossSe + std::fabs(r.energyLossPct)));
-        jrows.push_back({{"estimator", r.label}, {"seeds", r.seeds}, {"mean_signed_error", r.meanError},
-                         {"stderr", r.stderr}, {"z", r.z}, {"energy_loss_pct", r.energyLossPct},
-                         {"energy_loss_stderr_pct", lossSe}, {"biased", r.biased},
-                         {"seconds_per_render", r.secondsPerRender}});
+        t.add({r.label, std::uint64_t(r.seeds), r.meanError, r.stderr, r.z, r.energyLossPct, lossSe,
+               fmt::format("{:>8.3f} +- {:<5.3f}", r.energyLossPct, lossSe), r.biased, r.secondsPerRender,
+               r.biased ? "BIASED" : fmt::format("no bias detected (|bias| < {:.2g}%)", zCritical * lossSe + std::fabs(r.energyLossPct))});
     }
-    writeFileAtomic(prefix + ".csv", csv);
+    return t;
+}
+
+void runBias(const BiasArgs& a) {
+    const std::vector<FlagSetting> base = frameFlags(a.frames);
+    const Settings scene = loadSceneArgs(a);
+    const auto specs = parseEstimatorSpecs(a.estimators, "--estimators");
+    if (a.seeds < 2) throw InputError("command line --seeds: at least 2 seeds are needed for a standard error");
+    const std::uint32_t frame = a.frame.value_or(scene.render.frame_start);
+    const auto threads = limitThreads(a.threads);
+    const std::string prefix = a.out.empty() ? "out/" + scene.sceneName + ".bias" : a.out;
+    if (auto dir = std::filesystem::path(prefix).parent_path(); !dir.empty()) std::filesystem::create_directories(dir);
+
+    const BiasReference ref = loadBiasReference(a.reference, scene);
+    const ParticleSource source(scene);
+    std::vector<BiasRow> rows;
+    for (const EstimatorSpec& spec : specs) rows.push_back(measureBias(a, spec, base, source, frame, ref, prefix));
+
+    const Table table = biasTable(rows, ref.mean, a.zCritical);
+    fmt::print("{}", table.console());
+    writeFileAtomic(prefix + ".csv", table.csv());
     writeJson(prefix + ".json", {{"version", std::string(version())}, {"command", "bias"},
-                                 {"scene", sceneSettings.scenePath}, {"reference", a.reference},
+                                 {"scene", scene.scenePath}, {"reference", a.reference},
                                  {"frame", frame}, {"history_frames", a.history}, {"z_critical", a.zCritical},
-                                 {"reference_mean", refMean}, {"reference_mean_stderr", refMeanStderr},
-                                 {"settings", settingsToToml(sceneSettings)}, {"rows", jrows}});
+                                 {"reference_mean", ref.mean}, {"reference_mean_stderr", ref.meanStderr},
+                                 {"settings", settingsToToml(scene)}, {"rows", table.json()}});
     const std::string script = fmt::format(
         "set datafile separator ','\nset style fill solid 0.5\nset boxwidth 0.6\nset grid ytics\n"
         "set ylabel 'energy loss % (bars: {0:.2f} standard errors)'\nset xtics rotate by -30\nset key off\n"

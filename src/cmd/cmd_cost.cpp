@@ -18,6 +18,7 @@
 #include "accretion/gpu/cost_model.h"
 #include "accretion/core/atomic_file.h"
 #include "accretion/io/exr_output.h"
+#include "accretion/io/report_table.h"
 #include "accretion/io/stats_writer.h"
 #include "accretion/render/frame_renderer.h"
 #include "accretion/scene/scene_parser.h"
@@ -75,62 +76,49 @@ double median(std::vector<double> v) {
     return v.empty() ? 0.0 : v[v.size() / 2];
 }
 
-void runCost(const CostArgs& a) {
-    const Settings settings =
-        loadSceneArgs(a, {{"gpu.counters", "cost (counts every pass)", [](Settings& s) { s.gpu.counters = true; }}});
-    const std::vector<std::uint32_t> clusterSizes = parseList(a.clusterSizes, "--cluster-sizes", 1, 10000000);
-    const std::vector<std::uint32_t> ommLevels = parseList(a.ommLevels, "--omm-levels", 0, 6);
+/// What the sections of a cost report read.
+struct CostRun {
+    const CostArgs& args;
+    const Settings& settings;
+    const ParticleSource& source;
+    std::uint32_t frame;
+    std::vector<std::uint32_t> clusterSizes, ommLevels;
     std::vector<SerKey> serKeys;
-    for (const std::string& k : a.serKeys) serKeys.push_back(SerKey::parse(k, std::max(settings.gpu.ser_hint_bits, 4u), "--ser-keys " + k));
-    const CostCoefficients coef = settings.gpu.coefficients.empty() ? CostCoefficients::defaults()
-                                                                    : CostCoefficients::load(settings.gpu.coefficients);
-    const auto threads = limitThreads(a.threads);
-    const std::string prefix = a.output.empty() ? "out/" + settings.sceneName + ".cost" : std::filesystem::path(a.output).replace_extension().string();
-    const std::string config = a.config.empty() ? settings.sceneName : a.config;
-    const std::uint32_t frame = settings.render.frame_start;
-    const ParticleSource source(settings);
-    auto log = [&](const std::string& msg) {
-        if (!a.quiet) fmt::print(stderr, "cost: {}\n", msg);
-    };
+    void log(const std::string& msg) const {
+        if (!args.quiet) fmt::print(stderr, "cost: {}\n", msg);
+    }
+};
 
-    log(fmt::format("frame {} of {} with counters ({} history frames)", frame, settings.scenePath,
-                    settings.render.estimator == EstimatorKind::restir ? std::min(frame, a.history) : 0));
-    const CountedFrame main = renderCounted(settings, source, frame, a.history);
-    const GpuReport& r = main.report;
-
-    // Per-pass table.
-    fmt::print("{}: frame {}, {}x{}, {} particles, {} clusters, estimator {}; warps {}x{} groups of {} lanes; cost: {}\n",
-               settings.sceneName, frame, settings.camera.width, settings.camera.height, main.stats.particles,
-               main.stats.bvh.clusters, enumName(settings.render.estimator), r.layout.groupWidth, r.layout.groupHeight,
-               r.layout.warpSize, coef.source);
-    fmt::print("{:<20} {:>9} {:>11} {:>10} {:>8} {:>8} {:>8} {:>9} {:>9} {:>7} {:>7} {:>6} {:>9} {:>9}\n", "pass", "threads",
-               "trips", "rays", "BLAS/ray", "AH/ray", "proc/ray", "MB read", "MB write", "SIMTbr", "SIMTlp", "SER", "model",
-               "pred. ms");
-    nlohmann::json passes = nlohmann::json::array();
-    std::string csv = "config,pass";
-    for (std::string_view f : kCostFeatures) csv += fmt::format(",{}", f);
-    csv += ",predicted_ms\n";
-    double totalMs = 0.0;
+/// Per-pass counters, SIMT, SER and predicted time: the console table and
+/// the CSV calibrate reads (config, pass, features, predicted_ms).
+Table passTable(const GpuReport& r, const CostCoefficients& coef, const std::string& config, double& totalMs) {
+    std::vector<Column> columns{{"config", "", 0, "{}", "{}", false}, {"pass", "pass", -20}, {"", "threads", 9},
+                                {"", "trips", 11}, {"", "rays", 10}, {"", "BLAS/ray", 8, "{:.2f}"}, {"", "AH/ray", 8, "{:.2f}"},
+                                {"", "proc/ray", 8, "{:.2f}"}, {"", "MB read", 9, "{:.1f}"}, {"", "MB write", 9, "{:.1f}"},
+                                {"", "SIMTbr", 7, "{:>6.1f}%"}, {"", "SIMTlp", 7, "{:>6.1f}%"}, {"", "SER", 6, "{:>5.2f}x"},
+                                {"", "model", 9}};
+    for (std::string_view f : kCostFeatures) columns.push_back({std::string(f), "", 0, "{}", "{}", false});
+    columns.push_back({"predicted_ms", "pred. ms", 9, "{:.3f}", "{:.6g}"});
+    Table t(columns);
+    totalMs = 0.0;
     for (const PassReport& p : r.passes) {
         const CostFeatures f = costFeatures(p);
         const double ms = coef.predictMs(f);
         totalMs += ms;
-        fmt::print("{:<20} {:>9} {:>11} {:>10} {:>8.2f} {:>8.2f} {:>8.2f} {:>9.1f} {:>9.1f} {:>6.1f}% {:>6.1f}% {:>5.2f}x {:>9} {:>9.3f}\n",
-                   p.pass, p.threads, p.trips, p.rays, p.perRay(p.blasEntries), p.perRay(p.anyHits), p.perRay(p.proceeds),
-                   1e-6 * double(p.bytesRead), 1e-6 * double(p.bytesWritten), 100.0 * p.ser.branchBefore.efficiency,
-                   100.0 * p.ser.loopBefore.efficiency, p.ser.predictedSpeedup, p.rayModel, ms);
-        nlohmann::json j = toJson(p);
-        j["predicted_ms"] = ms;
-        passes.push_back(j);
-        csv += fmt::format("{},{}", config, p.pass);
-        for (double v : f) csv += fmt::format(",{}", v);
-        csv += fmt::format(",{:.6g}\n", ms);
+        std::vector<Cell> row{config, p.pass, p.threads, p.trips, p.rays, p.perRay(p.blasEntries), p.perRay(p.anyHits),
+                              p.perRay(p.proceeds), 1e-6 * double(p.bytesRead), 1e-6 * double(p.bytesWritten),
+                              100.0 * p.ser.branchBefore.efficiency, 100.0 * p.ser.loopBefore.efficiency,
+                              p.ser.predictedSpeedup, p.rayModel};
+        for (double v : f) row.push_back(v);
+        row.push_back(ms);
+        t.add(row);
     }
-    fmt::print("{:<20} predicted {:.3f} ms per frame\n", "total", totalMs);
-    for (const PassReport& p : r.passes)
-        if (p.rays > 0) fmt::print("  {}: {} ({})\n", p.pass, p.rayModel, p.reason);
+    return t;
+}
 
-    // SER key sweep on every pass with hits: efficiency before / after per key.
+/// SER key sweep on every pass with hits: efficiency before / after per key, and the best key.
+nlohmann::json reportSerSweep(const CostRun& run, const CountedFrame& main) {
+    const Settings& settings = run.settings;
     nlohmann::json serSweep = nlohmann::json::array();
     fmt::print("\nSER (window {} threads, reorder cost {} lane-steps per thread): branch SIMT efficiency before -> after, "
                "distinct keys per warp, predicted speed-up\n", settings.gpu.ser_window, settings.gpu.ser_reorder_cost);
@@ -138,7 +126,7 @@ void runCost(const CostArgs& a) {
         if (pc.pass == pass::buildClusters) continue;
         std::string best;
         double bestGain = 0.0;
-        for (const SerKey& k : serKeys) {
+        for (const SerKey& k : run.serKeys) {
             const SerReport s = serOf(pc, settings.gpu, k);
             fmt::print("  {:<20} {:<26} {:5.1f}% -> {:5.1f}%  keys {:5.2f} -> {:5.2f}  loop {:5.1f}% -> {:5.1f}%  {:5.2f}x\n",
                        pc.pass, s.key, 100.0 * s.branchBefore.efficiency, 100.0 * s.branchAfter.efficiency,
@@ -161,9 +149,17 @@ void runCost(const CostArgs& a) {
         fmt::print("  {:<20} best key: {} ({:.2f}x)\n", pc.pass, best, bestGain);
     }
 
-    // Any-hit and opacity micromaps: alpha testing against OMM levels (4-state: same image; 2-state: its error).
+    return serSweep;
+}
+
+/// Any-hit and opacity micromaps: alpha testing against OMM levels (4-state: same image; 2-state: its error).
+nlohmann::json reportOmm(const CostRun& run, const CountedFrame& main) {
+    const Settings& settings = run.settings;
+    const CostArgs& a = run.args;
+    const ParticleSource& source = run.source;
+    const std::uint32_t frame = run.frame;
     nlohmann::json omm = nlohmann::json::array();
-    if (settings.geometry.alpha == AlphaMode::disc && !ommLevels.empty()) {
+    if (settings.geometry.alpha == AlphaMode::disc && !run.ommLevels.empty()) {
         fmt::print("\nany-hit per ray (primary / shadow) and OMM memory (shared arrays vs one per triangle):\n");
         auto anyHits = [](const GpuReport& g, bool shadow) {
             std::uint64_t ah = 0, rays = 0;
@@ -184,11 +180,11 @@ void runCost(const CostArgs& a) {
         omm.push_back({{"variant", "alpha"}, {"any_hits_per_primary_ray", anyHits(ref.report, false)},
                        {"any_hits_per_shadow_ray", anyHits(ref.report, true)}});
         for (const bool four : {true, false})
-            for (std::uint32_t L : ommLevels) {
+            for (std::uint32_t L : run.ommLevels) {
                 Settings s = settings;
                 s.gpu.omm = four ? OmmMode::four_state : OmmMode::two_state;
                 s.gpu.omm_level = L;
-                log(fmt::format("OMM {}-state level {}", four ? 4 : 2, L));
+                run.log(fmt::format("OMM {}-state level {}", four ? 4 : 2, L));
                 const CountedFrame v = renderCounted(s, source, frame, a.history);
                 // The whole image (with a stochastic estimator this includes its noise, as the
                 // sample streams diverge) and the self-emission alone (coverage only, deterministic).
@@ -220,16 +216,23 @@ void runCost(const CostArgs& a) {
             }
     }
 
-    // BLAS memory at other cluster sizes: the frame's particles, rebuilt.
+    return omm;
+}
+
+/// BLAS memory at other cluster sizes: the frame's particles, rebuilt.
+nlohmann::json reportBlasMemory(const CostRun& run) {
+    const Settings& settings = run.settings;
+    const ParticleSource& source = run.source;
+    const std::uint32_t frame = run.frame;
     nlohmann::json memory = nlohmann::json::array();
-    if (!clusterSizes.empty()) {
+    if (!run.clusterSizes.empty()) {
         fmt::print("\nBLAS memory (GPU estimate {} B/triangle, {} B/node, width {}; Embree measured):\n",
                    settings.gpu.blas_bytes_per_triangle, settings.gpu.blas_bytes_per_node, settings.gpu.bvh_width);
         fmt::print("  {:>8} {:>8} {:>12} {:>14} {:>7} {:>12} {:>7} {:>12} {:>12}\n", "cluster", "BLASes", "GPU bytes",
                    "own alloc", "waste", "pooled", "waste", "compacted", "Embree");
         const Particles particles = source.frame(frame);
         const Camera camera = Camera::atFrame(settings.camera, frame);
-        for (std::uint32_t size : clusterSizes) {
+        for (std::uint32_t size : run.clusterSizes) {
             GeometrySettings g = settings.geometry;
             g.cluster_size = size;
             g.build = BuildPolicy::rebuild;
@@ -238,10 +241,8 @@ void runCost(const CostArgs& a) {
             const EmbreeDevice device;
             ParticleBvh bvh(device, g, gpu);
             bvh.build(particles, camera);
-            std::vector<std::uint32_t> tris;
-            for (std::size_t c = 0; c < bvh.clusters().count(); ++c)
-                tris.push_back(std::uint32_t(bvh.clusters().members(c).size()) * (g.primitive == Primitive::billboard ? 2u : 1u));
-            const BlasMemory m = blasMemory(tris, settings.gpu, bvh.stats().embreeBytes);
+            const AccelCounters accel = bvh.accelCounters();
+            const BlasMemory m = blasMemory(accel.blasPrimitives, settings.gpu, accel.embreeBytes);
             fmt::print("  {:>8} {:>8} {:>12} {:>14} {:>6.1f}% {:>12} {:>6.1f}% {:>12} {:>12}\n", size, m.clusters, m.gpuBytes,
                        m.perBlasAllocBytes, 100.0 * m.perBlasWaste(), m.pooledBytes, 100.0 * m.pooledWaste(),
                        m.compactedPooledBytes, m.embreeBytes);
@@ -257,6 +258,11 @@ void runCost(const CostArgs& a) {
                               {"embree_bytes", m.embreeBytes}});
         }
     }
+    return memory;
+}
+
+/// Reservoir, G-buffer and payload layouts, buffers and traffic.
+void printLayouts(const GpuReport& r) {
     const LayoutReport& L = r.layouts;
     fmt::print("\nlayouts: reservoir {} B, G-buffer texel {} B, payloads {} B primary / {} B shadow; buffers: reservoirs {:.1f} MB, "
                "G-buffer {:.1f} MB; traffic {:.1f} MB per frame = {:.1f} GB/s at 60 fps\n",
@@ -264,14 +270,21 @@ void runCost(const CostArgs& a) {
                1e-6 * double(L.reservoirBufferBytes), 1e-6 * double(L.gbufferBufferBytes), 1e-6 * double(L.bytesPerFrame),
                double(L.bytesPerFrame) * 60.0 / 1e9);
 
-    // Counting overhead: the same frame with counters off and on, medians of N.
+}
+
+/// Counting overhead: the same frame with counters off and on, medians of N.
+nlohmann::json measureOverhead(const CostRun& run) {
+    const Settings& settings = run.settings;
+    const CostArgs& a = run.args;
+    const ParticleSource& source = run.source;
+    const std::uint32_t frame = run.frame;
     nlohmann::json overhead;
     if (a.overhead > 0) {
         Settings off = settings;
         off.gpu.counters = false;
         std::vector<double> tOff, tOn;
         for (std::uint32_t k = 0; k < a.overhead; ++k) {
-            log(fmt::format("counting overhead {}/{}", k + 1, a.overhead));
+            run.log(fmt::format("counting overhead {}/{}", k + 1, a.overhead));
             tOff.push_back(renderCounted(off, source, frame, a.history).stats.seconds);
             tOn.push_back(renderCounted(settings, source, frame, a.history).stats.seconds);
         }
@@ -281,8 +294,57 @@ void runCost(const CostArgs& a) {
         overhead = {{"seconds_off", mOff}, {"seconds_on", mOn}, {"ratio", mOn / mOff}, {"runs", a.overhead}};
     }
 
+    return overhead;
+}
+
+/// The counter heatmaps: one EXR of every map and a PNG of each.
+void writeHeatmaps(const std::string& prefix, const CountedFrame& main, const Settings& settings, std::uint32_t frame) {
+    std::vector<FloatChannel> maps;
+    for (const Heatmap& h : main.image.heatmaps) {
+        maps.push_back({h.name, h.values});
+        writeHeatmapPng(prefix + "." + h.name + ".png", h.values, main.image.width, main.image.height);
+    }
+    writeChannelsExr(prefix + ".heatmaps.exr", main.image.width, main.image.height, maps,
+                     {{"version", std::string(version())}, {"scene", settings.scenePath}, {"frame", std::to_string(frame)}});
+}
+
+void runCost(const CostArgs& a) {
+    const Settings settings =
+        loadSceneArgs(a, {{"gpu.counters", "cost (counts every pass)", [](Settings& s) { s.gpu.counters = true; }}});
+    std::vector<SerKey> serKeys;
+    for (const std::string& k : a.serKeys) serKeys.push_back(SerKey::parse(k, std::max(settings.gpu.ser_hint_bits, 4u), "--ser-keys " + k));
+    const CostCoefficients coef = settings.gpu.coefficients.empty() ? CostCoefficients::defaults()
+                                                                    : CostCoefficients::load(settings.gpu.coefficients);
+    const auto threads = limitThreads(a.threads);
+    const std::string prefix = a.output.empty() ? "out/" + settings.sceneName + ".cost" : std::filesystem::path(a.output).replace_extension().string();
+    const std::string config = a.config.empty() ? settings.sceneName : a.config;
+    const ParticleSource source(settings);
+    const CostRun run{a, settings, source, settings.render.frame_start, parseList(a.clusterSizes, "--cluster-sizes", 1, 10000000),
+                      parseList(a.ommLevels, "--omm-levels", 0, 6), serKeys};
+    const std::uint32_t frame = run.frame;
+
+    run.log(fmt::format("frame {} of {} with counters ({} history frames)", frame, settings.scenePath,
+                        settings.render.estimator == EstimatorKind::restir ? std::min(frame, a.history) : 0));
+    const CountedFrame main = renderCounted(settings, source, frame, a.history);
+    const GpuReport& r = main.report;
+    fmt::print("{}: frame {}, {}x{}, {} particles, {} clusters, estimator {}; warps {}x{} groups of {} lanes; cost: {}\n",
+               settings.sceneName, frame, settings.camera.width, settings.camera.height, main.stats.particles,
+               main.stats.bvh.clusters, enumName(settings.render.estimator), r.layout.groupWidth, r.layout.groupHeight,
+               r.layout.warpSize, coef.source);
+    double totalMs = 0.0;
+    const Table passes = passTable(r, coef, config, totalMs);
+    fmt::print("{}", passes.console());
+    fmt::print("{:<20} predicted {:.3f} ms per frame\n", "total", totalMs);
+    for (const PassReport& p : r.passes)
+        if (p.rays > 0) fmt::print("  {}: {} ({})\n", p.pass, p.rayModel, p.reason);
+
     nlohmann::json doc = toJson(r);
-    doc["passes"] = passes;
+    for (std::size_t k = 0; k < r.passes.size(); ++k) doc["passes"][k]["predicted_ms"] = coef.predictMs(costFeatures(r.passes[k]));
+    doc["ser_sweep"] = reportSerSweep(run, main);
+    doc["any_hit_omm"] = reportOmm(run, main);
+    doc["blas_memory_by_cluster_size"] = reportBlasMemory(run);
+    printLayouts(r);
+    doc["counting_overhead"] = measureOverhead(run);
     doc["version"] = std::string(version());
     doc["scene"] = settings.scenePath;
     doc["config"] = config;
@@ -291,20 +353,10 @@ void runCost(const CostArgs& a) {
     doc["settings"] = settingsToToml(settings);
     doc["coefficients"] = coef.toJson();
     doc["predicted_ms"] = totalMs;
-    doc["ser_sweep"] = serSweep;
-    doc["any_hit_omm"] = omm;
-    doc["blas_memory_by_cluster_size"] = memory;
-    doc["counting_overhead"] = overhead;
     doc["frame_seconds"] = main.stats.seconds;
     writeJson(prefix + ".json", doc);
-    writeFileAtomic(prefix + ".csv", csv);
-    std::vector<FloatChannel> maps;
-    for (const Heatmap& h : main.image.heatmaps) {
-        maps.push_back({h.name, h.values});
-        writeHeatmapPng(prefix + "." + h.name + ".png", h.values, main.image.width, main.image.height);
-    }
-    writeChannelsExr(prefix + ".heatmaps.exr", main.image.width, main.image.height, maps,
-                     {{"version", std::string(version())}, {"scene", settings.scenePath}, {"frame", std::to_string(frame)}});
+    writeFileAtomic(prefix + ".csv", passes.csv());
+    writeHeatmaps(prefix, main, settings, frame);
     fmt::print("cost: {}.json, {}.csv, {}.heatmaps.exr, {}.gpu.*.png\n", prefix, prefix, prefix, prefix);
 }
 
