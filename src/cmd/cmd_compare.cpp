@@ -6,6 +6,7 @@
 
 #include "accretion/analysis/image_metrics.h"
 #include "accretion/core/error.h"
+#include "accretion/io/report_table.h"
 #include "commands.h"
 
 namespace accretion::cmd {
@@ -23,14 +24,12 @@ void runCompare(const CompareArgs& a) {
         throw InputError(fmt::format("{}: {}x{} pixels, but the reference {} is {}x{}", a.image, x.width, x.height,
                                      a.reference, ref.width, ref.height));
     const ErrorMetrics m = computeErrors(x.rgb, ref.rgb);
-    if (a.json) {
-        nlohmann::json j = {{"image", a.image},         {"reference", a.reference}, {"layer", a.layer.empty() ? "RGB" : a.layer},
-                            {"relMSE", m.relMSE},       {"MSE", m.MSE},             {"MAPE", m.MAPE},
-                            {"epsilon", kRelMseEpsilon}, {"pixels", m.pixels}};
-        fmt::print("{}\n", j.dump(2));
-        return;
-    }
-    fmt::print("relMSE {:.9g}\nMSE {:.9g}\nMAPE {:.9g}\n", m.relMSE, m.MSE, m.MAPE);
+    auto hidden = [](const char* key) { return Column{key, "", 0, "{}", "{}", false}; };
+    Table t({hidden("image"), hidden("reference"), hidden("layer"), {"relMSE", "relMSE", 0, "{:.9g}"},
+             {"MSE", "MSE", 0, "{:.9g}"}, {"MAPE", "MAPE", 0, "{:.9g}"}, hidden("epsilon"), hidden("pixels")});
+    t.add({a.image, a.reference, a.layer.empty() ? "RGB" : a.layer, m.relMSE, m.MSE, m.MAPE, kRelMseEpsilon,
+           std::uint64_t(m.pixels)});
+    fmt::print("{}", a.json ? t.json()[0].dump(2) + "\n" : t.keyValues());
 }
 
 }  // namespace
