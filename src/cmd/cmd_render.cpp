@@ -97,54 +97,150 @@ std::vector<FlagSetting> renderFlags(const RenderArgs& args) {
     return flags;
 }
 
-void runRender(const RenderArgs& args) {
-    const Settings settings = loadSceneArgs(args, renderFlags(args));
-    const auto threads = limitThreads(args.threads);
-    const int threadCount = args.threads > 0 ? args.threads : tbb::info::default_concurrency();
+/// Which frames this process renders and how a shard splits the work:
+/// accumulating estimators checkpoint and shard their samples (exact: row
+/// bands); adaptive sampling and restir shard whole frames instead.
+struct Sharding {
+    Shard shard;
+    bool accumulating = true;
+    bool bySamples = false;
+    std::uint32_t first = 0, end = 0;
+    Shard samples() const { return bySamples ? shard : Shard{}; }
+};
 
-    const Shard shard = args.shard.empty() ? Shard{} : parseShard(args.shard, "--shard");
-    // Accumulating estimators checkpoint and shard their samples (exact: row
-    // bands); adaptive sampling and restir shard whole frames instead.
-    const bool accumulating = settings.render.estimator != EstimatorKind::restir;
-    const bool shardSamples = !shard.whole() && accumulating && !(settings.render.target_stderr > 0.0);
-    std::uint32_t firstFrame = settings.render.frame_start, endFrame = firstFrame + settings.render.frames;
-    if (!shard.whole() && !shardSamples) {
+Sharding planSharding(const Settings& settings, const RenderArgs& args) {
+    Sharding s;
+    s.shard = args.shard.empty() ? Shard{} : parseShard(args.shard, "--shard");
+    s.accumulating = settings.render.estimator != EstimatorKind::restir;
+    s.bySamples = !s.shard.whole() && s.accumulating && !(settings.render.target_stderr > 0.0);
+    s.first = settings.render.frame_start;
+    s.end = s.first + settings.render.frames;
+    if (!s.shard.whole() && !s.bySamples) {
         const std::uint32_t F = settings.render.frames;
-        if (F < shard.count)
+        if (F < s.shard.count)
             throw InputError(fmt::format("command line --shard {}: {} shards of {} frame(s): {} cannot split samples, so give at "
-                                         "least as many frames as shards", args.shard, shard.count, F,
-                                         accumulating ? "adaptive sampling" : "restir"));
-        firstFrame = settings.render.frame_start + std::uint32_t(std::uint64_t(F) * shard.index / shard.count);
-        endFrame = settings.render.frame_start + std::uint32_t(std::uint64_t(F) * (shard.index + 1) / shard.count);
+                                         "least as many frames as shards", args.shard, s.shard.count, F,
+                                         s.accumulating ? "adaptive sampling" : "restir"));
+        s.first = settings.render.frame_start + std::uint32_t(std::uint64_t(F) * s.shard.index / s.shard.count);
+        s.end = settings.render.frame_start + std::uint32_t(std::uint64_t(F) * (s.shard.index + 1) / s.shard.count);
     }
-    if (shardSamples) planLighting(settings.render, settings.camera.height, shard);  // can it be cut? (throws)
-    if (args.resume && !accumulating)
+    if (s.bySamples) planLighting(settings.render, settings.camera.height, s.shard);  // can it be cut? (throws)
+    if (args.resume && !s.accumulating)
         throw InputError("command line --resume: restir keeps reservoir history across frames and is not checkpointed; "
                          "re-run the frames (finished frames are complete on disk)");
     if (!(args.checkpointEvery >= 0.0))
         throw InputError(fmt::format("command line --checkpoint-every {}: expected seconds >= 0", args.checkpointEvery));
+    return s;
+}
 
+/// What the run's outputs record.
+struct RenderRun {
+    const Settings& settings;
+    const Sharding& sharding;
+    std::string settingsToml;
+    std::string shardLabel;  ///< "i/n"
+};
+
+/// The writeOutputs pass of a frame: EXR, previews, a shard's sums and the
+/// counter heatmaps; returns the frame's stats with its outputs.
+nlohmann::json writeFrameOutputs(const RenderRun& run, std::uint32_t frame, const FrameImage& image, FrameStats& fs,
+                                 const Accumulation& sums) {
+    const Settings& settings = run.settings;
+    const std::string exr = shardPath(expandPattern(settings.render.output, settings.sceneName, frame), run.sharding.samples());
+    const std::string base = std::filesystem::path(exr).replace_extension().string();
+    const OutputMetadata meta = {
+        {"version", std::string(version())},   {"scene", settings.scenePath},
+        {"frame", std::to_string(frame)},      {"estimator", std::string(enumName(settings.render.estimator))},
+        {"samples", std::to_string(settings.render.samples)}, {"seed", std::to_string(settings.render.seed)},
+        {"shard", run.shardLabel},             {"render_time_s", fmt::format("{:.6f}", fs.seconds)},
+        {"settings", run.settingsToml},
+    };
+    nlohmann::json outputs;
+    {
+        auto t = fs.timer.scope(pass::writeOutputs);
+        writeFrameExr(exr, image, settings.render.estimator != EstimatorKind::exact, meta);
+        writePreviewPng(base + ".png", image.L, image.width, image.height, settings.render.auto_exposure, settings.render.exposure);
+        writePreviewPng(base + ".Lr.png", image.lighting.Lr, image.width, image.height, settings.render.auto_exposure,
+                        settings.render.exposure);
+        outputs = {{"exr", exr}, {"png", base + ".png"}, {"lr_png", base + ".Lr.png"}};
+        if (run.sharding.bySamples) {  // the sums a merge needs, next to the EXR
+            const LightingPlan plan = planLighting(settings.render, image.height, run.sharding.shard);
+            AccumulationFile f{accumulationHeader("shard", run.settingsToml, run.shardLabel, frame), sums};
+            f.header["chunks"] = {plan.begin, plan.end};
+            f.header["exact"] = plan.exact;
+            f.header["auto_exposure"] = settings.render.auto_exposure;
+            f.header["exposure"] = settings.render.exposure;
+            writeAccumulationFile(base + ".acc", f);
+            outputs["accumulation"] = base + ".acc";
+        }
+    }
+    nlohmann::json fj = frameStatsJson(fs);
+    fj["outputs"] = outputs;
+    if (settings.gpu.counters) {
+        // The GPU model of the frame, and a PNG of each counter heatmap.
+        fj["gpu"] = toJson(makeGpuReport(image.counters, settings, fs.reservoirBytes));
+        for (const Heatmap& h : image.heatmaps) {
+            const std::string png = base + "." + h.name + ".png";
+            writeHeatmapPng(png, h.values, image.width, image.height);
+            fj["outputs"][h.name + "_png"] = png;
+        }
+    }
+    return fj;
+}
+
+/// The frame's lines on stdout.
+void printFrame(const Settings& settings, std::uint32_t frame, const nlohmann::json& fj, const FrameStats& fs) {
+    if (settings.render.target_stderr > 0.0)
+        fmt::print("  adaptive: mean {:.1f}, max {:.0f} samples per hit pixel\n", fs.meanSpp, fs.maxSpp);
+    for (const auto& [name, count] : fs.nonFinite)
+        fmt::print("  {}: {} non-finite values rejected ({})\n", name, count, enumName(settings.render.nonfinite));
+    const double lighting = fs.timer.seconds(pass::estimateLighting);
+    fmt::print("frame {}: {} ({:.2f} s, {} particles, {} clusters, build {:.1f} ms, {:.2f} M shadow rays/s)\n", frame,
+               fj["outputs"]["exr"].get<std::string>(), fs.seconds, fs.particles, fs.bvh.clusters,
+               1e3 * (fs.bvh.clusterSeconds + fs.bvh.blasSeconds + fs.bvh.tlasSeconds),
+               lighting > 0 ? 1e-6 * double(fs.lighting.shadowRays) / lighting : 0.0);
+    const std::string base = std::filesystem::path(fj["outputs"]["exr"].get<std::string>()).replace_extension().string();
+    fmt::print("  preview: {}.png, lighting only: {}.Lr.png\n", base, base);
+}
+
+/// Once every frame is out (a run stopped by bad input leaves nothing): the
+/// settings, the stats and, when asked, the list of every file written.
+void writeRunOutputs(const std::string& stem, const std::string& settingsToml, const nlohmann::json& stats,
+                     const std::string& outputsFile) {
+    writeFileAtomic(stem + ".settings.toml", settingsToml);
+    writeJson(stem + ".stats.json", stats);
+    if (outputsFile.empty()) return;
+    nlohmann::json manifest = {{"stats", stem + ".stats.json"}, {"settings", stem + ".settings.toml"},
+                               {"frames", nlohmann::json::array()}};
+    for (const auto& f : stats["frames"]) manifest["frames"].push_back(f["outputs"]);
+    writeJson(outputsFile, manifest);
+}
+
+void runRender(const RenderArgs& args) {
+    const Settings settings = loadSceneArgs(args, renderFlags(args));
+    const auto threads = limitThreads(args.threads);
+    const Sharding sharding = planSharding(settings, args);
+    const Shard& shard = sharding.shard;
     const std::string stem = shardPath(runStem(settings), shard);
-    const std::string settingsToml = settingsToToml(settings);
-    const bool withErrors = settings.render.estimator != EstimatorKind::exact;
+    const RenderRun run{settings, sharding, settingsToToml(settings), fmt::format("{}/{}", shard.index, shard.count)};
     removeStaleTemporaries(std::filesystem::path(stem).parent_path());
-
     nlohmann::json stats = {
         {"version", std::string(version())},
         {"scene", settings.scenePath},
         {"estimator", std::string(enumName(settings.render.estimator))},
         {"seed", settings.render.seed},
         {"samples", settings.render.samples},
-        {"threads", threadCount},
-        {"shard", fmt::format("{}/{}", shard.index, shard.count)},
-        {"shard_by", shard.whole() ? "none" : shardSamples ? "samples" : "frames"},
-        {"settings", settingsToml},
+        {"threads", args.threads > 0 ? args.threads : tbb::info::default_concurrency()},
+        {"shard", run.shardLabel},
+        {"shard_by", shard.whole() ? "none" : sharding.bySamples ? "samples" : "frames"},
+        {"settings", run.settingsToml},
         {"frames", nlohmann::json::array()},
     };
 
     // A checkpoint: where to start, and the sums of the frame in progress.
-    const Checkpoint checkpoint(stem + ".checkpoint", settingsToml, stats["shard"]);
-    std::optional<AccumulationFile> resumed = checkpoint.load(args.resume, firstFrame, endFrame);
+    const Checkpoint checkpoint(stem + ".checkpoint", run.settingsToml, stats["shard"]);
+    std::uint32_t firstFrame = sharding.first;
+    std::optional<AccumulationFile> resumed = checkpoint.load(args.resume, firstFrame, sharding.end);
     if (resumed) {
         for (const auto& f : resumed->header.at("finished_frames")) stats["frames"].push_back(f);
         firstFrame = resumed->header.at("frame").get<std::uint32_t>();
@@ -157,7 +253,7 @@ void runRender(const RenderArgs& args) {
 
     const auto start = std::chrono::steady_clock::now();
     std::optional<StopSignal> stop;
-    if (accumulating) stop.emplace();
+    if (sharding.accumulating) stop.emplace();
     auto lastCheckpoint = start;
     auto saveCheckpoint = [&](std::uint32_t frame, const Accumulation& acc) {
         checkpoint.save(frame, acc, stats["frames"]);
@@ -173,12 +269,12 @@ void runRender(const RenderArgs& args) {
     std::uint64_t shadowRays = 0;
     double lightingSeconds = 0.0;
     Accumulation sums;  // the frame's lighting sums (reused: no reallocation per frame)
-    for (std::uint32_t frame = firstFrame; frame < endFrame; ++frame) {
+    for (std::uint32_t frame = firstFrame; frame < sharding.end; ++frame) {
         if (!args.quiet)
             fmt::print(stderr, "accretion: frame {} ({}/{})\n", frame, frame - settings.render.frame_start + 1,
                        settings.render.frames);
         LightingSession session;
-        session.shard = shardSamples ? shard : Shard{};
+        session.shard = sharding.samples();
         session.result = &sums;
         if (resumed && resumed->header.at("frame").get<std::uint32_t>() == frame) session.resume = &resumed->acc;
         session.afterChunk = [&](const Accumulation& acc) {
@@ -189,72 +285,18 @@ void runRender(const RenderArgs& args) {
             return true;
         };
         FrameStats fs;
-        const FrameImage image = renderer.render(frame, fs, accumulating ? &session : nullptr);
+        const FrameImage image = renderer.render(frame, fs, sharding.accumulating ? &session : nullptr);
         resumed.reset();
-
-        const std::string exr = shardPath(expandPattern(settings.render.output, settings.sceneName, frame),
-                                          shardSamples ? shard : Shard{});
-        const std::filesystem::path base = std::filesystem::path(exr).replace_extension();
-        OutputMetadata meta = {
-            {"version", std::string(version())},
-            {"scene", settings.scenePath},
-            {"frame", std::to_string(frame)},
-            {"estimator", std::string(enumName(settings.render.estimator))},
-            {"samples", std::to_string(settings.render.samples)},
-            {"seed", std::to_string(settings.render.seed)},
-            {"shard", stats["shard"].get<std::string>()},
-            {"render_time_s", fmt::format("{:.6f}", fs.seconds)},
-            {"settings", settingsToml},
-        };
-        nlohmann::json outputs;
-        {
-            auto t = fs.timer.scope(pass::writeOutputs);
-            writeFrameExr(exr, image, withErrors, meta);
-            writePreviewPng(base.string() + ".png", image.L, image.width, image.height, settings.render.auto_exposure,
-                            settings.render.exposure);
-            writePreviewPng(base.string() + ".Lr.png", image.lighting.Lr, image.width, image.height,
-                            settings.render.auto_exposure, settings.render.exposure);
-            outputs = {{"exr", exr}, {"png", base.string() + ".png"}, {"lr_png", base.string() + ".Lr.png"}};
-            if (shardSamples) {  // the sums a merge needs, next to the EXR
-                const LightingPlan plan = planLighting(settings.render, image.height, shard);
-                AccumulationFile f{accumulationHeader("shard", settingsToml, stats["shard"], frame), sums};
-                f.header["chunks"] = {plan.begin, plan.end};
-                f.header["exact"] = plan.exact;
-                f.header["auto_exposure"] = settings.render.auto_exposure;
-                f.header["exposure"] = settings.render.exposure;
-                writeAccumulationFile(base.string() + ".acc", f);
-                outputs["accumulation"] = base.string() + ".acc";
-            }
-        }
-        nlohmann::json fj = frameStatsJson(fs);
-        fj["outputs"] = outputs;
-        if (settings.gpu.counters) {
-            // The GPU model of the frame, and a PNG of each counter heatmap.
-            fj["gpu"] = toJson(makeGpuReport(image.counters, settings, fs.reservoirBytes));
-            for (const Heatmap& h : image.heatmaps) {
-                const std::string png = base.string() + "." + h.name + ".png";
-                writeHeatmapPng(png, h.values, image.width, image.height);
-                fj["outputs"][h.name + "_png"] = png;
-            }
-        }
+        const nlohmann::json fj = writeFrameOutputs(run, frame, image, fs, sums);
         stats["frames"].push_back(fj);
         shadowRays += fs.lighting.shadowRays;
         lightingSeconds += fs.timer.seconds(pass::estimateLighting);
-        if (settings.render.target_stderr > 0.0)
-            fmt::print("  adaptive: mean {:.1f}, max {:.0f} samples per hit pixel\n", fs.meanSpp, fs.maxSpp);
-        for (const auto& [name, count] : fs.nonFinite)
-            fmt::print("  {}: {} non-finite values rejected ({})\n", name, count, enumName(settings.render.nonfinite));
-        fmt::print("frame {}: {} ({:.2f} s, {} particles, {} clusters, build {:.1f} ms, {:.2f} M shadow rays/s)\n",
-                   frame, exr, fs.seconds, fs.particles, fs.bvh.clusters,
-                   1e3 * (fs.bvh.clusterSeconds + fs.bvh.blasSeconds + fs.bvh.tlasSeconds),
-                   fs.timer.seconds(pass::estimateLighting) > 0
-                       ? 1e-6 * double(fs.lighting.shadowRays) / fs.timer.seconds(pass::estimateLighting) : 0.0);
-        fmt::print("  preview: {}.png, lighting only: {}.Lr.png\n", base.string(), base.string());
+        printFrame(settings, frame, fj, fs);
         // Stopped between frames: the next frame starts from its first chunk.
-        if (const int signal = stop ? stop->pending() : 0; signal && frame + 1 < endFrame) {
+        if (const int signal = stop ? stop->pending() : 0; signal && frame + 1 < sharding.end) {
             Accumulation next;
             next.reset(settings.camera.width, settings.camera.height,
-                       shardSamples ? planLighting(settings.render, settings.camera.height, shard).begin : 0);
+                       sharding.bySamples ? planLighting(settings.render, settings.camera.height, shard).begin : 0);
             saveCheckpoint(frame + 1, next);
             interrupt(signal, frame + 1, next.nextChunk);
         }
@@ -263,15 +305,7 @@ void runRender(const RenderArgs& args) {
     stats["total_seconds"] = total;
     stats["peak_rss_bytes"] = peakResidentBytes();
     stats["shadow_rays_per_second"] = lightingSeconds > 0 ? double(shadowRays) / lightingSeconds : 0.0;
-    // Written once every frame is out: a run stopped by bad input leaves nothing.
-    writeFileAtomic(stem + ".settings.toml", settingsToml);
-    writeJson(stem + ".stats.json", stats);
-    if (!args.outputsFile.empty()) {  // what this run wrote, for a program (batch) to read
-        nlohmann::json manifest = {{"stats", stem + ".stats.json"}, {"settings", stem + ".settings.toml"},
-                                   {"frames", nlohmann::json::array()}};
-        for (const auto& f : stats["frames"]) manifest["frames"].push_back(f["outputs"]);
-        writeJson(args.outputsFile, manifest);
-    }
+    writeRunOutputs(stem, run.settingsToml, stats, args.outputsFile);
     checkpoint.remove();  // done: nothing left to resume
     fmt::print("stats: {}.stats.json\nsettings: {}.settings.toml\ntotal: {:.2f} s\n", stem, stem, total);
 }
