@@ -27,6 +27,7 @@
 #include "accretion/geometry/particle_bvh.h"
 #include "accretion/core/atomic_file.h"
 #include "accretion/io/plot.h"
+#include "accretion/io/report_table.h"
 #include "accretion/lighting/light_arrays.h"
 #include "accretion/lighting/light_sampler.h"
 #include "accretion/particles/particle_source.h"
@@ -348,43 +349,52 @@ std::string machine() {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-    CLI::App app{"accretion performance suite: bars against bare Embree loops, scaling curves, memory"};
+/// What the sections of the suite share: the options, the 100K disk frame and the results.
+struct Suite {
     bool quick = false;
     std::string outDir = "bench", binary = "build/accretion", micro = "build/bench/accretion_bench",
                 scene = "scenes/disk_100k.toml";
-    app.add_flag("--quick", quick, "Skip the tree 1% reference and the 1M-particle frame (for CI smoke runs)");
-    app.add_option("--out", outDir, "Directory of results.json and the scaling CSV/PNG");
-    app.add_option("--accretion", binary, "The accretion binary (memory runs)");
-    app.add_option("--scene", scene, "The disk scene");
-    app.add_option("--micro", micro, "The Google Benchmark micro-benchmarks binary (empty: skip)");
-    CLI11_PARSE(app, argc, argv);
-    const int cores = tbb::info::default_concurrency();
-    std::filesystem::create_directories(outDir);
-    nlohmann::json results = {{"version", std::string(version())},
-                              {"machine", {{"cpu", machine()}, {"cores", cores}}},
-                              {"scene", scene},
-                              {"quick", quick}};
+    int cores = 1;
+    Settings disk;
+    ParticleSource diskSource;
+    Particles p0, p1;
+    Camera cam;
+    EmbreeDevice device;
+    double build100k = 0.0;  ///< the 100K rebuild, the 1M bar's limit
     nlohmann::json bars, figures;
 
-    // --- BVH rebuild at 100K, clusters of ~100, fast build.
-    const Settings disk = diskScene(scene, 100'000, 1280, 720);
-    const ParticleSource diskSource(disk);
-    const Particles p0 = diskSource.frame(0), p1 = diskSource.frame(1);
-    const Camera cam = Camera::atFrame(disk.camera, 0);
-    EmbreeDevice device;
-    double build100k = 0.0;
+    explicit Suite(const std::string& scenePath)
+        : scene(scenePath), cores(tbb::info::default_concurrency()), disk(diskScene(scenePath, 100'000, 1280, 720)),
+          diskSource(disk), p0(diskSource.frame(0)), p1(diskSource.frame(1)), cam(Camera::atFrame(disk.camera, 0)) {}
+};
+
+/// The disk scene with restir.
+Settings restirScene(const Suite& suite) {
+    Settings restir = suite.disk;
+    restir.render.estimator = EstimatorKind::restir;
+    return restir;
+}
+
+/// BVH rebuild at 100K, clusters of ~100, fast build; refit and partial policies.
+void benchBvhRebuild(Suite& suite) {
+    nlohmann::json& bars = suite.bars;
+    nlohmann::json& figures = suite.figures;
+    const Particles& p0 = suite.p0;
+    const Particles& p1 = suite.p1;
+    const Camera& cam = suite.cam;
+    EmbreeDevice& device = suite.device;
+    const Settings& disk = suite.disk;
     {
         log("BVH rebuild, 100K particles");
         ParticleBvh bvh(device, disk.geometry);
         int f = 0;
         bvh.build(p0, cam);
-        build100k = timeIt(9, [&] { bvh.build(++f % 2 ? p1 : p0, cam); });
+        suite.build100k = timeIt(9, [&] { bvh.build(++f % 2 ? p1 : p0, cam); });
         BareBuilder bare;
         const Clusters clusters = bvh.clusters();
         bare.build(clusters, p0, cam);
         const double limit = timeIt(9, [&] { bare.build(clusters, ++f % 2 ? p1 : p0, cam); });
-        bars["bvh_rebuild_100k"] = bar(build100k, limit, 1.3);
+        bars["bvh_rebuild_100k"] = bar(suite.build100k, limit, 1.3);
         const BvhStats& st = bvh.stats();
         figures["bvh_rebuild_100k_breakdown_s"] = {{"cluster", st.clusterSeconds}, {"blas", st.blasSeconds},
                                                    {"tlas", st.tlasSeconds}, {"clusters", st.clusters}};
@@ -402,9 +412,17 @@ int main(int argc, char** argv) {
             partial.build(p0, cam);
             policies[fmt::format("partial_{}", fraction)] = timeIt(9, [&] { partial.build(++f % 2 ? p1 : p0, cam); });
         }
-        policies["rebuild"] = build100k;
+        policies["rebuild"] = suite.build100k;
         figures["bvh_policies_100k_s"] = policies;
     }
+}
+
+/// BVH rebuild at 1M particles, against 10x the 100K build.
+void benchBvhRebuild1M(Suite& suite) {
+    nlohmann::json& bars = suite.bars;
+    const Camera& cam = suite.cam;
+    EmbreeDevice& device = suite.device;
+    const std::string& scene = suite.scene;
     {
         log("BVH rebuild, 1M particles");
         const Settings big = diskScene(scene, 1'000'000, 1280, 720);
@@ -414,10 +432,20 @@ int main(int argc, char** argv) {
         int f = 0;
         bvh.build(q0, cam);
         const double t = timeIt(5, [&] { bvh.build(++f % 2 ? q1 : q0, cam); });
-        bars["bvh_rebuild_1m_vs_100k"] = bar(t, build100k, 10.0);
+        bars["bvh_rebuild_1m_vs_100k"] = bar(t, suite.build100k, 10.0);
     }
+}
 
-    // --- Rays: the real passes against bare Embree loops over the same rays and BVH.
+/// Rays: the real passes against bare Embree loops over the same rays and BVH.
+void benchRays(Suite& suite) {
+    nlohmann::json& bars = suite.bars;
+    nlohmann::json& figures = suite.figures;
+    const Settings& disk = suite.disk;
+    const Particles& p0 = suite.p0;
+    const Camera& cam = suite.cam;
+    EmbreeDevice& device = suite.device;
+    const int cores = suite.cores;
+    const std::string& scene = suite.scene;
     {
         log("primary and shadow rays, 100K particles at 1280x720");
         ParticleBvh bvh(device, disk.geometry);
@@ -469,10 +497,14 @@ int main(int argc, char** argv) {
                                                  {"occluded_fraction", double(occExact) / n},
                                                  {"occluded_fraction_bare_shortened", double(occ1) / n}};
     }
+}
 
-    // --- ReSTIR frame: per-pass breakdown and candidates per second per core.
-    Settings restir = disk;
-    restir.render.estimator = EstimatorKind::restir;
+/// ReSTIR frame: per-pass breakdown and candidates per second per core.
+void benchRestirFrame(Suite& suite) {
+    nlohmann::json& figures = suite.figures;
+    const ParticleSource& diskSource = suite.diskSource;
+    const int cores = suite.cores;
+    const Settings restir = restirScene(suite);
     {
         log("restir frame, 100K particles at 1280x720");
         const FrameTiming t = timeFrames(restir, diskSource, 4, 4, 3);
@@ -489,8 +521,14 @@ int main(int argc, char** argv) {
             {"candidates_per_s_per_core", candidates / t.passes.at("generateCandidates") / cores},
             {"shadow_rays", t.shadowRays}};
     }
+}
 
-    // --- The tree reference to 1% per-pixel relative standard error on the same frame.
+/// The tree reference to 1% per-pixel relative standard error on the same frame.
+void benchTreeReference(Suite& suite) {
+    nlohmann::json& figures = suite.figures;
+    const Settings& disk = suite.disk;
+    const ParticleSource& diskSource = suite.diskSource;
+    const bool quick = suite.quick;
     if (!quick) {
         log("tree to 1% relative standard error (minutes)");
         Settings tree = disk;
@@ -501,8 +539,14 @@ int main(int argc, char** argv) {
         const FrameTiming t = timeFrames(tree, diskSource, 8, 0, 1);
         figures["tree_to_1pct_100k_720p_s"] = t.frameSeconds;
     }
+}
 
-    // --- Scaling curves.
+/// Scaling curves over particles and resolution (CSV and PNG).
+void benchScaling(Suite& suite) {
+    const ParticleSource& diskSource = suite.diskSource;
+    const bool quick = suite.quick;
+    const std::string& outDir = suite.outDir;
+    const Settings restir = restirScene(suite);
     std::string csvP = "particles,bvh_build_s,restir_frame_s,trace_shadow_rays_s,shadow_rays\n";
     std::vector<std::uint32_t> counts = {10'000, 30'000, 100'000, 300'000, 1'000'000};
     if (quick) counts.pop_back();
@@ -539,8 +583,13 @@ int main(int argc, char** argv) {
     } catch (const std::exception& e) {
         log(fmt::format("no plot: {}", e.what()));
     }
+}
 
-    // --- Peak resident memory per particle (a child process per count).
+/// Peak resident memory per particle (a child process per count).
+void benchMemory(Suite& suite) {
+    nlohmann::json& figures = suite.figures;
+    const std::string& binary = suite.binary;
+    const std::string& scene = suite.scene;
     {
         nlohmann::json mem;
         std::vector<std::uint32_t> sizes = {100'000, 1'000'000};
@@ -562,8 +611,13 @@ int main(int argc, char** argv) {
         }
         figures["memory"] = mem;
     }
+}
 
-    // --- What each skip of the pass plan saves: the same frames with and without the work.
+/// What each skip of the frame plan saves: the same frames with and without the work.
+void benchPlanSkips(Suite& suite) {
+    nlohmann::json& figures = suite.figures;
+    const std::string& scene = suite.scene;
+    const Settings restir = restirScene(suite);
     {
         log("pass-plan skips, 100K particles at 640x360");
         nlohmann::json skips;
@@ -601,8 +655,12 @@ int main(int argc, char** argv) {
         pair("counters_off_no_counting_code", frame(counting), frame(base));
         figures["plan_skips_640x360"] = skips;
     }
+}
 
-    // --- Micro-benchmarks of the hot kernels (Google Benchmark, its JSON embedded).
+/// Micro-benchmarks of the hot kernels (Google Benchmark, its JSON embedded).
+void benchMicro(Suite& suite) {
+    nlohmann::json& figures = suite.figures;
+    const std::string& micro = suite.micro;
     if (!micro.empty()) {
         log("micro-benchmarks");
         const auto file = std::filesystem::temp_directory_path() / "accretion_suite_micro.json";
@@ -618,18 +676,55 @@ int main(int argc, char** argv) {
             figures["micro_benchmarks_median"] = m;
         }
     }
+}
 
-    results["bars"] = bars;
-    results["figures"] = figures;
+/// The bars against their limits.
+void printBars(const nlohmann::json& bars) {
+    Table t({{"bar", "bar", -26}, {"project_s", "project s", 12, "{:.5f}"}, {"limit_s", "limit s", 12, "{:.5f}"},
+             {"ratio", "ratio", 8, "{:.2f}"}, {"limit_ratio", "bar", 8, "{:.2f}"}, {"", "", 0, "{}", "{}", true, "  "}});
+    for (const auto& [name, b] : bars.items())
+        t.add({name, b["project_s"].get<double>(), b["limit_s"].get<double>(), b["ratio"].get<double>(),
+               b["limit_ratio"].get<double>(), b["ratio"].get<double>() <= b["limit_ratio"].get<double>() ? "ok" : "ABOVE"});
+    fmt::print("{}", t.console());
+}
+
+int main(int argc, char** argv) {
+    CLI::App app{"accretion performance suite: bars against bare Embree loops, scaling curves, memory"};
+    bool quick = false;
+    std::string outDir = "bench", binary = "build/accretion", micro = "build/bench/accretion_bench",
+                scene = "scenes/disk_100k.toml";
+    app.add_flag("--quick", quick, "Skip the tree 1% reference and the 1M-particle frame (for CI smoke runs)");
+    app.add_option("--out", outDir, "Directory of results.json and the scaling CSV/PNG");
+    app.add_option("--accretion", binary, "The accretion binary (memory runs)");
+    app.add_option("--scene", scene, "The disk scene");
+    app.add_option("--micro", micro, "The Google Benchmark micro-benchmarks binary (empty: skip)");
+    CLI11_PARSE(app, argc, argv);
+    std::filesystem::create_directories(outDir);
+    Suite suite(scene);
+    suite.quick = quick;
+    suite.outDir = outDir;
+    suite.binary = binary;
+    suite.micro = micro;
+    nlohmann::json results = {{"version", std::string(version())},
+                              {"machine", {{"cpu", machine()}, {"cores", suite.cores}}},
+                              {"scene", scene},
+                              {"quick", quick}};
+    benchBvhRebuild(suite);
+    benchBvhRebuild1M(suite);
+    benchRays(suite);
+    benchRestirFrame(suite);
+    if (!quick) benchTreeReference(suite);
+    benchScaling(suite);
+    benchMemory(suite);
+    benchPlanSkips(suite);
+    if (!micro.empty()) benchMicro(suite);
+
+    results["bars"] = suite.bars;
+    results["figures"] = suite.figures;
     std::ofstream(outDir + "/results.json.tmp") << results.dump(2) << "\n";
     std::filesystem::rename(outDir + "/results.json.tmp", outDir + "/results.json");
-
-    fmt::print("{:<26} {:>12} {:>12} {:>8} {:>8}  {}\n", "bar", "project s", "limit s", "ratio", "bar", "");
-    for (const auto& [name, b] : bars.items())
-        fmt::print("{:<26} {:>12.5f} {:>12.5f} {:>8.2f} {:>8.2f}  {}\n", name, b["project_s"].get<double>(),
-                   b["limit_s"].get<double>(), b["ratio"].get<double>(), b["limit_ratio"].get<double>(),
-                   b["ratio"].get<double>() <= b["limit_ratio"].get<double>() ? "ok" : "ABOVE");
-    fmt::print("{}\n", figures.dump(2));
+    printBars(suite.bars);
+    fmt::print("{}\n", suite.figures.dump(2));
     fmt::print("results: {}/results.json, scaling: {}/scaling_particles.csv/.png, {}/scaling_resolution.csv/.png\n", outDir,
                outDir, outDir);
     return 0;

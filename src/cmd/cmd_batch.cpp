@@ -238,7 +238,8 @@ nlohmann::json jobOutputs(const std::filesystem::path& manifest) {
     return {{"stats", j.value("stats", "")}, {"frames", j.value("frames", nlohmann::json::array())}};
 }
 
-void runBatch(BatchArgs args) {
+/// The jobs of the batch, checked before any runs: unique names, scenes that exist.
+std::vector<Job> batchJobs(BatchArgs& args) {
     std::vector<Job> jobs = args.jobsFile.empty() ? commandLineJobs(args) : readJobsFile(args.jobsFile, args);
     if (!args.jobsFile.empty() && !args.scenes.empty())
         throw InputError("command line: give a jobs file or --scene, not both");
@@ -249,18 +250,40 @@ void runBatch(BatchArgs args) {
             throw InputError(fmt::format("{}: two jobs named {}: outputs would collide", args.jobsFile.empty() ? "command line" : args.jobsFile, jobs[k].name));
     for (const Job& j : jobs)
         if (!std::filesystem::exists(j.scene)) throw InputError(fmt::format("{}: job {}: scene file not found", j.scene, j.name));
+    return jobs;
+}
 
+/// --resume: the jobs that finished in an earlier batch (not run again), by name.
+std::map<std::string, nlohmann::json> finishedJobs(const std::string& summaryPath, bool resume) {
+    std::map<std::string, nlohmann::json> previous;
+    if (!resume || !std::filesystem::exists(summaryPath)) return previous;
+    std::ifstream in(summaryPath);
+    const nlohmann::json old = nlohmann::json::parse(in, nullptr, false);
+    if (old.is_discarded()) throw InputError(fmt::format("{}: not a batch summary (JSON)", summaryPath));
+    for (const auto& j : old.value("jobs", nlohmann::json::array()))
+        if (j.value("outcome", "") == "ok") previous[j.value("name", "")] = j;
+    return previous;
+}
+
+/// A job's process ended with `status`: its outcome, and its outputs or its error.
+void recordOutcome(nlohmann::json& r, int status, double seconds, const std::filesystem::path& manifest) {
+    r["seconds"] = seconds;
+    if (WIFEXITED(status)) {
+        r["exit_code"] = WEXITSTATUS(status);
+        r["outcome"] = WEXITSTATUS(status) == 0 ? "ok" : WEXITSTATUS(status) > 128 ? "interrupted" : "failed";
+    } else {
+        r["signal"] = WTERMSIG(status);
+        r["outcome"] = "crashed";
+    }
+    if (r["outcome"] == "ok") r["outputs"] = jobOutputs(manifest);
+    else r["error"] = lastLine(r["log"].get<std::string>());
+}
+
+void runBatch(BatchArgs args) {
+    const std::vector<Job> jobs = batchJobs(args);
     const std::filesystem::path outDir(args.outputDir);
     const std::string summaryPath = args.summary.empty() ? (outDir / "batch.json").string() : args.summary;
-    // --resume: jobs that finished in an earlier batch are not run again.
-    std::map<std::string, nlohmann::json> previous;
-    if (args.resume && std::filesystem::exists(summaryPath)) {
-        std::ifstream in(summaryPath);
-        const nlohmann::json old = nlohmann::json::parse(in, nullptr, false);
-        if (old.is_discarded()) throw InputError(fmt::format("{}: not a batch summary (JSON)", summaryPath));
-        for (const auto& j : old.value("jobs", nlohmann::json::array()))
-            if (j.value("outcome", "") == "ok") previous[j.value("name", "")] = j;
-    }
+    const std::map<std::string, nlohmann::json> previous = finishedJobs(summaryPath, args.resume);
 
     nlohmann::json summary = {{"version", std::string(version())},
                               {"jobs_file", args.jobsFile},
@@ -325,17 +348,8 @@ void runBatch(BatchArgs args) {
         const auto it = std::find_if(running.begin(), running.end(), [&](const Running& r) { return r.pid == pid; });
         if (it == running.end()) continue;
         nlohmann::json& r = results[it->job];
-        const std::filesystem::path log = r["log"].get<std::string>();
-        r["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - it->start).count();
-        if (WIFEXITED(status)) {
-            r["exit_code"] = WEXITSTATUS(status);
-            r["outcome"] = WEXITSTATUS(status) == 0 ? "ok" : WEXITSTATUS(status) > 128 ? "interrupted" : "failed";
-        } else {
-            r["signal"] = WTERMSIG(status);
-            r["outcome"] = "crashed";
-        }
-        if (r["outcome"] == "ok") r["outputs"] = jobOutputs(outputsFile(args, jobs[it->job]));
-        else r["error"] = lastLine(log);
+        recordOutcome(r, status, std::chrono::duration<double>(std::chrono::steady_clock::now() - it->start).count(),
+                      outputsFile(args, jobs[it->job]));
         if (!args.quiet)
             fmt::print(stderr, "accretion batch: {} {} ({:.1f} s){}\n", r["name"].get<std::string>(), r["outcome"].get<std::string>(),
                        r["seconds"].get<double>(), r.contains("error") ? ": " + r["error"].get<std::string>() : "");

@@ -27,7 +27,9 @@ struct ShardInput {
     Shard shard;
 };
 
-void runMerge(const MergeArgs& args) {
+/// The shards' accumulation files, sorted by shard and checked to be the
+/// complete, finished parts of one run.
+std::vector<ShardInput> readShards(const MergeArgs& args) {
     std::vector<ShardInput> in;
     for (const std::string& exr : args.shards) {
         const std::string accPath = std::filesystem::path(exr).replace_extension(".acc").string();
@@ -73,18 +75,11 @@ void runMerge(const MergeArgs& args) {
         }
         throw InputError(fmt::format("merge: shard(s) {} missing: the image of one run needs all {}", missing, count));
     }
+    return in;
+}
 
-    // Sums in shard order (the same whatever order the files were given).
-    Accumulation merged = in.front().acc.acc;
-    for (std::size_t k = 1; k < in.size(); ++k) merged.merge(in[k].acc.acc);
-    const bool exact = first.value("exact", false);
-    LightingImage lighting;
-    resolveLighting(merged, exact, lighting);
-
-    RawExr exr = readRawExr(in.front().exr);
-    if (exr.width != merged.width || exr.height != merged.height)
-        throw InputError(fmt::format("{}: {}x{} pixels, its accumulation {}x{}", in.front().exr, exr.width, exr.height,
-                                     merged.width, merged.height));
+/// The first shard's EXR with the merged lighting (Lr, its error, spp, L = Le + Lr); returns the preview.
+std::vector<Vec3> mergeInto(RawExr& exr, const Accumulation& merged, const LightingImage& lighting, bool exact) {
     const char* rgb[3] = {"R", "G", "B"};
     std::size_t L[3], Le[3], Lr[3], err[3] = {0, 0, 0};
     for (int c = 0; c < 3; ++c) {
@@ -107,6 +102,26 @@ void runMerge(const MergeArgs& args) {
         if (!exact) exr.set(px, spp, lighting.spp[px]);
         exr.set(px, rejected, lighting.rejected[px]);
     }
+    return preview;
+}
+
+void runMerge(const MergeArgs& args) {
+    const std::vector<ShardInput> in = readShards(args);
+    const nlohmann::json& first = in.front().acc.header;
+    const std::uint32_t count = in.front().shard.count;
+
+    // Sums in shard order (the same whatever order the files were given).
+    Accumulation merged = in.front().acc.acc;
+    for (std::size_t k = 1; k < in.size(); ++k) merged.merge(in[k].acc.acc);
+    const bool exact = first.value("exact", false);
+    LightingImage lighting;
+    resolveLighting(merged, exact, lighting);
+
+    RawExr exr = readRawExr(in.front().exr);
+    if (exr.width != merged.width || exr.height != merged.height)
+        throw InputError(fmt::format("{}: {}x{} pixels, its accumulation {}x{}", in.front().exr, exr.width, exr.height,
+                                     merged.width, merged.height));
+    const std::vector<Vec3> preview = mergeInto(exr, merged, lighting, exact);
     exr.attributes["accretion:shard"] = fmt::format("merged {} shards", count);
     exr.attributes["accretion:merge_version"] = std::string(version());
     exr.attributes.erase("accretion:render_time_s");
