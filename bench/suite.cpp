@@ -366,35 +366,38 @@ struct Suite {
     explicit Suite(const std::string& scenePath)
         : scene(scenePath), cores(tbb::info::default_concurrency()), disk(diskScene(scenePath, 100'000, 1280, 720)),
           diskSource(disk), p0(diskSource.frame(0)), p1(diskSource.frame(1)), cam(Camera::atFrame(disk.camera, 0)) {}
+    Settings restirScene() const;  ///< the disk scene with restir
+    // The sections, in the order main runs them.
+    void benchBvhRebuild();
+    void benchBvhRebuild1M();
+    void benchRays();
+    void benchRestirFrame();
+    void benchTreeReference();
+    void benchScaling();
+    void benchMemory();
+    void benchPlanSkips();
+    void benchMicro();
 };
 
-/// The disk scene with restir.
-Settings restirScene(const Suite& suite) {
-    Settings restir = suite.disk;
+Settings Suite::restirScene() const {
+    Settings restir = disk;
     restir.render.estimator = EstimatorKind::restir;
     return restir;
 }
 
 /// BVH rebuild at 100K, clusters of ~100, fast build; refit and partial policies.
-void benchBvhRebuild(Suite& suite) {
-    nlohmann::json& bars = suite.bars;
-    nlohmann::json& figures = suite.figures;
-    const Particles& p0 = suite.p0;
-    const Particles& p1 = suite.p1;
-    const Camera& cam = suite.cam;
-    EmbreeDevice& device = suite.device;
-    const Settings& disk = suite.disk;
+void Suite::benchBvhRebuild() {
     {
         log("BVH rebuild, 100K particles");
         ParticleBvh bvh(device, disk.geometry);
         int f = 0;
         bvh.build(p0, cam);
-        suite.build100k = timeIt(9, [&] { bvh.build(++f % 2 ? p1 : p0, cam); });
+        build100k = timeIt(9, [&] { bvh.build(++f % 2 ? p1 : p0, cam); });
         BareBuilder bare;
         const Clusters clusters = bvh.clusters();
         bare.build(clusters, p0, cam);
         const double limit = timeIt(9, [&] { bare.build(clusters, ++f % 2 ? p1 : p0, cam); });
-        bars["bvh_rebuild_100k"] = bar(suite.build100k, limit, 1.3);
+        bars["bvh_rebuild_100k"] = bar(build100k, limit, 1.3);
         const BvhStats& st = bvh.stats();
         figures["bvh_rebuild_100k_breakdown_s"] = {{"cluster", st.clusterSeconds}, {"blas", st.blasSeconds},
                                                    {"tlas", st.tlasSeconds}, {"clusters", st.clusters}};
@@ -412,17 +415,13 @@ void benchBvhRebuild(Suite& suite) {
             partial.build(p0, cam);
             policies[fmt::format("partial_{}", fraction)] = timeIt(9, [&] { partial.build(++f % 2 ? p1 : p0, cam); });
         }
-        policies["rebuild"] = suite.build100k;
+        policies["rebuild"] = build100k;
         figures["bvh_policies_100k_s"] = policies;
     }
 }
 
 /// BVH rebuild at 1M particles, against 10x the 100K build.
-void benchBvhRebuild1M(Suite& suite) {
-    nlohmann::json& bars = suite.bars;
-    const Camera& cam = suite.cam;
-    EmbreeDevice& device = suite.device;
-    const std::string& scene = suite.scene;
+void Suite::benchBvhRebuild1M() {
     {
         log("BVH rebuild, 1M particles");
         const Settings big = diskScene(scene, 1'000'000, 1280, 720);
@@ -432,20 +431,12 @@ void benchBvhRebuild1M(Suite& suite) {
         int f = 0;
         bvh.build(q0, cam);
         const double t = timeIt(5, [&] { bvh.build(++f % 2 ? q1 : q0, cam); });
-        bars["bvh_rebuild_1m_vs_100k"] = bar(t, suite.build100k, 10.0);
+        bars["bvh_rebuild_1m_vs_100k"] = bar(t, build100k, 10.0);
     }
 }
 
 /// Rays: the real passes against bare Embree loops over the same rays and BVH.
-void benchRays(Suite& suite) {
-    nlohmann::json& bars = suite.bars;
-    nlohmann::json& figures = suite.figures;
-    const Settings& disk = suite.disk;
-    const Particles& p0 = suite.p0;
-    const Camera& cam = suite.cam;
-    EmbreeDevice& device = suite.device;
-    const int cores = suite.cores;
-    const std::string& scene = suite.scene;
+void Suite::benchRays() {
     {
         log("primary and shadow rays, 100K particles at 1280x720");
         ParticleBvh bvh(device, disk.geometry);
@@ -500,11 +491,8 @@ void benchRays(Suite& suite) {
 }
 
 /// ReSTIR frame: per-pass breakdown and candidates per second per core.
-void benchRestirFrame(Suite& suite) {
-    nlohmann::json& figures = suite.figures;
-    const ParticleSource& diskSource = suite.diskSource;
-    const int cores = suite.cores;
-    const Settings restir = restirScene(suite);
+void Suite::benchRestirFrame() {
+    const Settings restir = restirScene();
     {
         log("restir frame, 100K particles at 1280x720");
         const FrameTiming t = timeFrames(restir, diskSource, 4, 4, 3);
@@ -524,11 +512,7 @@ void benchRestirFrame(Suite& suite) {
 }
 
 /// The tree reference to 1% per-pixel relative standard error on the same frame.
-void benchTreeReference(Suite& suite) {
-    nlohmann::json& figures = suite.figures;
-    const Settings& disk = suite.disk;
-    const ParticleSource& diskSource = suite.diskSource;
-    const bool quick = suite.quick;
+void Suite::benchTreeReference() {
     if (!quick) {
         log("tree to 1% relative standard error (minutes)");
         Settings tree = disk;
@@ -542,11 +526,8 @@ void benchTreeReference(Suite& suite) {
 }
 
 /// Scaling curves over particles and resolution (CSV and PNG).
-void benchScaling(Suite& suite) {
-    const ParticleSource& diskSource = suite.diskSource;
-    const bool quick = suite.quick;
-    const std::string& outDir = suite.outDir;
-    const Settings restir = restirScene(suite);
+void Suite::benchScaling() {
+    const Settings restir = restirScene();
     std::string csvP = "particles,bvh_build_s,restir_frame_s,trace_shadow_rays_s,shadow_rays\n";
     std::vector<std::uint32_t> counts = {10'000, 30'000, 100'000, 300'000, 1'000'000};
     if (quick) counts.pop_back();
@@ -586,10 +567,7 @@ void benchScaling(Suite& suite) {
 }
 
 /// Peak resident memory per particle (a child process per count).
-void benchMemory(Suite& suite) {
-    nlohmann::json& figures = suite.figures;
-    const std::string& binary = suite.binary;
-    const std::string& scene = suite.scene;
+void Suite::benchMemory() {
     {
         nlohmann::json mem;
         std::vector<std::uint32_t> sizes = {100'000, 1'000'000};
@@ -614,10 +592,8 @@ void benchMemory(Suite& suite) {
 }
 
 /// What each skip of the frame plan saves: the same frames with and without the work.
-void benchPlanSkips(Suite& suite) {
-    nlohmann::json& figures = suite.figures;
-    const std::string& scene = suite.scene;
-    const Settings restir = restirScene(suite);
+void Suite::benchPlanSkips() {
+    const Settings restir = restirScene();
     {
         log("pass-plan skips, 100K particles at 640x360");
         nlohmann::json skips;
@@ -658,9 +634,7 @@ void benchPlanSkips(Suite& suite) {
 }
 
 /// Micro-benchmarks of the hot kernels (Google Benchmark, its JSON embedded).
-void benchMicro(Suite& suite) {
-    nlohmann::json& figures = suite.figures;
-    const std::string& micro = suite.micro;
+void Suite::benchMicro() {
     if (!micro.empty()) {
         log("micro-benchmarks");
         const auto file = std::filesystem::temp_directory_path() / "accretion_suite_micro.json";
@@ -709,15 +683,15 @@ int main(int argc, char** argv) {
                               {"machine", {{"cpu", machine()}, {"cores", suite.cores}}},
                               {"scene", scene},
                               {"quick", quick}};
-    benchBvhRebuild(suite);
-    benchBvhRebuild1M(suite);
-    benchRays(suite);
-    benchRestirFrame(suite);
-    if (!quick) benchTreeReference(suite);
-    benchScaling(suite);
-    benchMemory(suite);
-    benchPlanSkips(suite);
-    if (!micro.empty()) benchMicro(suite);
+    suite.benchBvhRebuild();
+    suite.benchBvhRebuild1M();
+    suite.benchRays();
+    suite.benchRestirFrame();
+    if (!quick) suite.benchTreeReference();
+    suite.benchScaling();
+    suite.benchMemory();
+    suite.benchPlanSkips();
+    if (!micro.empty()) suite.benchMicro();
 
     results["bars"] = suite.bars;
     results["figures"] = suite.figures;

@@ -25,11 +25,12 @@
 namespace accretion::cmd {
 namespace {
 
-struct BiasArgs : SceneArgs {
-    std::string reference, estimators = "ris,restir:none,restir:basic,restir:pairwise", out;
-    std::uint32_t seeds = 64, history = 8;
+struct BiasArgs : ExperimentArgs {
+    BiasArgs() {
+        estimators = "ris,restir:none,restir:basic,restir:pairwise";
+        seeds = 64;
+    }
     double zCritical = 3.29;  ///< two-sided 99.9%
-    std::optional<std::uint32_t> frame;
 };
 
 struct BiasRow {
@@ -193,14 +194,11 @@ void runBias(const BiasArgs& a) {
 void addBiasCommand(CLI::App& app) {
     auto args = std::make_shared<BiasArgs>();
     CLI::App* cmd = app.add_subcommand("bias", "Mean signed error over many seeds per estimator, with its standard error");
-    addSceneOptions(cmd, *args, "Frames A:B (= render.frame_start, render.frames); the first is measured");
-    cmd->add_option("--reference", args->reference, "Reference EXR with an Lr layer (and Lr_stderr if noisy)")->required();
-    cmd->add_option("--estimators", args->estimators, "Comma-separated specs, as for converge");
+    addExperimentOptions(cmd, *args, "Reference EXR with an Lr layer (and Lr_stderr if noisy)",
+                         "Comma-separated specs, as for converge",
+                         "Output prefix (default out/<scene>.bias): .csv, .png, .json, bias-map EXRs");
     cmd->add_option("--seeds", args->seeds, "Independent renders per estimator")->check(CLI::Range(2u, 1000000u));
-    cmd->add_option("--frame", args->frame, "Frame measured (default render.frame_start)");
-    cmd->add_option("--history", args->history, "restir: frames rendered before the measured one");
     cmd->add_option("--z", args->zCritical, "Two-sided critical |z| for the verdict (3.29: 99.9%)");
-    cmd->add_option("-o,--out", args->out, "Output prefix (default out/<scene>.bias): .csv, .png, .json, bias-map EXRs");
     cmd->callback([args] { runBias(*args); });
 }
 

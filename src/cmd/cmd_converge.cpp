@@ -26,10 +26,10 @@
 namespace accretion::cmd {
 namespace {
 
-struct ConvergeArgs : SceneArgs {
-    std::string reference, estimators = "uniform,power,tree,ris,restir", budget = "60s", out;
-    std::uint32_t history = 8, sequence = 0, minEffort = 1, maxEffort = 1u << 16, seeds = 1;
-    std::optional<std::uint32_t> frame;
+struct ConvergeArgs : ExperimentArgs {
+    ConvergeArgs() { estimators = "uniform,power,tree,ris,restir"; }
+    std::string budget = "60s";
+    std::uint32_t sequence = 0, minEffort = 1, maxEffort = 1u << 16;
 };
 
 double parseSeconds(const std::string& text) {
@@ -334,21 +334,17 @@ void runConverge(const ConvergeArgs& a) {
 void addConvergeCommand(CLI::App& app) {
     auto args = std::make_shared<ConvergeArgs>();
     CLI::App* cmd = app.add_subcommand("converge", "Error against time and rays per estimator, against a reference EXR");
-    addSceneOptions(cmd, *args, "Frames A:B (= render.frame_start, render.frames); the first is measured");
-    cmd->add_option("--reference", args->reference, "Reference EXR with an Lr layer ({frame} pattern with --sequence)")->required();
-    cmd->add_option("--estimators", args->estimators,
-                    "Comma-separated specs name[:option...]: uniform, power, tree, ris[:power], restir[:none|basic|basic+vis|pairwise], "
-                    "options key=value override settings");
+    addExperimentOptions(cmd, *args, "Reference EXR with an Lr layer ({frame} pattern with --sequence)",
+                         "Comma-separated specs name[:option...]: uniform, power, tree, ris[:power], "
+                         "restir[:none|basic|basic+vis|pairwise], options key=value override settings",
+                         "Output prefix (default out/<scene>.converge): .csv, .png, .json");
     cmd->add_option("--budget", args->budget, "Time budget per estimator (e.g. 60s, 2m)");
-    cmd->add_option("--frame", args->frame, "Frame measured (default render.frame_start)");
-    cmd->add_option("--history", args->history, "restir: frames rendered before the measured one");
     cmd->add_option("--sequence", args->sequence, "Error per frame over N frames from --frame (one history per estimator)");
     cmd->add_option("--min-effort", args->minEffort, "First spp (restir: candidates) tried; doubled from there")
         ->check(CLI::Range(1u, 1u << 30));
     cmd->add_option("--max-effort", args->maxEffort, "Largest spp (restir: candidates) tried");
     cmd->add_option("--seeds", args->seeds, "Renders per point: errors are their means, time their median")
         ->check(CLI::Range(1u, 100000u));
-    cmd->add_option("-o,--out", args->out, "Output prefix (default out/<scene>.converge): .csv, .png, .json");
     cmd->footer("Effort doubles from --min-effort (spp; ris reservoirs; restir candidates) until the budget is spent.\n"
                 "relMSE_corrected subtracts the reference's own noise (its Lr_stderr layer) in expectation.");
     cmd->callback([args] { runConverge(*args); });

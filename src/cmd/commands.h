@@ -1,6 +1,7 @@
 #pragma once
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -20,6 +21,18 @@ struct SceneArgs {
     int threads = 0;                     ///< --threads N (0: all cores)
     bool quiet = false;                  ///< --quiet: no progress on stderr
 };
+
+/// Options of the experiment commands (converge, bias): a scene measured
+/// against a reference, per estimator spec, over seeds.
+struct ExperimentArgs : SceneArgs {
+    std::string reference, estimators, out;
+    std::uint32_t history = 8, seeds = 1;
+    std::optional<std::uint32_t> frame;
+};
+
+/// Adds the scene options and --reference, --estimators, --frame, --history, -o,--out.
+void addExperimentOptions(CLI::App* cmd, ExperimentArgs& args, const std::string& referenceHelp,
+                          const std::string& estimatorsHelp, const std::string& outHelp);
 
 /// Thrown by batch when some job did not succeed (exit code 4).
 struct BatchFailed {};

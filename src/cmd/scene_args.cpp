@@ -52,4 +52,14 @@ void addSceneOptions(CLI::App* cmd, SceneArgs& args, const std::string& framesHe
     cmd->add_flag("-q,--quiet", args.quiet, "No progress on stderr");
 }
 
+void addExperimentOptions(CLI::App* cmd, ExperimentArgs& args, const std::string& referenceHelp,
+                          const std::string& estimatorsHelp, const std::string& outHelp) {
+    addSceneOptions(cmd, args, "Frames A:B (= render.frame_start, render.frames); the first is measured");
+    cmd->add_option("--reference", args.reference, referenceHelp)->required();
+    cmd->add_option("--estimators", args.estimators, estimatorsHelp);
+    cmd->add_option("--frame", args.frame, "Frame measured (default render.frame_start)");
+    cmd->add_option("--history", args.history, "restir: frames rendered before the measured one");
+    cmd->add_option("-o,--out", args.out, outHelp);
+}
+
 }  // namespace accretion::cmd

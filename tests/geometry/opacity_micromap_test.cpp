@@ -75,19 +75,13 @@ TEST_CASE("2-state OMM has no unknown micro-triangles, memory is shared across b
 #include "accretion/geometry/particle_bvh.h"
 #include "accretion/particles/disk_generator.h"
 #include "accretion/geometry/camera.h"
+#include "support/test_scenes.h"
 
 TEST_CASE("4-state OMM keeps every hit of alpha testing with fewer any-hits as L grows, 2-state none", "[gpu][omm][bvh]") {
     GeometrySettings g;
     g.alpha = AlphaMode::disc;
     g.cluster_size = 32;
-    ParticleSettings ps;
-    ps.count = 2000;
-    ps.outer_radius = 3.0;
-    ps.radius = 0.08;
-    CameraSettings cs;
-    cs.position = Vec3(0.0f, 2.0f, 6.0f);
-    cs.width = 96;
-    cs.height = 64;
+    const auto [ps, cs] = accretion::test::smallView(2000, 3.0, 0.08, Vec3(0.0f, 2.0f, 6.0f), 96, 64);
     const Particles p = generateDisk(ps, 0);
     const Camera cam = Camera::atFrame(cs, 0);
     EmbreeDevice device;

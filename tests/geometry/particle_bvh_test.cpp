@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "accretion/geometry/particle_bvh.h"
+#include "support/test_scenes.h"
 #include "accretion/particles/disk_generator.h"
 #include "accretion/geometry/camera.h"
 
@@ -55,15 +56,8 @@ TEST_CASE("Embree hits match brute force for every geometry and build policy", "
     g.cluster_size = 16;
     INFO(enumName(g.primitive) << " " << enumName(g.alpha) << " " << enumName(g.orientation) << " " << enumName(g.build));
 
-    ParticleSettings ps;
-    ps.count = 400;
-    ps.outer_radius = 3.0;
-    ps.radius = 0.1;
+    auto [ps, cs] = accretion::test::smallView(400, 3.0, 0.1, Vec3(0.0f, 3.0f, 6.0f), 40, 30);
     ps.time_step = 0.2;
-    CameraSettings cs;
-    cs.position = Vec3(0.0f, 3.0f, 6.0f);
-    cs.width = 40;
-    cs.height = 30;
     EmbreeDevice device;
     ParticleBvh bvh(device, g);
 
@@ -166,14 +160,7 @@ TEST_CASE("counting queries: same answers, BLAS entries bounded by the overlappe
     g.build = GENERATE(BuildPolicy::rebuild, BuildPolicy::refit);
     g.cluster_size = 16;
     INFO(enumName(g.primitive) << " " << enumName(g.alpha) << " " << enumName(g.build));
-    ParticleSettings ps;
-    ps.count = 400;
-    ps.outer_radius = 3.0;
-    ps.radius = 0.1;
-    CameraSettings cs;
-    cs.position = Vec3(0.0f, 3.0f, 6.0f);
-    cs.width = 40;
-    cs.height = 30;
+    const auto [ps, cs] = accretion::test::smallView(400, 3.0, 0.1, Vec3(0.0f, 3.0f, 6.0f), 40, 30);
     EmbreeDevice device;
     GpuSettings gpu;
     gpu.counters = true;

@@ -70,4 +70,16 @@ int runCommand(const std::string& command, std::string& output) {
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
+SmallView smallView(std::uint32_t count, double outerRadius, double radius, Vec3 eye, std::uint32_t width,
+                    std::uint32_t height) {
+    SmallView v;
+    v.particles.count = count;
+    v.particles.outer_radius = outerRadius;
+    v.particles.radius = radius;
+    v.camera.position = eye;
+    v.camera.width = width;
+    v.camera.height = height;
+    return v;
+}
+
 }  // namespace accretion::test

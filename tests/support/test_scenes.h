@@ -31,4 +31,12 @@ std::string readFile(const std::filesystem::path& file);
 /// Run a shell command; returns its exit status, stdout+stderr in `output`.
 int runCommand(const std::string& command, std::string& output);
 
+/// A small generated disk and a camera looking at it (the BVH and micromap tests).
+struct SmallView {
+    ParticleSettings particles;
+    CameraSettings camera;
+};
+SmallView smallView(std::uint32_t count, double outerRadius, double radius, Vec3 eye, std::uint32_t width,
+                    std::uint32_t height);
+
 }  // namespace accretion::test
