@@ -48,14 +48,14 @@ struct LightArrays {
 
     /// Unshadowed term of light i at the receiver (0 for its own particle).
     template <ShadingModel M>
-    bool term(const ShadingPoint& sp, std::uint32_t i, LightTerm& t) const {
+    [[gnu::always_inline]] bool term(const ShadingPoint& sp, std::uint32_t i, LightTerm& t) const {
         if (i == sp.self || i >= count) return false;
         const PackedLight& l = packed[i];
         return evalLight<M>(sp, l.position, l.emission, l.dmin2, t);
     }
     /// RIS target p_hat = luminance(f I G), no visibility.
     template <ShadingModel M>
-    float targetPdf(const ShadingPoint& sp, std::uint32_t i) const {
+    [[gnu::always_inline]] float targetPdf(const ShadingPoint& sp, std::uint32_t i) const {
         LightTerm t;
         return term<M>(sp, i, t) ? luminance(t.value) : 0.0f;
     }

@@ -19,7 +19,7 @@ struct LightTerm {
 /// f = rho / pi, cos_i = max(0, n . w_i); isotropic: f = rho / (4 pi), cos_i = 1.
 /// Returns false when the term is zero (so no shadow ray is needed).
 template <ShadingModel M>
-inline bool evalLight(const ShadingPoint& sp, const Vec3& p, const Vec3& I, float dmin2, LightTerm& out) {
+[[gnu::always_inline]] inline bool evalLight(const ShadingPoint& sp, const Vec3& p, const Vec3& I, float dmin2, LightTerm& out) {
     const Vec3 delta = (p - sp.centre) - sp.local;  // receiver-relative: exact to the inputs' rounding
     const float d2 = glm::dot(delta, delta);
     const float d = std::sqrt(d2);

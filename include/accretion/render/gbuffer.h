@@ -34,7 +34,7 @@ struct GBuffer {
 };
 
 /// The shading point of a hit texel.
-inline ShadingPoint shadingPoint(const GBufferTexel& g, const Particles& particles) {
+[[gnu::always_inline]] inline ShadingPoint shadingPoint(const GBufferTexel& g, const Particles& particles) {
     const Vec3 centre = particles.position[g.particle];
     return {centre + g.local, g.normal, g.geomNormal, particles.albedo[g.particle], g.particle, centre, g.local};
 }
