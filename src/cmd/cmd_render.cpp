@@ -216,6 +216,23 @@ void writeRunOutputs(const std::string& stem, const std::string& settingsToml, c
     writeJson(outputsFile, manifest);
 }
 
+/// The run's stats.json before its frames: what made it.
+nlohmann::json runStats(const RenderRun& run, int threads) {
+    const Settings& settings = run.settings;
+    return {
+        {"version", std::string(version())},
+        {"scene", settings.scenePath},
+        {"estimator", std::string(enumName(settings.render.estimator))},
+        {"seed", settings.render.seed},
+        {"samples", settings.render.samples},
+        {"threads", threads},
+        {"shard", run.shardLabel},
+        {"shard_by", run.sharding.shard.whole() ? "none" : run.sharding.bySamples ? "samples" : "frames"},
+        {"settings", run.settingsToml},
+        {"frames", nlohmann::json::array()},
+    };
+}
+
 void runRender(const RenderArgs& args) {
     const Settings settings = loadSceneArgs(args, renderFlags(args));
     const auto threads = limitThreads(args.threads);
@@ -224,18 +241,7 @@ void runRender(const RenderArgs& args) {
     const std::string stem = shardPath(runStem(settings), shard);
     const RenderRun run{settings, sharding, settingsToToml(settings), fmt::format("{}/{}", shard.index, shard.count)};
     removeStaleTemporaries(std::filesystem::path(stem).parent_path());
-    nlohmann::json stats = {
-        {"version", std::string(version())},
-        {"scene", settings.scenePath},
-        {"estimator", std::string(enumName(settings.render.estimator))},
-        {"seed", settings.render.seed},
-        {"samples", settings.render.samples},
-        {"threads", args.threads > 0 ? args.threads : tbb::info::default_concurrency()},
-        {"shard", run.shardLabel},
-        {"shard_by", shard.whole() ? "none" : sharding.bySamples ? "samples" : "frames"},
-        {"settings", run.settingsToml},
-        {"frames", nlohmann::json::array()},
-    };
+    nlohmann::json stats = runStats(run, args.threads > 0 ? args.threads : tbb::info::default_concurrency());
 
     // A checkpoint: where to start, and the sums of the frame in progress.
     const Checkpoint checkpoint(stem + ".checkpoint", run.settingsToml, stats["shard"]);

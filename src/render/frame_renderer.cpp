@@ -39,6 +39,48 @@ void recordCompose(const GBuffer& gbuffer, const Particles& particles, const Par
     }
 }
 
+/// composeImage: L = Le + Lr on hits (background on misses), depth, normal
+/// and particle AOVs, and the frame's spp statistics.
+void composeImage(const GBuffer& gbuffer, const Particles& particles, const ShadingSettings& shading, FrameImage& img,
+                  FrameStats& stats) {
+    const std::size_t pixels = std::size_t(img.width) * img.height;
+    img.L.resize(pixels);
+    img.Le.assign(pixels, Vec3(0.0f));
+    img.depth.resize(pixels);
+    img.normal.resize(pixels);
+    img.particle.resize(pixels);
+    const float se = static_cast<float>(shading.self_emission);
+    std::size_t hits = 0;
+    for (std::size_t px = 0; px < pixels; ++px) {
+        const GBufferTexel& g = gbuffer.texels[px];
+        img.particle[px] = g.particle;
+        if (!g.hit()) {
+            img.L[px] = shading.background;
+            img.depth[px] = std::numeric_limits<float>::infinity();
+            img.normal[px] = Vec3(0.0f);
+            continue;
+        }
+        ++hits;
+        img.Le[px] = se * particles.emission[g.particle];
+        img.L[px] = img.Le[px] + img.lighting.Lr[px];
+        if (!std::isfinite(img.L[px].x + img.L[px].y + img.L[px].z)) {  // float overflow: never in an output
+            img.Le[px] = img.L[px] = img.lighting.Lr[px] = img.lighting.Lr_stderr[px] = Vec3(0.0f);
+            img.lighting.rejected[px] += 1.0f;
+            ++stats.nonFinite[std::string(pass::composeImage)];
+        }
+        img.depth[px] = g.depth;
+        img.normal[px] = g.normal;
+    }
+    stats.hitPixels = hits;
+    double sppSum = 0.0;
+    for (std::size_t px = 0; px < pixels; ++px)
+        if (gbuffer.texels[px].hit()) {
+            sppSum += img.lighting.spp[px];
+            stats.maxSpp = std::max(stats.maxSpp, double(img.lighting.spp[px]));
+        }
+    stats.meanSpp = hits ? sppSum / double(hits) : 0.0;
+}
+
 }  // namespace
 
 FrameRenderer::FrameRenderer(const Settings& settings, ParticleSource source, RenderOptions options)
@@ -49,6 +91,80 @@ FrameRenderer::FrameRenderer(const Settings& settings, ParticleSource source, Re
 }
 
 FrameRenderer::~FrameRenderer() = default;
+
+const Particles& FrameRenderer::prepareGeometry(std::uint32_t frame, const Camera& camera, FrameStats& stats,
+                                                Particles& loaded) {
+    // A static scene loads its particles and builds its BVH once for all
+    // frames; the plan of this frame needs the particles (do they emit?).
+    FrameFacts facts;
+    facts.geometryBuilt = built_ && !options_.rebuildStatic;
+    facts.historyAvailable = restir_ && restir_->hasHistory();
+    if (planFrame(settings_, facts).loadParticles) {
+        auto t = stats.timer.scope(pass::loadParticles);
+        loaded = source_.frame(frame);
+        for (Vec3& p : loaded.position) p -= origin_;
+        if (plan_.staticGeometry) staticParticles_ = std::move(loaded);
+    }
+    const Particles& particles = plan_.staticGeometry ? staticParticles_ : loaded;
+    facts.emissive = emissive(particles);
+    plan_ = planFrame(settings_, facts);
+    stats.particles = particles.size();
+    if (plan_.buildClusters) {
+        auto t = stats.timer.scope(pass::buildClusters);
+        if (plan_.previousBvh) {  // double buffer: last frame's BVH stays valid
+            std::swap(bvh_, previousBvh_);
+            if (!bvh_) bvh_ = std::make_unique<ParticleBvh>(*device_, settings_.geometry, settings_.gpu);
+        }
+        bvh_->build(particles, camera);
+        built_ = true;
+    }
+    stats.bvh = bvh_->stats();
+    if (!plan_.buildClusters) {
+        stats.bvh.built = false;
+        stats.bvh.rebuiltClusters = 0;
+        stats.bvh.clusterSeconds = stats.bvh.blasSeconds = stats.bvh.tlasSeconds = 0.0;
+    }
+    return particles;
+}
+
+void FrameRenderer::lightFrame(std::uint32_t frame, const Camera& camera, const Particles& particles, const GBuffer& gbuffer,
+                               const AliasTable* powerTable, const LightTree* lightTree, const LightingSession* session,
+                               FrameImage& img, FrameStats& stats) {
+    const FramePlan& plan = plan_;
+    const std::size_t pixels = std::size_t(camera.width) * camera.height;
+    if (!plan.lighting) {  // nothing lights the scene: Lr = 0
+        img.lighting.Lr.assign(pixels, Vec3(0.0f));
+        img.lighting.Lr_stderr.assign(pixels, Vec3(0.0f));
+        img.lighting.spp.assign(pixels, 0.0f);
+        img.lighting.rejected.assign(pixels, 0.0f);
+        return;
+    }
+    auto t = stats.timer.scope(pass::estimateLighting);
+    if (plan.restir) {
+        RestirInputs in{*bvh_, particles, gbuffer, camera, settings_, plan, frame, powerTable,
+                        plan.previousBvh ? previousBvh_.get() : nullptr, plan.counting ? &img.counters : nullptr};
+        stats.lighting = restir_->render(in, img.lighting, img.reservoirs, stats.timer, stats.nonFinite);
+        stats.reservoirBytes = restir_->reservoirBytes();
+        if (img.lighting.rejected.empty()) img.lighting.rejected.assign(pixels, 0.0f);
+        return;
+    }
+    LightingInputs in{*bvh_, particles, gbuffer, settings_.shading, settings_.render, frame, powerTable, lightTree,
+                      plan.counting ? &img.counters.add(pass::estimateLighting, camera.width, camera.height) : nullptr};
+    const LightingPlan lp = planLighting(settings_.render, camera.height, session ? session->shard : Shard{});
+    Progress progress(fmt::format("frame {} {}", frame, pass::estimateLighting),
+                      std::uint64_t(pixels) * (lp.exact ? 1 : lp.chunks()), options_.quiet);
+    if (!session) {
+        stats.lighting = estimateLighting(in, img.lighting, &progress);
+    } else {  // in chunks, from a checkpoint, into the session's sums
+        Accumulation local;
+        Accumulation& acc = session->result ? *session->result : local;
+        if (session->resume) acc = *session->resume;
+        else acc.reset(camera.width, camera.height, lp.begin);
+        stats.lighting = accumulateLighting(in, lp, acc, session->afterChunk, &progress);
+        resolveLighting(acc, lp.exact, img.lighting, &stats.lighting.nonFinite);
+    }
+    if (stats.lighting.nonFinite) stats.nonFinite[std::string(pass::estimateLighting)] = stats.lighting.nonFinite;
+}
 
 FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const LightingSession* session) {
     const auto start = std::chrono::steady_clock::now();
@@ -65,136 +181,37 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const L
     stats.origin = origin_;
     PassTimer& timer = stats.timer;
 
-    // A static scene loads its particles and builds its BVH once for all
-    // frames; the plan of this frame needs the particles (do they emit?).
-    FrameFacts facts;
-    facts.geometryBuilt = built_ && !options_.rebuildStatic;
-    facts.historyAvailable = restir_ && restir_->hasHistory();
-    const bool load = planFrame(settings_, facts).loadParticles;
     Particles loaded;
-    if (load) {
-        auto t = timer.scope(pass::loadParticles);
-        loaded = source_.frame(frame);
-        for (Vec3& p : loaded.position) p -= origin_;
-        if (plan_.staticGeometry) staticParticles_ = std::move(loaded);
-    }
-    const Particles& particles = plan_.staticGeometry ? staticParticles_ : loaded;
-    facts.emissive = emissive(particles);
-    plan_ = planFrame(settings_, facts);
+    const Particles& particles = prepareGeometry(frame, camera, stats, loaded);
     const FramePlan& plan = plan_;
-    stats.particles = particles.size();
-    if (plan.buildClusters) {
-        auto t = timer.scope(pass::buildClusters);
-        if (plan.previousBvh) {  // double buffer: last frame's BVH stays valid
-            std::swap(bvh_, previousBvh_);
-            if (!bvh_) bvh_ = std::make_unique<ParticleBvh>(*device_, settings_.geometry, settings_.gpu);
-        }
-        bvh_->build(particles, camera);
-        built_ = true;
-    }
-    stats.bvh = bvh_->stats();
-    if (!plan.buildClusters) {
-        stats.bvh.built = false;
-        stats.bvh.rebuiltClusters = 0;
-        stats.bvh.clusterSeconds = stats.bvh.blasSeconds = stats.bvh.tlasSeconds = 0.0;
-    }
     FrameImage img;
-    const bool counting = plan.counting;
-    if (counting) recordClusterBuild(*bvh_, particles, img.counters);
+    if (plan.counting) recordClusterBuild(*bvh_, particles, img.counters);
 
     AliasTable powerTable;
     LightTree lightTree;
-    const bool power = plan.sampler == LightSamplerKind::power, tree = plan.sampler == LightSamplerKind::tree;
     if (plan.sampler != LightSamplerKind::none) {
         auto t = timer.scope(pass::buildLightSampler);
-        if (power) powerTable = buildPowerTable(particles);
-        if (tree) lightTree = LightTree(particles, settings_.shading);
+        if (plan.sampler == LightSamplerKind::power) powerTable = buildPowerTable(particles);
+        if (plan.sampler == LightSamplerKind::tree) lightTree = LightTree(particles, settings_.shading);
         stats.lightTreeNodes = lightTree.nodeCount();
     }
 
     GBuffer gbuffer;
     {
         auto t = timer.scope(pass::traceGBuffer);
-        PassCounters* pc = counting ? &img.counters.add(pass::traceGBuffer, camera.width, camera.height) : nullptr;
+        PassCounters* pc = plan.counting ? &img.counters.add(pass::traceGBuffer, camera.width, camera.height) : nullptr;
         stats.primaryRays = traceGBuffer(*bvh_, particles, camera, settings_.shading.model, gbuffer, pc);
     }
-
     img.width = camera.width;
     img.height = camera.height;
-    const std::size_t pixels = std::size_t(img.width) * img.height;
-    if (plan.lighting) {
-        auto t = timer.scope(pass::estimateLighting);
-        if (plan.restir) {
-            RestirInputs in{*bvh_, particles, gbuffer, camera, settings_, plan, frame, power ? &powerTable : nullptr,
-                            plan.previousBvh ? previousBvh_.get() : nullptr, counting ? &img.counters : nullptr};
-            stats.lighting = restir_->render(in, img.lighting, img.reservoirs, timer, stats.nonFinite);
-            stats.reservoirBytes = restir_->reservoirBytes();
-            if (img.lighting.rejected.empty()) img.lighting.rejected.assign(pixels, 0.0f);
-        } else {
-            LightingInputs in{*bvh_, particles, gbuffer, settings_.shading, settings_.render, frame,
-                              power ? &powerTable : nullptr, tree ? &lightTree : nullptr,
-                              counting ? &img.counters.add(pass::estimateLighting, camera.width, camera.height) : nullptr};
-            const LightingPlan lp = planLighting(settings_.render, camera.height, session ? session->shard : Shard{});
-            Progress progress(fmt::format("frame {} {}", frame, pass::estimateLighting),
-                              std::uint64_t(pixels) * (lp.exact ? 1 : lp.chunks()), options_.quiet);
-            if (!session) {
-                stats.lighting = estimateLighting(in, img.lighting, &progress);
-            } else {  // in chunks, from a checkpoint, into the session's sums
-                Accumulation local;
-                Accumulation& acc = session->result ? *session->result : local;
-                if (session->resume) acc = *session->resume;
-                else acc.reset(camera.width, camera.height, lp.begin);
-                stats.lighting = accumulateLighting(in, lp, acc, session->afterChunk, &progress);
-                resolveLighting(acc, lp.exact, img.lighting, &stats.lighting.nonFinite);
-            }
-            if (stats.lighting.nonFinite) stats.nonFinite[std::string(pass::estimateLighting)] = stats.lighting.nonFinite;
-        }
-    } else {  // nothing lights the scene: Lr = 0
-        img.lighting.Lr.assign(pixels, Vec3(0.0f));
-        img.lighting.Lr_stderr.assign(pixels, Vec3(0.0f));
-        img.lighting.spp.assign(pixels, 0.0f);
-        img.lighting.rejected.assign(pixels, 0.0f);
-    }
+    lightFrame(frame, camera, particles, gbuffer, plan.sampler == LightSamplerKind::power ? &powerTable : nullptr,
+               plan.sampler == LightSamplerKind::tree ? &lightTree : nullptr, session, img, stats);
     {
         auto t = timer.scope(pass::composeImage);
-        img.L.resize(pixels);
-        img.Le.assign(pixels, Vec3(0.0f));
-        img.depth.resize(pixels);
-        img.normal.resize(pixels);
-        img.particle.resize(pixels);
-        const float se = static_cast<float>(settings_.shading.self_emission);
-        std::size_t hits = 0;
-        for (std::size_t px = 0; px < pixels; ++px) {
-            const GBufferTexel& g = gbuffer.texels[px];
-            img.particle[px] = g.particle;
-            if (!g.hit()) {
-                img.L[px] = settings_.shading.background;
-                img.depth[px] = std::numeric_limits<float>::infinity();
-                img.normal[px] = Vec3(0.0f);
-                continue;
-            }
-            ++hits;
-            img.Le[px] = se * particles.emission[g.particle];
-            img.L[px] = img.Le[px] + img.lighting.Lr[px];
-            if (!std::isfinite(img.L[px].x + img.L[px].y + img.L[px].z)) {  // float overflow: never in an output
-                img.Le[px] = img.L[px] = img.lighting.Lr[px] = img.lighting.Lr_stderr[px] = Vec3(0.0f);
-                img.lighting.rejected[px] += 1.0f;
-                ++stats.nonFinite[std::string(pass::composeImage)];
-            }
-            img.depth[px] = g.depth;
-            img.normal[px] = g.normal;
-        }
-        stats.hitPixels = hits;
-        if (counting) recordCompose(gbuffer, particles, *bvh_, img.counters.add(pass::composeImage, img.width, img.height));
-        double sppSum = 0.0;
-        for (std::size_t px = 0; px < pixels; ++px)
-            if (gbuffer.texels[px].hit()) {
-                sppSum += img.lighting.spp[px];
-                stats.maxSpp = std::max(stats.maxSpp, double(img.lighting.spp[px]));
-            }
-        stats.meanSpp = hits ? sppSum / double(hits) : 0.0;
+        composeImage(gbuffer, particles, settings_.shading, img, stats);
+        if (plan.counting) recordCompose(gbuffer, particles, *bvh_, img.counters.add(pass::composeImage, img.width, img.height));
     }
-    if (counting) {
+    if (plan.counting) {
         img.counters.accel = bvh_->accelCounters();
         img.heatmaps = counterHeatmaps(img.counters, img.width, img.height);
     }

@@ -84,6 +84,14 @@ public:
     const FramePlan& plan() const { return plan_; }
 
 private:
+    /// loadParticles and buildClusters as this frame's plan says; plans the
+    /// frame (the plan needs to know whether the particles emit).
+    const Particles& prepareGeometry(std::uint32_t frame, const Camera& camera, FrameStats& stats, Particles& loaded);
+    /// estimateLighting (the restir passes for restir) into img.lighting, or Lr = 0 unlit.
+    void lightFrame(std::uint32_t frame, const Camera& camera, const Particles& particles, const GBuffer& gbuffer,
+                    const AliasTable* powerTable, const LightTree* lightTree, const LightingSession* session,
+                    FrameImage& img, FrameStats& stats);
+
     Settings settings_;
     FramePlan plan_;             ///< the last frame's
     ParticleSource source_;
