@@ -1,7 +1,6 @@
 #include "accretion/gpu/warp_model.h"
 
 #include <algorithm>
-#include <sstream>
 
 #include <fmt/format.h>
 

@@ -27,10 +27,10 @@ std::string pad(const std::string& text, int width) {
 
 std::string Table::consoleCell(const Column& c, const Cell& v) const { return pad(formatCell(c.consoleSpec, v), c.width); }
 
-std::string Table::console(const std::string& indent, bool header) const {
+std::string Table::console() const {
     std::string out;
     auto line = [&](auto&& cell) {
-        std::string s = indent;
+        std::string s;
         bool first = true;
         for (std::size_t k = 0; k < columns_.size(); ++k) {
             if (!columns_[k].console) continue;
@@ -39,7 +39,7 @@ std::string Table::console(const std::string& indent, bool header) const {
         }
         out += s + "\n";
     };
-    if (header) line([&](std::size_t k) { return pad(columns_[k].header, columns_[k].width); });
+    line([&](std::size_t k) { return pad(columns_[k].header, columns_[k].width); });
     for (const auto& row : rows_) line([&](std::size_t k) { return consoleCell(columns_[k], row[k]); });
     return out;
 }

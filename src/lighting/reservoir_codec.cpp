@@ -35,11 +35,7 @@ std::size_t ReservoirCodec::bytes() const {
     return half_ ? 8 : 12;
 }
 
-std::uint32_t ReservoirCodec::bitsFor(std::size_t n) {
-    std::uint32_t b = 1;
-    while (b < 64 && (std::uint64_t(1) << b) < n) ++b;
-    return b;
-}
+std::uint32_t ReservoirCodec::bitsFor(std::size_t n) { return indexBits(n); }
 
 void ReservoirCodec::checkCapacity(std::size_t lights, std::string_view where) const {
     if (layout_ == ReservoirLayout::full) return;

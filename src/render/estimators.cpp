@@ -419,6 +419,8 @@ LightingCounters accumulateLighting(const LightingInputs& in, const LightingPlan
     ACC_CHECK(acc.width == in.gbuffer.width && acc.height == in.gbuffer.height);
     if (in.particles.empty() || acc.nextChunk >= plan.end) return {};
     ACC_CHECK(in.render.estimator != EstimatorKind::power || in.powerTable);
+    // ris draws its candidates in proportion to power exactly when given the table: it must be the configured source.
+    ACC_CHECK(in.render.estimator != EstimatorKind::ris || (in.render.source == LightSource::power) == (in.powerTable != nullptr));
     ACC_CHECK(in.render.estimator != EstimatorKind::tree || in.lightTree);
     ACC_CHECK(in.render.estimator != EstimatorKind::restir);
     const LightArrays L(in.particles, in.shading);
@@ -473,6 +475,8 @@ LightingCounters estimateLighting(const LightingInputs& in, LightingImage& out, 
         return {};
     }
     ACC_CHECK(in.render.estimator != EstimatorKind::power || in.powerTable);
+    // ris draws its candidates in proportion to power exactly when given the table: it must be the configured source.
+    ACC_CHECK(in.render.estimator != EstimatorKind::ris || (in.render.source == LightSource::power) == (in.powerTable != nullptr));
     ACC_CHECK(in.render.estimator != EstimatorKind::tree || in.lightTree);
     ACC_CHECK(in.render.estimator != EstimatorKind::restir);
     allocate(out, pixels);

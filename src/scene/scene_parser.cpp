@@ -1,7 +1,6 @@
 #include "accretion/scene/scene_parser.h"
 
 #include <algorithm>
-#include <bit>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -277,7 +276,7 @@ void validate(const Settings& s, const std::map<std::string, std::string>& loc, 
         s.particles.file.empty() && s.particles.count > (std::uint64_t(1) << s.restir.light_bits))
         fail("restir.light_bits", fmt::format("{} bits address {} lights but particles.count = {}: the packed layout needs {} bits",
                                               s.restir.light_bits, std::uint64_t(1) << s.restir.light_bits,
-                                              s.particles.count, std::max(1, int(std::bit_width(s.particles.count - 1)))));
+                                              s.particles.count, indexBits(s.particles.count)));
     if (s.render.target_stderr > 0.0 && s.render.max_samples < s.render.samples)
         fail("render.max_samples", fmt::format("must be at least render.samples ({}) when target_stderr is set", s.render.samples));
     if (s.render.memory_limit_mb > 0.0) {

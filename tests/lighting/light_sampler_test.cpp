@@ -74,6 +74,16 @@ TEST_CASE("every light sampler draws in proportion to its pdf (one chi-square ha
         lit[i] = L.term<ShadingModel::lambert>(sp, i, t);
         emits[i] = luminance(particles.emission[i]) > 0.0f;
     }
+    // The source pdfs against their closed forms, computed here from the particles:
+    // 1 / N, and luminance(I_i) / sum of luminance (the frequencies are then checked against these).
+    double total = 0.0;
+    for (const Vec3& I : particles.emission) total += 0.2126 * I.x + 0.7152 * I.y + 0.0722 * I.z;
+    for (std::uint32_t i = 0; i < N; ++i) {
+        const Vec3& I = particles.emission[i];
+        CHECK(sourcePdf<false>(L, nullptr, i) == Approx(1.0 / N).epsilon(1e-6));
+        CHECK(sourcePdf<true>(L, &power, i) ==
+              Approx((0.2126 * I.x + 0.7152 * I.y + 0.0722 * I.z) / total).epsilon(1e-5).margin(1e-12));
+    }
     checkSampler({"uniform", [&](Rng& rng) { return sampleSource<false>(L, nullptr, rng); },
                   [&](std::uint32_t i) { return sourcePdf<false>(L, nullptr, i); }},
                  N, emits);

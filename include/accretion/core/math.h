@@ -17,6 +17,13 @@ inline constexpr float kInv4Pi = 1.0f / (4.0f * kPi);
 /// Rec.709 / sRGB luminance of a linear RGB triple.
 inline float luminance(const Vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
+/// Bits that address n items, indices 0..n-1 (at least 1): 100K particles need 17.
+inline std::uint32_t indexBits(std::uint64_t n) {
+    std::uint32_t b = 1;
+    while (b < 64 && (std::uint64_t(1) << b) < n) ++b;
+    return b;
+}
+
 inline bool isFinite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 /// Orthonormal basis around a unit vector n (Duff et al. 2017, branchless).

@@ -33,11 +33,9 @@ public:
     explicit Table(std::vector<Column> columns) : columns_(std::move(columns)) {}
     /// A row: one cell per column, in order.
     void add(std::vector<Cell> row) { rows_.push_back(std::move(row)); }
-    const std::vector<std::vector<Cell>>& rows() const { return rows_; }
-    bool empty() const { return rows_.empty(); }
 
-    /// Header line and rows, aligned, each line prefixed by `indent`.
-    std::string console(const std::string& indent = "", bool header = true) const;
+    /// Header line and rows, aligned.
+    std::string console() const;
     /// CSV with a header line (columns with a key; a flag is 1 or 0).
     std::string csv() const;
     /// An array of objects keyed by the column keys (a non-finite number is null).

@@ -75,11 +75,12 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
     const LightArrays L(in.particles, in.settings.shading);
     const FramePlan& plan = in.plan;
     ACC_CHECK(plan.restir);
+    ACC_CHECK((plan.sampler == LightSamplerKind::power) == (in.powerTable != nullptr));  // candidates from the planned source
     ACC_CHECK(!plan.temporal || (history_ && history_->gbuffer.width == lg->width && history_->gbuffer.height == lg->height));
     const History* prev = plan.temporal ? history_.get() : nullptr;
     std::vector<std::uint32_t> lowRejected(lpixels, 0);
     restir::FrameContext f{in, rs_, codec_, *lg, L, prev, lg == &full ? 1.0f : float(lg->width) / float(full.width),
-                   VisibilityOptions::from(in.settings.render), in.settings.shading.visibility, in.counters,
+                   VisibilityOptions::from(in.settings.render), plan.shadowRays, in.counters,
                    lowRejected.data()};
 
     std::vector<StoredReservoir> a(lpixels), b(lpixels);

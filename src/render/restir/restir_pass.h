@@ -55,7 +55,6 @@ struct Scratch {
     std::vector<std::uint8_t> counts;   ///< basic: the domain counts in Z
 };
 
-
 /// Runs body(px, x, y, counters) or body(px, x, y, counters, scratch) over
 /// the pixels of a w x h grid in 8x8 tiles; counters and scratch are the
 /// running thread's.
@@ -90,7 +89,7 @@ struct FrameContext {
     const Restir::History* prev;
     float scale;                ///< lighting / image resolution
     VisibilityOptions vis;      ///< render.visibility_rule
-    bool shadows;               ///< shading.visibility: trace shadow rays (off: V = 1)
+    bool shadows;               ///< plan.shadowRays: trace shadow rays (off: V = 1)
     FrameCounters* counters;    ///< counting mode: per-pass thread records
     std::uint32_t* rejected;    ///< per lighting texel: non-finite values rejected (render.nonfinite)
 
