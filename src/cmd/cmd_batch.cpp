@@ -28,6 +28,7 @@
 #include "accretion/core/stop_signal.h"
 #include "accretion/core/version.h"
 #include "accretion/core/atomic_file.h"
+#include "accretion/scene/toml_limits.h"
 #include "accretion/io/stats_writer.h"
 #include "commands.h"
 
@@ -78,9 +79,13 @@ std::vector<std::uint64_t> parseRange(const std::string& text, const char* optio
 /// [[job]] tables of a jobs file; paths relative to the file. Every key is
 /// checked: an unknown or mistyped one names its line.
 std::vector<Job> readJobsFile(const std::filesystem::path& file, BatchArgs& args) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw InputError(fmt::format("{}: cannot open jobs file", file.string()));
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    checkTomlNesting(text, file.string());
     toml::table root;
     try {
-        root = toml::parse_file(file.string());
+        root = toml::parse(text, file.string());
     } catch (const toml::parse_error& e) {
         const auto& src = e.source();
         throw InputError(fmt::format("{}:{}: {}", file.string(), src.begin.line, e.description()));

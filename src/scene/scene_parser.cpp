@@ -13,6 +13,7 @@
 #include <toml++/toml.h>
 
 #include "accretion/core/error.h"
+#include "accretion/scene/toml_limits.h"
 
 namespace accretion {
 namespace {
@@ -63,6 +64,7 @@ Overrides parseOverrides(const std::vector<std::string>& items) {
         const std::string value = item.substr(eq + 1);
         if (std::count(key.begin(), key.end(), '.') != 1)
             throw InputError(fmt::format("command line {}: key must be section.key (e.g. render.frames)", flag));
+        checkTomlNesting("v = " + value, flag);
         toml::table doc;
         try {
             doc = toml::parse("v = " + value, flag);
@@ -353,6 +355,7 @@ private:
 
 Settings parseScene(std::string_view text, std::string_view sourceName, const std::vector<std::string>& overrideItems,
                     const std::vector<FlagSetting>& flags) {
+    checkTomlNesting(text, sourceName);
     toml::table root;
     try {
         root = toml::parse(text, sourceName);
