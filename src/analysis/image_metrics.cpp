@@ -1,5 +1,7 @@
 #include "accretion/analysis/image_metrics.h"
 
+#include <fstream>
+
 #include <algorithm>
 #include <cmath>
 
@@ -20,7 +22,12 @@ ErrorMetrics computeErrors(const std::vector<Vec3>& x, const std::vector<Vec3>& 
     m.pixels = x.size();
     if (x.empty()) return m;
     double rel = 0.0, mse = 0.0, mape = 0.0, floor = 0.0;
+    auto finite = [](const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
     for (std::size_t i = 0; i < x.size(); ++i) {
+        if (!finite(x[i]) || !finite(ref[i]) || (refStderr && !finite((*refStderr)[i]))) {
+            if (m.nonFinite++ == 0) m.firstNonFinite = i;
+            continue;
+        }
         for (int c = 0; c < 3; ++c) {
             const double r = ref[i][c];
             const double d = double(x[i][c]) - r;
@@ -33,7 +40,9 @@ ErrorMetrics computeErrors(const std::vector<Vec3>& x, const std::vector<Vec3>& 
             }
         }
     }
-    const double n = 3.0 * double(x.size());
+    m.pixels = x.size() - m.nonFinite;
+    if (m.pixels == 0) return m;
+    const double n = 3.0 * double(m.pixels);
     m.relMSE = rel / n;
     m.MSE = mse / n;
     m.MAPE = mape / n;
@@ -51,6 +60,15 @@ std::vector<std::string> layerChannels(const std::string& layer) {
 }  // namespace
 
 bool exrHasLayer(const std::filesystem::path& file, const std::string& layer) {
+    {
+        std::ifstream f(file, std::ios::binary);
+        if (!f) throw InputError(fmt::format("{}: cannot open image", file.string()));
+        unsigned char magic[4] = {};
+        f.read(reinterpret_cast<char*>(magic), 4);
+        if (!(magic[0] == 0x76 && magic[1] == 0x2f && magic[2] == 0x31 && magic[3] == 0x01))
+            throw InputError(fmt::format("{}: not an OpenEXR file: images are compared as scene-referred floats (EXR), "
+                                         "not display-referred 8-bit previews", file.string()));
+    }
     auto in = OIIO::ImageInput::open(file.string());
     if (!in) return false;
     const OIIO::ImageSpec& spec = in->spec();
@@ -60,6 +78,15 @@ bool exrHasLayer(const std::filesystem::path& file, const std::string& layer) {
 }
 
 RgbLayer readExrLayer(const std::filesystem::path& file, const std::string& layer) {
+    {
+        std::ifstream f(file, std::ios::binary);
+        if (!f) throw InputError(fmt::format("{}: cannot open image", file.string()));
+        unsigned char magic[4] = {};
+        f.read(reinterpret_cast<char*>(magic), 4);
+        if (!(magic[0] == 0x76 && magic[1] == 0x2f && magic[2] == 0x31 && magic[3] == 0x01))
+            throw InputError(fmt::format("{}: not an OpenEXR file: images are compared as scene-referred floats (EXR), "
+                                         "not display-referred 8-bit previews", file.string()));
+    }
     auto in = OIIO::ImageInput::open(file.string());
     if (!in) throw InputError(fmt::format("{}: cannot read image: {}", file.string(), OIIO::geterror()));
     const OIIO::ImageSpec& spec = in->spec();

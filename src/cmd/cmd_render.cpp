@@ -12,6 +12,7 @@
 #include "accretion/core/error.h"
 #include "accretion/core/parse.h"
 #include "accretion/core/memory.h"
+#include "accretion/core/output_guard.h"
 #include "accretion/core/version.h"
 #include "accretion/gpu/gpu_report.h"
 #include "accretion/core/stop_signal.h"
@@ -20,6 +21,7 @@
 #include "accretion/core/atomic_file.h"
 #include "accretion/io/exr_output.h"
 #include "accretion/io/stats_writer.h"
+#include "accretion/particles/particle_source.h"
 #include "accretion/render/frame_renderer.h"
 #include "accretion/scene/scene_parser.h"
 #include "commands.h"
@@ -139,15 +141,52 @@ struct RenderRun {
     const Sharding& sharding;
     std::string settingsToml;
     std::string shardLabel;  ///< "i/n"
+    OutputGuard guard = {};  ///< the run's inputs, which no output may replace
 };
+
+/// A frame's image outputs: the EXR and, beside it, its previews and (shards
+/// of samples) the sums a merge needs.
+struct FramePaths {
+    std::string exr, base;
+    std::string png() const { return base + ".png"; }
+    std::string lrPng() const { return base + ".Lr.png"; }
+    std::string acc() const { return base + ".acc"; }
+};
+
+FramePaths framePaths(const RenderRun& run, std::uint32_t frame) {
+    const Settings& s = run.settings;
+    FramePaths p;
+    p.exr = shardPath(expandPattern(s.render.output, s.sceneName, frame), run.sharding.samples());
+    p.base = std::filesystem::path(p.exr).replace_extension().string();
+    return p;
+}
+
+/// Before anything is written: the run reads its scene and particle files
+/// (every frame's checked now: exists, header, size, count), and no output of
+/// any frame, nor the run's stats, settings, checkpoint or list, may replace
+/// one of them or land on a device or a directory.
+void guardRun(RenderRun& run, const std::string& stem, const std::string& outputsFile) {
+    const Settings& s = run.settings;
+    run.guard.addInput(s.scenePath);
+    for (const auto& f : ParticleSource(s).checkFiles(run.sharding.first, run.sharding.end)) run.guard.addInput(f);
+    for (std::uint32_t frame = run.sharding.first; frame < run.sharding.end; ++frame) {
+        const FramePaths p = framePaths(run, frame);
+        for (const std::string& out : {p.exr, p.png(), p.lrPng()}) run.guard.check(out, "output");
+        if (run.sharding.bySamples) run.guard.check(p.acc(), "output");
+    }
+    for (const char* suffix : {".settings.toml", ".stats.json", ".checkpoint"}) run.guard.check(stem + suffix, "output");
+    if (!outputsFile.empty()) run.guard.check(outputsFile, "--outputs-file");
+}
 
 /// The writeOutputs pass of a frame: EXR, previews, a shard's sums and the
 /// counter heatmaps; returns the frame's stats with its outputs.
 nlohmann::json writeFrameOutputs(const RenderRun& run, std::uint32_t frame, const FrameImage& image, FrameStats& fs,
                                  const Accumulation& sums) {
     const Settings& settings = run.settings;
-    const std::string exr = shardPath(expandPattern(settings.render.output, settings.sceneName, frame), run.sharding.samples());
-    const std::string base = std::filesystem::path(exr).replace_extension().string();
+    const FramePaths paths = framePaths(run, frame);
+    const std::string& exr = paths.exr;
+    const std::string& base = paths.base;
+    for (const Heatmap& h : image.heatmaps) run.guard.check(base + "." + h.name + ".png", "output");
     const OutputMetadata meta = {
         {"version", std::string(version())},   {"scene", settings.scenePath},
         {"frame", std::to_string(frame)},      {"estimator", std::string(enumName(settings.render.estimator))},
@@ -239,7 +278,9 @@ void runRender(const RenderArgs& args) {
     const Sharding sharding = planSharding(settings, args);
     const Shard& shard = sharding.shard;
     const std::string stem = shardPath(runStem(settings), shard);
-    const RenderRun run{settings, sharding, settingsToToml(settings), fmt::format("{}/{}", shard.index, shard.count)};
+    RenderRun run{settings, sharding, settingsToToml(settings), fmt::format("{}/{}", shard.index, shard.count)};
+    guardRun(run, stem, args.outputsFile);
+    const OutputLock lock(stem + ".lock");  // one run at a time writes these outputs
     removeStaleTemporaries(std::filesystem::path(stem).parent_path());
     nlohmann::json stats = runStats(run, args.threads > 0 ? args.threads : tbb::info::default_concurrency());
 

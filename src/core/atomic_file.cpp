@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "accretion/core/error.h"
+#include "accretion/core/output_guard.h"
 #include "accretion/core/parse.h"
 
 namespace accretion {
@@ -18,7 +19,9 @@ namespace {
 
 std::filesystem::path tempPathFor(const std::filesystem::path& file) {
     const auto dir = file.parent_path();
-    const std::string name = fmt::format(".{}.tmp{}{}", file.stem().string(), ::getpid(), file.extension().string());
+    // Within the system's limit on a name, however long the output's.
+    const std::string name = fmt::format(".{}.tmp{}{}", file.stem().string().substr(0, 160), ::getpid(),
+                                         file.extension().string().substr(0, 40));
     return dir.empty() ? std::filesystem::path(name) : dir / name;
 }
 
@@ -27,7 +30,7 @@ void ensureParent(const std::filesystem::path& file) {
     if (dir.empty()) return;
     std::error_code ec;
     std::filesystem::create_directories(dir, ec);
-    if (ec) throw InputError(fmt::format("{}: cannot create output directory: {}", dir.string(), ec.message()));
+    if (ec) throw InputError(fmt::format("{}: cannot create output directory: {}", displayPath(dir), ec.message()));
 }
 
 void syncFile(const std::filesystem::path& p) {
@@ -41,6 +44,7 @@ void syncFile(const std::filesystem::path& p) {
 }  // namespace
 
 void writeAtomicWith(const std::filesystem::path& file, const std::function<void(const std::filesystem::path&)>& write) {
+    checkOutputPath(file, "output");  // never onto a device, a directory, a FIFO
     ensureParent(file);
     const auto tmp = tempPathFor(file);
     try {
@@ -48,7 +52,7 @@ void writeAtomicWith(const std::filesystem::path& file, const std::function<void
         syncFile(tmp);
         std::error_code ec;
         std::filesystem::rename(tmp, file, ec);
-        if (ec) throw InputError(fmt::format("{}: cannot rename output into place: {}", file.string(), ec.message()));
+        if (ec) throw InputError(fmt::format("{}: cannot rename output into place: {}", displayPath(file), ec.message()));
     } catch (...) {
         std::error_code ignored;
         std::filesystem::remove(tmp, ignored);

@@ -272,6 +272,9 @@ void validate(const Settings& s, const std::map<std::string, std::string>& loc, 
     if (static_cast<std::uint64_t>(s.render.frame_start) + s.render.frames > 0xffffffffull)
         fail("render.frames", "frame_start + frames overflows");
     if (s.render.output.empty()) fail("render.output", "must not be empty");
+    if (const std::string& o = s.render.output; o.size() < 5 || o.compare(o.size() - 4, 4, ".exr") != 0 || o.back() == '/' ||
+                                                o[o.size() - 5] == '/')
+        fail("render.output", "must be a file name ending in .exr (the EXR goes there, its previews and stats beside it)");
     if (s.render.frames > 1 && s.render.output.find("{frame}") == std::string::npos)
         fail("render.output", "a multi-frame render needs a {frame} pattern in the output path");
     if (s.render.estimator == EstimatorKind::restir && s.restir.layout == ReservoirLayout::packed &&

@@ -18,7 +18,11 @@ struct ErrorMetrics {
     /// Mean of sigma_ref^2 / (ref^2 + eps): what the reference's own noise
     /// adds to relMSE in expectation (0 without a stderr layer).
     double relMSEFloor = 0.0;
-    std::size_t pixels = 0;
+    std::size_t pixels = 0;      ///< pixels measured
+    /// Pixels left out because a value of the image, the reference or its
+    /// stderr is NaN or infinite, and the first of them (row-major index).
+    std::size_t nonFinite = 0;
+    std::size_t firstNonFinite = 0;
 };
 
 inline constexpr double kRelMseEpsilon = 1e-2;
@@ -33,7 +37,9 @@ struct RgbLayer {
 };
 
 /// Read layer `layer` ("" = R,G,B; "Lr" = Lr.R, Lr.G, Lr.B; ...). Throws
-/// InputError naming the file when it cannot be read or lacks the channels.
+/// InputError naming the file when it is not an OpenEXR file (by its magic:
+/// a PNG or JPEG is display-referred and 8-bit, not a measurement), cannot
+/// be read or lacks the channels.
 RgbLayer readExrLayer(const std::filesystem::path& file, const std::string& layer);
 /// True if the file has all three channels of the layer.
 bool exrHasLayer(const std::filesystem::path& file, const std::string& layer);

@@ -1,5 +1,7 @@
 #pragma once
 #include <cstdint>
+#include <filesystem>
+#include <vector>
 #include <memory>
 #include <optional>
 
@@ -22,6 +24,13 @@ public:
     Particles frame(std::uint32_t frame) const;
     /// True if every frame holds the same particles.
     bool isStatic() const;
+
+    /// Before a run of frames [first, end): every particle file it reads
+    /// (the frames' and the neighbours that give velocities) inspected
+    /// (exists, header, size) and, for a {frame} sequence, all with the
+    /// same count, so that particle i is the same particle in every frame.
+    /// InputError names the first file that differs. Returns the files.
+    std::vector<std::filesystem::path> checkFiles(std::uint32_t first, std::uint32_t end) const;
 
 private:
     ParticleSource() = default;
