@@ -3,6 +3,7 @@
 // crashing job does not stop the others; a summary JSON lists every job's
 // outcome, time and outputs, rewritten atomically after each job.
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <csignal>
 #include <cstring>
@@ -25,6 +26,7 @@
 #include <toml++/toml.h>
 
 #include "accretion/core/error.h"
+#include "accretion/core/output_guard.h"
 #include "accretion/core/stop_signal.h"
 #include "accretion/core/version.h"
 #include "accretion/core/atomic_file.h"
@@ -59,7 +61,28 @@ struct BatchArgs {
     int parallel = 1;
     int threads = 0;
     bool resume = false, quiet = false;
+    bool outputDirGiven = false, parallelGiven = false;  ///< on the command line: the file's are ignored
 };
+
+/// Why `name` cannot name a job (its outputs are <output_dir>/<name>/...),
+/// or empty: a name, not a path.
+std::string badJobName(const std::string& name) {
+    if (name.empty()) return "empty";
+    if (name.size() > 128) return fmt::format("{} characters (at most 128)", name.size());
+    if (name.front() == '.') return "starts with '.'";
+    for (char c : name)
+        if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' || c == '+'))
+            return c == '/' || c == '\\' ? "is a path" : fmt::format("holds '{}'", c < 0x20 ? '?' : c);
+    return {};
+}
+
+/// A generated job name (from a scene's stem): the characters a name allows.
+std::string sanitizeJobName(std::string name) {
+    for (char& c : name)
+        if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' || c == '+')) c = '_';
+    if (name.empty() || name.front() == '.') name = "job" + name;
+    return name.substr(0, 128);
+}
 
 std::string where(const toml::node& n) {
     const auto& src = n.source();
@@ -106,8 +129,14 @@ std::vector<Job> readJobsFile(const std::filesystem::path& file, BatchArgs& args
             const toml::table* t = node.as_table();
             if (!t) throw InputError(fmt::format("{}: [batch] must be a table", where(node)));
             for (const auto& [k, v] : *t) {
-                if (k.str() == "output_dir") args.outputDir = path(str(v, "batch.output_dir"));
-                else if (k.str() == "parallel") args.parallel = int(integer(v, "batch.parallel", 1, 256));
+                // The command line overrides the file.
+                if (k.str() == "output_dir") {
+                    const std::string dirText = str(v, "batch.output_dir");
+                    if (!args.outputDirGiven) args.outputDir = path(dirText);
+                } else if (k.str() == "parallel") {
+                    const int n = int(integer(v, "batch.parallel", 1, 256));
+                    if (!args.parallelGiven) args.parallel = n;
+                }
                 else throw InputError(fmt::format("{}: batch.{}: unknown key (output_dir, parallel)", where(v), k.str()));
             }
         } else if (key.str() != "job") {
@@ -124,7 +153,13 @@ std::vector<Job> readJobsFile(const std::filesystem::path& file, BatchArgs& args
         Job j;
         for (const auto& [k, v] : *t) {
             const std::string key = "job." + std::string(k.str());
-            if (k.str() == "name") j.name = str(v, key);
+            if (k.str() == "name") {
+                j.name = str(v, key);
+                if (const std::string why = badJobName(j.name); !why.empty())
+                    throw InputError(fmt::format("{}: job.name \"{}\": {}; a job's name names its outputs in the output "
+                                                 "directory, so it is a name, not a path (letters, digits, . _ - +, not "
+                                                 "starting with .)", where(v), j.name.substr(0, 64), why));
+            }
             else if (k.str() == "scene") j.scene = path(str(v, key));
             else if (k.str() == "frames") j.frames = v.is_integer() ? std::to_string(integer(v, key, 0, 1000000000)) : str(v, key);
             else if (k.str() == "seed") j.seed = std::uint64_t(integer(v, key, 0, std::numeric_limits<std::int64_t>::max()));
@@ -142,8 +177,8 @@ std::vector<Job> readJobsFile(const std::filesystem::path& file, BatchArgs& args
         }
         if (j.scene.empty()) throw InputError(fmt::format("{}: job without a scene", where(n)));
         if (j.name.empty())
-            j.name = fmt::format("{}{}{}", std::filesystem::path(j.scene).stem().string(),
-                                 j.frames.empty() ? "" : "-f" + j.frames, j.seed ? fmt::format("-s{}", *j.seed) : "");
+            j.name = sanitizeJobName(fmt::format("{}{}{}", std::filesystem::path(j.scene).stem().string(),
+                                                 j.frames.empty() ? "" : "-f" + j.frames, j.seed ? fmt::format("-s{}", *j.seed) : ""));
         out.push_back(std::move(j));
     }
     return out;
@@ -163,8 +198,8 @@ std::vector<Job> commandLineJobs(const BatchArgs& args) {
                 j.scene = scene;
                 if (!frames.empty()) j.frames = std::to_string(frames[f]);
                 if (!seeds.empty()) j.seed = seeds[s];
-                j.name = fmt::format("{}{}{}", stem, frames.empty() ? "" : fmt::format("-f{}", frames[f]),
-                                     seeds.empty() ? "" : fmt::format("-s{}", seeds[s]));
+                j.name = sanitizeJobName(fmt::format("{}{}{}", stem, frames.empty() ? "" : fmt::format("-f{}", frames[f]),
+                                                     seeds.empty() ? "" : fmt::format("-s{}", seeds[s])));
                 jobs.push_back(std::move(j));
             }
     }
@@ -284,10 +319,25 @@ void recordOutcome(nlohmann::json& r, int status, double seconds, const std::fil
     else r["error"] = lastLine(r["log"].get<std::string>());
 }
 
+/// Nothing the batch writes itself (summary, logs, job lists) may replace
+/// the jobs file or a scene.
+void guardBatch(const BatchArgs& args, const std::vector<Job>& jobs, const std::string& summaryPath) {
+    OutputGuard guard;
+    guard.addInput(args.jobsFile);
+    for (const Job& j : jobs) guard.addInput(j.scene);
+    guard.check(summaryPath, "--summary");
+    for (const Job& j : jobs) {
+        guard.check(std::filesystem::path(args.outputDir) / (j.name + ".log"), "job log");
+        guard.check(outputsFile(args, j), "job outputs list");
+    }
+}
+
 void runBatch(BatchArgs args) {
     const std::vector<Job> jobs = batchJobs(args);
     const std::filesystem::path outDir(args.outputDir);
     const std::string summaryPath = args.summary.empty() ? (outDir / "batch.json").string() : args.summary;
+    guardBatch(args, jobs, summaryPath);
+    const OutputLock lock(std::filesystem::path(summaryPath).replace_extension(".lock"));  // one batch per summary
     const std::map<std::string, nlohmann::json> previous = finishedJobs(summaryPath, args.resume);
 
     nlohmann::json summary = {{"version", std::string(version())},
@@ -393,7 +443,11 @@ void addBatchCommand(CLI::App& app) {
     cmd->add_flag("--resume", args->resume, "Skip jobs the summary lists as ok; others continue from their checkpoints");
     cmd->add_flag("-q,--quiet", args->quiet, "No progress on stderr");
     cmd->footer("Exit codes: 0 every job ok, 1 bad input (jobs file, command line), 4 some job failed, 128+N stopped by signal N.");
-    cmd->callback([args] { runBatch(*args); });
+    cmd->callback([args, cmd] {
+        args->outputDirGiven = cmd->get_option("--output-dir")->count() > 0;
+        args->parallelGiven = cmd->get_option("--parallel")->count() > 0;
+        runBatch(*args);
+    });
 }
 
 }  // namespace accretion::cmd

@@ -9,6 +9,7 @@
 #include "accretion/core/error.h"
 #include "accretion/core/version.h"
 #include "accretion/io/accumulation_file.h"
+#include "accretion/core/output_guard.h"
 #include "accretion/io/exr_output.h"
 #include "accretion/render/estimators.h"
 #include "commands.h"
@@ -106,7 +107,21 @@ std::vector<Vec3> mergeInto(RawExr& exr, const Accumulation& merged, const Light
 }
 
 void runMerge(const MergeArgs& args) {
+    const std::filesystem::path output(args.output);
+    if (output.extension() != ".exr" || output.stem().empty())
+        throw InputError(fmt::format("command line -o {}: the merged image must be a file name ending in .exr",
+                                     displayPath(output)));
+    const std::filesystem::path png = std::filesystem::path(output).replace_extension(".png");
     const std::vector<ShardInput> in = readShards(args);
+    OutputGuard guard;  // the merge never writes over a shard it reads
+    for (const ShardInput& s : in) {
+        guard.addInput(s.exr);
+        guard.addInput(std::filesystem::path(s.exr).replace_extension(".acc"));
+        guard.addInput(std::filesystem::path(s.exr).replace_extension(".png"));
+    }
+    guard.check(output, "-o");
+    guard.check(png, "-o (its preview)");
+    const OutputLock lock(std::filesystem::path(output).replace_extension(".lock"));
     const nlohmann::json& first = in.front().acc.header;
     const std::uint32_t count = in.front().shard.count;
 
@@ -125,9 +140,9 @@ void runMerge(const MergeArgs& args) {
     exr.attributes["accretion:shard"] = fmt::format("merged {} shards", count);
     exr.attributes["accretion:merge_version"] = std::string(version());
     exr.attributes.erase("accretion:render_time_s");
-    writeRawExr(args.output, exr);
-    const std::filesystem::path base = std::filesystem::path(args.output).replace_extension();
-    writePreviewPng(base.string() + ".png", preview, exr.width, exr.height, first.value("auto_exposure", true),
+    writeRawExr(output, exr);
+    const std::filesystem::path base = std::filesystem::path(output).replace_extension();
+    writePreviewPng(png, preview, exr.width, exr.height, first.value("auto_exposure", true),
                     first.value("exposure", 0.0));
     double meanSpp = 0.0;
     std::size_t sampled = 0;

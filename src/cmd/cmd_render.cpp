@@ -127,9 +127,6 @@ Sharding planSharding(const Settings& settings, const RenderArgs& args) {
         s.end = settings.render.frame_start + std::uint32_t(std::uint64_t(F) * (s.shard.index + 1) / s.shard.count);
     }
     if (s.bySamples) planLighting(settings.render, settings.camera.height, s.shard);  // can it be cut? (throws)
-    if (args.resume && !s.accumulating)
-        throw InputError("command line --resume: restir keeps reservoir history across frames and is not checkpointed; "
-                         "re-run the frames (finished frames are complete on disk)");
     if (!(args.checkpointEvery >= 0.0))
         throw InputError(fmt::format("command line --checkpoint-every {}: expected seconds >= 0", args.checkpointEvery));
     return s;
@@ -294,8 +291,10 @@ void runRender(const RenderArgs& args) {
         if (!args.quiet)
             fmt::print(stderr, "accretion: resuming {} at frame {}, chunk {}\n", checkpoint.file().string(), firstFrame,
                        resumed->acc.nextChunk);
-    } else if (args.resume && !args.quiet) {
-        fmt::print(stderr, "accretion: no checkpoint at {}: starting from the beginning\n", checkpoint.file().string());
+    } else if (args.resume && !args.quiet) {  // nothing to resume: start afresh
+        fmt::print(stderr, "accretion: {}: starting from the beginning\n",
+                   sharding.accumulating ? fmt::format("no checkpoint at {}", checkpoint.file().string())
+                                         : std::string("restir keeps reservoir history across frames and is not checkpointed"));
     }
 
     const auto start = std::chrono::steady_clock::now();

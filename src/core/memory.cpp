@@ -4,6 +4,8 @@
 #include <sstream>
 #include <string>
 
+#include <unistd.h>
+
 namespace accretion {
 
 std::int64_t peakResidentBytes() {
@@ -16,6 +18,11 @@ std::int64_t peakResidentBytes() {
         return kb < 0 ? -1 : kb * 1024;
     }
     return -1;
+}
+
+std::uint64_t physicalMemoryBytes() {
+    const long pages = ::sysconf(_SC_PHYS_PAGES), size = ::sysconf(_SC_PAGESIZE);
+    return pages > 0 && size > 0 ? std::uint64_t(pages) * std::uint64_t(size) : 0;
 }
 
 }  // namespace accretion

@@ -13,6 +13,7 @@
 #include <toml++/toml.h>
 
 #include "accretion/core/error.h"
+#include "accretion/core/memory.h"
 #include "accretion/scene/toml_limits.h"
 
 namespace accretion {
@@ -64,7 +65,7 @@ Overrides parseOverrides(const std::vector<std::string>& items) {
         const std::string value = item.substr(eq + 1);
         if (std::count(key.begin(), key.end(), '.') != 1)
             throw InputError(fmt::format("command line {}: key must be section.key (e.g. render.frames)", flag));
-        checkTomlNesting("v = " + value, flag);
+        checkTomlNesting("v = " + value, "command line -D " + key);
         toml::table doc;
         try {
             doc = toml::parse("v = " + value, flag);
@@ -284,18 +285,25 @@ void validate(const Settings& s, const std::map<std::string, std::string>& loc, 
                                               s.particles.count, indexBits(s.particles.count)));
     if (s.render.target_stderr > 0.0 && s.render.max_samples < s.render.samples)
         fail("render.max_samples", fmt::format("must be at least render.samples ({}) when target_stderr is set", s.render.samples));
-    if (s.render.memory_limit_mb > 0.0) {
+    {
         // Peak resident estimate from bench/results.json: ~300 B per particle
         // (particles, clusters, BVH) and ~330 B per pixel (G-buffer, images,
         // AOVs; reservoirs and history for restir), plus ~60 MB of libraries.
+        // Refused above render.memory_limit_mb, or else above the machine's
+        // physical memory (a run that cannot fit ends in an allocation failure).
         const double particles = s.particles.file.empty() ? double(s.particles.count) : 0.0;
         const double pixels = double(s.camera.width) * s.camera.height;
         const double perPixel = s.render.estimator == EstimatorKind::restir ? 480.0 : 330.0;
         const double mb = (300.0 * particles + perPixel * pixels) / 1e6 + 60.0;
-        if (mb > s.render.memory_limit_mb)
+        const double physicalMb = double(physicalMemoryBytes()) / 1e6;
+        if (s.render.memory_limit_mb > 0.0 && mb > s.render.memory_limit_mb)
             fail("render.memory_limit_mb",
                  fmt::format("{} particles at {}x{} need about {:.0f} MB, more than the limit of {:.0f} MB", particles,
                              s.camera.width, s.camera.height, mb, s.render.memory_limit_mb));
+        if (s.render.memory_limit_mb <= 0.0 && physicalMb > 0.0 && mb > physicalMb)
+            fail(300.0 * particles > perPixel * pixels ? "particles.count" : "camera.width",
+                 fmt::format("{} particles at {}x{} need about {:.0f} MB, more than this machine's {:.0f} MB of physical "
+                             "memory", particles, s.camera.width, s.camera.height, mb, physicalMb));
     }
     if (s.gpu.omm != OmmMode::off && s.geometry.alpha != AlphaMode::disc)
         fail("gpu.omm", "opacity micromaps apply to disc-alpha billboards (geometry.alpha = \"disc\")");

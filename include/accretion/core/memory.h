@@ -8,4 +8,7 @@ namespace accretion {
 /// exec), or -1 where unavailable.
 std::int64_t peakResidentBytes();
 
+/// The machine's physical memory in bytes (sysconf), or 0 where unknown.
+std::uint64_t physicalMemoryBytes();
+
 }  // namespace accretion

@@ -1,0 +1,1 @@
+batch jobs_abs.toml --quiet --output-dir batch_out

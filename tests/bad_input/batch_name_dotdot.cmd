@@ -1,0 +1,1 @@
+batch jobs_dotdot.toml --quiet --output-dir batch_out

@@ -1,0 +1,1 @@
+batch jobs_empty_name.toml --quiet --output-dir batch_out

@@ -1,0 +1,1 @@
+batch jobs_escape.toml --quiet --output-dir batch_out

@@ -1,0 +1,1 @@
+batch jobs_slash.toml --quiet --output-dir batch_out

@@ -1,0 +1,1 @@
+batch jobs_ok.toml --quiet --summary jobs_ok.toml

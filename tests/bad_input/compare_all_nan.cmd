@@ -1,0 +1,1 @@
+compare all_nan.exr half.exr --allow-nonfinite

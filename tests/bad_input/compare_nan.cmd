@@ -1,0 +1,1 @@
+compare some_nan.exr half.exr

@@ -1,0 +1,1 @@
+compare half.exr some_nan.exr

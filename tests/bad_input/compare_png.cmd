@@ -1,0 +1,1 @@
+compare half.png half.exr

@@ -1,0 +1,1 @@
+compare ok.toml half.exr

@@ -1,0 +1,1 @@
+plan deep_header.toml

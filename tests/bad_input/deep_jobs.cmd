@@ -1,0 +1,1 @@
+batch deep_jobs.toml --quiet

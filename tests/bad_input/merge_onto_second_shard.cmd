@@ -1,0 +1,1 @@
+merge -o shard.shard2of2.exr shard.shard1of2.exr shard.shard2of2.exr

@@ -1,0 +1,1 @@
+render ok.toml --quiet -o new/x.exr --outputs-file ok.toml

@@ -1,0 +1,1 @@
+render particles_png.toml --quiet -o clash_particles.exr

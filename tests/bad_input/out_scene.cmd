@@ -1,0 +1,1 @@
+render ok.toml --quiet -o ok.toml

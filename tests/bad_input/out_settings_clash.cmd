@@ -1,0 +1,1 @@
+render clash.settings.toml --quiet -o clash.exr
