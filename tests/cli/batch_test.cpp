@@ -109,3 +109,38 @@ TEST_CASE("batch: a bad jobs file is refused with its line, nothing run", "[cli]
     CHECK_THAT(out, Contains(c.error));
     CHECK_FALSE(fs::exists(dir / "out"));
 }
+
+TEST_CASE("batch: the example interrupted in its first job resumes to success; --output-dir overrides the file",
+          "[cli][batch][resume]") {
+    const fs::path dir = accretion::test::scratchDir("batch_example_resume");
+    const std::string jobs = std::string(ACCRETION_SOURCE_DIR) + "/scenes/batch/example_jobs.toml";
+    const std::string cmd = kBin + " batch " + jobs + " --quiet --output-dir " + (dir / "out").string();
+    const std::string script = cmd + " > /dev/null 2>&1 & P=$!\n" + "i=0; while [ ! -s " +
+                               (dir / "out" / "quickstart-exact-f0.log").string() +
+                               " ] && [ ! -f " + (dir / "out" / "quickstart-exact-f0.log").string() +
+                               " ] && [ $i -lt 600 ]; do sleep 0.05; i=$((i+1)); done\nsleep 0.3\nkill -INT $P; wait $P; echo \"first=$?\"\n";
+    std::ofstream(dir / "script.sh") << script;
+    std::string out;
+    runCommand("sh " + (dir / "script.sh").string() + " 2>&1", out);
+    INFO(out);
+    CHECK_THAT(out, Contains("first=130"));
+    const auto stopped = readJson(dir / "out" / "batch.json");
+    CHECK(stopped["counts"].value("ok", 0) < 3);
+    // The jobs that never started have nothing to resume: they start afresh
+    // (restir among them), the interrupted one continues its checkpoint.
+    REQUIRE(runCommand(cmd + " --resume", out) == 0);
+    const auto done = readJson(dir / "out" / "batch.json");
+    CHECK(done["counts"]["ok"] == 3);
+    for (const auto& j : done["jobs"]) {
+        INFO(j.dump());
+        CHECK(j["outcome"] == "ok");
+    }
+    CHECK(fs::exists(dir / "out" / "quickstart-restir-f0-2" / "quickstart.0002.exr"));
+    // Everything under the command line's --output-dir, nothing where the file says.
+    std::ofstream(dir / "jobs.toml") << "[batch]\noutput_dir = \"from_file\"\n[[job]]\nname = \"j\"\nscene = \""
+                                     << accretion::test::smallDiskScene() << "\"\nestimator = \"uniform\"\nspp = 1\n";
+    REQUIRE(runCommand(kBin + " batch " + (dir / "jobs.toml").string() + " --quiet --output-dir " + (dir / "cli").string(), out) == 0);
+    CHECK(fs::exists(dir / "cli" / "batch.json"));
+    CHECK(fs::exists(dir / "cli" / "j" / "small_disk.0000.exr"));
+    CHECK(!fs::exists(dir / "from_file"));
+}

@@ -53,3 +53,40 @@ TEST_CASE("an output directory that cannot exist: a clear error and exit 1", "[c
     CHECK(accretion::test::runCommand(render(dir / "file" / "x.exr"), out) == 1);
     CHECK_THAT(out, Contains("cannot create output directory"));
 }
+
+TEST_CASE("two runs to one output: the second is refused naming the first's PID; the checkpoint survives",
+          "[cli][fault][lock]") {
+    const fs::path dir = accretion::test::scratchDir("fault_two_runs");
+    const std::string slow = std::string(ACCRETION_BINARY) + " render " + ACCRETION_SOURCE_DIR +
+                             "/scenes/quickstart.toml --quiet --frames 0:1 -D camera.width=320 -D camera.height=180 "
+                             "-D particles.count=20000 --estimator uniform --spp 2048 --checkpoint-every 0 -o " +
+                             (dir / "x.exr").string();
+    // The first run in the background; once it holds the lock, a second run
+    // to the same outputs; then the first is interrupted (it checkpoints),
+    // and a third run without --resume must leave that checkpoint alone.
+    const std::string script = slow + " > /dev/null 2> " + (dir / "first.err").string() + " & P=$!\n" +
+                               "i=0; while [ ! -s " + (dir / "x.lock").string() + " ] && [ $i -lt 600 ]; do sleep 0.05; i=$((i+1)); done\n" +
+                               slow + " 2>&1 > /dev/null; echo \"second=$? first_pid=$P\"\n" +
+                               "kill -INT $P; wait $P; echo \"first=$?\"\n" +
+                               slow + " 2>&1 > /dev/null; echo \"third=$?\"\n";
+    std::ofstream(dir / "script.sh") << script;
+    std::string out;
+    accretion::test::runCommand("sh " + (dir / "script.sh").string() + " 2>&1", out);
+    INFO(out << "\nfirst run:\n" << accretion::test::readFile(dir / "first.err"));
+    const auto pidAt = out.find("first_pid=");
+    REQUIRE(pidAt != std::string::npos);
+    const std::string pid = out.substr(pidAt + 10, out.find('\n', pidAt) - pidAt - 10);
+    CHECK_THAT(out, Contains("x.lock: another run (PID " + pid + ") is writing these outputs"));
+    CHECK_THAT(out, Contains("second=1 "));
+    CHECK_THAT(out, Contains("first=130"));
+    CHECK_THAT(out, Contains("a checkpoint of an interrupted run is here"));
+    CHECK_THAT(out, Contains("third=1"));
+    CHECK(fs::exists(dir / "x.checkpoint"));
+    CHECK(!fs::exists(dir / "x.exr"));
+    CHECK(!fs::exists(dir / "x.lock"));  // released by the interrupted run
+    // The checkpoint the first run named still resumes to a complete image.
+    CHECK(accretion::test::runCommand(slow + " --resume 2>&1", out) == 0);
+    CHECK(fs::exists(dir / "x.exr"));
+    CHECK(!fs::exists(dir / "x.checkpoint"));
+    CHECK(!fs::exists(dir / "x.lock"));
+}

@@ -89,6 +89,11 @@ std::vector<std::string> brokenFiles(const fs::path& dir, std::size_t& checked) 
             else if (ext == ".checkpoint" || ext == ".acc") accretion::readAccumulationFile(p);
             else if (ext == ".toml") {
                 if (accretion::test::readFile(p).find("[render]") == std::string::npos) throw std::runtime_error("truncated");
+            } else if (ext == ".lock") {
+                // Left by a killed run (the kernel released its flock): a PID,
+                // or empty when killed between creating and writing it.
+                const std::string pid = accretion::test::readFile(p);
+                if (pid.find_first_not_of("0123456789\n") != std::string::npos) throw std::runtime_error("not a PID");
             } else throw std::runtime_error("unexpected file");
         } catch (const std::exception& ex) {
             broken.push_back(name + ": " + ex.what());
