@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# libFuzzer runs of the scene parser and the particle readers (clang from
+# libFuzzer runs of the scene parser, the particle readers, the PLY header,
+# the accumulation reader and the batch jobs file (clang from
 # Debian, AddressSanitizer + UBSan), seeded from tests/fuzz/corpus_*.
 #   scripts/fuzz.sh [seconds per target]    (CI: 30; a longer run: 3600)
 # New inputs go to build-fuzz/corpus_*; a crash leaves build-fuzz/crash-* and fails.
@@ -8,8 +9,9 @@ cd "$(dirname "$0")/.."
 seconds=${1:-30}
 CXX=clang++ CC=clang cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DACCRETION_FUZZ=ON \
   -DACCRETION_BUILD_TESTS=OFF -DACCRETION_BUILD_BENCH=OFF >/dev/null
-cmake --build build-fuzz --target fuzz_scene fuzz_particles
-for target in scene particles; do
+targets="scene particles ply_header accumulation jobs"
+cmake --build build-fuzz --target $(for t in $targets; do printf "fuzz_%s " $t; done)
+for target in $targets; do
   mkdir -p build-fuzz/corpus_$target
   cp -n tests/fuzz/corpus_$target/* build-fuzz/corpus_$target/ 2>/dev/null || true
   (cd build-fuzz && ./fuzz_$target -max_total_time="$seconds" -timeout=10 -rss_limit_mb=4096 \

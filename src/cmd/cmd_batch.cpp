@@ -33,24 +33,13 @@
 #include "accretion/scene/toml_limits.h"
 #include "accretion/io/stats_writer.h"
 #include "commands.h"
+#include "jobs_file.h"
 
 extern char** environ;
 
 namespace accretion::cmd {
 namespace {
 
-/// One render of the batch: a scene, frames, seed and render options.
-struct Job {
-    std::string name;
-    std::string scene;
-    std::string frames;               ///< "A:B" or "A"; empty: the scene's
-    std::optional<std::uint64_t> seed;
-    std::string estimator;
-    std::optional<std::uint32_t> spp;
-    std::string output;               ///< EXR pattern; default <output_dir>/<name>/{scene}.{frame}.exr
-    std::string shard;
-    std::vector<std::string> defines;
-};
 
 struct BatchArgs {
     std::string jobsFile;
@@ -64,31 +53,6 @@ struct BatchArgs {
     bool outputDirGiven = false, parallelGiven = false;  ///< on the command line: the file's are ignored
 };
 
-/// Why `name` cannot name a job (its outputs are <output_dir>/<name>/...),
-/// or empty: a name, not a path.
-std::string badJobName(const std::string& name) {
-    if (name.empty()) return "empty";
-    if (name.size() > 128) return fmt::format("{} characters (at most 128)", name.size());
-    if (name.front() == '.') return "starts with '.'";
-    for (char c : name)
-        if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' || c == '+'))
-            return c == '/' || c == '\\' ? "is a path" : fmt::format("holds '{}'", c < 0x20 ? '?' : c);
-    return {};
-}
-
-/// A generated job name (from a scene's stem): the characters a name allows.
-std::string sanitizeJobName(std::string name) {
-    for (char& c : name)
-        if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' || c == '+')) c = '_';
-    if (name.empty() || name.front() == '.') name = "job" + name;
-    return name.substr(0, 128);
-}
-
-std::string where(const toml::node& n) {
-    const auto& src = n.source();
-    return fmt::format("{}:{}", src.path ? *src.path : std::string("<jobs>"), src.begin.line);
-}
-
 /// "0:4" -> 0,1,2,3; "7" -> 7.
 std::vector<std::uint64_t> parseRange(const std::string& text, const char* option) {
     const auto [a, b] = parseHalfOpen(text, option);
@@ -97,91 +61,6 @@ std::vector<std::uint64_t> parseRange(const std::string& text, const char* optio
     std::vector<std::uint64_t> v;
     for (std::uint64_t x = a; x < b; ++x) v.push_back(x);
     return v;
-}
-
-/// [[job]] tables of a jobs file; paths relative to the file. Every key is
-/// checked: an unknown or mistyped one names its line.
-std::vector<Job> readJobsFile(const std::filesystem::path& file, BatchArgs& args) {
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw InputError(fmt::format("{}: cannot open jobs file", file.string()));
-    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    checkTomlNesting(text, file.string());
-    toml::table root;
-    try {
-        root = toml::parse(text, file.string());
-    } catch (const toml::parse_error& e) {
-        const auto& src = e.source();
-        throw InputError(fmt::format("{}:{}: {}", file.string(), src.begin.line, e.description()));
-    }
-    const std::filesystem::path dir = file.parent_path();
-    auto path = [&](const std::string& p) { return std::filesystem::path(p).is_relative() && !dir.empty() ? (dir / p).string() : p; };
-    auto str = [&](const toml::node& n, const std::string& key) {
-        if (!n.is_string()) throw InputError(fmt::format("{}: {}: expected a string", where(n), key));
-        return n.as_string()->get();
-    };
-    auto integer = [&](const toml::node& n, const std::string& key, std::int64_t lo, std::int64_t hi) {
-        if (!n.is_integer() || n.as_integer()->get() < lo || n.as_integer()->get() > hi)
-            throw InputError(fmt::format("{}: {}: expected an integer in [{}, {}]", where(n), key, lo, hi));
-        return n.as_integer()->get();
-    };
-    for (const auto& [key, node] : root) {
-        if (key.str() == "batch") {
-            const toml::table* t = node.as_table();
-            if (!t) throw InputError(fmt::format("{}: [batch] must be a table", where(node)));
-            for (const auto& [k, v] : *t) {
-                // The command line overrides the file.
-                if (k.str() == "output_dir") {
-                    const std::string dirText = str(v, "batch.output_dir");
-                    if (!args.outputDirGiven) args.outputDir = path(dirText);
-                } else if (k.str() == "parallel") {
-                    const int n = int(integer(v, "batch.parallel", 1, 256));
-                    if (!args.parallelGiven) args.parallel = n;
-                }
-                else throw InputError(fmt::format("{}: batch.{}: unknown key (output_dir, parallel)", where(v), k.str()));
-            }
-        } else if (key.str() != "job") {
-            throw InputError(fmt::format("{}: {}: unknown table (expected [batch] and [[job]])", where(node), key.str()));
-        }
-    }
-    const toml::array* jobs = root["job"].as_array();
-    if (!jobs || jobs->empty())
-        throw InputError(fmt::format("{}: no [[job]] tables: nothing to run", file.string()));
-    std::vector<Job> out;
-    for (const toml::node& n : *jobs) {
-        const toml::table* t = n.as_table();
-        if (!t) throw InputError(fmt::format("{}: job must be a table ([[job]])", where(n)));
-        Job j;
-        for (const auto& [k, v] : *t) {
-            const std::string key = "job." + std::string(k.str());
-            if (k.str() == "name") {
-                j.name = str(v, key);
-                if (const std::string why = badJobName(j.name); !why.empty())
-                    throw InputError(fmt::format("{}: job.name \"{}\": {}; a job's name names its outputs in the output "
-                                                 "directory, so it is a name, not a path (letters, digits, . _ - +, not "
-                                                 "starting with .)", where(v), j.name.substr(0, 64), why));
-            }
-            else if (k.str() == "scene") j.scene = path(str(v, key));
-            else if (k.str() == "frames") j.frames = v.is_integer() ? std::to_string(integer(v, key, 0, 1000000000)) : str(v, key);
-            else if (k.str() == "seed") j.seed = std::uint64_t(integer(v, key, 0, std::numeric_limits<std::int64_t>::max()));
-            else if (k.str() == "estimator") j.estimator = str(v, key);
-            else if (k.str() == "spp") j.spp = std::uint32_t(integer(v, key, 1, 10000000));
-            else if (k.str() == "output") j.output = path(str(v, key));
-            else if (k.str() == "shard") j.shard = str(v, key);
-            else if (k.str() == "define") {
-                const toml::array* a = v.as_array();
-                if (!a) throw InputError(fmt::format("{}: {}: expected an array of \"section.key=value\" strings", where(v), key));
-                for (const toml::node& d : *a) j.defines.push_back(str(d, key));
-            } else
-                throw InputError(fmt::format("{}: {}: unknown key (name, scene, frames, seed, estimator, spp, output, "
-                                             "shard, define)", where(v), key));
-        }
-        if (j.scene.empty()) throw InputError(fmt::format("{}: job without a scene", where(n)));
-        if (j.name.empty())
-            j.name = sanitizeJobName(fmt::format("{}{}{}", std::filesystem::path(j.scene).stem().string(),
-                                                 j.frames.empty() ? "" : "-f" + j.frames, j.seed ? fmt::format("-s{}", *j.seed) : ""));
-        out.push_back(std::move(j));
-    }
-    return out;
 }
 
 /// Scene x frame x seed from the command line, one frame per job.
@@ -280,7 +159,16 @@ nlohmann::json jobOutputs(const std::filesystem::path& manifest) {
 
 /// The jobs of the batch, checked before any runs: unique names, scenes that exist.
 std::vector<Job> batchJobs(BatchArgs& args) {
-    std::vector<Job> jobs = args.jobsFile.empty() ? commandLineJobs(args) : readJobsFile(args.jobsFile, args);
+    std::vector<Job> jobs;
+    if (args.jobsFile.empty()) {
+        jobs = commandLineJobs(args);
+    } else {
+        JobsFile file = readJobsFile(args.jobsFile);
+        jobs = std::move(file.jobs);
+        // The command line overrides the file.
+        if (file.outputDir && !args.outputDirGiven) args.outputDir = *file.outputDir;
+        if (file.parallel && !args.parallelGiven) args.parallel = *file.parallel;
+    }
     if (!args.jobsFile.empty() && !args.scenes.empty())
         throw InputError("command line: give a jobs file or --scene, not both");
     if (args.parallel < 1) throw InputError("command line --parallel: expected at least 1");

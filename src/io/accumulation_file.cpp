@@ -77,6 +77,11 @@ AccumulationFile readAccumulationFile(const std::filesystem::path& file) {
     std::ifstream in(file, std::ios::binary);
     if (!in) throw InputError(fmt::format("{}: cannot open accumulation file", file.string()));
     const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (in.bad()) throw InputError(fmt::format("{}: cannot read accumulation file", file.string()));
+    return parseAccumulationFile(bytes, file);
+}
+
+AccumulationFile parseAccumulationFile(const std::string& bytes, const std::filesystem::path& file) {
     if (bytes.size() < 8 + 8 + 8 || std::memcmp(bytes.data(), kMagic, 8) != 0)
         throw InputError(fmt::format("{}: not an accretion accumulation file (checkpoint or shard)", file.string()));
     std::uint64_t stored = 0;
@@ -104,7 +109,9 @@ AccumulationFile readAccumulationFile(const std::filesystem::path& file) {
     }
     Accumulation& a = f.acc;
     const std::size_t px = a.pixels();
-    if (bytes.size() != r.position() + px * (6 * 8 + 4 + 1 + 4) + 8)
+    std::uint64_t arrays = 0;
+    if (__builtin_mul_overflow(std::uint64_t(px), std::uint64_t(6 * 8 + 4 + 1 + 4), &arrays) ||
+        bytes.size() != r.position() + arrays + 8)
         throw InputError(fmt::format("{}: {} bytes do not hold {}x{} pixels", file.string(), bytes.size(), a.width, a.height));
     a.sum.resize(px);
     a.sumSq.resize(px);

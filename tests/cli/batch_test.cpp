@@ -110,7 +110,7 @@ TEST_CASE("batch: a bad jobs file is refused with its line, nothing run", "[cli]
     CHECK_FALSE(fs::exists(dir / "out"));
 }
 
-TEST_CASE("batch: the example interrupted in its first job resumes to success; --output-dir overrides the file",
+TEST_CASE("batch: the example interrupted in its first job resumes to success, --output-dir overrides the file",
           "[cli][batch][resume]") {
     const fs::path dir = accretion::test::scratchDir("batch_example_resume");
     const std::string jobs = std::string(ACCRETION_SOURCE_DIR) + "/scenes/batch/example_jobs.toml";

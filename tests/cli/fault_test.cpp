@@ -54,7 +54,7 @@ TEST_CASE("an output directory that cannot exist: a clear error and exit 1", "[c
     CHECK_THAT(out, Contains("cannot create output directory"));
 }
 
-TEST_CASE("two runs to one output: the second is refused naming the first's PID; the checkpoint survives",
+TEST_CASE("two runs to one output: the second is refused naming the first's PID, the checkpoint survives",
           "[cli][fault][lock]") {
     const fs::path dir = accretion::test::scratchDir("fault_two_runs");
     const std::string slow = std::string(ACCRETION_BINARY) + " render " + ACCRETION_SOURCE_DIR +

@@ -30,6 +30,8 @@ void writeAccumulationFile(const std::filesystem::path& file, const Accumulation
 /// Throws InputError naming the file and what is wrong (not an accumulation
 /// file, truncated, checksum mismatch, array sizes).
 AccumulationFile readAccumulationFile(const std::filesystem::path& file);
+/// The same from a file's bytes in memory (`file` names them in messages).
+AccumulationFile parseAccumulationFile(const std::string& bytes, const std::filesystem::path& file);
 
 /// If `settings` (TOML) differ from those stored in `header`, a message
 /// naming the first differing line; empty when they match.
