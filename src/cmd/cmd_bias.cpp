@@ -94,6 +94,14 @@ void writeBiasMap(const std::string& file, const std::vector<DVec3>& s1, const s
     writeChannelsExr(file, ref.image.width, ref.image.height, ch, meta);
 }
 
+/// The <estimator> of prefix.<estimator>.exr: the spec's label, file-safe.
+std::string biasMapName(const EstimatorSpec& spec) {
+    std::string safe = spec.label;
+    for (char& c : safe)
+        if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
+    return safe;
+}
+
 /// One estimator over the seeds: its row, and its bias map at prefix.<estimator>.exr.
 BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vector<FlagSetting>& base,
                     const ParticleSource& source, std::uint32_t frame, const BiasReference& ref, const std::string& prefix) {
@@ -131,10 +139,7 @@ BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vec
     row.energyLossPct = ref.mean > 0.0 ? -100.0 * row.meanError / ref.mean : 0.0;
     row.secondsPerRender = seconds / S;
     row.biased = std::fabs(row.z) > a.zCritical;
-    std::string safe = spec.label;
-    for (char& c : safe)
-        if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
-    writeBiasMap(prefix + "." + safe + ".exr", s1, s2, S, ref,
+    writeBiasMap(prefix + "." + biasMapName(spec) + ".exr", s1, s2, S, ref,
                  {{"version", std::string(version())}, {"estimator", spec.label}, {"seeds", std::to_string(a.seeds)},
                   {"reference", a.reference}, {"settings", settingsToToml(specBase)}});
     return row;
@@ -165,6 +170,11 @@ void runBias(const BiasArgs& a) {
     const std::uint32_t frame = a.frame.value_or(scene.render.frame_start);
     const auto threads = limitThreads(a.threads);
     const std::string prefix = a.out.empty() ? "out/" + scene.sceneName + ".bias" : a.out;
+    OutputGuard guard = sceneInputs(scene);
+    guard.addInput(a.reference);
+    std::vector<std::string> suffixes = {".csv", ".png", ".json"};
+    for (const EstimatorSpec& spec : specs) suffixes.push_back("." + biasMapName(spec) + ".exr");
+    checkOutputs(guard, prefix, suffixes, "-o");
     if (auto dir = std::filesystem::path(prefix).parent_path(); !dir.empty()) std::filesystem::create_directories(dir);
 
     const BiasReference ref = loadBiasReference(a.reference, scene);

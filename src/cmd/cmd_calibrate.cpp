@@ -8,6 +8,7 @@
 #include "accretion/core/version.h"
 #include "accretion/gpu/cost_model.h"
 #include "accretion/io/stats_writer.h"
+#include "accretion/core/output_guard.h"
 #include "commands.h"
 
 namespace accretion::cmd {
@@ -23,6 +24,9 @@ void runCalibrate(const CalibrateArgs& args) {
         std::vector<std::string> counters;
         std::string timings, output;
     } a{{args.files.begin(), args.files.end() - 1}, args.files.back(), args.output};
+    OutputGuard guard;  // the fit never replaces the measurements it reads
+    for (const std::string& f : args.files) guard.addInput(f);
+    guard.check(a.output, "-o");
     std::vector<CostRow> rows;
     for (const std::string& file : a.counters) {
         std::vector<CostRow> r = readCounterCsv(file);

@@ -300,6 +300,9 @@ void runConverge(const ConvergeArgs& a) {
     const std::uint32_t frame = a.frame.value_or(scene.render.frame_start);
     const auto threads = limitThreads(a.threads);
     const std::string prefix = a.out.empty() ? "out/" + scene.sceneName + ".converge" : a.out;
+    OutputGuard guard = sceneInputs(scene);
+    guard.addInput(a.reference);
+    checkOutputs(guard, prefix, {".csv", ".png", ".json"}, "-o");
     if (auto dir = std::filesystem::path(prefix).parent_path(); !dir.empty()) std::filesystem::create_directories(dir);
 
     const ParticleSource source(scene);

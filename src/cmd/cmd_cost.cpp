@@ -317,6 +317,9 @@ void runCost(const CostArgs& a) {
     const auto threads = limitThreads(a.threads);
     const std::string prefix = a.output.empty() ? "out/" + settings.sceneName + ".cost" : std::filesystem::path(a.output).replace_extension().string();
     const std::string config = a.config.empty() ? settings.sceneName : a.config;
+    OutputGuard guard = sceneInputs(settings);
+    if (!settings.gpu.coefficients.empty()) guard.addInput(settings.gpu.coefficients);
+    checkOutputs(guard, prefix, {".json", ".csv", ".heatmaps.exr"}, "-o");
     const ParticleSource source(settings);
     const CostRun run{a, settings, source, settings.render.frame_start, parseList(a.clusterSizes, "--cluster-sizes", 1, 10000000),
                       parseList(a.ommLevels, "--omm-levels", 0, 6), serKeys};

@@ -24,10 +24,16 @@ void runParticles(const ParticlesArgs& args) {
     const ParticleFormat format = args.format == "ply" ? ParticleFormat::ply : ParticleFormat::raw;
     const ParticleSource source(settings);
     const std::filesystem::path dir(args.out);
+    auto fileOf = [&](std::uint32_t frame) {
+        return dir / fmt::format("{}.{:04d}.{}", settings.sceneName, frame, format == ParticleFormat::ply ? "ply" : "bin");
+    };
+    const OutputGuard guard = sceneInputs(settings);  // e.g. --out where the scene's own particle files are
+    for (std::uint32_t k = 0; k < settings.render.frames; ++k) guard.check(fileOf(settings.render.frame_start + k), "--out");
+    guard.check(dir / (settings.sceneName + ".settings.toml"), "--out");
     for (std::uint32_t k = 0; k < settings.render.frames; ++k) {
         const std::uint32_t frame = settings.render.frame_start + k;
         const Particles p = source.frame(frame);
-        const auto file = dir / fmt::format("{}.{:04d}.{}", settings.sceneName, frame, format == ParticleFormat::ply ? "ply" : "bin");
+        const auto file = fileOf(frame);
         writeParticles(file, p, format);
         fmt::print("{} ({} particles)\n", file.string(), p.size());
     }

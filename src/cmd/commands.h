@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 #include <tbb/global_control.h>
 
+#include "accretion/core/output_guard.h"
 #include "accretion/scene/scene_parser.h"
 
 namespace accretion::cmd {
@@ -46,6 +47,14 @@ std::vector<FlagSetting> frameFlags(const std::string& frames);
 
 /// The command's scene: the file, its -D overrides, --frames, then `flags`.
 Settings loadSceneArgs(const SceneArgs& args, const std::vector<FlagSetting>& flags = {});
+
+/// The scene's own files as inputs no output may replace: the scene and
+/// every particle file its frames read (the whole {frame} sequence checked).
+OutputGuard sceneInputs(const Settings& settings);
+
+/// Before any work: refuse each `prefix + suffix` that `guard` refuses.
+void checkOutputs(const OutputGuard& guard, const std::string& prefix, const std::vector<std::string>& suffixes,
+                  std::string_view what);
 
 /// --threads N as a TBB limit for the life of the result (none for 0).
 std::unique_ptr<tbb::global_control> limitThreads(int threads);

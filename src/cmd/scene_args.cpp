@@ -4,6 +4,7 @@
 
 #include "accretion/core/error.h"
 #include "accretion/core/parse.h"
+#include "accretion/particles/particle_source.h"
 #include "commands.h"
 
 namespace accretion::cmd {
@@ -35,6 +36,19 @@ Settings loadSceneArgs(const SceneArgs& a, const std::vector<FlagSetting>& flags
     std::vector<FlagSetting> all = frameFlags(a.frames);
     all.insert(all.end(), flags.begin(), flags.end());
     return loadScene(a.scene, a.defines, all);
+}
+
+OutputGuard sceneInputs(const Settings& settings) {
+    OutputGuard guard;
+    guard.addInput(settings.scenePath);
+    const std::uint32_t first = settings.render.frame_start;
+    for (const auto& f : ParticleSource(settings).checkFiles(first, first + settings.render.frames)) guard.addInput(f);
+    return guard;
+}
+
+void checkOutputs(const OutputGuard& guard, const std::string& prefix, const std::vector<std::string>& suffixes,
+                  std::string_view what) {
+    for (const std::string& s : suffixes) guard.check(prefix + s, what);
 }
 
 std::unique_ptr<tbb::global_control> limitThreads(int threads) {

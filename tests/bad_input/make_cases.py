@@ -79,3 +79,11 @@ for link, target in (("devnull.exr", "/dev/null"), ("link_to_scene.exr", "ok.tom
     os.symlink(target, link)
 os.makedirs("adir.exr", exist_ok=True)
 write("adir.exr/keep", "a directory named like an EXR\n")
+
+# Class 1, other commands: a reference named like a bias map, a particle
+# sequence where `particles --out .` would write, a scene named like an
+# output of converge.
+import shutil
+shutil.copy("half.exr", "ref.power.exr")
+shutil.copy("seq_missing.0000.bin", "selfseq.0000.bin")
+shutil.copy("ok.toml", "conv.json")

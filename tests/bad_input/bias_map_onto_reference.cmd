@@ -1,0 +1,1 @@
+bias ok.toml --reference ref.power.exr --estimators power --seeds 2 -o ref

@@ -1,0 +1,1 @@
+converge conv.json --reference half.exr -o conv --estimators power

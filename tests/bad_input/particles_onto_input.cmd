@@ -1,0 +1,1 @@
+particles selfseq.toml --out .
