@@ -9,6 +9,7 @@
 #include <fmt/core.h>
 #include <tbb/global_control.h>
 
+#include "accretion/geometry/camera_track.h"
 #include "accretion/analysis/image_metrics.h"
 #include "accretion/core/error.h"
 #include "accretion/core/parse.h"
@@ -230,7 +231,7 @@ nlohmann::json reportBlasMemory(const CostRun& run) {
         fmt::print("  {:>8} {:>8} {:>12} {:>14} {:>7} {:>12} {:>7} {:>12} {:>12}\n", "cluster", "BLASes", "GPU bytes",
                    "own alloc", "waste", "pooled", "waste", "compacted", "Embree");
         const Particles particles = source.frame(frame);
-        const Camera camera = Camera::atFrame(settings.camera, frame);
+        const Camera camera = CameraTrack(settings.camera).at(frame);
         for (std::uint32_t size : run.clusterSizes) {
             GeometrySettings g = settings.geometry;
             g.cluster_size = size;

@@ -166,6 +166,8 @@ void guardRun(RenderRun& run, const std::string& stem, const std::string& output
     const Settings& s = run.settings;
     run.guard.addInput(s.scenePath);
     for (const auto& f : ParticleSource(s).checkFiles(run.sharding.first, run.sharding.end)) run.guard.addInput(f);
+    checkCameras(s, run.sharding.first, run.sharding.end);
+    run.guard.addInput(s.camera.file);
     for (std::uint32_t frame = run.sharding.first; frame < run.sharding.end; ++frame) {
         const FramePaths p = framePaths(run, frame);
         for (const std::string& out : {p.exr, p.png(), p.lrPng()}) run.guard.check(out, "output");

@@ -52,6 +52,10 @@ Settings loadSceneArgs(const SceneArgs& args, const std::vector<FlagSetting>& fl
 /// every particle file its frames read (the whole {frame} sequence checked).
 OutputGuard sceneInputs(const Settings& settings);
 
+/// Every frame of [first, end) has a camera (camera.file): InputError naming
+/// the first that has none, before anything renders.
+void checkCameras(const Settings& settings, std::uint32_t first, std::uint32_t end);
+
 /// Before any work: refuse each `prefix + suffix` that `guard` refuses.
 void checkOutputs(const OutputGuard& guard, const std::string& prefix, const std::vector<std::string>& suffixes,
                   std::string_view what);
@@ -74,5 +78,6 @@ void addCalibrateCommand(CLI::App& app);
 void addPlanCommand(CLI::App& app);
 void addMergeCommand(CLI::App& app);
 void addBatchCommand(CLI::App& app);
+void addCamerasCommand(CLI::App& app);
 
 }  // namespace accretion::cmd

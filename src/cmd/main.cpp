@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
     accretion::cmd::addPlanCommand(app);
     accretion::cmd::addMergeCommand(app);
     accretion::cmd::addBatchCommand(app);
+    accretion::cmd::addCamerasCommand(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

@@ -4,6 +4,7 @@
 
 #include "accretion/core/error.h"
 #include "accretion/core/parse.h"
+#include "accretion/geometry/camera_track.h"
 #include "accretion/particles/particle_source.h"
 #include "commands.h"
 
@@ -43,7 +44,16 @@ OutputGuard sceneInputs(const Settings& settings) {
     guard.addInput(settings.scenePath);
     const std::uint32_t first = settings.render.frame_start;
     for (const auto& f : ParticleSource(settings).checkFiles(first, first + settings.render.frames)) guard.addInput(f);
+    guard.addInput(settings.camera.file);
     return guard;
+}
+
+void checkCameras(const Settings& settings, std::uint32_t first, std::uint32_t end) {
+    const CameraTrack cameras(settings.camera);
+    const std::vector<std::uint32_t> missing = cameras.missing(first, end);
+    if (!missing.empty())
+        throw InputError(fmt::format("{}: no camera for frame {} (frames {}..{} of this run are checked before the first "
+                                     "renders)", settings.camera.file, missing.front(), first, end - 1));
 }
 
 void checkOutputs(const OutputGuard& guard, const std::string& prefix, const std::vector<std::string>& suffixes,

@@ -4,22 +4,44 @@
 
 namespace accretion {
 
-Camera Camera::lookAt(const Vec3& eye, const Vec3& target, const Vec3& upHint, double fovDegrees,
-                      std::uint32_t width, std::uint32_t height) {
+CameraPose CameraPose::lookAt(const Vec3& eye, const Vec3& target, const Vec3& upHint, double fovDegrees) {
+    return lookAt(DVec3(eye), DVec3(target), DVec3(upHint), fovDegrees);
+}
+
+CameraPose CameraPose::lookAt(const DVec3& eye, const DVec3& target, const DVec3& upHint, double fovDegrees) {
+    CameraPose p;
+    p.eye = eye;
+    p.forward = glm::normalize(target - eye);
+    p.right = glm::normalize(glm::cross(p.forward, upHint));
+    p.up = glm::cross(p.right, p.forward);
+    p.tanHalfFov = std::tan(0.5 * fovDegrees * M_PI / 180.0);
+    return p;
+}
+
+Camera Camera::fromPose(const CameraPose& pose, std::uint32_t width, std::uint32_t height) {
     Camera c;
-    c.position = eye;
+    c.position = Vec3(pose.eye);
     // The basis in double; the float one (Embree's rays) is its rounding.
-    c.forwardD = glm::normalize(DVec3(target) - DVec3(eye));
-    c.rightD = glm::normalize(glm::cross(c.forwardD, DVec3(upHint)));
-    c.upD = glm::cross(c.rightD, c.forwardD);
-    c.tanHalfFovD = std::tan(0.5 * fovDegrees * M_PI / 180.0);
+    c.forwardD = pose.forward;
+    c.rightD = pose.right;
+    c.upD = pose.up;
+    c.tanHalfFovD = pose.tanHalfFov;
     c.forward = Vec3(c.forwardD);
     c.right = Vec3(c.rightD);
     c.up = Vec3(c.upD);
     c.tanHalfFov = float(c.tanHalfFovD);
+    c.sampleXD = 0.5 + pose.jitterX;
+    c.sampleYD = 0.5 + pose.jitterY;
+    c.sampleX = float(c.sampleXD);
+    c.sampleY = float(c.sampleYD);
     c.width = width;
     c.height = height;
     return c;
+}
+
+Camera Camera::lookAt(const Vec3& eye, const Vec3& target, const Vec3& upHint, double fovDegrees,
+                      std::uint32_t width, std::uint32_t height) {
+    return fromPose(CameraPose::lookAt(eye, target, upHint, fovDegrees), width, height);
 }
 
 Camera Camera::atFrame(const CameraSettings& s, std::uint32_t frame) {

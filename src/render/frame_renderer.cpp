@@ -84,7 +84,7 @@ void composeImage(const GBuffer& gbuffer, const Particles& particles, const Shad
 }  // namespace
 
 FrameRenderer::FrameRenderer(const Settings& settings, ParticleSource source, RenderOptions options)
-    : settings_(settings), plan_(planFrame(settings, FrameFacts{})), source_(std::move(source)), options_(options),
+    : settings_(settings), cameras_(settings.camera), plan_(planFrame(settings, FrameFacts{})), source_(std::move(source)), options_(options),
       device_(std::make_unique<EmbreeDevice>()),
       bvh_(std::make_unique<ParticleBvh>(*device_, settings.geometry, settings.gpu)) {
     if (settings_.render.estimator == EstimatorKind::restir) restir_ = std::make_unique<Restir>(settings_, plan_.keepHistory);
@@ -173,7 +173,7 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const L
     // that precision does not depend on where the scene is (docs/MODEL.md
     // section 3). Geometry that persists across frames (a static scene,
     // refit and partial builds) keeps the origin of its first build.
-    const Camera world = Camera::atFrame(settings_.camera, frame);
+    const Camera world = cameras_.at(frame);
     const BuildPolicy policy = settings_.geometry.build;
     const bool persistent = plan_.staticGeometry || policy == BuildPolicy::refit || policy == BuildPolicy::partial;
     if (!built_ || !persistent) origin_ = world.position;

@@ -266,6 +266,8 @@ void validate(const Settings& s, const std::map<std::string, std::string>& loc, 
     if (glm::length(view) <= 0.0f) fail("camera.look_at", "must differ from camera.position");
     if (glm::length(s.camera.up) <= 0.0f || glm::length(glm::cross(glm::normalize(view), glm::normalize(s.camera.up))) < 1e-4f)
         fail("camera.up", "must be non-zero and not parallel to the view direction");
+    if (!s.camera.file.empty() && s.camera.path != CameraPath::static_pose)
+        fail("camera.file", "the file gives every frame's camera: leave camera.path at \"static\"");
     if (s.camera.path == CameraPath::linear && glm::length(s.camera.end_look_at - s.camera.end_position) <= 0.0f)
         fail("camera.end_look_at", "must differ from camera.end_position");
     if (s.render.offset_far == FarEnd::relative && !(s.render.offset_far_margin < 1.0))
@@ -406,6 +408,9 @@ Settings loadScene(const std::filesystem::path& file, const std::vector<std::str
     const std::filesystem::path particles(s.particles.file);
     if (!particles.empty() && particles.is_relative() && !file.parent_path().empty())
         s.particles.file = (file.parent_path() / particles).string();
+    const std::filesystem::path cameras(s.camera.file);
+    if (!cameras.empty() && cameras.is_relative() && !file.parent_path().empty())
+        s.camera.file = (file.parent_path() / cameras).string();
     return s;
 }
 

@@ -6,6 +6,22 @@
 
 namespace accretion {
 
+/// A frame's camera as the engine states it, in double: the eye, the
+/// screen's axes in world space (right = image +x, up = image +y, forward =
+/// the view direction; orthonormal), tan of half the vertical field of view,
+/// and the sub-pixel jitter of the frame's samples (TAA): the offset of the
+/// sample from the pixel centre, in pixels, +x right, +y down.
+struct CameraPose {
+    DVec3 eye{0.0};
+    DVec3 forward{0.0, 0.0, -1.0}, right{1.0, 0.0, 0.0}, up{0.0, 1.0, 0.0};
+    double tanHalfFov = 1.0;
+    double jitterX = 0.0, jitterY = 0.0;
+
+    /// The pose of a look-at camera (what the scene's paths give).
+    static CameraPose lookAt(const Vec3& eye, const Vec3& target, const Vec3& up, double fovDegrees);
+    static CameraPose lookAt(const DVec3& eye, const DVec3& target, const DVec3& up, double fovDegrees);
+};
+
 /// A pinhole camera pose of one frame.
 struct Camera {
     Vec3 position;       ///< eye
@@ -16,25 +32,32 @@ struct Camera {
     std::uint32_t width, height;
     DVec3 forwardD, rightD, upD;  ///< the same basis computed in double (hit points are refined with it)
     double tanHalfFovD;
+    /// Where in the pixel the frame samples: its centre (0.5, 0.5) plus the
+    /// pose's jitter; float and double as the rays use them.
+    float sampleX = 0.5f, sampleY = 0.5f;
+    double sampleXD = 0.5, sampleYD = 0.5;
 
     /// The camera of a frame along the scene's path.
     static Camera atFrame(const CameraSettings& s, std::uint32_t frame);
     static Camera lookAt(const Vec3& eye, const Vec3& target, const Vec3& up, double fovDegrees,
                          std::uint32_t width, std::uint32_t height);
+    /// The camera of a pose: its float basis is the rounding of the double one.
+    static Camera fromPose(const CameraPose& pose, std::uint32_t width, std::uint32_t height);
 
-    /// Unit direction of the ray through the centre of pixel (x, y); y = 0 is the top row.
+    /// Unit direction of the ray through pixel (x, y)'s sample position (the
+    /// centre, jittered); y = 0 is the top row.
     Vec3 pixelDirection(std::uint32_t x, std::uint32_t y) const {
         const float aspect = float(width) / float(height);
-        const float sx = ((float(x) + 0.5f) / float(width) * 2.0f - 1.0f) * tanHalfFov * aspect;
-        const float sy = (1.0f - (float(y) + 0.5f) / float(height) * 2.0f) * tanHalfFov;
+        const float sx = ((float(x) + sampleX) / float(width) * 2.0f - 1.0f) * tanHalfFov * aspect;
+        const float sy = (1.0f - (float(y) + sampleY) / float(height) * 2.0f) * tanHalfFov;
         return glm::normalize(forward + sx * right + sy * up);
     }
 
     /// The same ray in double: what primary hits are refined along.
     DVec3 pixelRay(std::uint32_t x, std::uint32_t y) const {
         const double aspect = double(width) / double(height);
-        const double sx = ((double(x) + 0.5) / double(width) * 2.0 - 1.0) * tanHalfFovD * aspect;
-        const double sy = (1.0 - (double(y) + 0.5) / double(height) * 2.0) * tanHalfFovD;
+        const double sx = ((double(x) + sampleXD) / double(width) * 2.0 - 1.0) * tanHalfFovD * aspect;
+        const double sy = (1.0 - (double(y) + sampleYD) / double(height) * 2.0) * tanHalfFovD;
         return glm::normalize(forwardD + sx * rightD + sy * upD);
     }
 
@@ -46,8 +69,10 @@ struct Camera {
         return c;
     }
 
-    /// Continuous pixel coordinates (pixel centres at +0.5) and camera-space
-    /// depth of a world point; false when it is not in front of the camera.
+    /// Continuous pixel coordinates (the frame's sample positions at +0.5, so
+    /// that a jittered frame's own samples project to pixel centres) and
+    /// camera-space depth of a world point; false when it is not in front of
+    /// the camera.
     bool project(const Vec3& p, float& px, float& py, float& depth) const {
         const Vec3 d = p - position;
         depth = glm::dot(d, forward);
@@ -55,8 +80,8 @@ struct Camera {
         const float aspect = float(width) / float(height);
         const float sx = glm::dot(d, right) / (depth * tanHalfFov * aspect);
         const float sy = glm::dot(d, up) / (depth * tanHalfFov);
-        px = (sx + 1.0f) * 0.5f * float(width);
-        py = (1.0f - sy) * 0.5f * float(height);
+        px = (sx + 1.0f) * 0.5f * float(width) - (sampleX - 0.5f);
+        py = (1.0f - sy) * 0.5f * float(height) - (sampleY - 0.5f);
         return true;
     }
 };

@@ -11,6 +11,7 @@
 #include "accretion/render/restir.h"
 #include "accretion/particles/particle_source.h"
 #include "accretion/geometry/camera.h"
+#include "accretion/geometry/camera_track.h"
 #include "accretion/render/estimators.h"
 #include "accretion/render/gbuffer.h"
 #include "accretion/render/frame_plan.h"
@@ -93,6 +94,7 @@ private:
                     FrameImage& img, FrameStats& stats);
 
     Settings settings_;
+    CameraTrack cameras_;  ///< every frame's camera: the path, or the engine's file
     FramePlan plan_;             ///< the last frame's
     ParticleSource source_;
     Particles staticParticles_;  ///< static scenes: loaded once

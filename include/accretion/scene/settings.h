@@ -144,6 +144,7 @@ struct CameraSettings {
     Vec3 end_position{0.0f, 7.0f, 17.0f}; ///< linear: eye position at frame path_frames
     Vec3 end_look_at{0.0f, 0.0f, 0.0f};   ///< linear: target at frame path_frames
     std::uint32_t path_frames = 100;   ///< linear: frames from start to end pose
+    std::string file;                  ///< the engine's cameras per frame (JSON or CSV; relative to the scene file)
 
     template <class V> void visit(V& v) {
         v.field("position", position, "eye position at frame 0");
@@ -157,6 +158,8 @@ struct CameraSettings {
         v.field("end_position", end_position, "linear: eye position at frame path_frames");
         v.field("end_look_at", end_look_at, "linear: target at frame path_frames");
         v.field("path_frames", path_frames, "linear: frames from start to end pose", Range{1, 1e9});
+        v.field("file", file, "the engine's camera of each frame (JSON or CSV, relative to the scene file: pose or "
+                              "view/projection matrices, jitter); empty: the path above");
     }
 };
 

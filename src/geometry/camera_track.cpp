@@ -1,0 +1,455 @@
+#include "accretion/geometry/camera_track.h"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "accretion/core/atomic_file.h"
+#include "accretion/core/error.h"
+#include "accretion/core/parse.h"
+
+namespace accretion {
+namespace {
+
+using Convention = CameraConvention;
+
+Mat4 transpose(const Mat4& m) {
+    Mat4 t{};
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) t[r][c] = m[c][r];
+    return t;
+}
+
+/// The 16 numbers of a file as the matrix acting on column vectors.
+Mat4 fromStored(const std::array<double, 16>& v, const Convention& conv) {
+    Mat4 a{};
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) a[r][c] = conv.storage == Convention::Storage::row_major ? v[4 * r + c] : v[4 * c + r];
+    return conv.vectors == Convention::Vectors::row ? transpose(a) : a;
+}
+
+std::array<double, 16> toStored(const Mat4& m, const Convention& conv) {
+    const Mat4 a = conv.vectors == Convention::Vectors::row ? transpose(m) : m;
+    std::array<double, 16> v{};
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) (conv.storage == Convention::Storage::row_major ? v[4 * r + c] : v[4 * c + r]) = a[r][c];
+    return v;
+}
+
+double sign(double x) { return x < 0.0 ? -1.0 : 1.0; }
+
+/// The sign NDC y has on the image's upward axis.
+double clipUp(const Convention& c) { return c.clip == Convention::Clip::vulkan ? -1.0 : 1.0; }
+
+/// The sign of w = P[3][2] z: view space looks down -z (right-handed) or +z.
+double viewDepth(const Convention& c) { return c.handedness == Convention::Handedness::right ? -1.0 : 1.0; }
+
+/// A reciprocal that round-trips: 1 / result == t exactly (when some double
+/// within a few ulps has that property, as all tested ones do).
+double exactReciprocal(double t) {
+    double r = 1.0 / t;
+    for (int k = 0; k < 8 && 1.0 / r != t; ++k) r = std::nextafter(r, 1.0 / r < t ? 0.0 : 2.0 * r);
+    return r;
+}
+
+}  // namespace
+
+bool CameraConvention::preset(const std::string& name, CameraConvention& out) {
+    out = CameraConvention{};
+    if (name == "opengl") return true;
+    if (name == "vulkan") {
+        out.clip = Clip::vulkan;
+        return true;
+    }
+    if (name == "d3d") {
+        out.storage = Storage::row_major;
+        out.vectors = Vectors::row;
+        out.handedness = Handedness::left;
+        out.clip = Clip::d3d;
+        return true;
+    }
+    return false;
+}
+
+CameraPose poseFromMatrices(const Mat4& V, const Mat4& P, const CameraConvention& conv, std::uint32_t width,
+                            std::uint32_t height, const std::string& where) {
+    // The view: rows 0..2 of its rotation are the view axes in world space.
+    DVec3 axis[3];
+    for (int r = 0; r < 3; ++r) axis[r] = DVec3(V[r][0], V[r][1], V[r][2]);
+    for (int r = 0; r < 3; ++r)
+        for (int c = r; c < 3; ++c) {
+            const double d = glm::dot(axis[r], axis[c]);
+            if (std::fabs(d - (r == c ? 1.0 : 0.0)) > 1e-5)
+                throw InputError(fmt::format("{}: the view matrix is not a rigid transform (rows {} and {} of its rotation: "
+                                             "dot {:.6g}); check the convention's storage and vectors", where, r, c, d));
+        }
+    if (V[3][0] != 0.0 || V[3][1] != 0.0 || V[3][2] != 0.0 || V[3][3] != 1.0)
+        throw InputError(fmt::format("{}: the view matrix's last row is not (0, 0, 0, 1); check the convention's storage "
+                                     "and vectors", where));
+    // The projection: a perspective one, w = +-z.
+    const double w = P[3][2];
+    if (std::fabs(std::fabs(w) - 1.0) > 1e-9 || P[3][0] != 0.0 || P[3][1] != 0.0 || P[3][3] != 0.0)
+        throw InputError(fmt::format("{}: the projection is not a perspective one (its last row must be (0, 0, +-1, 0))", where));
+    if (sign(w) != viewDepth(conv))
+        throw InputError(fmt::format("{}: the projection divides by {}z, but the convention is {}-handed (view space looks "
+                                     "down {}z)", where, w > 0 ? "+" : "-",
+                                     conv.handedness == Convention::Handedness::right ? "right" : "left",
+                                     conv.handedness == Convention::Handedness::right ? "-" : "+"));
+    if (!(P[0][0] != 0.0 && P[1][1] != 0.0 && std::isfinite(P[0][0]) && std::isfinite(P[1][1])))
+        throw InputError(fmt::format("{}: the projection has no finite field of view", where));
+    const double aspect = std::fabs(P[1][1] / P[0][0]), imageAspect = double(width) / double(height);
+    if (std::fabs(aspect / imageAspect - 1.0) > 1e-4)
+        throw InputError(fmt::format("{}: the projection's aspect ratio is {:.6g}, the image's {}x{} is {:.6g}", where, aspect,
+                                     width, height, imageAspect));
+    CameraPose pose;
+    pose.right = axis[0] * sign(P[0][0]);
+    pose.up = axis[1] * (sign(P[1][1]) * clipUp(conv));
+    pose.forward = axis[2] * viewDepth(conv);  // view -z (right-handed) or +z is forward
+    pose.tanHalfFov = 1.0 / std::fabs(P[1][1]);
+    // eye = -R^T t
+    const DVec3 t(V[0][3], V[1][3], V[2][3]);
+    pose.eye = -(axis[0] * t.x + axis[1] * t.y + axis[2] * t.z);
+    // Off-centre terms: the image shifted by (ox, oy) in NDC, so the samples
+    // are offset the other way (NDC x is right everywhere; y up but in vulkan).
+    const double ox = P[0][2] * w, oy = P[1][2] * w;
+    pose.jitterX = -ox * 0.5 * double(width);
+    pose.jitterY = oy * clipUp(conv) * 0.5 * double(height);
+    return pose;
+}
+
+void matricesFromPose(const CameraPose& pose, const CameraConvention& conv, std::uint32_t width, std::uint32_t height,
+                      Mat4& V, Mat4& P) {
+    const DVec3 z = conv.handedness == Convention::Handedness::right ? -pose.forward : pose.forward;
+    const DVec3 up = pose.up * clipUp(conv);
+    const DVec3 axis[3] = {pose.right, up, z};
+    V = Mat4{};
+    for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) V[r][c] = axis[r][c];
+        V[r][3] = -glm::dot(axis[r], pose.eye);
+    }
+    V[3][3] = 1.0;
+    P = Mat4{};
+    const double w = viewDepth(conv);
+    P[1][1] = exactReciprocal(pose.tanHalfFov);
+    P[0][0] = P[1][1] * double(height) / double(width);
+    P[0][2] = -pose.jitterX / (0.5 * double(width)) * w;
+    P[1][2] = pose.jitterY * clipUp(conv) / (0.5 * double(height)) * w;
+    // Depth to [0, 1] (d3d, vulkan) or [-1, 1] (opengl) between 0.01 and 1e4: not used by accretion.
+    const double n = 0.01, f = 1e4;
+    const bool zeroToOne = conv.clip != Convention::Clip::opengl;
+    P[2][2] = w * (zeroToOne ? f / (f - n) : (f + n) / (f - n));
+    P[2][3] = zeroToOne ? -f * n / (f - n) : -2.0 * f * n / (f - n);
+    P[3][2] = w;
+}
+
+namespace {
+
+/// One frame's record of a camera file, whatever its format.
+struct CameraRecord {
+    std::uint32_t frame = 0;
+    bool matrices = false;
+    DVec3 eye{0.0}, lookAt{0.0}, up{0.0, 1.0, 0.0};
+    double fov = 45.0;
+    std::array<double, 16> view{}, projection{};
+    bool hasJitter = false;
+    double jitter[2] = {0.0, 0.0};
+};
+
+struct CameraFileContent {
+    CameraConvention convention;
+    bool ndcJitter = false;
+    std::vector<std::pair<std::string, CameraRecord>> records;  ///< where (file:line or file: frames[i]), record
+};
+
+CameraConvention parseConvention(const nlohmann::json& j, const std::string& where) {
+    CameraConvention c;
+    if (j.is_string()) {
+        if (!CameraConvention::preset(j.get<std::string>(), c))
+            throw InputError(fmt::format("{}: convention \"{}\": expected opengl, vulkan, d3d or an object", where,
+                                         j.get<std::string>()));
+        return c;
+    }
+    if (!j.is_object()) throw InputError(fmt::format("{}: convention: expected a preset name or an object", where));
+    for (const auto& [key, value] : j.items()) {
+        const std::string v = value.is_string() ? value.get<std::string>() : "";
+        auto bad = [&](const char* choices) {
+            return InputError(fmt::format("{}: convention.{} \"{}\": expected {}", where, key, v, choices));
+        };
+        if (key == "storage") {
+            if (v == "row_major") c.storage = CameraConvention::Storage::row_major;
+            else if (v == "column_major") c.storage = CameraConvention::Storage::column_major;
+            else throw bad("row_major or column_major");
+        } else if (key == "vectors") {
+            if (v == "column") c.vectors = CameraConvention::Vectors::column;
+            else if (v == "row") c.vectors = CameraConvention::Vectors::row;
+            else throw bad("column (M v) or row (v M)");
+        } else if (key == "handedness") {
+            if (v == "right") c.handedness = CameraConvention::Handedness::right;
+            else if (v == "left") c.handedness = CameraConvention::Handedness::left;
+            else throw bad("right or left");
+        } else if (key == "clip") {
+            if (v == "opengl") c.clip = CameraConvention::Clip::opengl;
+            else if (v == "d3d") c.clip = CameraConvention::Clip::d3d;
+            else if (v == "vulkan") c.clip = CameraConvention::Clip::vulkan;
+            else throw bad("opengl, d3d or vulkan");
+        } else {
+            throw InputError(fmt::format("{}: convention.{}: unknown key (storage, vectors, handedness, clip)", where, key));
+        }
+    }
+    return c;
+}
+
+template <std::size_t N> std::array<double, N> numbers(const nlohmann::json& j, const std::string& where, const char* key) {
+    std::array<double, N> out{};
+    if (!j.is_array() || j.size() != N) throw InputError(fmt::format("{}: {}: expected an array of {} numbers", where, key, N));
+    for (std::size_t k = 0; k < N; ++k) {
+        if (!j[k].is_number() || !std::isfinite(j[k].get<double>()))
+            throw InputError(fmt::format("{}: {}[{}]: expected a finite number", where, key, k));
+        out[k] = j[k].get<double>();
+    }
+    return out;
+}
+
+DVec3 vec3(const nlohmann::json& j, const std::string& where, const char* key) {
+    const auto a = numbers<3>(j, where, key);
+    return DVec3(a[0], a[1], a[2]);
+}
+
+CameraFileContent readJsonCameras(const std::string& name, const std::string& text) {
+    const nlohmann::json root = nlohmann::json::parse(text, nullptr, false);
+    if (root.is_discarded() || !root.is_object())
+        throw InputError(fmt::format("{}: not a camera file (a JSON object with \"frames\")", name));
+    CameraFileContent out;
+    for (const auto& [key, value] : root.items()) {
+        if (key == "convention") out.convention = parseConvention(value, name);
+        else if (key == "jitter_units") {
+            const std::string u = value.is_string() ? value.get<std::string>() : "";
+            if (u != "pixels" && u != "ndc") throw InputError(fmt::format("{}: jitter_units \"{}\": expected pixels or ndc", name, u));
+            out.ndcJitter = u == "ndc";
+        } else if (key != "frames" && key != "comment") {
+            throw InputError(fmt::format("{}: {}: unknown key (convention, jitter_units, frames, comment)", name, key));
+        }
+    }
+    const auto frames = root.find("frames");
+    if (frames == root.end() || !frames->is_array() || frames->empty())
+        throw InputError(fmt::format("{}: \"frames\": expected a non-empty array of cameras", name));
+    for (std::size_t i = 0; i < frames->size(); ++i) {
+        const nlohmann::json& f = (*frames)[i];
+        const std::string where = fmt::format("{}: frames[{}]", name, i);
+        if (!f.is_object()) throw InputError(fmt::format("{}: expected an object", where));
+        CameraRecord r;
+        const auto frame = f.find("frame");
+        if (frame == f.end() || !frame->is_number_unsigned() || frame->get<std::uint64_t>() > 0xffffffffull)
+            throw InputError(fmt::format("{}: \"frame\": expected the frame number (an integer >= 0)", where));
+        r.frame = frame->get<std::uint32_t>();
+        const bool pose = f.contains("eye"), matrix = f.contains("view");
+        if (pose == matrix)
+            throw InputError(fmt::format("{}: give either eye, look_at, up, fov or view, projection", where));
+        r.matrices = matrix;
+        for (const auto& [key, value] : f.items()) {
+            if (key == "frame") continue;
+            if (pose && key == "eye") r.eye = vec3(value, where, "eye");
+            else if (pose && key == "look_at") r.lookAt = vec3(value, where, "look_at");
+            else if (pose && key == "up") r.up = vec3(value, where, "up");
+            else if (pose && key == "fov") {
+                if (!value.is_number() || !(value.get<double>() > 0.0 && value.get<double>() < 179.0))
+                    throw InputError(fmt::format("{}: fov: expected degrees in (0, 179)", where));
+                r.fov = value.get<double>();
+            } else if (matrix && key == "view") r.view = numbers<16>(value, where, "view");
+            else if (matrix && key == "projection") r.projection = numbers<16>(value, where, "projection");
+            else if (key == "jitter") {
+                const auto j = numbers<2>(value, where, "jitter");
+                r.hasJitter = true;
+                r.jitter[0] = j[0];
+                r.jitter[1] = j[1];
+            } else {
+                throw InputError(fmt::format("{}: {}: unknown key ({})", where, key,
+                                             pose ? "frame, eye, look_at, up, fov, jitter" : "frame, view, projection, jitter"));
+            }
+        }
+        if (pose && !f.contains("look_at")) throw InputError(fmt::format("{}: look_at missing", where));
+        if (matrix && !f.contains("projection")) throw InputError(fmt::format("{}: projection missing", where));
+        out.records.emplace_back(where + fmt::format(" (frame {})", r.frame), r);
+    }
+    return out;
+}
+
+CameraFileContent readCsvCameras(const std::string& name, const std::string& text) {
+    CameraFileContent out;
+    std::istringstream in(text);
+    std::string line;
+    std::size_t lineNo = 0;
+    std::vector<std::string> columns;
+    while (std::getline(in, line)) {
+        ++lineNo;
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        const std::string where = fmt::format("{}:{}", name, lineNo);
+        if (line.empty()) continue;
+        if (line[0] == '#') {  // "# convention = d3d", "# jitter_units = ndc"
+            const auto eq = line.find('=');
+            if (eq == std::string::npos) continue;
+            auto trim = [](std::string s) {
+                const auto b = s.find_first_not_of(" \t#"), e = s.find_last_not_of(" \t");
+                return b == std::string::npos ? std::string() : s.substr(b, e - b + 1);
+            };
+            const std::string key = trim(line.substr(0, eq)), value = trim(line.substr(eq + 1));
+            if (key == "convention") out.convention = parseConvention(nlohmann::json(value), where);
+            else if (key == "jitter_units") out.ndcJitter = value == "ndc";
+            continue;
+        }
+        const std::vector<std::string> cells = splitList(line, ',');
+        if (columns.empty()) {
+            columns = cells;
+            if (columns.empty() || columns[0] != "frame")
+                throw InputError(fmt::format("{}: the header must start with 'frame' (then eye_x.., look_at_x.., up_x.., "
+                                             "fov or view_0..15, projection_0..15; jitter_x, jitter_y)", where));
+            continue;
+        }
+        if (cells.size() != columns.size())
+            throw InputError(fmt::format("{}: {} values, the header names {}", where, cells.size(), columns.size()));
+        CameraRecord r;
+        std::size_t seen = 0;
+        for (std::size_t k = 0; k < cells.size(); ++k) {
+            const std::string& c = columns[k];
+            if (c == "frame") {
+                const auto f = parseUnsigned(cells[k], 0xffffffffull);
+                if (!f) throw InputError(fmt::format("{}: frame '{}': expected an integer >= 0", where, cells[k]));
+                r.frame = std::uint32_t(*f);
+                continue;
+            }
+            const std::optional<double> v = parseNumber(cells[k]);
+            if (!v || !std::isfinite(*v)) throw InputError(fmt::format("{}: {} '{}': expected a finite number", where, c, cells[k]));
+            auto at = [&](const char* prefix, std::size_t n) -> int {
+                const std::string p(prefix);
+                if (c.rfind(p, 0) != 0) return -1;
+                const auto i = parseUnsigned(c.substr(p.size()), n - 1);
+                return i ? int(*i) : -1;
+            };
+            static const char* xyz[] = {"x", "y", "z"};
+            bool used = false;
+            for (int a = 0; a < 3; ++a) {
+                if (c == std::string("eye_") + xyz[a]) r.eye[a] = *v, used = true;
+                if (c == std::string("look_at_") + xyz[a]) r.lookAt[a] = *v, used = true;
+                if (c == std::string("up_") + xyz[a]) r.up[a] = *v, used = true;
+            }
+            if (c == "fov") r.fov = *v, used = true;
+            if (c == "jitter_x") r.jitter[0] = *v, r.hasJitter = used = true;
+            if (c == "jitter_y") r.jitter[1] = *v, r.hasJitter = used = true;
+            if (const int i = at("view_", 16); i >= 0) r.view[std::size_t(i)] = *v, r.matrices = used = true;
+            if (const int i = at("projection_", 16); i >= 0) r.projection[std::size_t(i)] = *v, used = true;
+            if (!used) throw InputError(fmt::format("{}:{}: unknown column '{}'", name, 1, c));
+            ++seen;
+        }
+        out.records.emplace_back(where + fmt::format(" (frame {})", r.frame), r);
+    }
+    if (out.records.empty()) throw InputError(fmt::format("{}: no camera records", name));
+    return out;
+}
+
+}  // namespace
+
+CameraTrack::CameraTrack(const CameraSettings& settings) : settings_(settings) {
+    if (settings.file.empty()) return;
+    const std::string name = settings.file;
+    std::ifstream in(settings.file, std::ios::binary);
+    if (!in) throw InputError(fmt::format("{}: cannot open camera file", name));
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    const std::string text = ss.str();
+    const auto first = text.find_first_not_of(" \t\r\n");
+    const CameraFileContent content = first != std::string::npos && text[first] == '{' ? readJsonCameras(name, text)
+                                                                                       : readCsvCameras(name, text);
+    const double w = double(settings.width), h = double(settings.height), up = clipUp(content.convention);
+    for (const auto& [where, r] : content.records) {
+        CameraPose pose;
+        if (r.matrices) {
+            pose = poseFromMatrices(fromStored(r.view, content.convention), fromStored(r.projection, content.convention),
+                                    content.convention, settings.width, settings.height, where);
+        } else {
+            if (glm::length(r.lookAt - r.eye) <= 0.0)
+                throw InputError(fmt::format("{}: look_at must differ from eye", where));
+            const DVec3 f = glm::normalize(r.lookAt - r.eye);
+            if (!(glm::length(r.up) > 0.0) || glm::length(glm::cross(f, glm::normalize(r.up))) < 1e-4)
+                throw InputError(fmt::format("{}: up must be non-zero and not parallel to the view direction", where));
+            pose = CameraPose::lookAt(r.eye, r.lookAt, r.up, r.fov);
+        }
+        if (r.hasJitter) {
+            const double jx = content.ndcJitter ? r.jitter[0] * 0.5 * w : r.jitter[0];
+            const double jy = content.ndcJitter ? -r.jitter[1] * up * 0.5 * h : r.jitter[1];
+            if (r.matrices && (pose.jitterX != 0.0 || pose.jitterY != 0.0) &&
+                (std::fabs(pose.jitterX - jx) > 1e-6 || std::fabs(pose.jitterY - jy) > 1e-6))
+                throw InputError(fmt::format("{}: jitter ({}, {}) px differs from the projection's off-centre terms ({}, {}) px",
+                                             where, jx, jy, pose.jitterX, pose.jitterY));
+            pose.jitterX = jx;
+            pose.jitterY = jy;
+        }
+        if (!(std::fabs(pose.jitterX) <= 0.5 && std::fabs(pose.jitterY) <= 0.5))
+            throw InputError(fmt::format("{}: jitter ({:.6g}, {:.6g}) px is outside the pixel ([-0.5, 0.5]); check "
+                                         "jitter_units", where, pose.jitterX, pose.jitterY));
+        if (!poses_.emplace(r.frame, pose).second)
+            throw InputError(fmt::format("{}: frame {} given twice", where, r.frame));
+    }
+}
+
+CameraPose CameraTrack::pose(std::uint32_t frame) const {
+    if (settings_.file.empty()) {
+        const Camera path = Camera::atFrame(settings_, frame);
+        CameraPose p;
+        p.eye = DVec3(path.position);
+        p.forward = path.forwardD;
+        p.right = path.rightD;
+        p.up = path.upD;
+        p.tanHalfFov = path.tanHalfFovD;
+        return p;
+    }
+    const auto it = poses_.find(frame);
+    if (it == poses_.end())
+        throw InputError(fmt::format("{}: no camera for frame {} (the file holds frames {}..{})", settings_.file, frame,
+                                     poses_.begin()->first, poses_.rbegin()->first));
+    return it->second;
+}
+
+std::vector<std::uint32_t> CameraTrack::missing(std::uint32_t first, std::uint32_t end) const {
+    std::vector<std::uint32_t> out;
+    if (settings_.file.empty()) return out;
+    for (std::uint32_t f = first; f < end && out.size() < 16; ++f)
+        if (!poses_.count(f)) out.push_back(f);
+    return out;
+}
+
+void writeCameraFile(const std::filesystem::path& file, const CameraTrack& track, const CameraSettings& settings,
+                     std::uint32_t first, std::uint32_t end, const CameraConvention& conv, bool matrices) {
+    nlohmann::json doc;
+    doc["comment"] = "accretion camera file: one camera per frame (see README, Cameras from the engine)";
+    doc["convention"] = {{"storage", conv.storage == CameraConvention::Storage::row_major ? "row_major" : "column_major"},
+                         {"vectors", conv.vectors == CameraConvention::Vectors::row ? "row" : "column"},
+                         {"handedness", conv.handedness == CameraConvention::Handedness::left ? "left" : "right"},
+                         {"clip", conv.clip == CameraConvention::Clip::vulkan ? "vulkan"
+                                  : conv.clip == CameraConvention::Clip::d3d   ? "d3d"
+                                                                               : "opengl"}};
+    doc["jitter_units"] = "pixels";
+    doc["frames"] = nlohmann::json::array();
+    for (std::uint32_t f = first; f < end; ++f) {
+        const CameraPose p = track.pose(f);
+        nlohmann::json r = {{"frame", f}};
+        if (matrices) {
+            Mat4 V, P;
+            matricesFromPose(p, conv, settings.width, settings.height, V, P);
+            r["view"] = toStored(V, conv);
+            r["projection"] = toStored(P, conv);
+        } else {
+            r["eye"] = {p.eye.x, p.eye.y, p.eye.z};
+            r["look_at"] = {p.eye.x + p.forward.x, p.eye.y + p.forward.y, p.eye.z + p.forward.z};
+            r["up"] = {p.up.x, p.up.y, p.up.z};
+            r["fov"] = 2.0 * std::atan(p.tanHalfFov) * 180.0 / M_PI;
+            if (p.jitterX != 0.0 || p.jitterY != 0.0) r["jitter"] = {p.jitterX, p.jitterY};
+        }
+        doc["frames"].push_back(r);
+    }
+    writeFileAtomic(file, doc.dump(1) + "\n");
+}
+
+}  // namespace accretion
