@@ -15,6 +15,43 @@ namespace accretion {
 
 namespace OIIO = OIIO_NAMESPACE;
 
+ExrCameraMatrices exrCameraMatrices(const CameraPose& c, std::uint32_t width, std::uint32_t height) {
+    const DVec3 axis[3] = {c.right, c.up, c.forward};
+    double cam[4][4] = {};  // column vectors: camera = cam * world
+    for (int r = 0; r < 3; ++r) {
+        for (int k = 0; k < 3; ++k) cam[r][k] = axis[r][k];
+        cam[r][3] = -glm::dot(axis[r], c.eye);
+    }
+    cam[3][3] = 1.0;
+    const double aspect = double(width) / double(height);
+    const double ndc[4][4] = {{0.5 / (c.tanHalfFov * aspect), 0.0, 0.5 - c.jitterX / double(width), 0.0},
+                              {0.0, -0.5 / c.tanHalfFov, 0.5 - c.jitterY / double(height), 0.0},
+                              {0.0, 0.0, 1.0, 0.0},
+                              {0.0, 0.0, 1.0, 0.0}};
+    ExrCameraMatrices m;
+    for (int r = 0; r < 4; ++r)
+        for (int k = 0; k < 4; ++k) {
+            double sum = 0.0;
+            for (int j = 0; j < 4; ++j) sum += ndc[r][j] * cam[j][k];
+            // Imath stores the transpose (row vectors): element [k][r].
+            m.worldToCamera[std::size_t(4 * k + r)] = float(cam[r][k]);
+            m.worldToNDC[std::size_t(4 * k + r)] = float(sum);
+        }
+    return m;
+}
+
+namespace {
+
+void setCameraAttributes(OIIO::ImageSpec& spec, const CameraPose& c, std::uint32_t width, std::uint32_t height) {
+    const ExrCameraMatrices m = exrCameraMatrices(c, width, height);
+    spec.attribute("worldToCamera", OIIO::TypeMatrix44, m.worldToCamera.data());
+    spec.attribute("worldToNDC", OIIO::TypeMatrix44, m.worldToNDC.data());
+    const float jitter[2] = {float(c.jitterX), float(c.jitterY)};
+    spec.attribute("accretion:jitter", OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, OIIO::TypeDesc::VEC2), jitter);
+}
+
+}  // namespace
+
 void writeFrameExr(const std::filesystem::path& file, const FrameImage& img, bool withErrors, const OutputMetadata& metadata) {
     // One entry per channel: name, UINT or FLOAT, and the value of pixel px.
     struct Channel {
@@ -62,6 +99,7 @@ void writeFrameExr(const std::filesystem::path& file, const FrameImage& img, boo
     }
     spec.attribute("compression", "zip");
     for (const auto& [k, v] : metadata) spec.attribute("accretion:" + k, v);
+    setCameraAttributes(spec, img.camera, img.width, img.height);
 
     // Interleaved pixels in the native per-channel formats (all 4 bytes).
     const std::size_t pixels = std::size_t(img.width) * img.height;

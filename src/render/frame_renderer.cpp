@@ -173,7 +173,8 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const L
     // that precision does not depend on where the scene is (docs/MODEL.md
     // section 3). Geometry that persists across frames (a static scene,
     // refit and partial builds) keeps the origin of its first build.
-    const Camera world = cameras_.at(frame);
+    const CameraPose pose = cameras_.pose(frame);
+    const Camera world = Camera::fromPose(pose, settings_.camera.width, settings_.camera.height);
     const BuildPolicy policy = settings_.geometry.build;
     const bool persistent = plan_.staticGeometry || policy == BuildPolicy::refit || policy == BuildPolicy::partial;
     if (!built_ || !persistent) origin_ = world.position;
@@ -185,6 +186,7 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const L
     const Particles& particles = prepareGeometry(frame, camera, stats, loaded);
     const FramePlan& plan = plan_;
     FrameImage img;
+    img.camera = pose;
     if (plan.counting) recordClusterBuild(*bvh_, particles, img.counters);
 
     AliasTable powerTable;

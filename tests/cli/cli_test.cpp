@@ -140,3 +140,28 @@ TEST_CASE("accretion plan prints every pass, the skipped ones with their reason"
     CHECK(accretion::test::runCommand(std::string(ACCRETION_BINARY) + " plan no_such_scene.toml", out) == 1);
     CHECK_THAT(out, Catch::Contains("no_such_scene.toml"));
 }
+
+TEST_CASE("a camera file written from the orbit path renders bit-identically to orbit, in every convention",
+          "[cli][camera][determinism]") {
+    const auto dir = accretion::test::scratchDir("camera_file_orbit");
+    const std::string scene = "[particles]\ncount = 1500\n[camera]\nwidth = 96\nheight = 54\n";
+    std::ofstream(dir / "orbit.toml") << scene << "path = \"orbit\"\norbit_speed = 9\n";
+    const std::string estimator = GENERATE("uniform", "restir");
+    std::string out;
+    const std::string common = " --quiet --frames 0:3 --spp 2 --estimator " + estimator;
+    REQUIRE(accretion::test::runCommand(kBin + " render " + (dir / "orbit.toml").string() + common + " -o " +
+                                            (dir / "orbit.{frame}.exr").string(), out) == 0);
+    for (const std::string convention : {"opengl", "d3d", "vulkan"}) {
+        INFO(estimator << ", " << convention);
+        const std::string cams = (dir / ("cams_" + convention + ".json")).string();
+        REQUIRE(accretion::test::runCommand(kBin + " cameras " + (dir / "orbit.toml").string() +
+                                                " --frames 0:3 --convention " + convention + " -o " + cams, out) == 0);
+        const auto fileScene = dir / ("file_" + convention + ".toml");
+        std::ofstream(fileScene) << scene << "file = \"" << cams << "\"\n";
+        REQUIRE(accretion::test::runCommand(kBin + " render " + fileScene.string() + common + " -o " +
+                                                (dir / (convention + ".{frame}.exr")).string(), out) == 0);
+        for (const char* frame : {"0000", "0001", "0002"})
+            CHECK(bitIdentical(readPixels(dir / ("orbit." + std::string(frame) + ".exr")),
+                               readPixels(dir / (convention + "." + frame + ".exr"))));
+    }
+}

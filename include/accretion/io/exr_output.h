@@ -1,4 +1,5 @@
 #pragma once
+#include <array>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -10,6 +11,18 @@ namespace accretion {
 
 /// Metadata stored in every output (string attributes `accretion:<key>`).
 using OutputMetadata = std::map<std::string, std::string>;
+
+/// OpenEXR's standard camera attributes of a frame, as Imath stores them
+/// (row vectors: p' = p M, 16 floats row by row). worldToCamera maps into a
+/// space with x right, y up and z the view direction (left-handed, as
+/// OpenEXR defines it, whatever the world's handedness); worldToNDC maps onto
+/// the display window, (0, 0) its upper-left and (1, 1) its lower-right
+/// corner after the division by w, so that the frame's (jittered) sample of
+/// pixel (x, y) lands at ((x + 0.5) / width, (y + 0.5) / height).
+struct ExrCameraMatrices {
+    std::array<float, 16> worldToCamera{}, worldToNDC{};
+};
+ExrCameraMatrices exrCameraMatrices(const CameraPose& camera, std::uint32_t width, std::uint32_t height);
 
 /// Write a frame as a multi-layer float32 EXR (zip): R,G,B, Le.*, Lr.*,
 /// depth.Z, N.X/Y/Z, particle.id (uint32, 0xffffffff on a miss), rejected

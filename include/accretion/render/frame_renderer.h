@@ -23,6 +23,7 @@ namespace accretion {
 /// Every per-pixel output of one frame (the EXR layers).
 struct FrameImage {
     std::uint32_t width = 0, height = 0;
+    CameraPose camera;                ///< the frame's camera in world space (its jitter included)
     std::vector<Vec3> L;              ///< pixel value: Le + Lr, or the background
     std::vector<Vec3> Le;             ///< self-emission s_e I_j
     LightingImage lighting;           ///< Lr, its standard error, spp
