@@ -304,6 +304,7 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
     tbb::parallel_for(tbb::blocked_range2d<std::uint32_t>(row0, row1, 8, 0, gb.width, 8), [&](const auto& r) {
         LightingCounters& c = counters.local();
         GroupPixel pix[kGroupPixels];
+        std::uint64_t hitPixels = 0;
         for (std::uint32_t y = r.rows().begin(); y != r.rows().end(); ++y) {
             for (std::uint32_t x0 = r.cols().begin(); x0 < r.cols().end(); x0 += kGroupPixels) {
                 const std::uint32_t x1 = std::min(r.cols().end(), x0 + kGroupPixels);
@@ -332,6 +333,7 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
                     pix[n++].px = px;
                 }
                 if (n == 0) continue;
+                hitPixels += n;
                 for (std::uint32_t k = 0; k < n; ++k) {
                     GroupPixel& p = pix[k];
                     p.sp = shadingPoint(gb.texels[p.px], in.particles);
@@ -366,7 +368,9 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
                 }
             }
         }
-        if (progress) progress->advance(std::uint64_t(r.rows().size()) * r.cols().size() * (plan.exact ? 1 : c1 - c0));
+        // Work, not pixels: a hit pixel's samples (exact: its light terms, the
+        // same count for every hit pixel); misses cost next to nothing.
+        if (progress) progress->advance(hitPixels * (plan.exact ? 1 : c1 - c0));
     });
     LightingCounters total;
     for (const auto& c : counters) total += c;

@@ -151,8 +151,16 @@ void FrameRenderer::lightFrame(std::uint32_t frame, const Camera& camera, const 
     LightingInputs in{*bvh_, particles, gbuffer, settings_.shading, settings_.render, frame, powerTable, lightTree,
                       plan.counting ? &img.counters.add(pass::estimateLighting, camera.width, camera.height) : nullptr};
     const LightingPlan lp = planLighting(settings_.render, camera.height, session ? session->shard : Shard{});
-    Progress progress(fmt::format("frame {} {}", frame, pass::estimateLighting),
-                      std::uint64_t(pixels) * (lp.exact ? 1 : lp.chunks()), options_.quiet);
+    // Progress by work: the hit pixels of the rows (exact) or the chunks
+    // (samples) still to run, as the sweep counts them.
+    const std::uint64_t firstChunk = session && session->resume ? session->resume->nextChunk : lp.begin;
+    std::uint64_t work = 0;
+    for (std::uint32_t y = 0; y < gbuffer.height; ++y) {
+        if (lp.exact && (y / LightingPlan::kChunkRows < firstChunk || y / LightingPlan::kChunkRows >= lp.end)) continue;
+        for (std::uint32_t x = 0; x < gbuffer.width; ++x) work += gbuffer.texels[std::size_t(y) * gbuffer.width + x].hit();
+    }
+    if (!lp.exact) work *= lp.end > firstChunk ? lp.end - firstChunk : 0;
+    Progress progress(fmt::format("frame {} {}", frame, pass::estimateLighting), work, options_.quiet);
     if (!session) {
         stats.lighting = estimateLighting(in, img.lighting, &progress);
     } else {  // in chunks, from a checkpoint, into the session's sums
