@@ -6,7 +6,7 @@ packages=(
   libembree-dev libtbb-dev libglm-dev
   libopenexr-dev libopenimageio-dev openimageio-tools
   catch2 libtomlplusplus-dev nlohmann-json3-dev libcli11-dev libfmt-dev
-  libpcg-cpp-dev libeigen3-dev libbenchmark-dev gnuplot-nox clang parallel
+  libpcg-cpp-dev libeigen3-dev libbenchmark-dev gnuplot-nox clang parallel fonts-dejavu-core
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -7,6 +7,7 @@
 
 #include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "accretion/core/error.h"
 
@@ -77,7 +78,8 @@ bool exrHasLayer(const std::filesystem::path& file, const std::string& layer) {
     return true;
 }
 
-RgbLayer readExrLayer(const std::filesystem::path& file, const std::string& layer) {
+RgbLayer readExrChannels(const std::filesystem::path& file, const std::vector<std::string>& names) {
+    ACC_CHECK(names.size() == 3);
     {
         std::ifstream f(file, std::ios::binary);
         if (!f) throw InputError(fmt::format("{}: cannot open image", file.string()));
@@ -97,17 +99,29 @@ RgbLayer readExrLayer(const std::filesystem::path& file, const std::string& laye
     std::vector<float> all(pixels * std::size_t(spec.nchannels));
     if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
         throw InputError(fmt::format("{}: cannot read pixels: {}", file.string(), in->geterror()));
-    const auto names = layerChannels(layer);
     int idx[3];
     for (int c = 0; c < 3; ++c) {
         idx[c] = spec.channelindex(names[c]);
         if (idx[c] < 0)
-            throw InputError(fmt::format("{}: no channel '{}' (layer '{}')", file.string(), names[c],
-                                         layer.empty() ? "RGB" : layer));
+            throw InputError(fmt::format("{}: no channel '{}' (it has {})", file.string(), names[c],
+                                         fmt::join(spec.channelnames, ", ")));
     }
     out.rgb.resize(pixels);
     for (std::size_t p = 0; p < pixels; ++p)
         for (int c = 0; c < 3; ++c) out.rgb[p][c] = all[p * spec.nchannels + idx[c]];
+    return out;
+}
+
+RgbLayer readExrLayer(const std::filesystem::path& file, const std::string& layer) {
+    return readExrChannels(file, layerChannels(layer));
+}
+
+std::map<std::string, std::string> readExrAttributes(const std::filesystem::path& file) {
+    auto in = OIIO::ImageInput::open(file.string());
+    if (!in) throw InputError(fmt::format("{}: cannot read image: {}", file.string(), OIIO::geterror()));
+    std::map<std::string, std::string> out;
+    for (const auto& p : in->spec().extra_attribs)
+        out[p.name().string()] = p.type() == OIIO::TypeDesc::STRING ? p.get_string() : p.get_string();
     return out;
 }
 

@@ -7,6 +7,7 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include "accretion/analysis/image_metrics.h"
 #include "accretion/io/exr_output.h"
 #include "support/cli.h"
 
@@ -168,4 +169,37 @@ TEST_CASE("a restir EXR carries the reservoir AOVs, consistent with the image", 
         CHECK(c[M] >= 16.0f);  // at least this frame's candidates
     }
     CHECK(withSample > 100);
+}
+
+TEST_CASE("compare: error maps in closed form, a GPU frame's channel names, metadata that differ", "[cli][experiments][compare]") {
+    const auto dir = accretion::test::scratchDir("compare_maps");
+    // The reference: 1 everywhere with Lr_stderr 0.05; the GPU frame: 1.1 in
+    // its own channel names.
+    std::vector<FloatChannel> ref = {{"R", std::vector<float>(12, 1.0f)}, {"G", std::vector<float>(12, 1.0f)},
+                                     {"B", std::vector<float>(12, 1.0f)}, {"Lr_stderr.R", std::vector<float>(12, 0.05f)},
+                                     {"Lr_stderr.G", std::vector<float>(12, 0.05f)}, {"Lr_stderr.B", std::vector<float>(12, 0.05f)}};
+    writeChannelsExr(dir / "ref.exr", 4, 3, ref, {{"frame", "0"}});
+    std::vector<FloatChannel> gpu = {{"color.r", std::vector<float>(12, 1.1f)}, {"color.g", std::vector<float>(12, 1.1f)},
+                                     {"color.b", std::vector<float>(12, 1.1f)}};
+    writeChannelsExr(dir / "gpu.exr", 4, 3, gpu, {{"frame", "3"}});
+    std::string out;
+    const std::string cmd = kBin + " compare " + (dir / "gpu.exr").string() + " " + (dir / "ref.exr").string() +
+                            " --channels color.r,color.g,color.b --error-map " + (dir / "err.exr").string();
+    REQUIRE(runCommand(cmd, out) == 0);
+    INFO(out);
+    CHECK_THAT(out, Contains("warning") && Contains("frame: 3 here, 0 in the reference"));
+    const float d = 1.1f - 1.0f;
+    CHECK(readExrChannels(dir / "err.exr", {"error.R", "error.G", "error.B"}).rgb[5].x == Approx(d).epsilon(1e-6));
+    CHECK(readExrChannels(dir / "err.exr", {"relative.R", "relative.G", "relative.B"}).rgb[7].y == Approx(d / 1.01).epsilon(1e-5));
+    CHECK(readExrChannels(dir / "err.exr", {"z.R", "z.G", "z.B"}).rgb[0].z == Approx(d / 0.05).epsilon(1e-5));
+    for (const char* png : {"err.error.png", "err.relative.png", "err.z.png"}) CHECK(std::filesystem::exists(dir / png));
+    // --strict: the other frame is an error, and nothing is written.
+    CHECK(runCommand(kBin + " compare " + (dir / "gpu.exr").string() + " " + (dir / "ref.exr").string() +
+                         " --channels color.r,color.g,color.b --strict --error-map " + (dir / "strict.exr").string(), out) == 1);
+    CHECK_THAT(out, Contains("not the reference's view: frame: 3 here, 0 in the reference (--strict)"));
+    CHECK(!std::filesystem::exists(dir / "strict.exr"));
+    // The error map never replaces an input.
+    CHECK(runCommand(kBin + " compare " + (dir / "gpu.exr").string() + " " + (dir / "ref.exr").string() +
+                         " --channels color.r,color.g,color.b --error-map " + (dir / "ref.exr").string(), out) == 1);
+    CHECK_THAT(out, Contains("an input of this run"));
 }

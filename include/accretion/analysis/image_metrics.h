@@ -1,6 +1,7 @@
 #pragma once
 #include <cstddef>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,11 @@ struct RgbLayer {
 /// a PNG or JPEG is display-referred and 8-bit, not a measurement), cannot
 /// be read or lacks the channels.
 RgbLayer readExrLayer(const std::filesystem::path& file, const std::string& layer);
+/// The same with the three channels named (a GPU frame's own names).
+RgbLayer readExrChannels(const std::filesystem::path& file, const std::vector<std::string>& channels);
+/// An EXR's attributes as text (strings as they are, numbers and matrices
+/// printed), by name: what compare checks between two images.
+std::map<std::string, std::string> readExrAttributes(const std::filesystem::path& file);
 /// True if the file has all three channels of the layer.
 bool exrHasLayer(const std::filesystem::path& file, const std::string& layer);
 
