@@ -302,7 +302,7 @@ void writeHeatmaps(const std::string& prefix, const CountedFrame& main, const Se
     std::vector<FloatChannel> maps;
     for (const Heatmap& h : main.image.heatmaps) {
         maps.push_back({h.name, h.values});
-        writeHeatmapPng(prefix + "." + h.name + ".png", h.values, main.image.width, main.image.height);
+        writeHeatmapPng(prefix + "." + h.name + ".png", h.values, main.image.width, main.image.height, h.name + ": " + h.unit);
     }
     writeChannelsExr(prefix + ".heatmaps.exr", main.image.width, main.image.height, maps,
                      {{"version", std::string(version())}, {"scene", settings.scenePath}, {"frame", std::to_string(frame)}});

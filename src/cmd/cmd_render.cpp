@@ -219,7 +219,7 @@ nlohmann::json writeFrameOutputs(const RenderRun& run, std::uint32_t frame, cons
         fj["gpu"] = toJson(makeGpuReport(image.counters, settings, fs.reservoirBytes));
         for (const Heatmap& h : image.heatmaps) {
             const std::string png = base + "." + h.name + ".png";
-            writeHeatmapPng(png, h.values, image.width, image.height);
+            writeHeatmapPng(png, h.values, image.width, image.height, h.name + ": " + h.unit);
             fj["outputs"][h.name + "_png"] = png;
         }
     }

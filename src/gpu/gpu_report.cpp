@@ -183,11 +183,11 @@ nlohmann::json toJson(const GpuReport& r) {
 
 std::vector<Heatmap> counterHeatmaps(const FrameCounters& counters, std::uint32_t width, std::uint32_t height) {
     const std::size_t pixels = std::size_t(width) * height;
-    std::vector<Heatmap> maps{{"gpu.rays", std::vector<float>(pixels, 0.0f)},
-                              {"gpu.blas_entries", std::vector<float>(pixels, 0.0f)},
-                              {"gpu.any_hits", std::vector<float>(pixels, 0.0f)},
-                              {"gpu.trips", std::vector<float>(pixels, 0.0f)},
-                              {"gpu.bytes", std::vector<float>(pixels, 0.0f)}};
+    std::vector<Heatmap> maps{{"gpu.rays", std::vector<float>(pixels, 0.0f), "rays per pixel, all passes"},
+                              {"gpu.blas_entries", std::vector<float>(pixels, 0.0f), "BLAS entries per pixel, all passes"},
+                              {"gpu.any_hits", std::vector<float>(pixels, 0.0f), "any-hit calls per pixel, all passes"},
+                              {"gpu.trips", std::vector<float>(pixels, 0.0f), "light-loop trips per pixel, all passes"},
+                              {"gpu.bytes", std::vector<float>(pixels, 0.0f), "bytes read + written per pixel, all passes"}};
     for (const PassCounters& pc : counters.passes) {
         if (pc.pass == pass::buildClusters || pc.width == 0 || pc.height == 0) continue;
         for (std::uint32_t y = 0; y < height; ++y)

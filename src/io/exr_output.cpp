@@ -9,6 +9,7 @@
 
 #include "accretion/core/error.h"
 #include "accretion/core/atomic_file.h"
+#include "accretion/io/false_colour.h"
 #include "accretion/render/gbuffer.h"
 
 namespace accretion {
@@ -163,22 +164,9 @@ void writeRgb8Png(const std::filesystem::path& file, const std::vector<std::uint
 }  // namespace
 
 void writeHeatmapPng(const std::filesystem::path& file, const std::vector<float>& values, std::uint32_t width,
-                     std::uint32_t height) {
+                     std::uint32_t height, const std::string& title) {
     const float p = percentile995(values);
-    const float top = p > 0.0f ? p : 1.0f;
-    // A viridis-like ramp: dark blue, blue, teal, green, yellow.
-    static const float ramp[5][3] = {{0.27f, 0.00f, 0.33f}, {0.23f, 0.32f, 0.55f}, {0.13f, 0.57f, 0.55f},
-                                     {0.37f, 0.79f, 0.38f}, {0.99f, 0.91f, 0.14f}};
-    std::vector<std::uint8_t> px(values.size() * 3, 0);
-    for (std::size_t i = 0; i < values.size(); ++i) {
-        if (!(values[i] > 0.0f)) continue;
-        const float t = std::clamp(values[i] / top, 0.0f, 1.0f) * 4.0f;
-        const int a = std::min(3, int(t));
-        const float f = t - float(a);
-        for (int c = 0; c < 3; ++c)
-            px[3 * i + c] = static_cast<std::uint8_t>(std::lround(255.0f * (ramp[a][c] + f * (ramp[a + 1][c] - ramp[a][c]))));
-    }
-    writeRgb8Png(file, px, width, height);
+    writeFalseColourPng(file, values, width, height, {0.0, p > 0.0f ? double(p) : 1.0, false, title + " (scale: 99.5th percentile)"});
 }
 
 void writePreviewPng(const std::filesystem::path& file, const std::vector<Vec3>& rgb, std::uint32_t width,

@@ -30,7 +30,7 @@ void colourOf(double t, bool diverging, float rgb[3]) {
     }
 }
 
-std::string label(double v) { return std::fabs(v) >= 1e-3 && std::fabs(v) < 1e4 ? fmt::format("{:.4g}", v) : fmt::format("{:.2e}", v); }
+std::string label(double v) { return v == 0.0 ? std::string("0") : std::fabs(v) >= 1e-3 && std::fabs(v) < 1e4 ? fmt::format("{:.4g}", v) : fmt::format("{:.2e}", v); }
 
 }  // namespace
 
@@ -48,7 +48,7 @@ double symmetricScale(const std::vector<float>& values) {
 void writeFalseColourPng(const std::filesystem::path& file, const std::vector<float>& values, std::uint32_t width,
                          std::uint32_t height, const ColourScale& scale) {
     ACC_CHECK(values.size() == std::size_t(width) * height);
-    const int W = std::max<int>(int(width), 360), barTop = int(height) + 6, barH = 14, H = int(height) + 56;
+    const int W = std::max<int>(int(width), 360), barTop = int(height) + 6, barH = 14, H = int(height) + 74;
     OIIO::ImageBuf img(OIIO::ImageSpec(W, H, 3, OIIO::TypeDesc::FLOAT));
     OIIO::ImageBufAlgo::zero(img);
     const double span = scale.hi - scale.lo;
@@ -75,7 +75,11 @@ void writeFalseColourPng(const std::filesystem::path& file, const std::vector<fl
                                             OIIO::ImageBufAlgo::TextAlignX::Center);
         OIIO::ImageBufAlgo::render_text(img, barX1, textY, label(scale.hi), size, kFont, white,
                                         OIIO::ImageBufAlgo::TextAlignX::Right);
-        OIIO::ImageBufAlgo::render_text(img, barX0, textY + 17, scale.title, size, kFont, white);
+        // The title on two lines when it has a parenthesis: it must fit 360 pixels.
+        const auto paren = scale.title.find(" (");
+        OIIO::ImageBufAlgo::render_text(img, barX0, textY + 17, scale.title.substr(0, paren), size, kFont, white);
+        if (paren != std::string::npos)
+            OIIO::ImageBufAlgo::render_text(img, barX0, textY + 34, scale.title.substr(paren + 1), size, kFont, white);
     }
     img.specmod().attribute("ImageDescription", fmt::format("{}: scale [{}, {}]", scale.title, scale.lo, scale.hi));
     writeAtomicWith(file, [&](const std::filesystem::path& tmp) {

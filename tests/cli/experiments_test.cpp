@@ -192,7 +192,14 @@ TEST_CASE("compare: error maps in closed form, a GPU frame's channel names, meta
     CHECK(readExrChannels(dir / "err.exr", {"error.R", "error.G", "error.B"}).rgb[5].x == Approx(d).epsilon(1e-6));
     CHECK(readExrChannels(dir / "err.exr", {"relative.R", "relative.G", "relative.B"}).rgb[7].y == Approx(d / 1.01).epsilon(1e-5));
     CHECK(readExrChannels(dir / "err.exr", {"z.R", "z.G", "z.B"}).rgb[0].z == Approx(d / 0.05).epsilon(1e-5));
-    for (const char* png : {"err.error.png", "err.relative.png", "err.z.png"}) CHECK(std::filesystem::exists(dir / png));
+    for (const char* png : {"err.error.png", "err.relative.png", "err.z.png"}) {
+        // The image, and under it the colour bar with its scale: a wider, taller PNG.
+        auto in = OIIO::ImageInput::open((dir / png).string());
+        REQUIRE(in);
+        CHECK(in->spec().width >= 360);
+        CHECK(in->spec().height == 3 + 74);
+        CHECK_THAT(in->spec().get_string_attribute("ImageDescription"), Contains("scale ["));
+    }
     // --strict: the other frame is an error, and nothing is written.
     CHECK(runCommand(kBin + " compare " + (dir / "gpu.exr").string() + " " + (dir / "ref.exr").string() +
                          " --channels color.r,color.g,color.b --strict --error-map " + (dir / "strict.exr").string(), out) == 1);

@@ -69,6 +69,7 @@ nlohmann::json toJson(const GpuReport& r);
 struct Heatmap {
     std::string name;
     std::vector<float> values;
+    std::string unit;  ///< what a value counts, e.g. "shadow and primary rays per pixel, all passes"
 };
 std::vector<Heatmap> counterHeatmaps(const FrameCounters& counters, std::uint32_t width, std::uint32_t height);
 

@@ -42,10 +42,12 @@ struct FloatChannel {
 void writeChannelsExr(const std::filesystem::path& file, std::uint32_t width, std::uint32_t height,
                       const std::vector<FloatChannel>& channels, const OutputMetadata& metadata);
 
-/// A counter heatmap as an 8-bit PNG: 0 black, the 99.5th percentile of the
-/// non-zero values (or the maximum) bright yellow, through a perceptual ramp. Atomic.
+/// A counter heatmap as an 8-bit PNG in false colour (io/false_colour.h): 0
+/// dark purple, the 99.5th percentile of the non-zero values (or the
+/// maximum) bright yellow, with a colour bar, its scale and `title` (the
+/// counter and its unit) under the image. Atomic.
 void writeHeatmapPng(const std::filesystem::path& file, const std::vector<float>& values, std::uint32_t width,
-                     std::uint32_t height);
+                     std::uint32_t height, const std::string& title);
 
 /// An EXR's pixels in their native 4-byte channel formats, with its header:
 /// what `merge` reads from a shard and writes back with new lighting.
