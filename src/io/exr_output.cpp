@@ -212,8 +212,14 @@ RawExr readRawExr(const std::filesystem::path& file) {
         if (t.size() != 4) throw InputError(fmt::format("{}: channel {} is not 32-bit", file.string(), spec.channelnames[c]));
         exr.uints.push_back(t == OIIO::TypeDesc::UINT);
     }
-    for (const auto& p : spec.extra_attribs)
+    for (const auto& p : spec.extra_attribs) {
         if (p.type() == OIIO::TypeDesc::STRING) exr.attributes[p.name().string()] = p.get_string();
+        if (p.type().basetype == OIIO::TypeDesc::FLOAT) {
+            const auto* v = static_cast<const float*>(p.data());
+            const std::size_t n = std::size_t(p.nvalues()) * p.type().numelements() * p.type().aggregate;
+            exr.floatAttributes[p.name().string()] = {p.type().c_str(), std::vector<float>(v, v + n)};
+        }
+    }
     exr.bits.resize(std::size_t(exr.width) * exr.height * exr.channels.size());
     if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UNKNOWN, exr.bits.data()))
         throw InputError(fmt::format("{}: cannot read EXR pixels: {}", file.string(), in->geterror()));
@@ -227,6 +233,7 @@ void writeRawExr(const std::filesystem::path& file, const RawExr& exr) {
     for (const bool u : exr.uints) spec.channelformats.push_back(u ? OIIO::TypeDesc::UINT : OIIO::TypeDesc::FLOAT);
     spec.attribute("compression", "zip");
     for (const auto& [k, v] : exr.attributes) spec.attribute(k, v);
+    for (const auto& [k, tv] : exr.floatAttributes) spec.attribute(k, OIIO::TypeDesc(tv.first), tv.second.data());
     writeAtomicWith(file, [&](const std::filesystem::path& tmp) {
         auto out = OIIO::ImageOutput::create("openexr");
         if (!out) throw InternalError("OpenImageIO has no OpenEXR writer");

@@ -57,6 +57,9 @@ struct RawExr {
     std::vector<std::uint32_t> bits;     ///< interleaved, width x height x channels
     std::vector<bool> uints;             ///< per channel: UINT (else FLOAT)
     std::map<std::string, std::string> attributes;  ///< string attributes (accretion:*)
+    /// Float attributes as they were (the camera's worldToCamera, worldToNDC,
+    /// accretion:jitter): name -> (OpenImageIO type name, values).
+    std::map<std::string, std::pair<std::string, std::vector<float>>> floatAttributes;
     std::string file;                    ///< where it was read (for messages)
 
     /// Index of a channel; throws InputError naming the file when absent.
