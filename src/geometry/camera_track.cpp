@@ -173,8 +173,9 @@ CameraConvention parseConvention(const nlohmann::json& j, const std::string& whe
         return c;
     }
     if (!j.is_object()) throw InputError(fmt::format("{}: convention: expected a preset name or an object", where));
-    for (const auto& [key, value] : j.items()) {
-        const std::string v = value.is_string() ? value.get<std::string>() : "";
+    for (const auto& item : j.items()) {
+        const std::string key = item.key();
+        const std::string v = item.value().is_string() ? item.value().get<std::string>() : "";
         auto bad = [&](const char* choices) {
             return InputError(fmt::format("{}: convention.{} \"{}\": expected {}", where, key, v, choices));
         };
