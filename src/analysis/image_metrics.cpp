@@ -26,7 +26,7 @@ ErrorMetrics computeErrors(const std::vector<Vec3>& x, const std::vector<Vec3>& 
     auto finite = [](const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
     for (std::size_t i = 0; i < x.size(); ++i) {
         if (!finite(x[i]) || !finite(ref[i]) || (refStderr && !finite((*refStderr)[i]))) {
-            if (m.nonFinite++ == 0) m.firstNonFinite = i;
+            if (m.nonFinite++ < ErrorMetrics::kNonFiniteListed) m.firstNonFinite.push_back(i);
             continue;
         }
         for (int c = 0; c < 3; ++c) {

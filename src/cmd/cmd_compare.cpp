@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include "accretion/analysis/image_metrics.h"
@@ -150,9 +151,11 @@ void runCompare(const CompareArgs& a) {
     t.add({a.image, a.reference, a.layer.empty() ? "RGB" : a.layer, m.relMSE, m.MSE, m.MAPE, kRelMseEpsilon,
            std::uint64_t(m.pixels), std::uint64_t(m.nonFinite)});
     if (m.nonFinite > 0) {
-        const std::size_t p = m.firstNonFinite;
-        const std::string msg = fmt::format("{} of {} pixels are NaN or infinite (first at x={} y={}, in {}) and left out",
-                                            m.nonFinite, x.rgb.size(), p % x.width, p / x.width, nonFiniteOwner(a, x, p));
+        std::vector<std::string> at;  // (x, y) of the first few, and where the first is
+        for (const std::size_t p : m.firstNonFinite) at.push_back(fmt::format("({}, {})", p % x.width, p / x.width));
+        const std::string msg = fmt::format("{} of {} pixels are NaN or infinite (at {}{}; the first in {}) and left out",
+                                            m.nonFinite, x.rgb.size(), fmt::join(at, ", "), m.nonFinite > at.size() ? ", ..." : "",
+                                            nonFiniteOwner(a, x, m.firstNonFinite.front()));
         if (!a.allowNonFinite || m.pixels == 0)
             throw InputError(fmt::format("{}: {}{}", a.image, msg,
                                          m.pixels == 0 ? ": no finite pixel is left to measure"

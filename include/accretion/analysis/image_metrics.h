@@ -21,9 +21,10 @@ struct ErrorMetrics {
     double relMSEFloor = 0.0;
     std::size_t pixels = 0;      ///< pixels measured
     /// Pixels left out because a value of the image, the reference or its
-    /// stderr is NaN or infinite, and the first of them (row-major index).
+    /// stderr is NaN or infinite, and the first few of them (row-major indices).
     std::size_t nonFinite = 0;
-    std::size_t firstNonFinite = 0;
+    std::vector<std::size_t> firstNonFinite;  ///< at most kNonFiniteListed
+    static constexpr std::size_t kNonFiniteListed = 5;
 };
 
 inline constexpr double kRelMseEpsilon = 1e-2;
