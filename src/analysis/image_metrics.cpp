@@ -53,6 +53,18 @@ ErrorMetrics computeErrors(const std::vector<Vec3>& x, const std::vector<Vec3>& 
 
 namespace {
 
+/// Refuse a file that is not an OpenEXR file, by its magic: a PNG or JPEG
+/// is display-referred and 8-bit, not a measurement.
+void requireExr(const std::filesystem::path& file) {
+    std::ifstream f(file, std::ios::binary);
+    if (!f) throw InputError(fmt::format("{}: cannot open image", file.string()));
+    unsigned char magic[4] = {};
+    f.read(reinterpret_cast<char*>(magic), 4);
+    if (!(magic[0] == 0x76 && magic[1] == 0x2f && magic[2] == 0x31 && magic[3] == 0x01))
+        throw InputError(fmt::format("{}: not an OpenEXR file: images are compared as scene-referred floats (EXR), "
+                                     "not display-referred 8-bit previews", file.string()));
+}
+
 std::vector<std::string> layerChannels(const std::string& layer) {
     if (layer.empty()) return {"R", "G", "B"};
     return {layer + ".R", layer + ".G", layer + ".B"};
@@ -61,15 +73,6 @@ std::vector<std::string> layerChannels(const std::string& layer) {
 }  // namespace
 
 bool exrHasLayer(const std::filesystem::path& file, const std::string& layer) {
-    {
-        std::ifstream f(file, std::ios::binary);
-        if (!f) throw InputError(fmt::format("{}: cannot open image", file.string()));
-        unsigned char magic[4] = {};
-        f.read(reinterpret_cast<char*>(magic), 4);
-        if (!(magic[0] == 0x76 && magic[1] == 0x2f && magic[2] == 0x31 && magic[3] == 0x01))
-            throw InputError(fmt::format("{}: not an OpenEXR file: images are compared as scene-referred floats (EXR), "
-                                         "not display-referred 8-bit previews", file.string()));
-    }
     auto in = OIIO::ImageInput::open(file.string());
     if (!in) return false;
     const OIIO::ImageSpec& spec = in->spec();
@@ -80,15 +83,7 @@ bool exrHasLayer(const std::filesystem::path& file, const std::string& layer) {
 
 RgbLayer readExrChannels(const std::filesystem::path& file, const std::vector<std::string>& names) {
     ACC_CHECK(names.size() == 3);
-    {
-        std::ifstream f(file, std::ios::binary);
-        if (!f) throw InputError(fmt::format("{}: cannot open image", file.string()));
-        unsigned char magic[4] = {};
-        f.read(reinterpret_cast<char*>(magic), 4);
-        if (!(magic[0] == 0x76 && magic[1] == 0x2f && magic[2] == 0x31 && magic[3] == 0x01))
-            throw InputError(fmt::format("{}: not an OpenEXR file: images are compared as scene-referred floats (EXR), "
-                                         "not display-referred 8-bit previews", file.string()));
-    }
+    requireExr(file);
     auto in = OIIO::ImageInput::open(file.string());
     if (!in) throw InputError(fmt::format("{}: cannot read image: {}", file.string(), OIIO::geterror()));
     const OIIO::ImageSpec& spec = in->spec();

@@ -24,8 +24,7 @@ void runCameras(const CamerasArgs& a) {
     if (!CameraConvention::preset(a.convention, convention))
         throw InputError(fmt::format("command line --convention {}: expected opengl, vulkan or d3d", a.convention));
     const std::uint32_t first = settings.render.frame_start, end = first + settings.render.frames;
-    checkCameras(settings, first, end);
-    OutputGuard guard = sceneInputs(settings);
+    const OutputGuard guard = sceneInputs(settings, first, end);
     guard.check(a.output, "-o");
     writeCameraFile(a.output, CameraTrack(settings.camera), settings.camera, first, end, convention, !a.pose);
     fmt::print("cameras: {} (frames {}..{}, {})\n", a.output, first, end - 1, a.pose ? "look-at poses" : a.convention + " matrices");

@@ -164,10 +164,7 @@ FramePaths framePaths(const RenderRun& run, std::uint32_t frame) {
 /// one of them or land on a device or a directory.
 void guardRun(RenderRun& run, const std::string& stem, const std::string& outputsFile) {
     const Settings& s = run.settings;
-    run.guard.addInput(s.scenePath);
-    for (const auto& f : ParticleSource(s).checkFiles(run.sharding.first, run.sharding.end)) run.guard.addInput(f);
-    checkCameras(s, run.sharding.first, run.sharding.end);
-    run.guard.addInput(s.camera.file);
+    run.guard = sceneInputs(s, run.sharding.first, run.sharding.end);
     for (std::uint32_t frame = run.sharding.first; frame < run.sharding.end; ++frame) {
         const FramePaths p = framePaths(run, frame);
         for (const std::string& out : {p.exr, p.png(), p.lrPng()}) run.guard.check(out, "output");

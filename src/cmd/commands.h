@@ -48,13 +48,13 @@ std::vector<FlagSetting> frameFlags(const std::string& frames);
 /// The command's scene: the file, its -D overrides, --frames, then `flags`.
 Settings loadSceneArgs(const SceneArgs& args, const std::vector<FlagSetting>& flags = {});
 
-/// The scene's own files as inputs no output may replace: the scene and
-/// every particle file its frames read (the whole {frame} sequence checked).
+/// The scene's own files as inputs no output may replace, checked before
+/// anything renders: the scene, every particle file frames [first, end)
+/// read (the whole {frame} sequence: exists, valid, one count) and the
+/// camera file (a camera for every frame). Without a range: the scene's
+/// render.frames.
+OutputGuard sceneInputs(const Settings& settings, std::uint32_t first, std::uint32_t end);
 OutputGuard sceneInputs(const Settings& settings);
-
-/// Every frame of [first, end) has a camera (camera.file): InputError naming
-/// the first that has none, before anything renders.
-void checkCameras(const Settings& settings, std::uint32_t first, std::uint32_t end);
 
 /// Before any work: refuse each `prefix + suffix` that `guard` refuses.
 void checkOutputs(const OutputGuard& guard, const std::string& prefix, const std::vector<std::string>& suffixes,

@@ -9,6 +9,7 @@
 #include <toml++/toml.h>
 
 #include "accretion/core/error.h"
+#include "accretion/core/read_file.h"
 #include "accretion/scene/toml_limits.h"
 
 namespace accretion::cmd {
@@ -114,11 +115,7 @@ JobsFile parseJobsFile(std::string_view text, const std::filesystem::path& file)
 }
 
 JobsFile readJobsFile(const std::filesystem::path& file) {
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw InputError(fmt::format("{}: cannot open jobs file", file.string()));
-    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (in.bad()) throw InputError(fmt::format("{}: cannot read jobs file", file.string()));
-    return parseJobsFile(text, file);
+    return parseJobsFile(readWholeFile(file, "jobs file"), file);
 }
 
 }  // namespace accretion::cmd

@@ -39,21 +39,21 @@ Settings loadSceneArgs(const SceneArgs& a, const std::vector<FlagSetting>& flags
     return loadScene(a.scene, a.defines, all);
 }
 
-OutputGuard sceneInputs(const Settings& settings) {
+OutputGuard sceneInputs(const Settings& settings, std::uint32_t first, std::uint32_t end) {
     OutputGuard guard;
     guard.addInput(settings.scenePath);
-    const std::uint32_t first = settings.render.frame_start;
-    for (const auto& f : ParticleSource(settings).checkFiles(first, first + settings.render.frames)) guard.addInput(f);
+    for (const auto& f : ParticleSource(settings).checkFiles(first, end)) guard.addInput(f);
+    const std::vector<std::uint32_t> missing = CameraTrack(settings.camera).missing(first, end);
+    if (!missing.empty())
+        throw InputError(fmt::format("{}: no camera for frame {} (frames {}..{} of this run are checked before the first "
+                                     "renders)", settings.camera.file, missing.front(), first, end - 1));
     guard.addInput(settings.camera.file);
     return guard;
 }
 
-void checkCameras(const Settings& settings, std::uint32_t first, std::uint32_t end) {
-    const CameraTrack cameras(settings.camera);
-    const std::vector<std::uint32_t> missing = cameras.missing(first, end);
-    if (!missing.empty())
-        throw InputError(fmt::format("{}: no camera for frame {} (frames {}..{} of this run are checked before the first "
-                                     "renders)", settings.camera.file, missing.front(), first, end - 1));
+OutputGuard sceneInputs(const Settings& settings) {
+    const std::uint32_t first = settings.render.frame_start;
+    return sceneInputs(settings, first, first + settings.render.frames);
 }
 
 void checkOutputs(const OutputGuard& guard, const std::string& prefix, const std::vector<std::string>& suffixes,

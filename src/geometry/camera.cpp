@@ -44,7 +44,7 @@ Camera Camera::lookAt(const Vec3& eye, const Vec3& target, const Vec3& upHint, d
     return fromPose(CameraPose::lookAt(eye, target, upHint, fovDegrees), width, height);
 }
 
-Camera Camera::atFrame(const CameraSettings& s, std::uint32_t frame) {
+CameraPose CameraPose::atFrame(const CameraSettings& s, std::uint32_t frame) {
     Vec3 eye = s.position, target = s.look_at;
     switch (s.path) {
     case CameraPath::static_pose: break;
@@ -62,7 +62,11 @@ Camera Camera::atFrame(const CameraSettings& s, std::uint32_t frame) {
         break;
     }
     }
-    return lookAt(eye, target, s.up, s.fov, s.width, s.height);
+    return lookAt(eye, target, s.up, s.fov);
+}
+
+Camera Camera::atFrame(const CameraSettings& s, std::uint32_t frame) {
+    return fromPose(CameraPose::atFrame(s, frame), s.width, s.height);
 }
 
 }  // namespace accretion

@@ -2,14 +2,19 @@
 
 #include <cmath>
 #include <fstream>
+#include <map>
+#include <optional>
 #include <sstream>
+#include <type_traits>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include "accretion/core/atomic_file.h"
 #include "accretion/core/error.h"
 #include "accretion/core/parse.h"
+#include "accretion/core/read_file.h"
 
 namespace accretion {
 namespace {
@@ -164,6 +169,21 @@ struct CameraFileContent {
     std::vector<std::pair<std::string, CameraRecord>> records;  ///< where (file:line or file: frames[i]), record
 };
 
+/// `out` = the value named `v` among `options`, else InputError listing them.
+template <class E>
+void pickValue(E& out, const std::string& v, std::initializer_list<std::pair<const char*, std::type_identity_t<E>>> options,
+               const std::string& where, const std::string& key) {
+    std::vector<std::string> names;
+    for (const auto& [name, value] : options) {
+        if (v == name) {
+            out = value;
+            return;
+        }
+        names.emplace_back(name);
+    }
+    throw InputError(fmt::format("{}: convention.{} \"{}\": expected one of {}", where, key, v, fmt::join(names, ", ")));
+}
+
 CameraConvention parseConvention(const nlohmann::json& j, const std::string& where) {
     CameraConvention c;
     if (j.is_string()) {
@@ -176,29 +196,16 @@ CameraConvention parseConvention(const nlohmann::json& j, const std::string& whe
     for (const auto& item : j.items()) {
         const std::string key = item.key();
         const std::string v = item.value().is_string() ? item.value().get<std::string>() : "";
-        auto bad = [&](const char* choices) {
-            return InputError(fmt::format("{}: convention.{} \"{}\": expected {}", where, key, v, choices));
-        };
-        if (key == "storage") {
-            if (v == "row_major") c.storage = CameraConvention::Storage::row_major;
-            else if (v == "column_major") c.storage = CameraConvention::Storage::column_major;
-            else throw bad("row_major or column_major");
-        } else if (key == "vectors") {
-            if (v == "column") c.vectors = CameraConvention::Vectors::column;
-            else if (v == "row") c.vectors = CameraConvention::Vectors::row;
-            else throw bad("column (M v) or row (v M)");
-        } else if (key == "handedness") {
-            if (v == "right") c.handedness = CameraConvention::Handedness::right;
-            else if (v == "left") c.handedness = CameraConvention::Handedness::left;
-            else throw bad("right or left");
-        } else if (key == "clip") {
-            if (v == "opengl") c.clip = CameraConvention::Clip::opengl;
-            else if (v == "d3d") c.clip = CameraConvention::Clip::d3d;
-            else if (v == "vulkan") c.clip = CameraConvention::Clip::vulkan;
-            else throw bad("opengl, d3d or vulkan");
-        } else {
-            throw InputError(fmt::format("{}: convention.{}: unknown key (storage, vectors, handedness, clip)", where, key));
-        }
+        using C = CameraConvention;
+        if (key == "storage")
+            pickValue(c.storage, v, {{"row_major", C::Storage::row_major}, {"column_major", C::Storage::column_major}}, where, key);
+        else if (key == "vectors")
+            pickValue(c.vectors, v, {{"column", C::Vectors::column}, {"row", C::Vectors::row}}, where, key);
+        else if (key == "handedness")
+            pickValue(c.handedness, v, {{"right", C::Handedness::right}, {"left", C::Handedness::left}}, where, key);
+        else if (key == "clip")
+            pickValue(c.clip, v, {{"opengl", C::Clip::opengl}, {"d3d", C::Clip::d3d}, {"vulkan", C::Clip::vulkan}}, where, key);
+        else throw InputError(fmt::format("{}: convention.{}: unknown key (storage, vectors, handedness, clip)", where, key));
     }
     return c;
 }
@@ -256,8 +263,7 @@ CameraFileContent readJsonCameras(const std::string& name, const std::string& te
             else if (pose && key == "look_at") r.lookAt = vec3(value, where, "look_at");
             else if (pose && key == "up") r.up = vec3(value, where, "up");
             else if (pose && key == "fov") {
-                if (!value.is_number() || !(value.get<double>() > 0.0 && value.get<double>() < 179.0))
-                    throw InputError(fmt::format("{}: fov: expected degrees in (0, 179)", where));
+                if (!value.is_number()) throw InputError(fmt::format("{}: fov: expected degrees in (0, 179)", where));
                 r.fov = value.get<double>();
             } else if (matrix && key == "view") r.view = numbers<16>(value, where, "view");
             else if (matrix && key == "projection") r.projection = numbers<16>(value, where, "projection");
@@ -278,12 +284,44 @@ CameraFileContent readJsonCameras(const std::string& name, const std::string& te
     return out;
 }
 
+/// A CSV column after 'frame': where its value goes in a record.
+struct CsvColumn {
+    enum Kind { eye, lookAt, up, fov, jitter, view, projection } kind;
+    std::size_t index;  ///< the component: x y z, jitter x y, matrix element
+    std::string name;
+
+    static std::optional<CsvColumn> of(const std::string& name) {
+        static const std::pair<const char*, Kind> vectors[] = {{"eye_", eye}, {"look_at_", lookAt}, {"up_", up}, {"jitter_", jitter}};
+        for (const auto& [prefix, kind] : vectors)
+            for (std::size_t i = 0; i < (kind == jitter ? 2u : 3u); ++i)
+                if (name == std::string(prefix) + "xyz"[i]) return CsvColumn{kind, i, name};
+        if (name == "fov") return CsvColumn{fov, 0, name};
+        for (const auto& [prefix, kind] : {std::pair{"view_", view}, std::pair{"projection_", projection}})
+            if (name.rfind(prefix, 0) == 0)
+                if (const auto i = parseUnsigned(name.substr(std::string_view(prefix).size()), 15))
+                    return CsvColumn{kind, std::size_t(*i), name};
+        return std::nullopt;
+    }
+
+    void store(CameraRecord& r, double v) const {
+        switch (kind) {
+        case eye: r.eye[int(index)] = v; break;
+        case lookAt: r.lookAt[int(index)] = v; break;
+        case up: r.up[int(index)] = v; break;
+        case fov: r.fov = v; break;
+        case jitter: r.jitter[index] = v, r.hasJitter = true; break;
+        case view: r.view[index] = v, r.matrices = true; break;
+        case projection: r.projection[index] = v; break;
+        }
+    }
+};
+
 CameraFileContent readCsvCameras(const std::string& name, const std::string& text) {
     CameraFileContent out;
     std::istringstream in(text);
     std::string line;
     std::size_t lineNo = 0;
-    std::vector<std::string> columns;
+    std::vector<CsvColumn> columns;  ///< after 'frame'
     while (std::getline(in, line)) {
         ++lineNo;
         if (!line.empty() && line.back() == '\r') line.pop_back();
@@ -302,47 +340,35 @@ CameraFileContent readCsvCameras(const std::string& name, const std::string& tex
             continue;
         }
         const std::vector<std::string> cells = splitList(line, ',');
-        if (columns.empty()) {
-            columns = cells;
-            if (columns.empty() || columns[0] != "frame")
+        if (columns.empty()) {  // the header: every name known, one complete form
+            if (cells.empty() || cells[0] != "frame")
                 throw InputError(fmt::format("{}: the header must start with 'frame' (then eye_x.., look_at_x.., up_x.., "
                                              "fov or view_0..15, projection_0..15; jitter_x, jitter_y)", where));
+            std::map<CsvColumn::Kind, std::size_t> counts;
+            for (std::size_t k = 1; k < cells.size(); ++k) {
+                const std::optional<CsvColumn> c = CsvColumn::of(cells[k]);
+                if (!c) throw InputError(fmt::format("{}: unknown column '{}'", where, cells[k]));
+                columns.push_back(*c);
+                ++counts[c->kind];
+            }
+            const bool pose = counts[CsvColumn::eye] == 3 && counts[CsvColumn::lookAt] == 3;
+            const bool matrices = counts[CsvColumn::view] == 16 && counts[CsvColumn::projection] == 16;
+            if (pose == matrices)
+                throw InputError(fmt::format("{}: give either eye_x..z and look_at_x..z (up, fov optional) or view_0..15 and "
+                                             "projection_0..15", where));
             continue;
         }
-        if (cells.size() != columns.size())
-            throw InputError(fmt::format("{}: {} values, the header names {}", where, cells.size(), columns.size()));
+        if (cells.size() != columns.size() + 1)
+            throw InputError(fmt::format("{}: {} values, the header names {}", where, cells.size(), columns.size() + 1));
         CameraRecord r;
-        std::size_t seen = 0;
-        for (std::size_t k = 0; k < cells.size(); ++k) {
-            const std::string& c = columns[k];
-            if (c == "frame") {
-                const auto f = parseUnsigned(cells[k], 0xffffffffull);
-                if (!f) throw InputError(fmt::format("{}: frame '{}': expected an integer >= 0", where, cells[k]));
-                r.frame = std::uint32_t(*f);
-                continue;
-            }
-            const std::optional<double> v = parseNumber(cells[k]);
-            if (!v || !std::isfinite(*v)) throw InputError(fmt::format("{}: {} '{}': expected a finite number", where, c, cells[k]));
-            auto at = [&](const char* prefix, std::size_t n) -> int {
-                const std::string p(prefix);
-                if (c.rfind(p, 0) != 0) return -1;
-                const auto i = parseUnsigned(c.substr(p.size()), n - 1);
-                return i ? int(*i) : -1;
-            };
-            static const char* xyz[] = {"x", "y", "z"};
-            bool used = false;
-            for (int a = 0; a < 3; ++a) {
-                if (c == std::string("eye_") + xyz[a]) r.eye[a] = *v, used = true;
-                if (c == std::string("look_at_") + xyz[a]) r.lookAt[a] = *v, used = true;
-                if (c == std::string("up_") + xyz[a]) r.up[a] = *v, used = true;
-            }
-            if (c == "fov") r.fov = *v, used = true;
-            if (c == "jitter_x") r.jitter[0] = *v, r.hasJitter = used = true;
-            if (c == "jitter_y") r.jitter[1] = *v, r.hasJitter = used = true;
-            if (const int i = at("view_", 16); i >= 0) r.view[std::size_t(i)] = *v, r.matrices = used = true;
-            if (const int i = at("projection_", 16); i >= 0) r.projection[std::size_t(i)] = *v, used = true;
-            if (!used) throw InputError(fmt::format("{}:{}: unknown column '{}'", name, 1, c));
-            ++seen;
+        const auto f = parseUnsigned(cells[0], 0xffffffffull);
+        if (!f) throw InputError(fmt::format("{}: frame '{}': expected an integer >= 0", where, cells[0]));
+        r.frame = std::uint32_t(*f);
+        for (std::size_t k = 0; k < columns.size(); ++k) {
+            const std::optional<double> v = parseNumber(cells[k + 1]);
+            if (!v || !std::isfinite(*v))
+                throw InputError(fmt::format("{}: {} '{}': expected a finite number", where, columns[k].name, cells[k + 1]));
+            columns[k].store(r, *v);
         }
         out.records.emplace_back(where + fmt::format(" (frame {})", r.frame), r);
     }
@@ -355,11 +381,7 @@ CameraFileContent readCsvCameras(const std::string& name, const std::string& tex
 CameraTrack::CameraTrack(const CameraSettings& settings) : settings_(settings) {
     if (settings.file.empty()) return;
     const std::string name = settings.file;
-    std::ifstream in(settings.file, std::ios::binary);
-    if (!in) throw InputError(fmt::format("{}: cannot open camera file", name));
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    const std::string text = ss.str();
+    const std::string text = readWholeFile(settings.file, "camera file");
     const auto first = text.find_first_not_of(" \t\r\n");
     const CameraFileContent content = first != std::string::npos && text[first] == '{' ? readJsonCameras(name, text)
                                                                                        : readCsvCameras(name, text);
@@ -372,6 +394,8 @@ CameraTrack::CameraTrack(const CameraSettings& settings) : settings_(settings) {
         } else {
             if (glm::length(r.lookAt - r.eye) <= 0.0)
                 throw InputError(fmt::format("{}: look_at must differ from eye", where));
+            if (!(r.fov > 0.0 && r.fov < 179.0))
+                throw InputError(fmt::format("{}: fov: expected degrees in (0, 179), got {}", where, r.fov));
             const DVec3 f = glm::normalize(r.lookAt - r.eye);
             if (!(glm::length(r.up) > 0.0) || glm::length(glm::cross(f, glm::normalize(r.up))) < 1e-4)
                 throw InputError(fmt::format("{}: up must be non-zero and not parallel to the view direction", where));
@@ -396,16 +420,7 @@ CameraTrack::CameraTrack(const CameraSettings& settings) : settings_(settings) {
 }
 
 CameraPose CameraTrack::pose(std::uint32_t frame) const {
-    if (settings_.file.empty()) {
-        const Camera path = Camera::atFrame(settings_, frame);
-        CameraPose p;
-        p.eye = DVec3(path.position);
-        p.forward = path.forwardD;
-        p.right = path.rightD;
-        p.up = path.upD;
-        p.tanHalfFov = path.tanHalfFovD;
-        return p;
-    }
+    if (settings_.file.empty()) return CameraPose::atFrame(settings_, frame);
     const auto it = poses_.find(frame);
     if (it == poses_.end())
         throw InputError(fmt::format("{}: no camera for frame {} (the file holds frames {}..{})", settings_.file, frame,

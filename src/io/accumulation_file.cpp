@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "accretion/core/error.h"
+#include "accretion/core/read_file.h"
 #include "accretion/core/atomic_file.h"
 
 namespace accretion {
@@ -74,11 +75,7 @@ void writeAccumulationFile(const std::filesystem::path& file, const Accumulation
 }
 
 AccumulationFile readAccumulationFile(const std::filesystem::path& file) {
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw InputError(fmt::format("{}: cannot open accumulation file", file.string()));
-    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (in.bad()) throw InputError(fmt::format("{}: cannot read accumulation file", file.string()));
-    return parseAccumulationFile(bytes, file);
+    return parseAccumulationFile(readWholeFile(file, "accumulation file"), file);
 }
 
 AccumulationFile parseAccumulationFile(const std::string& bytes, const std::filesystem::path& file) {

@@ -86,7 +86,7 @@ struct PlyProperty {
     std::string name;
     PlyType type = PlyType::other;
     std::string typeName;
-    std::size_t offset = 0, size = 0;
+    std::size_t offset = 0;  ///< within a vertex record
     std::size_t line = 0;
 };
 
@@ -96,7 +96,7 @@ struct PlyLayout {
     std::size_t count = 0;        ///< vertices
     std::size_t stride = 0;       ///< bytes per vertex
     std::size_t vertexStart = 0;  ///< offset of the first vertex in the file
-    std::array<const PlyProperty*, 8> fields{};  ///< kFields, null when absent (opacity only)
+    std::array<std::optional<PlyProperty>, 8> fields{};  ///< kFields as declared; empty when absent (opacity only)
     std::vector<PlyProperty> properties;
 };
 
@@ -180,7 +180,7 @@ PlyLayout parsePlyHeader(const std::string& name, std::string_view head, std::ui
             if (elements.size() - 1 == vertexElement) {
                 for (const PlyProperty& q : layout.properties)
                     if (q.name == w[2]) fail(fmt::format("vertex property '{}' declared twice (first at line {})", w[2], q.line));
-                layout.properties.push_back({std::string(w[2]), kind, std::string(w[1]), std::size_t(e.stride), size, lineNo});
+                layout.properties.push_back({std::string(w[2]), kind, std::string(w[1]), std::size_t(e.stride), lineNo});
             }
             e.stride += size;
         } else {
@@ -209,7 +209,7 @@ PlyLayout parsePlyHeader(const std::string& name, std::string_view head, std::ui
                     throw InputError(fmt::format("{}:{}: vertex property '{}' is {}: accretion reads float, float32, double, "
                                                  "float64{}", name, q.line, q.name, q.typeName,
                                                  k == 7 ? ", and uchar/uint8 (0..255 = 0..1)" : ""));
-                layout.fields[k] = &q;
+                layout.fields[k] = q;
             }
     for (int k = 0; k < 7; ++k)
         if (!layout.fields[k])

@@ -14,6 +14,7 @@
 
 #include "accretion/core/error.h"
 #include "accretion/core/memory.h"
+#include "accretion/core/read_file.h"
 #include "accretion/scene/toml_limits.h"
 
 namespace accretion {
@@ -396,12 +397,7 @@ Settings parseScene(std::string_view text, std::string_view sourceName, const st
 
 Settings loadScene(const std::filesystem::path& file, const std::vector<std::string>& overrides,
                    const std::vector<FlagSetting>& flags) {
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw InputError(fmt::format("{}: cannot open scene file", file.string()));
-    std::ostringstream text;
-    text << in.rdbuf();
-    if (in.bad()) throw InputError(fmt::format("{}: cannot read scene file", file.string()));
-    Settings s = parseScene(text.str(), file.string(), overrides, flags);
+    Settings s = parseScene(readWholeFile(file, "scene file"), file.string(), overrides, flags);
     s.scenePath = file.string();
     s.sceneName = file.stem().string();
     // A relative particle file is found next to the scene, wherever it runs from.

@@ -4,6 +4,9 @@
 #include <catch2/catch.hpp>
 
 #include <fstream>
+#include <random>
+
+#include <nlohmann/json.hpp>
 
 #include "accretion/core/error.h"
 #include "accretion/geometry/camera_track.h"
@@ -130,6 +133,113 @@ TEST_CASE("camera files: JSON and CSV, poses and matrices, errors naming the rec
     CHECK_THAT(refusal(s), Contains("outside the pixel"));
     write("conv.json", R"({"convention": "directx", "frames": []})");
     CHECK_THAT(refusal(s), Contains("convention \"directx\": expected opengl, vulkan, d3d"));
-    write("bad.csv", "frame,eye_x,eye_y\n0,1\n");
-    CHECK_THAT(refusal(s), Contains("bad.csv:2: 2 values, the header names 3"));
+    write("bad.csv", "frame,eye_x,eye_y,eye_z,look_at_x,look_at_y,look_at_z\n0,1\n");
+    CHECK_THAT(refusal(s), Contains("bad.csv:2: 2 values, the header names 7"));
+    write("half.csv", "# convention = d3d\nframe,eye_x,eye_y,eye_z\n0,1,2,3\n");
+    CHECK_THAT(refusal(s), Contains("half.csv:2: give either eye_x..z and look_at_x..z"));
+    write("column.csv", "frame,eye_x,eye_y,eye_z,look_at_x,look_at_y,look_at_z,fovy\n0,0,0,5,0,0,0,40\n");
+    CHECK_THAT(refusal(s), Contains("column.csv:1: unknown column 'fovy'"));
+    write("fov.csv", "frame,eye_x,eye_y,eye_z,look_at_x,look_at_y,look_at_z,fov\n0,0,0,5,0,0,0,0\n");
+    CHECK_THAT(refusal(s), Contains("fov.csv:2 (frame 0): fov: expected degrees in (0, 179), got 0"));
+}
+
+namespace {
+
+using M4 = std::array<std::array<double, 4>, 4>;
+
+/// gluLookAt and gluPerspective as their manual defines them (column
+/// vectors, m[row][col]).
+M4 glLookAt(DVec3 eye, DVec3 center, DVec3 up) {
+    const DVec3 f = glm::normalize(center - eye), s = glm::normalize(glm::cross(f, up)), u = glm::cross(s, f);
+    return {{{s.x, s.y, s.z, -glm::dot(s, eye)}, {u.x, u.y, u.z, -glm::dot(u, eye)}, {-f.x, -f.y, -f.z, glm::dot(f, eye)},
+             {0, 0, 0, 1}}};
+}
+M4 glPerspective(double fovyDeg, double aspect, double n, double far) {
+    const double f = 1.0 / std::tan(fovyDeg * M_PI / 360.0);
+    return {{{f / aspect, 0, 0, 0}, {0, f, 0, 0}, {0, 0, (far + n) / (n - far), 2 * far * n / (n - far)}, {0, 0, -1, 0}}};
+}
+/// XMMatrixLookAtLH and XMMatrixPerspectiveFovLH as DirectXMath documents
+/// them (row vectors: p' = p M, m[row][col]).
+M4 dxLookAtLH(DVec3 eye, DVec3 at, DVec3 up) {
+    const DVec3 z = glm::normalize(at - eye), x = glm::normalize(glm::cross(up, z)), y = glm::cross(z, x);
+    return {{{x.x, y.x, z.x, 0}, {x.y, y.y, z.y, 0}, {x.z, y.z, z.z, 0}, {-glm::dot(x, eye), -glm::dot(y, eye), -glm::dot(z, eye), 1}}};
+}
+M4 dxPerspectiveFovLH(double fovyDeg, double aspect, double zn, double zf) {
+    const double h = 1.0 / std::tan(fovyDeg * M_PI / 360.0), w = h / aspect;
+    return {{{w, 0, 0, 0}, {0, h, 0, 0}, {0, 0, zf / (zf - zn), 1}, {0, 0, -zn * zf / (zf - zn), 0}}};
+}
+
+std::array<double, 4> columnTimes(const M4& m, const std::array<double, 4>& v) {
+    std::array<double, 4> r{};
+    for (int i = 0; i < 4; ++i)
+        for (int k = 0; k < 4; ++k) r[i] += m[i][k] * v[k];
+    return r;
+}
+std::array<double, 4> rowTimes(const std::array<double, 4>& v, const M4& m) {
+    std::array<double, 4> r{};
+    for (int k = 0; k < 4; ++k)
+        for (int i = 0; i < 4; ++i) r[k] += v[i] * m[i][k];
+    return r;
+}
+
+/// The 16 numbers as a file stores them: rows one after the other, or columns.
+std::vector<double> stored(const M4& m, bool rowMajor) {
+    std::vector<double> v;
+    for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b) v.push_back(rowMajor ? m[a][b] : m[b][a]);
+    return v;
+}
+
+}  // namespace
+
+TEST_CASE("engine matrices from the APIs' own formulas project every point where the engine draws it",
+          "[camera][file][oracle]") {
+    // An independent check of the reader: the matrices are built here from
+    // the formulas of gluLookAt/gluPerspective and DirectXMath's LookAtLH/
+    // PerspectiveFovLH, the engine's pixel of each point computed by its own
+    // clip, divide and viewport; accretion's camera must put it there.
+    const auto dir = accretion::test::scratchDir("camera_oracle");
+    const std::uint32_t W = 160, H = 90;
+    const DVec3 eye(3.0, 7.0, 17.0), at(0.5, -1.0, 0.25), up(0.0, 1.0, 0.0);
+    const double fov = 38.0, jx = 0.25, jy = -0.125;  // jitter of the engine's samples, pixels
+    const char* api = GENERATE("opengl", "vulkan", "d3d");
+    INFO(api);
+    const bool dx = std::string(api) == "d3d", vk = std::string(api) == "vulkan";
+    M4 V, P;
+    if (dx) {
+        V = dxLookAtLH(eye, at, up);
+        P = dxPerspectiveFovLH(fov, double(W) / H, 0.1, 1000.0);
+        // TAA: the projection shifted so that pixel centres sample at +j.
+        P[2][0] += -2.0 * jx / W;
+        P[2][1] += 2.0 * jy / H;
+    } else {
+        V = glLookAt(eye, at, up);
+        P = glPerspective(fov, double(W) / H, 0.1, 1000.0);
+        if (vk) P[1][1] = -P[1][1];  // Vulkan: NDC y points down
+        P[0][2] += 2.0 * jx / W;     // w = -z: the offset enters with the sign flipped
+        P[1][2] += (vk ? 2.0 : -2.0) * jy / H;
+    }
+    nlohmann::json doc = {{"convention", api},
+                          {"frames", {{{"frame", 0}, {"view", stored(V, dx)}, {"projection", stored(P, dx)}}}}};
+    std::ofstream(dir / "cams.json") << doc.dump();
+    CameraSettings s;
+    s.width = W;
+    s.height = H;
+    s.file = (dir / "cams.json").string();
+    const Camera cam = CameraTrack(s).at(0);
+    CHECK(cam.sampleXD - 0.5 == Approx(jx).margin(1e-12));
+    CHECK(cam.sampleYD - 0.5 == Approx(jy).margin(1e-12));
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(-4.0, 4.0);
+    for (int k = 0; k < 50; ++k) {
+        const DVec3 p = at + DVec3(u(rng), u(rng), u(rng));
+        const std::array<double, 4> h = {p.x, p.y, p.z, 1.0};
+        const std::array<double, 4> clip = dx ? rowTimes(rowTimes(h, V), P) : columnTimes(P, columnTimes(V, h));
+        const double nx = clip[0] / clip[3], ny = clip[1] / clip[3];
+        const double ex = (nx + 1.0) * 0.5 * W, ey = (vk ? (1.0 + ny) : (1.0 - ny)) * 0.5 * H;
+        float px, py, depth;
+        REQUIRE(cam.project(Vec3(p), px, py, depth));
+        CHECK(px == Approx(ex).margin(2e-3));
+        CHECK(py == Approx(ey).margin(2e-3));
+    }
 }

@@ -20,6 +20,8 @@ struct CameraPose {
     /// The pose of a look-at camera (what the scene's paths give).
     static CameraPose lookAt(const Vec3& eye, const Vec3& target, const Vec3& up, double fovDegrees);
     static CameraPose lookAt(const DVec3& eye, const DVec3& target, const DVec3& up, double fovDegrees);
+    /// The pose of a frame along the scene's path (static, orbit, linear).
+    static CameraPose atFrame(const CameraSettings& s, std::uint32_t frame);
 };
 
 /// A pinhole camera pose of one frame.
