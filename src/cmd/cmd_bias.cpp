@@ -165,6 +165,7 @@ Table biasTable(const std::vector<BiasRow>& rows, double refMean, double zCritic
 void runBias(const BiasArgs& a) {
     const std::vector<FlagSetting> base = frameFlags(a.frames);
     const Settings scene = loadSceneArgs(a);
+    requireWholeImage(scene, "bias");
     const auto specs = parseEstimatorSpecs(a.estimators, "--estimators");
     if (a.seeds < 2) throw InputError("command line --seeds: at least 2 seeds are needed for a standard error");
     const std::uint32_t frame = a.frame.value_or(scene.render.frame_start);

@@ -295,6 +295,7 @@ void plotConverge(const std::string& prefix, const std::vector<EstimatorSpec>& s
 void runConverge(const ConvergeArgs& a) {
     const std::vector<FlagSetting> base = frameFlags(a.frames);
     const Settings scene = loadSceneArgs(a);
+    requireWholeImage(scene, "converge");
     const auto specs = parseEstimatorSpecs(a.estimators, "--estimators");
     const double budget = parseSeconds(a.budget);
     const std::uint32_t frame = a.frame.value_or(scene.render.frame_start);

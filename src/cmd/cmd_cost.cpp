@@ -311,6 +311,7 @@ void writeHeatmaps(const std::string& prefix, const CountedFrame& main, const Se
 void runCost(const CostArgs& a) {
     const Settings settings =
         loadSceneArgs(a, {{"gpu.counters", "cost (counts every pass)", [](Settings& s) { s.gpu.counters = true; }}});
+    requireWholeImage(settings, "cost");
     std::vector<SerKey> serKeys;
     for (const std::string& k : a.serKeys) serKeys.push_back(SerKey::parse(k, std::max(settings.gpu.ser_hint_bits, 4u), "--ser-keys " + k));
     const CostCoefficients coef = settings.gpu.coefficients.empty() ? CostCoefficients::defaults()

@@ -25,6 +25,7 @@
 #include "accretion/render/frame_renderer.h"
 #include "accretion/scene/scene_parser.h"
 #include "commands.h"
+#include "explain_pixel.h"
 
 namespace accretion::cmd {
 
@@ -39,7 +40,22 @@ struct RenderArgs : SceneArgs {
     bool resume = false;             ///< --resume
     double checkpointEvery = 300.0;  ///< --checkpoint-every seconds (0: only on SIGINT/SIGTERM)
     std::string outputsFile;         ///< --outputs-file: a JSON list of every file written (for batch)
+    std::string crop;                ///< --crop x0,x1,y0,y1 (= render.crop)
+    std::string pixel;               ///< --pixel x,y: explain one pixel, write nothing
 };
+
+/// "a,b,..." as `count` unsigned integers, or an error naming the option.
+std::vector<std::uint32_t> parseInts(const std::string& text, std::size_t count, const char* option, const char* form) {
+    std::vector<std::uint32_t> v;
+    for (const std::string& part : splitList(text, ',')) {
+        const std::optional<std::uint64_t> n = parseUnsigned(part);
+        if (!n || *n > 16384) break;
+        v.push_back(std::uint32_t(*n));
+    }
+    if (v.size() != count || splitList(text, ',').size() != count)
+        throw InputError(fmt::format("command line {} {}: expected {} (pixel coordinates, integers >= 0)", option, text, form));
+    return v;
+}
 
 /// "out/x.0008.exr" -> "out/x.0008.shard2of4.exr".
 std::string shardPath(const std::string& path, const Shard& shard) {
@@ -91,6 +107,19 @@ std::vector<FlagSetting> renderFlags(const RenderArgs& args) {
         flags.push_back({"render.samples", fmt::format("--spp {}", *args.spp), [n = *args.spp](Settings& s) { s.render.samples = n; }});
     if (args.seed)
         flags.push_back({"render.seed", fmt::format("--seed {}", *args.seed), [n = *args.seed](Settings& s) { s.render.seed = n; }});
+    if (!args.crop.empty() && !args.pixel.empty())
+        throw InputError(fmt::format("command line --crop {} --pixel {}: give one (--pixel renders its own window)", args.crop, args.pixel));
+    if (!args.crop.empty()) {
+        const std::vector<std::uint32_t> c = parseInts(args.crop, 4, "--crop", "x0,x1,y0,y1");
+        flags.push_back({"render.crop", "--crop " + args.crop,
+                         [c](Settings& s) { s.render.crop = {double(c[0]), double(c[1]), double(c[2]), double(c[3])}; }});
+    }
+    if (!args.pixel.empty()) {
+        const std::vector<std::uint32_t> p = parseInts(args.pixel, 2, "--pixel", "x,y");
+        flags.push_back({"render.crop", "--pixel " + args.pixel, [p](Settings& s) {
+                             s.render.crop = {double(p[0]), double(p[0]) + 1, double(p[1]), double(p[1]) + 1};
+                         }});
+    }
     if (!args.targetStderr.empty()) {
         const double t = parseRelative(args.targetStderr, "--target-stderr");
         flags.push_back({"render.target_stderr", "--target-stderr " + args.targetStderr,
@@ -113,6 +142,9 @@ struct Sharding {
 Sharding planSharding(const Settings& settings, const RenderArgs& args) {
     Sharding s;
     s.shard = args.shard.empty() ? Shard{} : parseShard(args.shard, "--shard");
+    if (!s.shard.whole() && !settings.render.crop.empty())
+        throw InputError(fmt::format("command line --shard {}: render.crop renders a window; render it whole (shards split whole images)",
+                                     args.shard));
     s.accumulating = settings.render.estimator != EstimatorKind::restir;
     s.bySamples = !s.shard.whole() && s.accumulating && !(settings.render.target_stderr > 0.0);
     s.first = settings.render.frame_start;
@@ -194,9 +226,11 @@ nlohmann::json writeFrameOutputs(const RenderRun& run, std::uint32_t frame, cons
     {
         auto t = fs.timer.scope(pass::writeOutputs);
         writeFrameExr(exr, image, settings.render.estimator != EstimatorKind::exact, meta);
-        writePreviewPng(base + ".png", image.L, image.width, image.height, settings.render.auto_exposure, settings.render.exposure);
-        writePreviewPng(base + ".Lr.png", image.lighting.Lr, image.width, image.height, settings.render.auto_exposure,
+        const PixelWindow& w = image.window;  // the previews show the rendered window
+        writePreviewPng(base + ".png", cropPixels(image.L, image.width, w), w.width(), w.height(), settings.render.auto_exposure,
                         settings.render.exposure);
+        writePreviewPng(base + ".Lr.png", cropPixels(image.lighting.Lr, image.width, w), w.width(), w.height(),
+                        settings.render.auto_exposure, settings.render.exposure);
         outputs = {{"exr", exr}, {"png", base + ".png"}, {"lr_png", base + ".Lr.png"}};
         if (run.sharding.bySamples) {  // the sums a merge needs, next to the EXR
             const LightingPlan plan = planLighting(settings.render, image.height, run.sharding.shard);
@@ -216,7 +250,8 @@ nlohmann::json writeFrameOutputs(const RenderRun& run, std::uint32_t frame, cons
         fj["gpu"] = toJson(makeGpuReport(image.counters, settings, fs.reservoirBytes));
         for (const Heatmap& h : image.heatmaps) {
             const std::string png = base + "." + h.name + ".png";
-            writeHeatmapPng(png, h.values, image.width, image.height, h.name + ": " + h.unit);
+            writeHeatmapPng(png, cropPixels(h.values, image.width, image.window), image.window.width(), image.window.height(),
+                            h.name + ": " + h.unit);
             fj["outputs"][h.name + "_png"] = png;
         }
     }
@@ -272,6 +307,13 @@ void runRender(const RenderArgs& args) {
     const Settings settings = loadSceneArgs(args, renderFlags(args));
     const auto threads = limitThreads(args.threads);
     const Sharding sharding = planSharding(settings, args);
+    if (!args.pixel.empty()) {  // one pixel explained on stdout; nothing written
+        if (args.resume || !args.outputsFile.empty())
+            throw InputError("command line --pixel: writes no file, so --resume and --outputs-file do not apply");
+        sceneInputs(settings, sharding.first, sharding.end);
+        explainPixel(settings, std::uint32_t(settings.render.crop[0]), std::uint32_t(settings.render.crop[2]), args.quiet);
+        return;
+    }
     const Shard& shard = sharding.shard;
     const std::string stem = shardPath(runStem(settings), shard);
     RenderRun run{settings, sharding, settingsToToml(settings), fmt::format("{}/{}", shard.index, shard.count)};
@@ -370,6 +412,12 @@ void addRenderCommand(CLI::App& app) {
     cmd->add_option("--shard", args->shard,
                     "Render part i/n (0 <= i < n) of the work: a sample range (exact: rows) with its own streams, "
                     "to combine with `accretion merge`; adaptive sampling and restir split frames");
+    cmd->add_option("--crop", args->crop,
+                    "Render only the pixels x0 <= x < x1, y0 <= y < y1 (the EXR's data window; each pixel equals the whole "
+                    "image's) = render.crop");
+    cmd->add_option("--pixel", args->pixel,
+                    "Explain pixel x,y of the last frame on stdout: its hit, the estimator's terms, samples or reservoirs, "
+                    "and its value (bit for bit the full render's); writes no file");
     cmd->add_flag("--resume", args->resume, "Continue from the checkpoint of an interrupted run (same command line)");
     cmd->add_option("--outputs-file", args->outputsFile,
                     "Write a JSON list of the files this run wrote (stats, settings, each frame's outputs) here at the end");

@@ -48,6 +48,10 @@ std::vector<FlagSetting> frameFlags(const std::string& frames);
 /// The command's scene: the file, its -D overrides, --frames, then `flags`.
 Settings loadSceneArgs(const SceneArgs& args, const std::vector<FlagSetting>& flags = {});
 
+/// Experiments measure whole images: refuse render.crop (only render, and
+/// its --pixel, take a window).
+void requireWholeImage(const Settings& settings, std::string_view command);
+
 /// The scene's own files as inputs no output may replace, checked before
 /// anything renders: the scene, every particle file frames [first, end)
 /// read (the whole {frame} sequence: exists, valid, one count) and the

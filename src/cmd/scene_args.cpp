@@ -86,4 +86,10 @@ void addExperimentOptions(CLI::App* cmd, ExperimentArgs& args, const std::string
     cmd->add_option("-o,--out", args.out, outHelp);
 }
 
+void requireWholeImage(const Settings& settings, std::string_view command) {
+    if (!settings.render.crop.empty())
+        throw InputError(fmt::format("{}: render.crop: {} measures whole images; render a window with `accretion render --crop`",
+                                     settings.scenePath.empty() ? std::string("command line") : settings.scenePath, command));
+}
+
 }  // namespace accretion::cmd

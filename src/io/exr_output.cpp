@@ -91,7 +91,15 @@ void writeFrameExr(const std::filesystem::path& file, const FrameImage& img, boo
     for (const Heatmap& h : img.heatmaps) addFloat(h.name, h.values);
     const int nch = static_cast<int>(channels.size());
 
-    OIIO::ImageSpec spec(int(img.width), int(img.height), nch, OIIO::TypeDesc::FLOAT);
+    // The data window is the rendered window (render.crop), inside the
+    // display window of the whole image.
+    const PixelWindow w = img.window.pixels() ? img.window : PixelWindow::whole(img.width, img.height);
+    OIIO::ImageSpec spec(int(w.width()), int(w.height()), nch, OIIO::TypeDesc::FLOAT);
+    spec.x = int(w.x0);
+    spec.y = int(w.y0);
+    spec.full_x = spec.full_y = 0;
+    spec.full_width = int(img.width);
+    spec.full_height = int(img.height);
     spec.channelnames.clear();
     spec.channelformats.clear();
     for (const Channel& c : channels) {
@@ -103,10 +111,11 @@ void writeFrameExr(const std::filesystem::path& file, const FrameImage& img, boo
     setCameraAttributes(spec, img.camera, img.width, img.height);
 
     // Interleaved pixels in the native per-channel formats (all 4 bytes).
-    const std::size_t pixels = std::size_t(img.width) * img.height;
-    std::vector<std::uint32_t> buf(pixels * nch);
-    for (int ch = 0; ch < nch; ++ch)
-        for (std::size_t px = 0; px < pixels; ++px) buf[px * nch + ch] = channels[ch].bits(px);
+    std::vector<std::uint32_t> buf(w.pixels() * nch);
+    std::size_t k = 0;
+    for (std::uint32_t y = w.y0; y < w.y1; ++y)
+        for (std::uint32_t x = w.x0; x < w.x1; ++x, ++k)
+            for (int ch = 0; ch < nch; ++ch) buf[k * nch + ch] = channels[ch].bits(std::size_t(y) * img.width + x);
 
     writeAtomicWith(file, [&](const std::filesystem::path& tmp) {
         auto out = OIIO::ImageOutput::create("openexr");

@@ -32,17 +32,21 @@ inline bool seen(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoin
 }
 
 /// exact: sum over every light i != j of f I G V, in double.
+/// With a trace (render --pixel), every non-zero term and its V are recorded.
 template <ShadingModel M, Primitive P>
 DVec3 exactPixel(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint& sp, const VisibilityOptions& vis, bool shadows,
-                LightingCounters& c, RayCounters* rc) {
+                LightingCounters& c, RayCounters* rc, PixelTrace* trace) {
     DVec3 sum(0.0);
     for (std::uint32_t i = 0; i < L.count; ++i) {
         if (i == sp.self) continue;
         LightTerm t;
         ++c.lightTerms;
         if (!evalLight<M>(sp, L.position[i], L.emission[i], L.packed[i].dmin2, t)) continue;
-        if (seen<P>(bvh, L, sp, i, t, vis, shadows, c, rc)) sum += DVec3(t.value);
+        const bool v = seen<P>(bvh, L, sp, i, t, vis, shadows, c, rc);
+        if (v) sum += DVec3(t.value);
+        if (trace) [[unlikely]] trace->terms.push_back({i, t.value, v});
     }
+    if (trace) trace->lightsSeen = L.count - (sp.self < L.count ? 1 : 0);
     return sum;
 }
 
@@ -60,6 +64,7 @@ struct PixelSums {
     std::uint8_t done = 0;
     NonFinitePolicy policy = NonFinitePolicy::zero_sample;
     LightingCounters c;   ///< this pixel's work (added to its thread's when it finishes)
+    PixelTrace* trace = nullptr;  ///< render --pixel: this is the pixel traced
 
     /// Count a non-finite value; true if the policy discards it (else it counts as 0).
     bool reject() {
@@ -152,8 +157,13 @@ void shadeSamples(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoi
         const LightSample& x = xs[k];
         LightTerm t;
         ++c.lightTerms;
-        if (L.term<M>(sp, x.i, t) && seen<P>(bvh, L, sp, x.i, t, vis, shadows, c, rc)) acc.add(DVec3(t.value) / double(x.pdf));
+        const bool term = L.term<M>(sp, x.i, t);
+        const bool v = term && seen<P>(bvh, L, sp, x.i, t, vis, shadows, c, rc);
+        if (v) acc.add(DVec3(t.value) / double(x.pdf));
         else acc.addZero();
+        if (acc.trace) [[unlikely]]
+            acc.trace->samples.push_back({x.i, x.pdf, term ? t.value : Vec3(0.0f), v,
+                                          v ? Vec3(DVec3(t.value) / double(x.pdf)) : Vec3(0.0f)});
     }
 }
 
@@ -183,15 +193,26 @@ void risChunk(const ParticleBvh& bvh, const LightArrays& L, const AliasTable* ta
                 w = p_hat = 0.0f;
             }
             if (r.update(x.i, w, p_hat, rng.uniform())) t_y = t;
+            if (acc.trace) [[unlikely]] {
+                if (m == 0) acc.trace->reservoirs.emplace_back();
+                acc.trace->reservoirs.back().candidates.push_back({x.i, x.pdf, p_hat, w});
+            }
         }
         if (discarded) continue;
         r.finalize();
+        PixelTrace::RisReservoir* traced = acc.trace ? &acc.trace->reservoirs.back() : nullptr;
+        if (traced) traced->reservoir = r;
         if (r.W <= 0.0f) {
             acc.addZero();
             continue;
         }
-        if (seen<P>(bvh, L, sp, r.y, t_y, vis, shadows, c, rc)) acc.add(DVec3(t_y.value) * double(r.W));
+        const bool v = seen<P>(bvh, L, sp, r.y, t_y, vis, shadows, c, rc);
+        if (v) acc.add(DVec3(t_y.value) * double(r.W));
         else acc.addZero();
+        if (traced) {
+            traced->visible = v;
+            traced->estimate = v ? Vec3(DVec3(t_y.value) * double(r.W)) : Vec3(0.0f);
+        }
     }
 }
 
@@ -341,11 +362,12 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
                     p.sums.policy = in.render.nonfinite;
                     p.rays = RayCounters{};
                     if (acc) p.sums.load(*acc, p.px);
+                    if (in.trace && in.trace->px == p.px) [[unlikely]] p.sums.trace = in.trace;
                 }
                 if (kind == EstimatorKind::exact) {
                     for (std::uint32_t k = 0; k < n; ++k) {
                         PixelSums& s = pix[k].sums;
-                        const DVec3 v = exactPixel<M, P>(in.bvh, L, pix[k].sp, vis, shadows, s.c, Count ? &pix[k].rays : nullptr);
+                        const DVec3 v = exactPixel<M, P>(in.bvh, L, pix[k].sp, vis, shadows, s.c, Count ? &pix[k].rays : nullptr, s.trace);
                         if (finite(v)) s.sum = v;
                         else s.reject();  // exact has one value: 0 either way
                         s.n = 1;

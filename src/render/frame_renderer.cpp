@@ -129,7 +129,7 @@ const Particles& FrameRenderer::prepareGeometry(std::uint32_t frame, const Camer
 
 void FrameRenderer::lightFrame(std::uint32_t frame, const Camera& camera, const Particles& particles, const GBuffer& gbuffer,
                                const AliasTable* powerTable, const LightTree* lightTree, const LightingSession* session,
-                               FrameImage& img, FrameStats& stats) {
+                               PixelTrace* trace, FrameImage& img, FrameStats& stats) {
     const FramePlan& plan = plan_;
     const std::size_t pixels = std::size_t(camera.width) * camera.height;
     if (!plan.lighting) {  // nothing lights the scene: Lr = 0
@@ -142,14 +142,14 @@ void FrameRenderer::lightFrame(std::uint32_t frame, const Camera& camera, const 
     auto t = stats.timer.scope(pass::estimateLighting);
     if (plan.restir) {
         RestirInputs in{*bvh_, particles, gbuffer, camera, settings_, plan, frame, powerTable,
-                        plan.previousBvh ? previousBvh_.get() : nullptr, plan.counting ? &img.counters : nullptr};
+                        plan.previousBvh ? previousBvh_.get() : nullptr, plan.counting ? &img.counters : nullptr, trace};
         stats.lighting = restir_->render(in, img.lighting, img.reservoirs, stats.timer, stats.nonFinite);
         stats.reservoirBytes = restir_->reservoirBytes();
         if (img.lighting.rejected.empty()) img.lighting.rejected.assign(pixels, 0.0f);
         return;
     }
     LightingInputs in{*bvh_, particles, gbuffer, settings_.shading, settings_.render, frame, powerTable, lightTree,
-                      plan.counting ? &img.counters.add(pass::estimateLighting, camera.width, camera.height) : nullptr};
+                      plan.counting ? &img.counters.add(pass::estimateLighting, camera.width, camera.height) : nullptr, trace};
     const LightingPlan lp = planLighting(settings_.render, camera.height, session ? session->shard : Shard{});
     // Progress by work: the hit pixels of the rows (exact) or the chunks
     // (samples) still to run, as the sweep counts them.
@@ -174,7 +174,7 @@ void FrameRenderer::lightFrame(std::uint32_t frame, const Camera& camera, const 
     if (stats.lighting.nonFinite) stats.nonFinite[std::string(pass::estimateLighting)] = stats.lighting.nonFinite;
 }
 
-FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const LightingSession* session) {
+FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const LightingSession* session, PixelTrace* trace) {
     const auto start = std::chrono::steady_clock::now();
     stats.frame = frame;
     // Frame coordinates: the world less an origin at the frame's camera, so
@@ -206,16 +206,23 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const L
         stats.lightTreeNodes = lightTree.nodeCount();
     }
 
+    // A crop renders only its window, each pixel as in the whole image:
+    // every estimator but restir lights a pixel from its own streams alone.
+    // restir (spatial reuse reads the neighbours; history is the whole
+    // frame's) and counting mode (the GPU's dispatch is the whole frame)
+    // render everything and keep the window.
+    img.window = PixelWindow::of(settings_);
+    const PixelWindow traced = plan.restir || plan.counting ? PixelWindow::whole(camera.width, camera.height) : img.window;
     GBuffer gbuffer;
     {
         auto t = timer.scope(pass::traceGBuffer);
         PassCounters* pc = plan.counting ? &img.counters.add(pass::traceGBuffer, camera.width, camera.height) : nullptr;
-        stats.primaryRays = traceGBuffer(*bvh_, particles, camera, settings_.shading.model, gbuffer, pc);
+        stats.primaryRays = traceGBuffer(*bvh_, particles, camera, settings_.shading.model, gbuffer, pc, &traced);
     }
     img.width = camera.width;
     img.height = camera.height;
     lightFrame(frame, camera, particles, gbuffer, plan.sampler == LightSamplerKind::power ? &powerTable : nullptr,
-               plan.sampler == LightSamplerKind::tree ? &lightTree : nullptr, session, img, stats);
+               plan.sampler == LightSamplerKind::tree ? &lightTree : nullptr, session, trace, img, stats);
     {
         auto t = timer.scope(pass::composeImage);
         composeImage(gbuffer, particles, settings_.shading, img, stats);

@@ -286,6 +286,15 @@ void validate(const Settings& s, const std::map<std::string, std::string>& loc, 
         fail("restir.light_bits", fmt::format("{} bits address {} lights but particles.count = {}: the packed layout needs {} bits",
                                               s.restir.light_bits, std::uint64_t(1) << s.restir.light_bits,
                                               s.particles.count, indexBits(s.particles.count)));
+    if (const std::vector<double>& c = s.render.crop; !c.empty()) {
+        if (c.size() != 4) fail("render.crop", fmt::format("expected [x0, x1, y0, y1] (4 numbers), got {}", c.size()));
+        for (const double v : c)
+            if (v != std::floor(v)) fail("render.crop", fmt::format("pixel bounds are integers (got {})", v));
+        if (!(c[0] < c[1] && c[1] <= s.camera.width && c[2] < c[3] && c[3] <= s.camera.height))
+            fail("render.crop", fmt::format("[{}, {}, {}, {}] is not a window of the {}x{} image (0 <= x0 < x1 <= width, "
+                                            "0 <= y0 < y1 <= height; x1 and y1 are past the window)",
+                                            c[0], c[1], c[2], c[3], s.camera.width, s.camera.height));
+    }
     if (s.render.target_stderr > 0.0 && s.render.max_samples < s.render.samples)
         fail("render.max_samples", fmt::format("must be at least render.samples ({}) when target_stderr is set", s.render.samples));
     {

@@ -12,6 +12,7 @@
 #include "accretion/lighting/light_sampler.h"
 #include "accretion/render/accumulation.h"
 #include "accretion/render/gbuffer.h"
+#include "accretion/render/pixel_trace.h"
 #include "accretion/scene/settings.h"
 
 namespace accretion {
@@ -57,6 +58,7 @@ struct LightingInputs {
     const AliasTable* powerTable = nullptr;  ///< power (required); ris: candidates in proportion to power when given
     const LightTree* lightTree = nullptr;    ///< required by `tree`
     PassCounters* counters = nullptr;        ///< counting mode: one thread record per pixel (the BVH must count)
+    PixelTrace* trace = nullptr;             ///< render --pixel: record the terms or samples of trace->px
 };
 
 /// Called after each chunk with the sums so far; returning false stops the

@@ -15,6 +15,7 @@
 #include "accretion/render/estimators.h"
 #include "accretion/render/gbuffer.h"
 #include "accretion/render/frame_plan.h"
+#include "accretion/render/pixel_window.h"
 #include "accretion/render/restir.h"
 #include "accretion/scene/settings.h"
 
@@ -23,6 +24,7 @@ namespace accretion {
 /// Every per-pixel output of one frame (the EXR layers).
 struct FrameImage {
     std::uint32_t width = 0, height = 0;
+    PixelWindow window;               ///< the pixels rendered (render.crop; the whole image by default)
     CameraPose camera;                ///< the frame's camera in world space (its jitter included)
     std::vector<Vec3> L;              ///< pixel value: Le + Lr, or the background
     std::vector<Vec3> Le;             ///< self-emission s_e I_j
@@ -76,8 +78,10 @@ public:
     FrameRenderer(const Settings& settings, ParticleSource source, RenderOptions options = {});
     ~FrameRenderer();
 
-    /// Render one frame; the passes' times go to stats.timer.
-    FrameImage render(std::uint32_t frame, FrameStats& stats, const LightingSession* session = nullptr);
+    /// Render one frame; the passes' times go to stats.timer. With a trace
+    /// (render --pixel), the lighting of pixel trace->px is recorded in it.
+    FrameImage render(std::uint32_t frame, FrameStats& stats, const LightingSession* session = nullptr,
+                      PixelTrace* trace = nullptr);
 
     const Settings& settings() const { return settings_; }
     /// The BVH of the last frame rendered.
@@ -92,7 +96,7 @@ private:
     /// estimateLighting (the restir passes for restir) into img.lighting, or Lr = 0 unlit.
     void lightFrame(std::uint32_t frame, const Camera& camera, const Particles& particles, const GBuffer& gbuffer,
                     const AliasTable* powerTable, const LightTree* lightTree, const LightingSession* session,
-                    FrameImage& img, FrameStats& stats);
+                    PixelTrace* trace, FrameImage& img, FrameStats& stats);
 
     Settings settings_;
     CameraTrack cameras_;  ///< every frame's camera: the path, or the engine's file

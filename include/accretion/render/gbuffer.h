@@ -8,6 +8,7 @@
 #include "accretion/counters/thread_counters.h"
 #include "accretion/geometry/camera.h"
 #include "accretion/lighting/shading.h"
+#include "accretion/render/pixel_window.h"
 
 namespace accretion {
 
@@ -53,8 +54,11 @@ inline void recordTexel(ThreadCounters& t, const GBufferTexel& g, const Particle
 
 /// traceGBuffer: one primary ray per pixel through its centre (docs/MODEL.md
 /// section 3). Returns the number of rays traced. With counters (counting
-/// mode), records each pixel's thread: hit key, the ray, bytes.
+/// mode), records each pixel's thread: hit key, the ray, bytes. With a
+/// window, only its pixels are traced (each as in the whole image; the rest
+/// are misses).
 std::uint64_t traceGBuffer(const ParticleBvh& bvh, const Particles& particles, const Camera& camera,
-                           ShadingModel model, GBuffer& gbuffer, PassCounters* counters = nullptr);
+                           ShadingModel model, GBuffer& gbuffer, PassCounters* counters = nullptr,
+                           const PixelWindow* window = nullptr);
 
 }  // namespace accretion

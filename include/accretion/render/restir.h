@@ -38,6 +38,7 @@ struct RestirInputs {
     const AliasTable* powerTable = nullptr;  ///< candidates in proportion to power (the plan built it), else uniform
     const ParticleBvh* previousBvh = nullptr; ///< last frame's BVH (see needsPreviousBvh), else the current one is used
     FrameCounters* counters = nullptr;        ///< counting mode: each pass adds its thread records (the BVH must count)
+    PixelTrace* trace = nullptr;              ///< render --pixel: the reservoir of trace->px after each pass
 };
 
 /// ReSTIR DI (docs/MODEL.md section 4; Bitterli et al. 2020): generateCandidates

@@ -224,6 +224,7 @@ struct RenderSettings {
     double memory_limit_mb = 0.0;                ///< refuse runs estimated to need more (0: no limit)
     double exposure = 0.0;                       ///< preview exposure in stops, added to auto exposure
     bool auto_exposure = true;                   ///< preview: map the 99th luminance percentile to 1
+    std::vector<double> crop;                    ///< [x0, x1, y0, y1]: render only this pixel window (empty: the whole image)
 
     template <class V> void visit(V& v) {
         v.field("frame_start", frame_start, "first frame", Range{0, 1e9});
@@ -245,6 +246,7 @@ struct RenderSettings {
         v.field("memory_limit_mb", memory_limit_mb, "refuse a run whose estimated peak memory exceeds this (MB; 0: no limit)", kNonNegative);
         v.field("exposure", exposure, "preview exposure (stops)", Range{-64.0, 64.0});
         v.field("auto_exposure", auto_exposure, "preview: scale the 99th luminance percentile to 1");
+        v.field("crop", crop, "[x0, x1, y0, y1]: render only the pixels x0 <= x < x1, y0 <= y < y1 (the EXR's data window; empty: all)", Range{0, 16384});
     }
 };
 

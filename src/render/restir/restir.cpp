@@ -9,28 +9,35 @@ namespace {
 
 /// The plan's restir passes: generateCandidates, temporalResampling,
 /// spatialResampling (plan.spatialIterations times), traceShadowRays.
+/// With a trace (render --pixel), the reservoir of texel `traced` after each pass.
 LightingCounters runPasses(const restir::FrameContext& f, std::vector<StoredReservoir>& a, std::vector<StoredReservoir>& b,
-                           std::vector<Vec3>& lowLr, PassTimer& timer, PassRejections& rejected) {
+                           std::vector<Vec3>& lowLr, PassTimer& timer, PassRejections& rejected, std::size_t traced) {
     const FramePlan& plan = f.in.plan;
     LightingCounters total;
     auto add = [&](std::string_view name, const LightingCounters& c) {
         total += c;
         if (c.nonFinite) rejected[std::string(name)] += c.nonFinite;
     };
+    auto snapshot = [&](std::string_view name, const std::vector<StoredReservoir>& r) {
+        if (f.in.trace) f.in.trace->passes.push_back({std::string(name), r[traced]});
+    };
     {
         auto t = timer.scope(pass::generateCandidates);
         add(pass::generateCandidates, restir::generateCandidates(f, a));
     }
+    snapshot(pass::generateCandidates, a);
     if (plan.temporal) {
         auto t = timer.scope(pass::temporalResampling);
         add(pass::temporalResampling, restir::temporalResampling(f, a, b));
         std::swap(a, b);
+        snapshot(pass::temporalResampling, a);
     }
     if (plan.spatialIterations > 0) {
         auto t = timer.scope(pass::spatialResampling);
         for (std::uint32_t it = 0; it < plan.spatialIterations; ++it) {
             add(pass::spatialResampling, restir::spatialResampling(f, it, a, b));
             std::swap(a, b);
+            snapshot(pass::spatialResampling, a);
         }
     }
     {
@@ -85,7 +92,13 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
 
     std::vector<StoredReservoir> a(lpixels), b(lpixels);
     std::vector<Vec3> lowLr(lpixels);
-    LightingCounters counters = runPasses(f, a, b, lowLr, timer, rejected);
+    std::size_t traced = 0;  // the lighting texel of the traced pixel
+    if (in.trace) {
+        const std::uint32_t x = std::uint32_t(in.trace->px % full.width), y = std::uint32_t(in.trace->px / full.width);
+        traced = std::size_t(std::min(lg->height - 1, std::uint32_t(float(y) * f.scale))) * lg->width +
+                 std::min(lg->width - 1, std::uint32_t(float(x) * f.scale));
+    }
+    LightingCounters counters = runPasses(f, a, b, lowLr, timer, rejected, traced);
 
     if (!plan.upsample) {
         out.Lr = lowLr;
