@@ -88,9 +88,13 @@ RgbLayer readExrChannels(const std::filesystem::path& file, const std::vector<st
     if (!in) throw InputError(fmt::format("{}: cannot read image: {}", file.string(), OIIO::geterror()));
     const OIIO::ImageSpec& spec = in->spec();
     RgbLayer out;
-    out.width = static_cast<std::uint32_t>(spec.width);
-    out.height = static_cast<std::uint32_t>(spec.height);
-    const std::size_t pixels = std::size_t(out.width) * out.height;
+    out.width = static_cast<std::uint32_t>(spec.full_width);
+    out.height = static_cast<std::uint32_t>(spec.full_height);
+    out.x0 = spec.x - spec.full_x;
+    out.y0 = spec.y - spec.full_y;
+    out.dataWidth = static_cast<std::uint32_t>(spec.width);
+    out.dataHeight = static_cast<std::uint32_t>(spec.height);
+    const std::size_t pixels = std::size_t(out.dataWidth) * out.dataHeight;
     std::vector<float> all(pixels * std::size_t(spec.nchannels));
     if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
         throw InputError(fmt::format("{}: cannot read pixels: {}", file.string(), in->geterror()));
@@ -104,6 +108,15 @@ RgbLayer readExrChannels(const std::filesystem::path& file, const std::vector<st
     out.rgb.resize(pixels);
     for (std::size_t p = 0; p < pixels; ++p)
         for (int c = 0; c < 3; ++c) out.rgb[p][c] = all[p * spec.nchannels + idx[c]];
+    return out;
+}
+
+std::vector<Vec3> RgbLayer::window(int x, int y, std::uint32_t w, std::uint32_t h) const {
+    ACC_CHECK(x >= x0 && y >= y0 && x + int(w) <= x0 + int(dataWidth) && y + int(h) <= y0 + int(dataHeight));
+    std::vector<Vec3> out;
+    out.reserve(std::size_t(w) * h);
+    for (int py = y; py < y + int(h); ++py)
+        for (int px = x; px < x + int(w); ++px) out.push_back(rgb[std::size_t(py - y0) * dataWidth + (px - x0)]);
     return out;
 }
 

@@ -54,6 +54,9 @@ struct BiasReference {
 BiasReference loadBiasReference(const std::string& file, const Settings& scene) {
     BiasReference r;
     r.image = readExrLayer(file, "Lr");
+    if (!r.image.whole())
+        throw InputError(fmt::format("{}: a cropped reference (data window {}x{} at ({}, {})); bias measures whole images", file,
+                                     r.image.dataWidth, r.image.dataHeight, r.image.x0, r.image.y0));
     if (r.image.width != scene.camera.width || r.image.height != scene.camera.height)
         throw InputError(fmt::format("{}: reference is {}x{}, the scene renders {}x{}", file, r.image.width, r.image.height,
                                      scene.camera.width, scene.camera.height));

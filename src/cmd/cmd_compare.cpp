@@ -2,6 +2,7 @@
 // against a reference EXR; error maps; a check that the two show the same
 // frame of the same scene from the same camera.
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <sstream>
 
@@ -10,12 +11,15 @@
 #include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
+#include "accretion/analysis/flip.h"
 #include "accretion/analysis/image_metrics.h"
+#include "accretion/core/atomic_file.h"
 #include "accretion/core/error.h"
 #include "accretion/core/output_guard.h"
 #include "accretion/core/parse.h"
 #include "accretion/io/exr_output.h"
 #include "accretion/io/false_colour.h"
+#include "accretion/io/plot.h"
 #include "accretion/io/report_table.h"
 #include "commands.h"
 
@@ -24,15 +28,107 @@ namespace {
 
 struct CompareArgs {
     std::string image, reference, layer, channels, errorMap;
+    std::string flip = "hdr";     ///< --flip hdr | ldr | none
+    double ppd = FlipOptions{}.ppd;
+    std::string frames;           ///< --frames A:B: image and reference are {frame} patterns
+    std::string csv;              ///< --csv FILE: the per-frame table of a sequence (+ FILE.png plot)
     bool json = false;
     bool allowNonFinite = false;  ///< --allow-nonfinite: measure the finite pixels, exit 0
     bool strict = false;          ///< --strict: metadata that differ are an error
 };
 
-/// "image.exr" or "reference ref.exr": which of them holds a non-finite value at pixel p.
-std::string nonFiniteOwner(const CompareArgs& a, const RgbLayer& x, std::size_t p) {
-    const Vec3& v = x.rgb[p];
-    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z) ? "the reference " + a.reference : a.image;
+/// Two images on the pixels both hold: the overlap of their data windows.
+struct Pair {
+    std::string image, reference;
+    RgbLayer x, ref;
+    int x0 = 0, y0 = 0;
+    std::uint32_t w = 0, h = 0;
+    std::vector<Vec3> xs, rs;  ///< the overlap's pixels of each
+    bool partial() const { return !(x.whole() && ref.whole()); }
+    /// "(x, y)" of the overlap's pixel p.
+    std::string at(std::size_t p) const { return fmt::format("({}, {})", x0 + int(p % w), y0 + int(p / w)); }
+};
+
+Pair loadPair(const CompareArgs& a, const std::string& image, const std::string& reference,
+              const std::vector<std::string>& channels) {
+    Pair p{image, reference, channels.empty() ? readExrLayer(image, a.layer) : readExrChannels(image, channels),
+           readExrLayer(reference, a.layer)};
+    if (p.x.width != p.ref.width || p.x.height != p.ref.height)
+        throw InputError(fmt::format("{}: {}x{} pixels, but the reference {} is {}x{}", image, p.x.width, p.x.height, reference,
+                                     p.ref.width, p.ref.height));
+    const int x1 = std::min(p.x.x0 + int(p.x.dataWidth), p.ref.x0 + int(p.ref.dataWidth));
+    const int y1 = std::min(p.x.y0 + int(p.x.dataHeight), p.ref.y0 + int(p.ref.dataHeight));
+    p.x0 = std::max(p.x.x0, p.ref.x0);
+    p.y0 = std::max(p.x.y0, p.ref.y0);
+    if (x1 <= p.x0 || y1 <= p.y0)
+        throw InputError(fmt::format("{}: its data window ({}x{} at ({}, {})) and the reference's ({}x{} at ({}, {})) share no pixel",
+                                     image, p.x.dataWidth, p.x.dataHeight, p.x.x0, p.x.y0, p.ref.dataWidth, p.ref.dataHeight,
+                                     p.ref.x0, p.ref.y0));
+    p.w = std::uint32_t(x1 - p.x0);
+    p.h = std::uint32_t(y1 - p.y0);
+    p.xs = p.x.window(p.x0, p.y0, p.w, p.h);
+    p.rs = p.ref.window(p.x0, p.y0, p.w, p.h);
+    return p;
+}
+
+/// "image.exr" or "reference ref.exr": which of them holds a non-finite value at overlap pixel q.
+std::string nonFiniteOwner(const Pair& p, std::size_t q) {
+    const Vec3& v = p.xs[q];
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z) ? "the reference " + p.reference : p.image;
+}
+
+/// The metrics of one pair: relMSE, MSE, MAPE and FLIP over the finite pixels.
+struct Comparison {
+    ErrorMetrics m;
+    double flip = std::numeric_limits<double>::quiet_NaN();  ///< mean FLIP (--flip none: NaN)
+    std::vector<float> flipMap;                              ///< per overlap pixel (non-finite pixels: 0)
+    HdrFlip hdr;                                             ///< hdr: the exposure range used
+};
+
+Comparison measure(const CompareArgs& a, const Pair& p) {
+    Comparison c;
+    c.m = computeErrors(p.xs, p.rs);
+    if (c.m.nonFinite > 0) {
+        std::vector<std::string> at;  // (x, y) of the first few, and where the first is
+        for (const std::size_t q : c.m.firstNonFinite) at.push_back(p.at(q));
+        const std::string msg = fmt::format("{} of {} pixels are NaN or infinite (at {}{}; the first in {}) and left out",
+                                            c.m.nonFinite, p.xs.size(), fmt::join(at, ", "), c.m.nonFinite > at.size() ? ", ..." : "",
+                                            nonFiniteOwner(p, c.m.firstNonFinite.front()));
+        if (!a.allowNonFinite || c.m.pixels == 0)
+            throw InputError(fmt::format("{}: {}{}", p.image, msg,
+                                         c.m.pixels == 0 ? ": no finite pixel is left to measure"
+                                                         : "; give --allow-nonfinite to measure the rest"));
+        fmt::print(stderr, "accretion: warning: {}\n", msg);
+    }
+    if (a.flip == "none") return c;
+    // FLIP filters neighbourhoods: a non-finite pixel enters as black and is left out of the mean.
+    std::vector<Vec3> x = p.xs, r = p.rs;
+    std::vector<bool> finite(x.size());
+    for (std::size_t q = 0; q < x.size(); ++q) {
+        finite[q] = std::isfinite(x[q].x + x[q].y + x[q].z) && std::isfinite(r[q].x + r[q].y + r[q].z);
+        if (!finite[q]) x[q] = r[q] = Vec3(0.0f);
+    }
+    const FlipOptions opt{a.ppd};
+    if (a.flip == "hdr") {
+        c.hdr = hdrFlip(r, x, p.w, p.h, opt);
+        c.flipMap = c.hdr.error;
+    } else {  // ldr: the images as a display shows them at exposure 0 (clamped, sRGB-encoded)
+        for (std::vector<Vec3>* img : {&x, &r})
+            for (Vec3& v : *img)
+                for (int k = 0; k < 3; ++k) v[k] = linearToSrgb(std::clamp(v[k], 0.0f, 1.0f));
+        c.flipMap = ldrFlip(r, x, p.w, p.h, opt);
+    }
+    double sum = 0.0;
+    std::size_t n = 0;
+    for (std::size_t q = 0; q < x.size(); ++q)
+        if (finite[q]) {
+            sum += c.flipMap[q];
+            ++n;
+        } else {
+            c.flipMap[q] = 0.0f;
+        }
+    c.flip = n ? sum / double(n) : 0.0;
+    return c;
 }
 
 /// The scene-defining sections of a settings TOML (what two renders of the
@@ -51,8 +147,8 @@ std::vector<std::string> sceneLines(const std::string& toml) {
 
 /// What the two images' metadata say differently: frame, scene, camera,
 /// scene settings (only what both record; a GPU frame records little).
-std::vector<std::string> metadataDifferences(const CompareArgs& a) {
-    const auto x = readExrAttributes(a.image), r = readExrAttributes(a.reference);
+std::vector<std::string> metadataDifferences(const std::string& image, const std::string& reference) {
+    const auto x = readExrAttributes(image), r = readExrAttributes(reference);
     std::vector<std::string> diffs;
     auto check = [&](const char* key, const char* what) {
         const auto i = x.find(key), j = r.find(key);
@@ -77,13 +173,14 @@ std::vector<std::string> metadataDifferences(const CompareArgs& a) {
     return diffs;
 }
 
-/// --error-map OUT.exr: signed error, relative error and (with the
-/// reference's Lr_stderr) z = error / stderr, per channel, and a false-colour
-/// PNG of each (the channel mean) with its colour bar and scale.
-void writeErrorMaps(const CompareArgs& a, const RgbLayer& x, const RgbLayer& ref) {
+/// --error-map OUT.exr: signed error, relative error, (with the
+/// reference's Lr_stderr) z = error / stderr per channel, and FLIP, over the
+/// pixels compared (the EXR's data window); a false-colour PNG of each (the
+/// channel mean) with its colour bar and scale.
+void writeErrorMaps(const CompareArgs& a, const Pair& p, const Comparison& cmp) {
     const bool hasStderr = exrHasLayer(a.reference, "Lr_stderr");
-    const RgbLayer sd = hasStderr ? readExrLayer(a.reference, "Lr_stderr") : RgbLayer{};
-    const std::size_t n = x.rgb.size();
+    const std::vector<Vec3> sd = hasStderr ? readExrLayer(a.reference, "Lr_stderr").window(p.x0, p.y0, p.w, p.h) : std::vector<Vec3>{};
+    const std::size_t n = p.xs.size();
     std::vector<FloatChannel> ch;
     const char* rgb[3] = {"R", "G", "B"};
     std::vector<float> meanError(n), meanRel(n), meanZ(n);
@@ -91,33 +188,63 @@ void writeErrorMaps(const CompareArgs& a, const RgbLayer& x, const RgbLayer& ref
         if (std::string(layer) == "z" && !hasStderr) continue;
         for (int c = 0; c < 3; ++c) {
             FloatChannel f{fmt::format("{}.{}", layer, rgb[c]), std::vector<float>(n)};
-            for (std::size_t p = 0; p < n; ++p) {
-                const double e = double(x.rgb[p][c]) - double(ref.rgb[p][c]);
+            for (std::size_t q = 0; q < n; ++q) {
+                const double e = double(p.xs[q][c]) - double(p.rs[q][c]);
                 const double v = layer[0] == 'e' ? e
-                               : layer[0] == 'r' ? e / (std::fabs(double(ref.rgb[p][c])) + kRelMseEpsilon)
-                                                 : (sd.rgb[p][c] > 0.0f ? e / double(sd.rgb[p][c]) : 0.0);
-                f.values[p] = float(v);
-                (layer[0] == 'e' ? meanError : layer[0] == 'r' ? meanRel : meanZ)[p] += float(v / 3.0);
+                               : layer[0] == 'r' ? e / (std::fabs(double(p.rs[q][c])) + kRelMseEpsilon)
+                                                 : (sd[q][c] > 0.0f ? e / double(sd[q][c]) : 0.0);
+                f.values[q] = float(v);
+                (layer[0] == 'e' ? meanError : layer[0] == 'r' ? meanRel : meanZ)[q] += float(v / 3.0);
             }
             ch.push_back(std::move(f));
         }
     }
-    writeChannelsExr(a.errorMap, x.width, x.height, ch,
-                     {{"image", a.image}, {"reference", a.reference}, {"layer", a.layer.empty() ? "RGB" : a.layer}});
+    if (!cmp.flipMap.empty()) ch.push_back({"flip", cmp.flipMap});
+    writeChannelsExr(a.errorMap, p.w, p.h, ch,
+                     {{"image", a.image}, {"reference", a.reference}, {"layer", a.layer.empty() ? "RGB" : a.layer},
+                      {"flip", a.flip}, {"ppd", fmt::format("{}", a.ppd)}},
+                     DataWindow{p.x0, p.y0, p.x.width, p.x.height});
     const std::string base = std::filesystem::path(a.errorMap).replace_extension().string();
     const double se = symmetricScale(meanError), sr = symmetricScale(meanRel);
-    writeFalseColourPng(base + ".error.png", meanError, x.width, x.height,
-                        {-se, se, true, "error x - ref (mean of RGB; scale: 99th percentile)"});
-    writeFalseColourPng(base + ".relative.png", meanRel, x.width, x.height,
+    writeFalseColourPng(base + ".error.png", meanError, p.w, p.h,
+                        {-se, se, true, "error x - ref, radiance (mean of RGB; scale: 99th percentile of |error|)"});
+    writeFalseColourPng(base + ".relative.png", meanRel, p.w, p.h,
                         {-sr, sr, true, "relative error (x - ref) / (|ref| + 0.01), mean of RGB"});
     if (hasStderr)
-        writeFalseColourPng(base + ".z.png", meanZ, x.width, x.height,
+        writeFalseColourPng(base + ".z.png", meanZ, p.w, p.h,
                             {-4.0, 4.0, true, "z = (x - ref) / reference stderr, mean of RGB"});
-    fmt::print(stderr, "accretion: error maps {} (+ {}.error.png, {}.relative.png{})\n", a.errorMap, base, base,
-               hasStderr ? ", " + base + ".z.png" : std::string(", no z: the reference has no Lr_stderr"));
+    if (!cmp.flipMap.empty())
+        writeFalseColourPng(base + ".flip.png", cmp.flipMap, p.w, p.h,
+                            {0.0, 1.0, false, fmt::format("{}-FLIP (0: no visible difference, 1: the largest; {:.0f} pixels per degree)",
+                                                          a.flip == "hdr" ? "HDR" : "LDR", a.ppd)});
+    fmt::print(stderr, "accretion: error maps {} (+ {}.error.png, {}.relative.png{}{})\n", a.errorMap, base, base,
+               hasStderr ? ", " + base + ".z.png" : std::string(", no z: the reference has no Lr_stderr"),
+               cmp.flipMap.empty() ? std::string() : ", " + base + ".flip.png");
 }
 
-void runCompare(const CompareArgs& a) {
+/// Metadata differences: a warning each, or (--strict) an error.
+void checkMetadata(const CompareArgs& a, const std::string& image, const std::string& reference) {
+    for (const std::string& d : metadataDifferences(image, reference)) {
+        if (a.strict) throw InputError(fmt::format("{}: not the reference's view: {} (--strict)", image, d));
+        fmt::print(stderr, "accretion: warning: {}: {}\n", image, d);
+    }
+}
+
+void checkFlipOption(const CompareArgs& a) {
+    if (a.flip != "hdr" && a.flip != "ldr" && a.flip != "none")
+        throw InputError(fmt::format("command line --flip {}: expected hdr, ldr or none", a.flip));
+    if (!(a.ppd > 0.0 && a.ppd < 1e4)) throw InputError(fmt::format("command line --ppd {}: expected pixels per degree in (0, 1e4)", a.ppd));
+}
+
+std::vector<std::string> parseChannels(const CompareArgs& a) {
+    if (a.channels.empty()) return {};
+    std::vector<std::string> channels = splitList(a.channels, ',');
+    if (channels.size() != 3)
+        throw InputError(fmt::format("command line --channels {}: expected three channel names (R,G,B)", a.channels));
+    return channels;
+}
+
+void runCompareOne(const CompareArgs& a) {
     if (!a.errorMap.empty()) {  // before any work: never over an input, and an EXR
         OutputGuard guard;
         guard.addInput(a.image);
@@ -125,45 +252,107 @@ void runCompare(const CompareArgs& a) {
         if (std::filesystem::path(a.errorMap).extension() != ".exr")
             throw InputError(fmt::format("command line --error-map {}: must end in .exr", a.errorMap));
         const std::string base = std::filesystem::path(a.errorMap).replace_extension().string();
-        for (const std::string& out : {a.errorMap, base + ".error.png", base + ".relative.png", base + ".z.png"})
+        for (const std::string& out : {a.errorMap, base + ".error.png", base + ".relative.png", base + ".z.png", base + ".flip.png"})
             guard.check(out, "--error-map");
     }
-    std::vector<std::string> channels;
-    if (!a.channels.empty()) {
-        channels = splitList(a.channels, ',');
-        if (channels.size() != 3)
-            throw InputError(fmt::format("command line --channels {}: expected three channel names (R,G,B)", a.channels));
-    }
-    const RgbLayer x = channels.empty() ? readExrLayer(a.image, a.layer) : readExrChannels(a.image, channels);
-    const RgbLayer ref = readExrLayer(a.reference, a.layer);
-    if (x.width != ref.width || x.height != ref.height)
-        throw InputError(fmt::format("{}: {}x{} pixels, but the reference {} is {}x{}", a.image, x.width, x.height,
-                                     a.reference, ref.width, ref.height));
-    for (const std::string& d : metadataDifferences(a)) {
-        if (a.strict) throw InputError(fmt::format("{}: not the reference's view: {} (--strict)", a.image, d));
-        fmt::print(stderr, "accretion: warning: {}: {}\n", a.image, d);
-    }
-    const ErrorMetrics m = computeErrors(x.rgb, ref.rgb);
+    const Pair p = loadPair(a, a.image, a.reference, parseChannels(a));
+    checkMetadata(a, a.image, a.reference);
+    if (p.partial())
+        fmt::print(stderr, "accretion: compared the {}x{} pixels at ({}, {}) that both data windows hold (of {}x{})\n", p.w, p.h,
+                   p.x0, p.y0, p.x.width, p.x.height);
+    const Comparison c = measure(a, p);
     auto hidden = [](const char* key) { return Column{key, "", 0, "{}", "{}", false}; };
     Table t({hidden("image"), hidden("reference"), hidden("layer"), {"relMSE", "relMSE", 0, "{:.9g}"},
-             {"MSE", "MSE", 0, "{:.9g}"}, {"MAPE", "MAPE", 0, "{:.9g}"}, hidden("epsilon"), hidden("pixels"),
-             hidden("nonfinite_pixels")});
-    t.add({a.image, a.reference, a.layer.empty() ? "RGB" : a.layer, m.relMSE, m.MSE, m.MAPE, kRelMseEpsilon,
-           std::uint64_t(m.pixels), std::uint64_t(m.nonFinite)});
-    if (m.nonFinite > 0) {
-        std::vector<std::string> at;  // (x, y) of the first few, and where the first is
-        for (const std::size_t p : m.firstNonFinite) at.push_back(fmt::format("({}, {})", p % x.width, p / x.width));
-        const std::string msg = fmt::format("{} of {} pixels are NaN or infinite (at {}{}; the first in {}) and left out",
-                                            m.nonFinite, x.rgb.size(), fmt::join(at, ", "), m.nonFinite > at.size() ? ", ..." : "",
-                                            nonFiniteOwner(a, x, m.firstNonFinite.front()));
-        if (!a.allowNonFinite || m.pixels == 0)
-            throw InputError(fmt::format("{}: {}{}", a.image, msg,
-                                         m.pixels == 0 ? ": no finite pixel is left to measure"
-                                                       : "; give --allow-nonfinite to measure the rest"));
-        fmt::print(stderr, "accretion: warning: {}\n", msg);
-    }
-    if (!a.errorMap.empty()) writeErrorMaps(a, x, ref);
+             {"MSE", "MSE", 0, "{:.9g}"}, {"MAPE", "MAPE", 0, "{:.9g}"},
+             {"flip", a.flip == "ldr" ? "LDR-FLIP" : "HDR-FLIP", 0, "{:.6f}"}, hidden("flip_variant"), hidden("ppd"),
+             hidden("epsilon"), hidden("pixels"), hidden("nonfinite_pixels"), hidden("window")});
+    t.add({a.image, a.reference, a.layer.empty() ? "RGB" : a.layer, c.m.relMSE, c.m.MSE, c.m.MAPE, c.flip, a.flip, a.ppd,
+           kRelMseEpsilon, std::uint64_t(c.m.pixels), std::uint64_t(c.m.nonFinite),
+           fmt::format("{}x{}+{}+{}", p.w, p.h, p.x0, p.y0)});
+    if (!a.errorMap.empty()) writeErrorMaps(a, p, c);
     fmt::print("{}", a.json ? t.json()[0].dump(2) + "\n" : t.keyValues());
+    if (a.flip == "hdr" && !a.json)
+        fmt::print("HDR-FLIP exposures: {} from {:.4f} to {:.4f} stops (ACES)\n", c.hdr.exposures, c.hdr.startExposure,
+                   c.hdr.stopExposure);
+}
+
+/// compare 'gpu.{frame}.exr' 'ref.{frame}.exr' --frames A:B --csv FILE:
+/// each frame's metrics, and the frame-to-frame change of the error
+/// (flicker: mean ((e_t - e_t-1)^2 / (ref_t^2 + eps)), what temporal reuse
+/// makes or hides), as a CSV and a plot.
+void runCompareSequence(const CompareArgs& a) {
+    const auto [first, end] = parseHalfOpen(a.frames, "--frames");
+    for (const std::string* pattern : {&a.image, &a.reference})
+        if (pattern->find("{frame}") == std::string::npos)
+            throw InputError(fmt::format("command line --frames {}: {} has no {{frame}} pattern", a.frames, *pattern));
+    if (a.csv.empty()) throw InputError(fmt::format("command line --frames {}: give --csv FILE for the per-frame table", a.frames));
+    if (!a.errorMap.empty()) throw InputError("command line --error-map: maps one pair of images; give it without --frames");
+    const std::string png = std::filesystem::path(a.csv).replace_extension(".png").string();
+    OutputGuard guard;
+    std::vector<std::pair<std::string, std::string>> files;
+    for (std::uint64_t f = first; f < end; ++f) {
+        files.push_back({expandPattern(a.image, "", std::uint32_t(f)), expandPattern(a.reference, "", std::uint32_t(f))});
+        guard.addInput(files.back().first);
+        guard.addInput(files.back().second);
+    }
+    guard.check(a.csv, "--csv");
+    guard.check(png, "--csv (its plot)");
+    const std::vector<std::string> channels = parseChannels(a);
+    Table t({{"frame", "frame", 6}, {"relMSE", "relMSE", 13, "{:.6g}", "{:.9g}"}, {"MSE", "MSE", 13, "{:.6g}", "{:.9g}"},
+             {"MAPE", "MAPE", 11, "{:.6g}", "{:.9g}"}, {"flip", a.flip == "ldr" ? "LDR-FLIP" : "HDR-FLIP", 9, "{:.5f}", "{:.6f}"},
+             {"flicker", "flicker", 13, "{:.6g}", "{:.9g}"}, {"nonfinite_pixels", "nonfinite", 9},
+             {"image", "", 0, "{}", "{}", false}, {"reference", "", 0, "{}", "{}", false}});
+    std::vector<Vec3> lastError;
+    for (std::size_t k = 0; k < files.size(); ++k) {
+        const auto& [image, reference] = files[k];
+        const Pair p = loadPair(a, image, reference, channels);
+        checkMetadata(a, image, reference);
+        const Comparison c = measure(a, p);
+        std::vector<Vec3> error(p.xs.size());
+        for (std::size_t q = 0; q < error.size(); ++q) error[q] = p.xs[q] - p.rs[q];
+        double flicker = std::numeric_limits<double>::quiet_NaN();
+        if (!lastError.empty() && lastError.size() == error.size()) {
+            double sum = 0.0;
+            std::size_t n = 0;
+            for (std::size_t q = 0; q < error.size(); ++q)
+                for (int ch = 0; ch < 3; ++ch) {
+                    const double d = double(error[q][ch]) - double(lastError[q][ch]), r = p.rs[q][ch];
+                    if (!std::isfinite(d)) continue;
+                    sum += d * d / (r * r + kRelMseEpsilon);
+                    ++n;
+                }
+            flicker = n ? sum / double(n) : 0.0;
+        }
+        lastError = std::move(error);
+        t.add({first + k, c.m.relMSE, c.m.MSE, c.m.MAPE, c.flip, flicker, std::uint64_t(c.m.nonFinite), image, reference});
+        if (!a.json) fmt::print(stderr, "accretion: frame {}: relMSE {:.4g}, FLIP {:.4f}\n", first + k, c.m.relMSE, c.flip);
+    }
+    writeFileAtomic(a.csv, t.csv());
+    const std::string flipName = a.flip == "ldr" ? "LDR-FLIP" : "HDR-FLIP";
+    const bool flip = a.flip != "none";
+    std::string script = fmt::format(
+        "set datafile separator ','\nset key outside top center horizontal box\nset grid\n"
+        "set xlabel 'frame'\nset xtics {}\nset ylabel 'relMSE, flicker (relative squared error, unitless)'\nset logscale y\n"
+        "set title {}\n",
+        end - first <= 20 ? "1" : "autofreq",
+        gnuplotQuote(fmt::format("{} against {}\nflicker: the relMSE of the error's change from the previous frame", a.image, a.reference)));
+    if (flip) script += fmt::format("set y2label '{} (mean, 0 to 1)'\nset y2range [0:*]\nset y2tics\nset ytics nomirror\n", flipName);
+    script += fmt::format("plot {} using 1:2 with linespoints title 'relMSE', '' using 1:6 with linespoints title 'flicker'",
+                          gnuplotQuote(a.csv));
+    if (flip) script += fmt::format(", '' using 1:5 axes x1y2 with linespoints title '{} (right axis)'", flipName);
+    plotPng(png, script + "\n", 900, 560);
+    fmt::print("{}", a.json ? t.json().dump(2) + "\n" : t.console());
+    fmt::print("per-frame table: {} (plot: {})\n", a.csv, png);
+}
+
+void runCompare(const CompareArgs& a) {
+    checkFlipOption(a);
+    if (a.frames.empty()) {
+        if (!a.csv.empty()) throw InputError("command line --csv: the per-frame table of a sequence; give --frames A:B too");
+        runCompareOne(a);
+    } else {
+        runCompareSequence(a);
+    }
 }
 
 }  // namespace
@@ -177,12 +366,21 @@ void addCompareCommand(CLI::App& app) {
     cmd->add_option("--channels", args->channels, "The image's three channels, e.g. color.r,color.g,color.b (a GPU frame's names)");
     cmd->add_option("--error-map", args->errorMap,
                     "Write signed, relative and z errors to this EXR, and false-colour PNGs of each beside it");
+    cmd->add_option("--flip", args->flip,
+                    "Perceptual metric: hdr (HDR-FLIP over the reference's exposure range, default), ldr (LDR-FLIP of the "
+                    "images clamped to [0, 1] as sRGB) or none");
+    cmd->add_option("--ppd", args->ppd, "FLIP observer: pixels per degree (default 67: a 0.7 m wide 4K monitor at 0.7 m)");
+    cmd->add_option("--frames", args->frames,
+                    "A:B: image and reference are {frame} patterns (e.g. 'gpu.{frame}.exr'); one row per frame, with the "
+                    "frame-to-frame change of the error (flicker)");
+    cmd->add_option("--csv", args->csv, "With --frames: the per-frame table (CSV), and a plot beside it (.png)");
     cmd->add_flag("--strict", args->strict, "A different frame, scene, camera or scene settings is an error (else a warning)");
     cmd->add_flag("--json", args->json, "Machine-readable output");
     cmd->add_flag("--allow-nonfinite", args->allowNonFinite,
                   "Measure the finite pixels when some are NaN or infinite (counted, first one located; else exit 1)");
     cmd->footer("relMSE = mean (x-ref)^2/(ref^2+1e-2); MSE = mean (x-ref)^2; MAPE = mean |x-ref|/(|ref|+1e-2);\n"
-                "means over pixels and RGB channels.");
+                "means over pixels and RGB channels, over the pixels both data windows hold.\n"
+                "FLIP: Andersson et al. 2020 (LDR) and 2021 (HDR), mean over the pixels.");
     cmd->callback([args] { runCompare(*args); });
 }
 

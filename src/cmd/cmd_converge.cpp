@@ -81,6 +81,9 @@ struct Reference {
 Reference loadReference(const std::string& pattern, const Settings& scene, std::uint32_t frame) {
     const std::string file = expandPattern(pattern, scene.sceneName, frame);
     const RgbLayer L = readExrLayer(file, "Lr");
+    if (!L.whole())
+        throw InputError(fmt::format("{}: a cropped reference (data window {}x{} at ({}, {})); converge measures whole images", file,
+                                     L.dataWidth, L.dataHeight, L.x0, L.y0));
     if (L.width != scene.camera.width || L.height != scene.camera.height)
         throw InputError(fmt::format("{}: reference is {}x{}, the scene renders {}x{}", file, L.width, L.height,
                                      scene.camera.width, scene.camera.height));

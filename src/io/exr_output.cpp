@@ -126,9 +126,16 @@ void writeFrameExr(const std::filesystem::path& file, const FrameImage& img, boo
 }
 
 void writeChannelsExr(const std::filesystem::path& file, std::uint32_t width, std::uint32_t height,
-                      const std::vector<FloatChannel>& channels, const OutputMetadata& metadata) {
+                      const std::vector<FloatChannel>& channels, const OutputMetadata& metadata, DataWindow window) {
     const int nch = static_cast<int>(channels.size());
     OIIO::ImageSpec spec(int(width), int(height), nch, OIIO::TypeDesc::FLOAT);
+    if (window.fullWidth > 0) {
+        spec.x = window.x;
+        spec.y = window.y;
+        spec.full_x = spec.full_y = 0;
+        spec.full_width = int(window.fullWidth);
+        spec.full_height = int(window.fullHeight);
+    }
     spec.channelnames.clear();
     for (const FloatChannel& c : channels) spec.channelnames.push_back(c.name);
     spec.attribute("compression", "zip");

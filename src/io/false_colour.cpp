@@ -48,7 +48,7 @@ double symmetricScale(const std::vector<float>& values) {
 void writeFalseColourPng(const std::filesystem::path& file, const std::vector<float>& values, std::uint32_t width,
                          std::uint32_t height, const ColourScale& scale) {
     ACC_CHECK(values.size() == std::size_t(width) * height);
-    const int W = std::max<int>(int(width), 360), barTop = int(height) + 6, barH = 14, H = int(height) + 74;
+    const int W = std::max<int>(int(width), 520), barTop = int(height) + 6, barH = 14, H = int(height) + 74;
     OIIO::ImageBuf img(OIIO::ImageSpec(W, H, 3, OIIO::TypeDesc::FLOAT));
     OIIO::ImageBufAlgo::zero(img);
     const double span = scale.hi - scale.lo;

@@ -12,6 +12,10 @@ namespace accretion {
 std::string gnuplotQuote(const std::string& s) {
     std::string out = "\"";
     for (char c : s) {
+        if (c == '\n') {  // a line break inside the string
+            out += "\\n";
+            continue;
+        }
         if (c == '"' || c == '\\') out += '\\';
         out += c;
     }

@@ -32,10 +32,18 @@ inline constexpr double kRelMseEpsilon = 1e-2;
 ErrorMetrics computeErrors(const std::vector<Vec3>& x, const std::vector<Vec3>& ref,
                            const std::vector<Vec3>* refStderr = nullptr, double eps = kRelMseEpsilon);
 
-/// An RGB layer of an EXR file, read back with OpenImageIO.
+/// An RGB layer of an EXR file, read back with OpenImageIO (half or float
+/// channels, as floats): the pixels of its data window, which may be any
+/// part of (or reach outside) the display window of the whole image.
 struct RgbLayer {
-    std::uint32_t width = 0, height = 0;
-    std::vector<Vec3> rgb;
+    std::uint32_t width = 0, height = 0;          ///< the display window (the whole image)
+    int x0 = 0, y0 = 0;                           ///< the data window's upper-left pixel
+    std::uint32_t dataWidth = 0, dataHeight = 0;  ///< and its size
+    std::vector<Vec3> rgb;                        ///< the data window's pixels, row by row
+    /// The data window is the display window.
+    bool whole() const { return x0 == 0 && y0 == 0 && dataWidth == width && dataHeight == height; }
+    /// The pixels of window [x0, x0 + w) x [y0, y0 + h), which the data window must contain.
+    std::vector<Vec3> window(int x, int y, std::uint32_t w, std::uint32_t h) const;
 };
 
 /// Read layer `layer` ("" = R,G,B; "Lr" = Lr.R, Lr.G, Lr.B; ...). Throws

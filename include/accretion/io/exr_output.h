@@ -39,8 +39,14 @@ struct FloatChannel {
     std::string name;
     std::vector<float> values;  ///< width x height, row-major
 };
+/// Where a window's pixels lie in the whole image (the EXR's data window
+/// inside its display window); fullWidth 0: the pixels are the whole image.
+struct DataWindow {
+    int x = 0, y = 0;
+    std::uint32_t fullWidth = 0, fullHeight = 0;
+};
 void writeChannelsExr(const std::filesystem::path& file, std::uint32_t width, std::uint32_t height,
-                      const std::vector<FloatChannel>& channels, const OutputMetadata& metadata);
+                      const std::vector<FloatChannel>& channels, const OutputMetadata& metadata, DataWindow window = {});
 
 /// A counter heatmap as an 8-bit PNG in false colour (io/false_colour.h): 0
 /// dark purple, the 99.5th percentile of the non-zero values (or the
