@@ -180,9 +180,6 @@ Prepared prepare(const std::vector<Vec3>& srgb, std::uint32_t w, std::uint32_t h
 
 }  // namespace
 
-float linearToSrgb(float v) { return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f; }
-float srgbToLinear(float v) { return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f); }
-
 std::vector<float> ldrFlip(const std::vector<Vec3>& reference, const std::vector<Vec3>& test, std::uint32_t w, std::uint32_t h,
                            const FlipOptions& options) {
     const Prepared r = prepare(reference, w, h, options.ppd), t = prepare(test, w, h, options.ppd);
@@ -209,12 +206,6 @@ double acesInverse(double t) {
     return -0.5 * c0 + std::sqrt(0.25 * c0 * c0 - c1);
 }
 }  // namespace
-
-float acesToneMap(float x) {
-    const double v = std::max(double(x), 0.0);
-    if (!std::isfinite(v)) return 1.0f;
-    return float(std::clamp((kA0 * v * v + kA1 * v) / (kA3 * v * v + kA4 * v + kA5), 0.0, 1.0));
-}
 
 std::pair<double, double> flipExposureRange(const std::vector<Vec3>& reference) {
     std::vector<double> Y;

@@ -11,6 +11,7 @@
 #include "accretion/io/accumulation_file.h"
 #include "accretion/core/output_guard.h"
 #include "accretion/io/exr_output.h"
+#include "accretion/io/preview.h"
 #include "accretion/render/estimators.h"
 #include "commands.h"
 
@@ -140,10 +141,13 @@ void runMerge(const MergeArgs& args) {
     exr.attributes["accretion:shard"] = fmt::format("merged {} shards", count);
     exr.attributes["accretion:merge_version"] = std::string(version());
     exr.attributes.erase("accretion:render_time_s");
+    ToneMap curve = ToneMap::filmic;
+    parseEnum(first.value("tonemap", std::string("filmic")), curve);
+    const PreviewTone tone = previewTone(preview, curve, first.value("auto_exposure", true), first.value("exposure", 0.0));
+    exr.attributes["accretion:preview"] = tone.describe();
     writeRawExr(output, exr);
     const std::filesystem::path base = std::filesystem::path(output).replace_extension();
-    writePreviewPng(png, preview, exr.width, exr.height, first.value("auto_exposure", true),
-                    first.value("exposure", 0.0));
+    writePreviewPng(png, preview, exr.width, exr.height, tone);
     double meanSpp = 0.0;
     std::size_t sampled = 0;
     for (const std::uint32_t n : merged.n) {

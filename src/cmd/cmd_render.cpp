@@ -20,6 +20,7 @@
 #include "accretion/io/checkpoint.h"
 #include "accretion/core/atomic_file.h"
 #include "accretion/io/exr_output.h"
+#include "accretion/io/preview.h"
 #include "accretion/io/stats_writer.h"
 #include "accretion/particles/particle_source.h"
 #include "accretion/render/frame_renderer.h"
@@ -215,8 +216,15 @@ nlohmann::json writeFrameOutputs(const RenderRun& run, std::uint32_t frame, cons
     const std::string& exr = paths.exr;
     const std::string& base = paths.base;
     for (const Heatmap& h : image.heatmaps) run.guard.check(base + "." + h.name + ".png", "output");
+    // The previews show the rendered window; their tone is stated in the EXR.
+    const PixelWindow& w = image.window;
+    const std::vector<Vec3> L = cropPixels(image.L, image.width, w), Lr = cropPixels(image.lighting.Lr, image.width, w);
+    const RenderSettings& rs = settings.render;
+    const PreviewTone tone = previewTone(L, rs.tonemap, rs.auto_exposure, rs.exposure);
+    const PreviewTone lrTone = previewTone(Lr, rs.tonemap, rs.auto_exposure, rs.exposure);
     const OutputMetadata meta = {
         {"version", std::string(version())},   {"scene", settings.scenePath},
+        {"preview", tone.describe()},
         {"frame", std::to_string(frame)},      {"estimator", std::string(enumName(settings.render.estimator))},
         {"samples", std::to_string(settings.render.samples)}, {"seed", std::to_string(settings.render.seed)},
         {"shard", run.shardLabel},             {"render_time_s", fmt::format("{:.6f}", fs.seconds)},
@@ -226,12 +234,9 @@ nlohmann::json writeFrameOutputs(const RenderRun& run, std::uint32_t frame, cons
     {
         auto t = fs.timer.scope(pass::writeOutputs);
         writeFrameExr(exr, image, settings.render.estimator != EstimatorKind::exact, meta);
-        const PixelWindow& w = image.window;  // the previews show the rendered window
-        writePreviewPng(base + ".png", cropPixels(image.L, image.width, w), w.width(), w.height(), settings.render.auto_exposure,
-                        settings.render.exposure);
-        writePreviewPng(base + ".Lr.png", cropPixels(image.lighting.Lr, image.width, w), w.width(), w.height(),
-                        settings.render.auto_exposure, settings.render.exposure);
-        outputs = {{"exr", exr}, {"png", base + ".png"}, {"lr_png", base + ".Lr.png"}};
+        writePreviewPng(base + ".png", L, w.width(), w.height(), tone);
+        writePreviewPng(base + ".Lr.png", Lr, w.width(), w.height(), lrTone);
+        outputs = {{"exr", exr}, {"png", base + ".png"}, {"lr_png", base + ".Lr.png"}, {"preview_tone", tone.describe()}};
         if (run.sharding.bySamples) {  // the sums a merge needs, next to the EXR
             const LightingPlan plan = planLighting(settings.render, image.height, run.sharding.shard);
             AccumulationFile f{accumulationHeader("shard", run.settingsToml, run.shardLabel, frame), sums};
@@ -239,6 +244,7 @@ nlohmann::json writeFrameOutputs(const RenderRun& run, std::uint32_t frame, cons
             f.header["exact"] = plan.exact;
             f.header["auto_exposure"] = settings.render.auto_exposure;
             f.header["exposure"] = settings.render.exposure;
+            f.header["tonemap"] = std::string(enumName(settings.render.tonemap));
             writeAccumulationFile(base + ".acc", f);
             outputs["accumulation"] = base + ".acc";
         }

@@ -165,7 +165,8 @@ float percentile995(std::vector<float> v) {
     return v[k];
 }
 
-/// An 8-bit RGB PNG, written atomically.
+}  // namespace
+
 void writeRgb8Png(const std::filesystem::path& file, const std::vector<std::uint8_t>& px, std::uint32_t width,
                   std::uint32_t height) {
     OIIO::ImageSpec spec(int(width), int(height), 3, OIIO::TypeDesc::UINT8);
@@ -177,7 +178,6 @@ void writeRgb8Png(const std::filesystem::path& file, const std::vector<std::uint
     });
 }
 
-}  // namespace
 
 void writeHeatmapPng(const std::filesystem::path& file, const std::vector<float>& values, std::uint32_t width,
                      std::uint32_t height, const std::string& title) {
@@ -185,24 +185,6 @@ void writeHeatmapPng(const std::filesystem::path& file, const std::vector<float>
     writeFalseColourPng(file, values, width, height, {0.0, p > 0.0f ? double(p) : 1.0, false, title + " (scale: 99.5th percentile)"});
 }
 
-void writePreviewPng(const std::filesystem::path& file, const std::vector<Vec3>& rgb, std::uint32_t width,
-                     std::uint32_t height, bool autoExposure, double exposure) {
-    double scale = std::exp2(exposure);
-    if (autoExposure) {
-        std::vector<float> lum(rgb.size());
-        for (std::size_t i = 0; i < rgb.size(); ++i) lum[i] = luminance(rgb[i]);
-        if (const float p = percentile995(std::move(lum)); p > 0.0f) scale /= p;
-    }
-    auto encode = [](float v) {
-        v = std::clamp(v, 0.0f, 1.0f);
-        v = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
-        return static_cast<std::uint8_t>(std::lround(v * 255.0f));
-    };
-    std::vector<std::uint8_t> px(rgb.size() * 3);
-    for (std::size_t i = 0; i < rgb.size(); ++i)
-        for (int c = 0; c < 3; ++c) px[3 * i + c] = encode(float(scale) * rgb[i][c]);
-    writeRgb8Png(file, px, width, height);
-}
 
 std::size_t RawExr::channel(const std::string& name) const {
     for (std::size_t c = 0; c < channels.size(); ++c)

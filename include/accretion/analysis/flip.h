@@ -2,6 +2,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "accretion/core/colour.h"
 #include "accretion/core/math.h"
 
 namespace accretion {
@@ -39,12 +40,5 @@ HdrFlip hdrFlip(const std::vector<Vec3>& reference, const std::vector<Vec3>& tes
 /// The exposure range HDR-FLIP derives from a reference (start, stop).
 std::pair<double, double> flipExposureRange(const std::vector<Vec3>& reference);
 
-/// ACES filmic fit (Narkowicz 2016) of a linear value after exposure 2^e,
-/// clamped to [0, 1]: the tone mapper HDR-FLIP assumes.
-float acesToneMap(float x);
-
-/// Linear <-> sRGB transfer (IEC 61966-2-1).
-float linearToSrgb(float v);
-float srgbToLinear(float v);
 
 }  // namespace accretion

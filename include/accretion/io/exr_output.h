@@ -31,9 +31,6 @@ ExrCameraMatrices exrCameraMatrices(const CameraPose& camera, std::uint32_t widt
 void writeFrameExr(const std::filesystem::path& file, const FrameImage& image, bool withErrors,
                    const OutputMetadata& metadata);
 
-/// Tonemapped 8-bit sRGB preview of an RGB buffer: scale so that the 99.5th
-/// luminance percentile of non-black pixels maps to 1 (when autoExposure),
-/// times 2^exposure, clip. Atomic.
 /// A float EXR of named channels (e.g. bias maps), written atomically.
 struct FloatChannel {
     std::string name;
@@ -76,7 +73,8 @@ struct RawExr {
 RawExr readRawExr(const std::filesystem::path& file);
 void writeRawExr(const std::filesystem::path& file, const RawExr& exr);
 
-void writePreviewPng(const std::filesystem::path& file, const std::vector<Vec3>& rgb, std::uint32_t width,
-                     std::uint32_t height, bool autoExposure, double exposure);
+/// An 8-bit RGB PNG (interleaved sRGB bytes), written atomically.
+void writeRgb8Png(const std::filesystem::path& file, const std::vector<std::uint8_t>& px, std::uint32_t width,
+                  std::uint32_t height);
 
 }  // namespace accretion

@@ -48,6 +48,7 @@ enum class NonFinitePolicy { zero_sample, discard };
 enum class VisibilityRule { exact, offset };
 enum class OffsetOrigin { tmin, waechter_binder };
 enum class FarEnd { absolute, relative };
+enum class ToneMap { filmic, log, linear };
 
 ACC_ENUM_NAMES(CameraPath, "static", "orbit", "linear");
 ACC_ENUM_NAMES(SerComponent, "hit", "type", "cluster", "hint");
@@ -65,6 +66,7 @@ ACC_ENUM_NAMES(NonFinitePolicy, "zero_sample", "discard");
 ACC_ENUM_NAMES(VisibilityRule, "exact", "offset");
 ACC_ENUM_NAMES(OffsetOrigin, "tmin", "waechter_binder");
 ACC_ENUM_NAMES(FarEnd, "absolute", "relative");
+ACC_ENUM_NAMES(ToneMap, "filmic", "log", "linear");
 
 template <class E> constexpr std::string_view enumName(E e) {
     return EnumNames<E>::names[static_cast<std::size_t>(e)];
@@ -223,7 +225,8 @@ struct RenderSettings {
     NonFinitePolicy nonfinite = NonFinitePolicy::zero_sample; ///< a NaN/Inf sample counts as 0, or is discarded (restir: its reservoir)
     double memory_limit_mb = 0.0;                ///< refuse runs estimated to need more (0: no limit)
     double exposure = 0.0;                       ///< preview exposure in stops, added to auto exposure
-    bool auto_exposure = true;                   ///< preview: map the 99th luminance percentile to 1
+    bool auto_exposure = true;                   ///< preview: exposure from the image (see tonemap)
+    ToneMap tonemap = ToneMap::filmic;           ///< preview tone curve
     std::vector<double> crop;                    ///< [x0, x1, y0, y1]: render only this pixel window (empty: the whole image)
 
     template <class V> void visit(V& v) {
@@ -245,7 +248,8 @@ struct RenderSettings {
         v.field("nonfinite", nonfinite, "a NaN/Inf sample: zero_sample (counts as 0) | discard (not counted; restir: the reservoir is emptied)");
         v.field("memory_limit_mb", memory_limit_mb, "refuse a run whose estimated peak memory exceeds this (MB; 0: no limit)", kNonNegative);
         v.field("exposure", exposure, "preview exposure (stops)", Range{-64.0, 64.0});
-        v.field("auto_exposure", auto_exposure, "preview: scale the 99th luminance percentile to 1");
+        v.field("auto_exposure", auto_exposure, "preview: exposure from the image (filmic: the median lit luminance to 0.18; log: the median to 1; linear: the 99.5th percentile to 1)");
+        v.field("tonemap", tonemap, "preview curve: filmic (ACES fit: the whole disk, highlights rolled off), log (log2(1 + x), to the 99.9th percentile) or linear (clipped)");
         v.field("crop", crop, "[x0, x1, y0, y1]: render only the pixels x0 <= x < x1, y0 <= y < y1 (the EXR's data window; empty: all)", Range{0, 16384});
     }
 };
