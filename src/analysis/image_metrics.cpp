@@ -120,6 +120,18 @@ std::vector<Vec3> RgbLayer::window(int x, int y, std::uint32_t w, std::uint32_t 
     return out;
 }
 
+std::vector<std::uint32_t> readExrUintChannel(const std::filesystem::path& file, const std::string& name) {
+    auto in = OIIO::ImageInput::open(file.string());
+    if (!in) throw InputError(fmt::format("{}: cannot read image: {}", file.string(), OIIO::geterror()));
+    const OIIO::ImageSpec& spec = in->spec();
+    const int c = spec.channelindex(name);
+    if (c < 0 || spec.channelformat(c) != OIIO::TypeDesc::UINT) return {};
+    std::vector<std::uint32_t> v(std::size_t(spec.width) * spec.height);
+    if (!in->read_image(0, 0, c, c + 1, OIIO::TypeDesc::UINT, v.data()))
+        throw InputError(fmt::format("{}: cannot read pixels: {}", file.string(), in->geterror()));
+    return v;
+}
+
 RgbLayer readExrLayer(const std::filesystem::path& file, const std::string& layer) {
     return readExrChannels(file, layerChannels(layer));
 }

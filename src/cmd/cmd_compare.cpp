@@ -278,8 +278,10 @@ void runCompareOne(const CompareArgs& a) {
 
 /// compare 'gpu.{frame}.exr' 'ref.{frame}.exr' --frames A:B --csv FILE:
 /// each frame's metrics, and the frame-to-frame change of the error
-/// (flicker: mean ((e_t - e_t-1)^2 / (ref_t^2 + eps)), what temporal reuse
-/// makes or hides), as a CSV and a plot.
+/// (flicker: mean ((e_t - e_t-1)^2 / (ref_t^2 + eps)) over the pixels whose
+/// reference sees the same particle in both frames, when it has a
+/// particle.id channel; the fraction of such pixels is `tracked`), what
+/// temporal reuse makes or hides, as a CSV and a plot.
 void runCompareSequence(const CompareArgs& a) {
     const auto [first, end] = parseHalfOpen(a.frames, "--frames");
     for (const std::string* pattern : {&a.image, &a.reference})
@@ -300,9 +302,11 @@ void runCompareSequence(const CompareArgs& a) {
     const std::vector<std::string> channels = parseChannels(a);
     Table t({{"frame", "frame", 6}, {"relMSE", "relMSE", 13, "{:.6g}", "{:.9g}"}, {"MSE", "MSE", 13, "{:.6g}", "{:.9g}"},
              {"MAPE", "MAPE", 11, "{:.6g}", "{:.9g}"}, {"flip", a.flip == "ldr" ? "LDR-FLIP" : "HDR-FLIP", 9, "{:.5f}", "{:.6f}"},
-             {"flicker", "flicker", 13, "{:.6g}", "{:.9g}"}, {"nonfinite_pixels", "nonfinite", 9},
+             {"flicker", "flicker", 13, "{:.6g}", "{:.9g}"}, {"flicker_pixels", "tracked", 8, "{:.3f}", "{:.6f}"},
+             {"nonfinite_pixels", "nonfinite", 9},
              {"image", "", 0, "{}", "{}", false}, {"reference", "", 0, "{}", "{}", false}});
     std::vector<Vec3> lastError;
+    std::vector<std::uint32_t> lastIds;
     for (std::size_t k = 0; k < files.size(); ++k) {
         const auto& [image, reference] = files[k];
         const Pair p = loadPair(a, image, reference, channels);
@@ -310,21 +314,32 @@ void runCompareSequence(const CompareArgs& a) {
         const Comparison c = measure(a, p);
         std::vector<Vec3> error(p.xs.size());
         for (std::size_t q = 0; q < error.size(); ++q) error[q] = p.xs[q] - p.rs[q];
-        double flicker = std::numeric_limits<double>::quiet_NaN();
+        // Which particle the reference sees at each pixel: flicker compares a
+        // pixel's error with its previous error only where the same particle
+        // is seen in both frames (a moving camera or disk moves the rest).
+        std::vector<std::uint32_t> ids;
+        if (p.ref.whole() && p.x.whole()) ids = readExrUintChannel(reference, "particle.id");
+        double flicker = std::numeric_limits<double>::quiet_NaN(), tracked = std::numeric_limits<double>::quiet_NaN();
         if (!lastError.empty() && lastError.size() == error.size()) {
+            const bool byParticle = !ids.empty() && ids.size() == lastIds.size();
             double sum = 0.0;
-            std::size_t n = 0;
-            for (std::size_t q = 0; q < error.size(); ++q)
+            std::size_t n = 0, pixels = 0;
+            for (std::size_t q = 0; q < error.size(); ++q) {
+                if (byParticle && (ids[q] != lastIds[q] || ids[q] == 0xffffffffu)) continue;
+                ++pixels;
                 for (int ch = 0; ch < 3; ++ch) {
                     const double d = double(error[q][ch]) - double(lastError[q][ch]), r = p.rs[q][ch];
                     if (!std::isfinite(d)) continue;
                     sum += d * d / (r * r + kRelMseEpsilon);
                     ++n;
                 }
+            }
             flicker = n ? sum / double(n) : 0.0;
+            tracked = double(pixels) / double(error.size());
         }
         lastError = std::move(error);
-        t.add({first + k, c.m.relMSE, c.m.MSE, c.m.MAPE, c.flip, flicker, std::uint64_t(c.m.nonFinite), image, reference});
+        lastIds = std::move(ids);
+        t.add({first + k, c.m.relMSE, c.m.MSE, c.m.MAPE, c.flip, flicker, tracked, std::uint64_t(c.m.nonFinite), image, reference});
         if (!a.json) fmt::print(stderr, "accretion: frame {}: relMSE {:.4g}, FLIP {:.4f}\n", first + k, c.m.relMSE, c.flip);
     }
     writeFileAtomic(a.csv, t.csv());

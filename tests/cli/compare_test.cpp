@@ -126,7 +126,7 @@ TEST_CASE("compare a {frame} sequence: per-frame CSV with flicker, and a plot", 
     std::ifstream csv(dir / "seq.csv");
     std::string header, line;
     std::getline(csv, header);
-    CHECK(header.rfind("frame,relMSE,MSE,MAPE,flip,flicker,nonfinite_pixels", 0) == 0);
+    CHECK(header.rfind("frame,relMSE,MSE,MAPE,flip,flicker,flicker_pixels,nonfinite_pixels", 0) == 0);
     std::vector<std::vector<std::string>> rows;
     while (std::getline(csv, line)) {
         std::vector<std::string> cells;
@@ -145,6 +145,7 @@ TEST_CASE("compare a {frame} sequence: per-frame CSV with flicker, and a plot", 
     const double d = double(1.2f) - double(1.1f);
     CHECK(std::stod(rows[1][5]) == Approx(d * d / 1.01).epsilon(1e-5));
     CHECK(std::stod(rows[2][5]) == 0.0);
+    CHECK(std::stod(rows[1][6]) == 1.0);  // no particle.id: every pixel is compared
     CHECK(std::filesystem::file_size(dir / "seq.png") > 1000);
     // A pattern without {frame}: one clear error.
     REQUIRE(runCommand(kBin + " compare " + (dir / "gpu.0000.exr").string() + " '" + (dir / "ref.{frame}.exr").string() +

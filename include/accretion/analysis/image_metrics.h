@@ -56,6 +56,9 @@ RgbLayer readExrChannels(const std::filesystem::path& file, const std::vector<st
 /// An EXR's attributes as text (strings as they are, numbers and matrices
 /// printed), by name: what compare checks between two images.
 std::map<std::string, std::string> readExrAttributes(const std::filesystem::path& file);
+/// A 32-bit unsigned channel (e.g. particle.id) over the data window, read
+/// as integers; empty when the file has no such channel.
+std::vector<std::uint32_t> readExrUintChannel(const std::filesystem::path& file, const std::string& name);
 /// True if the file has all three channels of the layer.
 bool exrHasLayer(const std::filesystem::path& file, const std::string& layer);
 
