@@ -33,9 +33,10 @@ inline bool seen(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoin
 
 /// exact: sum over every light i != j of f I G V, in double.
 /// With a trace (render --pixel), every non-zero term and its V are recorded.
-template <ShadingModel M, Primitive P>
+/// (Traced is a template argument: the light loop of every other pixel has no trace test.)
+template <ShadingModel M, Primitive P, bool Traced = false>
 DVec3 exactPixel(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint& sp, const VisibilityOptions& vis, bool shadows,
-                LightingCounters& c, RayCounters* rc, PixelTrace* trace) {
+                LightingCounters& c, RayCounters* rc, PixelTrace* trace = nullptr) {
     DVec3 sum(0.0);
     for (std::uint32_t i = 0; i < L.count; ++i) {
         if (i == sp.self) continue;
@@ -44,9 +45,9 @@ DVec3 exactPixel(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoin
         if (!evalLight<M>(sp, L.position[i], L.emission[i], L.packed[i].dmin2, t)) continue;
         const bool v = seen<P>(bvh, L, sp, i, t, vis, shadows, c, rc);
         if (v) sum += DVec3(t.value);
-        if (trace) [[unlikely]] trace->terms.push_back({i, t.value, v});
+        if constexpr (Traced) trace->terms.push_back({i, t.value, v});
     }
-    if (trace) trace->lightsSeen = L.count - (sp.self < L.count ? 1 : 0);
+    if constexpr (Traced) trace->lightsSeen = L.count - (sp.self < L.count ? 1 : 0);
     return sum;
 }
 
@@ -149,7 +150,7 @@ void drawLights(const LightingInputs& in, const LightArrays& L, const ShadingPoi
 
 /// uniform / power / tree: the one-sample estimates f I G V / p(i) of drawn
 /// lights (a zero sample when no light or i = j).
-template <ShadingModel M, Primitive P>
+template <ShadingModel M, Primitive P, bool Traced = false>
 void shadeSamples(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint& sp, const LightSample* xs,
                   std::uint32_t count, const VisibilityOptions& vis, bool shadows, PixelSums& acc, RayCounters* rc) {
     LightingCounters& c = acc.c;
@@ -161,7 +162,7 @@ void shadeSamples(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoi
         const bool v = term && seen<P>(bvh, L, sp, x.i, t, vis, shadows, c, rc);
         if (v) acc.add(DVec3(t.value) / double(x.pdf));
         else acc.addZero();
-        if (acc.trace) [[unlikely]]
+        if constexpr (Traced)
             acc.trace->samples.push_back({x.i, x.pdf, term ? t.value : Vec3(0.0f), v,
                                           v ? Vec3(DVec3(t.value) / double(x.pdf)) : Vec3(0.0f)});
     }
@@ -172,7 +173,7 @@ void shadeSamples(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoi
 /// without visibility; the kept y gets one shadow ray, weighted by W. A
 /// non-finite candidate weight is rejected (zero_sample: the candidate gets
 /// weight 0; discard: the reservoir is dropped).
-template <ShadingModel M, Primitive P, bool Power>
+template <ShadingModel M, Primitive P, bool Power, bool Traced = false>
 void risChunk(const ParticleBvh& bvh, const LightArrays& L, const AliasTable* table, const ShadingPoint& sp,
               std::uint32_t count, std::uint32_t candidates, const VisibilityOptions& vis, bool shadows, Rng& rng, PixelSums& acc,
               RayCounters* rc) {
@@ -193,14 +194,14 @@ void risChunk(const ParticleBvh& bvh, const LightArrays& L, const AliasTable* ta
                 w = p_hat = 0.0f;
             }
             if (r.update(x.i, w, p_hat, rng.uniform())) t_y = t;
-            if (acc.trace) [[unlikely]] {
+            if constexpr (Traced) {
                 if (m == 0) acc.trace->reservoirs.emplace_back();
                 acc.trace->reservoirs.back().candidates.push_back({x.i, x.pdf, p_hat, w});
             }
         }
         if (discarded) continue;
         r.finalize();
-        PixelTrace::RisReservoir* traced = acc.trace ? &acc.trace->reservoirs.back() : nullptr;
+        PixelTrace::RisReservoir* traced = Traced ? &acc.trace->reservoirs.back() : nullptr;
         if (traced) traced->reservoir = r;
         if (r.W <= 0.0f) {
             acc.addZero();
@@ -256,8 +257,14 @@ void runChunk(const LightingInputs& in, const LightArrays& L, const VisibilityOp
             if (p.sums.done) continue;
             Rng rng = stream(p);
             RayCounters* rc = Count ? &p.rays : nullptr;
-            if (power) risChunk<M, P, true>(in.bvh, L, in.powerTable, p.sp, count, in.render.candidates, vis, shadows, rng, p.sums, rc);
-            else risChunk<M, P, false>(in.bvh, L, nullptr, p.sp, count, in.render.candidates, vis, shadows, rng, p.sums, rc);
+            if (p.sums.trace) [[unlikely]] {  // render --pixel
+                if (power) risChunk<M, P, true, true>(in.bvh, L, in.powerTable, p.sp, count, in.render.candidates, vis, shadows, rng, p.sums, rc);
+                else risChunk<M, P, false, true>(in.bvh, L, nullptr, p.sp, count, in.render.candidates, vis, shadows, rng, p.sums, rc);
+            } else if (power) {
+                risChunk<M, P, true>(in.bvh, L, in.powerTable, p.sp, count, in.render.candidates, vis, shadows, rng, p.sums, rc);
+            } else {
+                risChunk<M, P, false>(in.bvh, L, nullptr, p.sp, count, in.render.candidates, vis, shadows, rng, p.sums, rc);
+            }
         }
     } else {
         for (std::uint32_t k = 0; k < n; ++k) {
@@ -267,7 +274,11 @@ void runChunk(const LightingInputs& in, const LightArrays& L, const VisibilityOp
         }
         for (std::uint32_t k = 0; k < n; ++k) {
             GroupPixel& p = pix[k];
-            if (!p.sums.done) shadeSamples<M, P>(in.bvh, L, p.sp, p.xs, count, vis, shadows, p.sums, Count ? &p.rays : nullptr);
+            if (p.sums.done) continue;
+            if (p.sums.trace) [[unlikely]]  // render --pixel
+                shadeSamples<M, P, true>(in.bvh, L, p.sp, p.xs, count, vis, shadows, p.sums, Count ? &p.rays : nullptr);
+            else
+                shadeSamples<M, P>(in.bvh, L, p.sp, p.xs, count, vis, shadows, p.sums, Count ? &p.rays : nullptr);
         }
     }
 }
@@ -367,7 +378,8 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
                 if (kind == EstimatorKind::exact) {
                     for (std::uint32_t k = 0; k < n; ++k) {
                         PixelSums& s = pix[k].sums;
-                        const DVec3 v = exactPixel<M, P>(in.bvh, L, pix[k].sp, vis, shadows, s.c, Count ? &pix[k].rays : nullptr, s.trace);
+                        const DVec3 v = s.trace ? exactPixel<M, P, true>(in.bvh, L, pix[k].sp, vis, shadows, s.c, Count ? &pix[k].rays : nullptr, s.trace)
+                                              : exactPixel<M, P>(in.bvh, L, pix[k].sp, vis, shadows, s.c, Count ? &pix[k].rays : nullptr);
                         if (finite(v)) s.sum = v;
                         else s.reject();  // exact has one value: 0 either way
                         s.n = 1;
