@@ -141,7 +141,7 @@ std::map<std::string, std::string> readExrAttributes(const std::filesystem::path
     if (!in) throw InputError(fmt::format("{}: cannot read image: {}", file.string(), OIIO::geterror()));
     std::map<std::string, std::string> out;
     for (const auto& p : in->spec().extra_attribs)
-        out[p.name().string()] = p.type() == OIIO::TypeDesc::STRING ? p.get_string() : p.get_string();
+        out[p.name().string()] = p.get_string();  // strings as they are, numbers and matrices printed
     return out;
 }
 

@@ -37,6 +37,9 @@ struct CompareArgs {
     bool strict = false;          ///< --strict: metadata that differ are an error
 };
 
+/// The FLIP variant's name, as tables, maps and plots show it.
+std::string flipName(const CompareArgs& a) { return a.flip == "ldr" ? "LDR-FLIP" : a.flip == "hdr" ? "HDR-FLIP" : "FLIP (off)"; }
+
 /// Two images on the pixels both hold: the overlap of their data windows.
 struct Pair {
     std::string image, reference;
@@ -215,8 +218,8 @@ void writeErrorMaps(const CompareArgs& a, const Pair& p, const Comparison& cmp) 
                             {-4.0, 4.0, true, "z = (x - ref) / reference stderr, mean of RGB"});
     if (!cmp.flipMap.empty())
         writeFalseColourPng(base + ".flip.png", cmp.flipMap, p.w, p.h,
-                            {0.0, 1.0, false, fmt::format("{}-FLIP (0: no visible difference, 1: the largest; {:.0f} pixels per degree)",
-                                                          a.flip == "hdr" ? "HDR" : "LDR", a.ppd)});
+                            {0.0, 1.0, false, fmt::format("{} (0: no visible difference, 1: the largest; {:.0f} pixels per degree)",
+                                                          flipName(a), a.ppd)});
     fmt::print(stderr, "accretion: error maps {} (+ {}.error.png, {}.relative.png{}{})\n", a.errorMap, base, base,
                hasStderr ? ", " + base + ".z.png" : std::string(", no z: the reference has no Lr_stderr"),
                cmp.flipMap.empty() ? std::string() : ", " + base + ".flip.png");
@@ -264,7 +267,7 @@ void runCompareOne(const CompareArgs& a) {
     auto hidden = [](const char* key) { return Column{key, "", 0, "{}", "{}", false}; };
     Table t({hidden("image"), hidden("reference"), hidden("layer"), {"relMSE", "relMSE", 0, "{:.9g}"},
              {"MSE", "MSE", 0, "{:.9g}"}, {"MAPE", "MAPE", 0, "{:.9g}"},
-             {"flip", a.flip == "ldr" ? "LDR-FLIP" : "HDR-FLIP", 0, "{:.6f}"}, hidden("flip_variant"), hidden("ppd"),
+             {"flip", flipName(a), 0, "{:.6f}"}, hidden("flip_variant"), hidden("ppd"),
              hidden("epsilon"), hidden("pixels"), hidden("nonfinite_pixels"), hidden("window")});
     t.add({a.image, a.reference, a.layer.empty() ? "RGB" : a.layer, c.m.relMSE, c.m.MSE, c.m.MAPE, c.flip, a.flip, a.ppd,
            kRelMseEpsilon, std::uint64_t(c.m.pixels), std::uint64_t(c.m.nonFinite),
@@ -301,7 +304,7 @@ void runCompareSequence(const CompareArgs& a) {
     guard.check(png, "--csv (its plot)");
     const std::vector<std::string> channels = parseChannels(a);
     Table t({{"frame", "frame", 6}, {"relMSE", "relMSE", 13, "{:.6g}", "{:.9g}"}, {"MSE", "MSE", 13, "{:.6g}", "{:.9g}"},
-             {"MAPE", "MAPE", 11, "{:.6g}", "{:.9g}"}, {"flip", a.flip == "ldr" ? "LDR-FLIP" : "HDR-FLIP", 9, "{:.5f}", "{:.6f}"},
+             {"MAPE", "MAPE", 11, "{:.6g}", "{:.9g}"}, {"flip", flipName(a), 10, "{:.5f}", "{:.6f}"},
              {"flicker", "flicker", 13, "{:.6g}", "{:.9g}"}, {"flicker_pixels", "tracked", 8, "{:.3f}", "{:.6f}"},
              {"nonfinite_pixels", "nonfinite", 9},
              {"image", "", 0, "{}", "{}", false}, {"reference", "", 0, "{}", "{}", false}});
@@ -343,18 +346,18 @@ void runCompareSequence(const CompareArgs& a) {
         if (!a.json) fmt::print(stderr, "accretion: frame {}: relMSE {:.4g}, FLIP {:.4f}\n", first + k, c.m.relMSE, c.flip);
     }
     writeFileAtomic(a.csv, t.csv());
-    const std::string flipName = a.flip == "ldr" ? "LDR-FLIP" : "HDR-FLIP";
     const bool flip = a.flip != "none";
     std::string script = fmt::format(
         "set datafile separator ','\nset key outside top center horizontal box\nset grid\n"
         "set xlabel 'frame'\nset xtics {}\nset ylabel 'relMSE, flicker (relative squared error, unitless)'\nset logscale y\n"
         "set title {}\n",
         end - first <= 20 ? "1" : "autofreq",
-        gnuplotQuote(fmt::format("{} against {}\nflicker: the relMSE of the error's change from the previous frame", a.image, a.reference)));
-    if (flip) script += fmt::format("set y2label '{} (mean, 0 to 1)'\nset y2range [0:*]\nset y2tics\nset ytics nomirror\n", flipName);
+        gnuplotQuote(fmt::format("{} against {}\nflicker: relMSE of the error's change from the previous frame, where the same "
+                                 "particle is seen", a.image, a.reference)));
+    if (flip) script += fmt::format("set y2label '{} (mean, 0 to 1)'\nset y2range [0:*]\nset y2tics\nset ytics nomirror\n", flipName(a));
     script += fmt::format("plot {} using 1:2 with linespoints title 'relMSE', '' using 1:6 with linespoints title 'flicker'",
                           gnuplotQuote(a.csv));
-    if (flip) script += fmt::format(", '' using 1:5 axes x1y2 with linespoints title '{} (right axis)'", flipName);
+    if (flip) script += fmt::format(", '' using 1:5 axes x1y2 with linespoints title '{} (right axis)'", flipName(a));
     plotPng(png, script + "\n", 900, 560);
     fmt::print("{}", a.json ? t.json().dump(2) + "\n" : t.console());
     fmt::print("per-frame table: {} (plot: {})\n", a.csv, png);

@@ -47,13 +47,11 @@ struct RenderArgs : SceneArgs {
 
 /// "a,b,..." as `count` unsigned integers, or an error naming the option.
 std::vector<std::uint32_t> parseInts(const std::string& text, std::size_t count, const char* option, const char* form) {
+    const std::vector<std::string> parts = splitList(text, ',');
     std::vector<std::uint32_t> v;
-    for (const std::string& part : splitList(text, ',')) {
-        const std::optional<std::uint64_t> n = parseUnsigned(part);
-        if (!n || *n > 16384) break;
-        v.push_back(std::uint32_t(*n));
-    }
-    if (v.size() != count || splitList(text, ',').size() != count)
+    for (const std::string& part : parts)
+        if (const std::optional<std::uint64_t> n = parseUnsigned(part, 16384)) v.push_back(std::uint32_t(*n));
+    if (parts.size() != count || v.size() != count)
         throw InputError(fmt::format("command line {} {}: expected {} (pixel coordinates, integers >= 0)", option, text, form));
     return v;
 }

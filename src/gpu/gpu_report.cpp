@@ -188,20 +188,15 @@ std::vector<Heatmap> counterHeatmaps(const FrameCounters& counters, std::uint32_
                               {"gpu.any_hits", std::vector<float>(pixels, 0.0f), "any-hit calls per pixel, all passes"},
                               {"gpu.trips", std::vector<float>(pixels, 0.0f), "light-loop trips per pixel, all passes"},
                               {"gpu.bytes", std::vector<float>(pixels, 0.0f), "bytes read + written per pixel, all passes"}};
-    // Per pass: the BLAS entries of its rays (traversal work), for the passes that trace.
     for (const PassCounters& pc : counters.passes) {
         if (pc.pass == pass::buildClusters || pc.width == 0 || pc.height == 0) continue;
+        // A pass that traces also gets its own map: the BLAS entries of its rays.
         bool traces = false;
         for (const ThreadCounters& t : pc.threads) traces = traces || t.rays > 0;
         if (traces)
             maps.push_back({fmt::format("gpu.{}.blas_entries", pc.pass), std::vector<float>(pixels, 0.0f),
                             fmt::format("BLAS entries per pixel, {}", pc.pass)});
-    }
-    for (const PassCounters& pc : counters.passes) {
-        if (pc.pass == pass::buildClusters || pc.width == 0 || pc.height == 0) continue;
-        Heatmap* own = nullptr;
-        for (Heatmap& m : maps)
-            if (m.name == fmt::format("gpu.{}.blas_entries", pc.pass)) own = &m;
+        Heatmap* own = traces ? &maps.back() : nullptr;
         for (std::uint32_t y = 0; y < height; ++y)
             for (std::uint32_t x = 0; x < width; ++x) {
                 const std::uint32_t lx = std::min(pc.width - 1, std::uint32_t(std::uint64_t(x) * pc.width / width));

@@ -43,6 +43,15 @@ ExrCameraMatrices exrCameraMatrices(const CameraPose& c, std::uint32_t width, st
 
 namespace {
 
+/// The EXR's data window at (x, y) inside a display window of the whole image.
+void setDataWindow(OIIO::ImageSpec& spec, int x, int y, std::uint32_t fullWidth, std::uint32_t fullHeight) {
+    spec.x = x;
+    spec.y = y;
+    spec.full_x = spec.full_y = 0;
+    spec.full_width = int(fullWidth);
+    spec.full_height = int(fullHeight);
+}
+
 void setCameraAttributes(OIIO::ImageSpec& spec, const CameraPose& c, std::uint32_t width, std::uint32_t height) {
     const ExrCameraMatrices m = exrCameraMatrices(c, width, height);
     spec.attribute("worldToCamera", OIIO::TypeMatrix44, m.worldToCamera.data());
@@ -95,11 +104,7 @@ void writeFrameExr(const std::filesystem::path& file, const FrameImage& img, boo
     // display window of the whole image.
     const PixelWindow w = img.window.pixels() ? img.window : PixelWindow::whole(img.width, img.height);
     OIIO::ImageSpec spec(int(w.width()), int(w.height()), nch, OIIO::TypeDesc::FLOAT);
-    spec.x = int(w.x0);
-    spec.y = int(w.y0);
-    spec.full_x = spec.full_y = 0;
-    spec.full_width = int(img.width);
-    spec.full_height = int(img.height);
+    setDataWindow(spec, int(w.x0), int(w.y0), img.width, img.height);
     spec.channelnames.clear();
     spec.channelformats.clear();
     for (const Channel& c : channels) {
@@ -129,13 +134,7 @@ void writeChannelsExr(const std::filesystem::path& file, std::uint32_t width, st
                       const std::vector<FloatChannel>& channels, const OutputMetadata& metadata, DataWindow window) {
     const int nch = static_cast<int>(channels.size());
     OIIO::ImageSpec spec(int(width), int(height), nch, OIIO::TypeDesc::FLOAT);
-    if (window.fullWidth > 0) {
-        spec.x = window.x;
-        spec.y = window.y;
-        spec.full_x = spec.full_y = 0;
-        spec.full_width = int(window.fullWidth);
-        spec.full_height = int(window.fullHeight);
-    }
+    if (window.fullWidth > 0) setDataWindow(spec, window.x, window.y, window.fullWidth, window.fullHeight);
     spec.channelnames.clear();
     for (const FloatChannel& c : channels) spec.channelnames.push_back(c.name);
     spec.attribute("compression", "zip");

@@ -75,7 +75,7 @@ void writeFalseColourPng(const std::filesystem::path& file, const std::vector<fl
                                             OIIO::ImageBufAlgo::TextAlignX::Center);
         OIIO::ImageBufAlgo::render_text(img, barX1, textY, label(scale.hi), size, kFont, white,
                                         OIIO::ImageBufAlgo::TextAlignX::Right);
-        // The title on two lines when it has a parenthesis: it must fit 360 pixels.
+        // The title on two lines when it has a parenthesis: each must fit the panel (at least 520 pixels).
         const auto paren = scale.title.find(" (");
         OIIO::ImageBufAlgo::render_text(img, barX0, textY + 17, scale.title.substr(0, paren), size, kFont, white);
         if (paren != std::string::npos)

@@ -92,12 +92,12 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
 
     std::vector<StoredReservoir> a(lpixels), b(lpixels);
     std::vector<Vec3> lowLr(lpixels);
-    std::size_t traced = 0;  // the lighting texel of the traced pixel
-    if (in.trace) {
-        const std::uint32_t x = std::uint32_t(in.trace->px % full.width), y = std::uint32_t(in.trace->px / full.width);
-        traced = std::size_t(std::min(lg->height - 1, std::uint32_t(float(y) * f.scale))) * lg->width +
-                 std::min(lg->width - 1, std::uint32_t(float(x) * f.scale));
-    }
+    // The lighting texel of image pixel (x, y).
+    const auto texelOf = [&](std::uint32_t x, std::uint32_t y) {
+        return std::size_t(std::min(lg->height - 1, std::uint32_t(float(y) * f.scale))) * lg->width +
+               std::min(lg->width - 1, std::uint32_t(float(x) * f.scale));
+    };
+    const std::size_t traced = in.trace ? texelOf(std::uint32_t(in.trace->px % full.width), std::uint32_t(in.trace->px / full.width)) : 0;
     LightingCounters counters = runPasses(f, a, b, lowLr, timer, rejected, traced);
 
     if (!plan.upsample) {
@@ -117,10 +117,9 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
             const std::size_t px = std::size_t(y) * full.width + x;
             if (!full.texels[px].hit()) continue;
             out.spp[px] = 1.0f;
-            const auto lx = std::min(lg->width - 1, std::uint32_t(float(x) * f.scale));
-            const auto ly = std::min(lg->height - 1, std::uint32_t(float(y) * f.scale));
-            const StoredReservoir& r = a[std::size_t(ly) * lg->width + lx];
-            out.rejected[px] = float(lowRejected[std::size_t(ly) * lg->width + lx]);
+            const std::size_t lpx = texelOf(x, y);
+            const StoredReservoir& r = a[lpx];
+            out.rejected[px] = float(lowRejected[lpx]);
             aov.W[px] = r.W;
             aov.M[px] = float(r.M);
             aov.light[px] = r.W > 0.0f ? r.y : kNoLight;
