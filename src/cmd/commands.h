@@ -83,5 +83,6 @@ void addPlanCommand(CLI::App& app);
 void addMergeCommand(CLI::App& app);
 void addBatchCommand(CLI::App& app);
 void addCamerasCommand(CLI::App& app);
+void addImportGpuCommand(CLI::App& app);
 
 }  // namespace accretion::cmd

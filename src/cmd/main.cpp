@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
     accretion::cmd::addMergeCommand(app);
     accretion::cmd::addBatchCommand(app);
     accretion::cmd::addCamerasCommand(app);
+    accretion::cmd::addImportGpuCommand(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

@@ -16,54 +16,12 @@ void trace(const ParticleBvh& bvh, const Particles& particles, const Camera& cam
            const PixelWindow& window, GBuffer& gbuffer, PassCounters* counters) {
     const bool spheres = bvh.settings().primitive == Primitive::sphere;
 
-    // One G-buffer texel from a primary hit: Embree decides which particle
-    // the pixel ray hits; the point on it is found again in double along the
-    // pixel ray, relative to the particle (local = x - p_j), so that its
-    // error is that of the inputs, not of the ray length or the coordinates.
+    // One G-buffer texel from a primary hit (gbuffer_texel.h: shared with the OptiX twin).
     auto fill = [&](std::size_t px, std::uint32_t x, std::uint32_t y, const Vec3& dir, const SurfaceHit& hit) {
-        GBufferTexel& g = gbuffer.texels[px];
         const std::uint32_t j = hit.particle;
-        const Vec3 p = particles.position[j];
-        const float rj = particles.radius[j];
-        const DVec3 o = DVec3(camera.position) - DVec3(p), ray = camera.pixelRay(x, y);  // o relative to p_j
-        g.particle = j;
-        if (spheres) {
-            // The near root of |o + t ray| = r, or Embree's point when the
-            // double test grazes past (then only on the silhouette).
-            const double b = glm::dot(o, ray), c = glm::dot(o, o) - double(rj) * double(rj);
-            const double disc = b * b - c;
-            DVec3 local;
-            if (disc >= 0.0) {
-                const double t0 = -b - std::sqrt(disc);
-                local = o + (t0 > 0.0 ? t0 : -b + std::sqrt(disc)) * ray;
-            } else {
-                local = o + double(hit.t) * DVec3(dir);
-            }
-            const double len = glm::length(local);
-            const DVec3 n = len > 0.0 ? local / len : -ray;
-            g.local = Vec3(double(rj) * n);
-            g.normal = g.geomNormal = Vec3(n);
-        } else {
-            const BillboardFrame& f = bvh.frame(j);
-            const DVec3 R(f.right), U(f.up), N = glm::cross(R, U);
-            const double denom = glm::dot(N, ray);
-            // The pixel ray meets the quad's plane; in the plane (never a hit
-            // in practice), Embree's uv.
-            const DVec3 local = denom != 0.0 ? o - (glm::dot(N, o) / denom) * ray
-                                             : (2.0 * double(hit.uv.x) - 1.0) * double(rj) * R +
-                                                   (2.0 * double(hit.uv.y) - 1.0) * double(rj) * U;
-            g.local = Vec3(local);
-            g.geomNormal = glm::normalize(f.normal());
-            if (glm::dot(g.geomNormal, dir) > 0.0f) g.geomNormal = -g.geomNormal;
-            if (model == ShadingModel::sphere) {
-                const Vec2 uv(glm::clamp(0.5 + 0.5 * glm::dot(local, R) / double(rj), 0.0, 1.0),
-                              glm::clamp(0.5 + 0.5 * glm::dot(local, U) / double(rj), 0.0, 1.0));
-                g.normal = impostorNormal(f, uv);
-            } else {
-                g.normal = g.geomNormal;
-            }
-        }
-        g.depth = glm::dot((p + g.local) - camera.position, camera.forward);
+        gbuffer.texels[px] = spheres ? sphereTexel(camera, x, y, dir, j, particles.position[j], particles.radius[j], hit.t)
+                                     : billboardTexel(camera, x, y, dir, j, particles.position[j], particles.radius[j],
+                                                      bvh.frame(j), hit.uv, model);
     };
 
     // 8x8 tiles at fixed positions, so that the packets (tile rows) do not

@@ -4,6 +4,15 @@
 
 #include <glm/glm.hpp>
 
+/// Functions the OptiX twin (src/twin) shares with the CPU renderer: host and
+/// device under nvcc, plain inline functions otherwise. The twin compiles them
+/// without FMA contraction, so both sides round every operation alike.
+#if defined(__CUDACC__)
+#define ACC_HD __host__ __device__
+#else
+#define ACC_HD
+#endif
+
 namespace accretion {
 
 using Vec2 = glm::vec2;
@@ -15,7 +24,7 @@ inline constexpr float kInvPi = 1.0f / kPi;
 inline constexpr float kInv4Pi = 1.0f / (4.0f * kPi);
 
 /// Rec.709 / sRGB luminance of a linear RGB triple.
-inline float luminance(const Vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+ACC_HD inline float luminance(const Vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
 /// Bits that address n items, indices 0..n-1 (at least 1): 100K particles need 17.
 inline std::uint32_t indexBits(std::uint64_t n) {

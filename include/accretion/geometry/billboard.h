@@ -11,7 +11,7 @@ struct Camera;
 struct BillboardFrame {
     Vec3 right;
     Vec3 up;
-    Vec3 normal() const { return glm::cross(right, up); }
+    ACC_HD Vec3 normal() const { return glm::cross(right, up); }
 };
 
 /// The frame of a billboard at p moving with v (docs/MODEL.md section 2):
@@ -21,7 +21,7 @@ BillboardFrame billboardFrame(Orientation mode, const Camera& camera, const Vec3
 
 /// Quad uv in [0,1]^2 from the barycentrics (u, v) of triangle `primID`
 /// (0,1,2) or (0,2,3) with uv corners (0,0), (1,0), (1,1), (0,1).
-inline Vec2 quadUv(unsigned primID, float u, float v) {
+ACC_HD inline Vec2 quadUv(unsigned primID, float u, float v) {
     return (primID & 1u) ? Vec2(u, u + v) : Vec2(u + v, v);
 }
 
@@ -37,7 +37,7 @@ inline unsigned quadTriangle(Vec2 uv, Vec2& bary) {
 }
 
 /// Inside the inscribed disc of the quad (the `disc` alpha test).
-inline bool insideDisc(Vec2 uv) {
+ACC_HD inline bool insideDisc(Vec2 uv) {
     const Vec2 c = uv - Vec2(0.5f);
     return glm::dot(c, c) <= 0.25f;
 }
@@ -45,7 +45,7 @@ inline bool insideDisc(Vec2 uv) {
 /// Normal of the sphere impostor at quad uv: (x, y, sqrt(1-x^2-y^2)) in the
 /// billboard frame, x, y = 2 uv - 1, clamped to the rim (z = 0) outside the
 /// disc. In double: near the rim z moves fast with uv.
-inline Vec3 impostorNormal(const BillboardFrame& f, Vec2 uv) {
+ACC_HD inline Vec3 impostorNormal(const BillboardFrame& f, Vec2 uv) {
     double x = 2.0 * double(uv.x) - 1.0, y = 2.0 * double(uv.y) - 1.0;
     const double q2 = x * x + y * y;
     double z = 0.0;

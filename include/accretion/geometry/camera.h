@@ -48,7 +48,7 @@ struct Camera {
 
     /// Unit direction of the ray through pixel (x, y)'s sample position (the
     /// centre, jittered); y = 0 is the top row.
-    Vec3 pixelDirection(std::uint32_t x, std::uint32_t y) const {
+    ACC_HD Vec3 pixelDirection(std::uint32_t x, std::uint32_t y) const {
         const float aspect = float(width) / float(height);
         const float sx = ((float(x) + sampleX) / float(width) * 2.0f - 1.0f) * tanHalfFov * aspect;
         const float sy = (1.0f - (float(y) + sampleY) / float(height) * 2.0f) * tanHalfFov;
@@ -56,7 +56,7 @@ struct Camera {
     }
 
     /// The same ray in double: what primary hits are refined along.
-    DVec3 pixelRay(std::uint32_t x, std::uint32_t y) const {
+    ACC_HD DVec3 pixelRay(std::uint32_t x, std::uint32_t y) const {
         const double aspect = double(width) / double(height);
         const double sx = ((double(x) + sampleXD) / double(width) * 2.0 - 1.0) * tanHalfFovD * aspect;
         const double sy = (1.0 - (double(y) + sampleYD) / double(height) * 2.0) * tanHalfFovD;

@@ -19,7 +19,7 @@ struct LightTerm {
 /// f = rho / pi, cos_i = max(0, n . w_i); isotropic: f = rho / (4 pi), cos_i = 1.
 /// Returns false when the term is zero (so no shadow ray is needed).
 template <ShadingModel M>
-[[gnu::always_inline]] inline bool evalLight(const ShadingPoint& sp, const Vec3& p, const Vec3& I, float dmin2, LightTerm& out) {
+[[gnu::always_inline]] ACC_HD inline bool evalLight(const ShadingPoint& sp, const Vec3& p, const Vec3& I, float dmin2, LightTerm& out) {
     const Vec3 delta = (p - sp.centre) - sp.local;  // receiver-relative: exact to the inputs' rounding
     const float d2 = glm::dot(delta, delta);
     const float d = std::sqrt(d2);
@@ -35,7 +35,7 @@ template <ShadingModel M>
         if (!(cosTerm > 0.0f)) return false;
         f = kInvPi;
     }
-    const float G = cosTerm / std::max(d2, dmin2);
+    const float G = cosTerm / (d2 < dmin2 ? dmin2 : d2);  // std::max(d2, dmin2), also on the device
     out.value = (f * G) * sp.rho * I;
     out.dist = d;
     return out.value.x > 0.0f || out.value.y > 0.0f || out.value.z > 0.0f;

@@ -8,25 +8,10 @@
 #include "accretion/counters/thread_counters.h"
 #include "accretion/geometry/camera.h"
 #include "accretion/lighting/shading.h"
+#include "accretion/render/gbuffer_texel.h"
 #include "accretion/render/pixel_window.h"
 
 namespace accretion {
-
-inline constexpr std::uint32_t kNoParticle = std::numeric_limits<std::uint32_t>::max();
-
-/// One G-buffer texel: what the primary ray through the pixel centre hit
-/// (44 bytes: the lighting passes stream it for every pixel). The hit point
-/// is not stored: shadingPoint() forms x = p_j + local.
-struct GBufferTexel {
-    std::uint32_t particle = kNoParticle; ///< hit particle, kNoParticle on a miss
-    Vec3 local{0.0f};                     ///< x - p_j, from the pixel ray intersected in double
-    Vec3 normal{0.0f};                    ///< shading normal n
-    Vec3 geomNormal{0.0f};                ///< geometric normal (origin offsets)
-    float depth = 0.0f;                   ///< camera-space z (along the view direction)
-    bool hit() const { return particle != kNoParticle; }
-};
-
-static_assert(sizeof(GBufferTexel) == 44, "the texel the lighting passes stream");
 
 struct GBuffer {
     std::uint32_t width = 0, height = 0;

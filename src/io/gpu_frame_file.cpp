@@ -1,0 +1,101 @@
+#include "accretion/io/gpu_frame_file.h"
+
+#include <cstring>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "accretion/core/atomic_file.h"
+#include "accretion/core/error.h"
+
+namespace accretion {
+namespace {
+
+constexpr char kMagic[8] = {'A', 'C', 'C', 'G', 'P', 'U', 'F', '1'};
+constexpr std::uint64_t kMaxHeader = 1u << 26;
+
+nlohmann::json vec(const DVec3& v) { return {v.x, v.y, v.z}; }
+DVec3 dvec(const nlohmann::json& j) { return {j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>()}; }
+
+template <class T>
+void append(std::string& out, const std::vector<T>& plane) {
+    out.append(reinterpret_cast<const char*>(plane.data()), plane.size() * sizeof(T));
+}
+
+}  // namespace
+
+void writeGpuFrame(const std::filesystem::path& file, const GpuFrame& f) {
+    const std::size_t n = std::size_t(f.width) * f.height;
+    ACC_CHECK(f.L.size() == n && f.Le.size() == n && f.Lr.size() == n && f.normal.size() == n && f.depth.size() == n &&
+              f.particle.size() == n);
+    const nlohmann::json header = {
+        {"width", f.width}, {"height", f.height}, {"frame", f.frame},
+        {"camera", {{"eye", vec(f.camera.eye)}, {"forward", vec(f.camera.forward)}, {"right", vec(f.camera.right)},
+                    {"up", vec(f.camera.up)}, {"tan_half_fov", f.camera.tanHalfFov},
+                    {"jitter", {f.camera.jitterX, f.camera.jitterY}}}},
+        {"metadata", f.metadata},
+    };
+    const std::string text = header.dump();
+    std::string bytes(kMagic, sizeof kMagic);
+    const std::uint64_t len = text.size();
+    bytes.append(reinterpret_cast<const char*>(&len), sizeof len);
+    bytes += text;
+    append(bytes, f.L);
+    append(bytes, f.Le);
+    append(bytes, f.Lr);
+    append(bytes, f.normal);
+    append(bytes, f.depth);
+    append(bytes, f.particle);
+    writeFileAtomic(file, bytes);
+}
+
+GpuFrame readGpuFrame(const std::filesystem::path& file) {
+    const std::string name = file.string();
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw InputError(fmt::format("{}: cannot open", name));
+    char magic[sizeof kMagic];
+    std::uint64_t len = 0;
+    if (!in.read(magic, sizeof magic) || std::memcmp(magic, kMagic, sizeof kMagic) != 0)
+        throw InputError(fmt::format("{}: not an accretion-optix frame (no ACCGPUF1 magic)", name));
+    if (!in.read(reinterpret_cast<char*>(&len), sizeof len) || len > kMaxHeader)
+        throw InputError(fmt::format("{}: bad header length", name));
+    std::string text(len, '\0');
+    if (!in.read(text.data(), std::streamsize(len))) throw InputError(fmt::format("{}: truncated header", name));
+    GpuFrame f;
+    try {
+        const nlohmann::json h = nlohmann::json::parse(text);
+        f.width = h.at("width").get<std::uint32_t>();
+        f.height = h.at("height").get<std::uint32_t>();
+        f.frame = h.at("frame").get<std::uint32_t>();
+        const auto& c = h.at("camera");
+        f.camera.eye = dvec(c.at("eye"));
+        f.camera.forward = dvec(c.at("forward"));
+        f.camera.right = dvec(c.at("right"));
+        f.camera.up = dvec(c.at("up"));
+        f.camera.tanHalfFov = c.at("tan_half_fov").get<double>();
+        f.camera.jitterX = c.at("jitter").at(0).get<double>();
+        f.camera.jitterY = c.at("jitter").at(1).get<double>();
+        f.metadata = h.at("metadata").get<std::map<std::string, std::string>>();
+    } catch (const nlohmann::json::exception& e) {
+        throw InputError(fmt::format("{}: bad header: {}", name, e.what()));
+    }
+    if (f.width == 0 || f.height == 0 || f.width > 16384 || f.height > 16384)
+        throw InputError(fmt::format("{}: bad size {}x{}", name, f.width, f.height));
+    const std::size_t n = std::size_t(f.width) * f.height;
+    auto read = [&](auto& plane, const char* what) {
+        plane.resize(n);
+        if (!in.read(reinterpret_cast<char*>(plane.data()), std::streamsize(n * sizeof(plane[0]))))
+            throw InputError(fmt::format("{}: truncated in plane {}", name, what));
+    };
+    read(f.L, "L");
+    read(f.Le, "Le");
+    read(f.Lr, "Lr");
+    read(f.normal, "normal");
+    read(f.depth, "depth");
+    read(f.particle, "particle");
+    if (in.peek() != std::ifstream::traits_type::eof()) throw InputError(fmt::format("{}: trailing bytes", name));
+    return f;
+}
+
+}  // namespace accretion

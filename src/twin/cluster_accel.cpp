@@ -1,0 +1,205 @@
+#include "cluster_accel.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <map>
+
+#include <optix_stubs.h>
+
+#include "kernels.h"
+
+namespace accretion::twin {
+namespace {
+
+constexpr std::size_t kPoolAlignment = 256;  // >= OPTIX_ACCEL_BUFFER_BYTE_ALIGNMENT
+std::size_t alignUp(std::size_t x, std::size_t a) { return (x + a - 1) / a * a; }
+
+const unsigned kGeometryFlags = OPTIX_GEOMETRY_FLAG_NONE;  // any-hit allowed: identity exclusion, alpha
+
+}  // namespace
+
+ClusterAccel::ClusterAccel(OptixDeviceContext context, AccelOptions options) : context_(context), options_(options) {}
+
+unsigned ClusterAccel::buildFlags() const {
+    unsigned f = options_.build == BuildPolicy::fast_trace ? OPTIX_BUILD_FLAG_PREFER_FAST_TRACE : OPTIX_BUILD_FLAG_PREFER_FAST_BUILD;
+    if (options_.build == BuildPolicy::refit) f |= OPTIX_BUILD_FLAG_ALLOW_UPDATE;
+    if (options_.compact) f |= OPTIX_BUILD_FLAG_ALLOW_COMPACTION;
+    return f;
+}
+
+OptixBuildInput ClusterAccel::triangles(std::size_t c) const {
+    const std::uint32_t n = offset_[c + 1] - offset_[c];
+    OptixBuildInput in{};
+    in.type = OPTIX_BUILD_INPUT_TYPE_TRIANGLES;
+    auto& t = in.triangleArray;
+    t.vertexFormat = OPTIX_VERTEX_FORMAT_FLOAT3;
+    t.vertexStrideInBytes = sizeof(Vec3);
+    t.numVertices = 4 * n;
+    t.vertexBuffers = &vertexPointers_[c];
+    t.indexFormat = OPTIX_INDICES_FORMAT_UNSIGNED_INT3;
+    t.indexStrideInBytes = 3 * sizeof(std::uint32_t);
+    t.numIndexTriplets = 2 * n;
+    t.indexBuffer = indices_.address();  // the same local indices in every cluster
+    t.flags = &kGeometryFlags;
+    t.numSbtRecords = 1;
+    return in;
+}
+
+void ClusterAccel::setClusters(const Clusters& clusters) {
+    offset_ = clusters.offset;
+    clusterParticle_.upload(clusters.particle);
+    clusterOffset_.upload(clusters.offset);
+    const std::size_t C = clusters.count(), n = clusters.particle.size();
+    vertices_.reserve(4 * n * sizeof(Vec3));
+    std::uint32_t largest = 0;
+    for (std::size_t c = 0; c < C; ++c) largest = std::max(largest, offset_[c + 1] - offset_[c]);
+    std::vector<std::uint32_t> idx(6 * std::size_t(largest));
+    for (std::uint32_t k = 0; k < largest; ++k) {
+        const std::uint32_t v = 4 * k, q[6] = {v, v + 1, v + 2, v, v + 2, v + 3};
+        std::copy(q, q + 6, idx.begin() + 6 * k);
+    }
+    indices_.upload(idx);
+    vertexPointers_.resize(C);
+    for (std::size_t c = 0; c < C; ++c) vertexPointers_[c] = vertices_.address() + 4 * std::size_t(offset_[c]) * sizeof(Vec3);
+
+    // Sizes per cluster size (clusters of one size need the same memory).
+    const OptixAccelBuildOptions opts{buildFlags(), OPTIX_BUILD_OPERATION_BUILD, {}};
+    std::map<std::uint32_t, OptixAccelBufferSizes> bySize;
+    outputBytes_.resize(C);
+    blasOffset_.resize(C);
+    std::size_t tempBytes = 0, pool = 0;
+    for (std::size_t c = 0; c < C; ++c) {
+        const std::uint32_t n = offset_[c + 1] - offset_[c];
+        auto it = bySize.find(n);
+        if (it == bySize.end()) {
+            const OptixBuildInput in = triangles(c);
+            OptixAccelBufferSizes s{};
+            OPTIX_CHECK(optixAccelComputeMemoryUsage(context_, &opts, &in, 1, &s));
+            it = bySize.emplace(n, s).first;
+        }
+        outputBytes_[c] = it->second.outputSizeInBytes;
+        tempBytes = std::max({tempBytes, it->second.tempSizeInBytes, it->second.tempUpdateSizeInBytes});
+        blasOffset_[c] = pool;
+        pool = alignUp(pool + outputBytes_[c], kPoolAlignment);
+    }
+    temp_.reserve(tempBytes);
+    stats_.tempBytes = temp_.bytes();
+    perBlas_.clear();
+    if (options_.pooled) {
+        pool_.reserve(pool);
+        stats_.poolBytes = pool_.bytes();
+    } else {
+        // What one cudaMalloc per BLAS really takes: the device's free memory before and after.
+        std::size_t free0 = 0, free1 = 0, total = 0;
+        CUDA_CHECK(cudaMemGetInfo(&free0, &total));
+        perBlas_.resize(C);
+        for (std::size_t c = 0; c < C; ++c) perBlas_[c].resize(outputBytes_[c]);
+        CUDA_CHECK(cudaMemGetInfo(&free1, &total));
+        stats_.poolBytes = free0 > free1 ? free0 - free1 : 0;
+    }
+    handles_.assign(C, 0);
+    partialCursor_ = 0;
+}
+
+void ClusterAccel::build(const Clusters& clusters, const DeviceParticles& particles, cudaStream_t stream, GpuTimer& timer) {
+    const BuildPolicy policy = options_.build;
+    const bool keep = (policy == BuildPolicy::refit || policy == BuildPolicy::partial) && built() &&
+                      clusters.particle.size() == offset_.back();
+    if (!keep) setClusters(clusters);
+    const std::size_t C = offset_.size() - 1;
+    const bool refit = keep && policy == BuildPolicy::refit;
+    std::size_t first = 0, count = C;
+    if (keep && policy == BuildPolicy::partial) {
+        count = std::min(C, static_cast<std::size_t>(std::ceil(options_.rebuildFraction * double(C))));
+        first = partialCursor_ % std::max<std::size_t>(C, 1);
+        partialCursor_ += count;
+    }
+    // The slots of clusters [first, first + count) mod C: one or two ranges.
+    {
+        GpuScope s(timer, "expandBillboards");
+        auto expand = [&](std::size_t c0, std::size_t c1) {
+            expandBillboards(clusterParticle(), offset_[c0], offset_[c1], particles.position, particles.radius,
+                             particles.frames, vertices_.as<Vec3>(), stream);
+        };
+        if (first + count <= C) expand(first, first + count);
+        else {
+            expand(first, C);
+            expand(0, first + count - C);
+        }
+        CUDA_CHECK(cudaGetLastError());
+    }
+    const bool compact = options_.compact && !refit && policy != BuildPolicy::partial;
+    if (compact) compactSizes_.reserve(C * sizeof(std::uint64_t));
+    {
+        GpuScope s(timer, "buildBlas");
+        OptixAccelBuildOptions opts{buildFlags(), refit ? OPTIX_BUILD_OPERATION_UPDATE : OPTIX_BUILD_OPERATION_BUILD, {}};
+        for (std::size_t k = 0; k < count; ++k) {
+            const std::size_t c = (first + k) % C;
+            const OptixBuildInput in = triangles(c);
+            const CUdeviceptr out = options_.pooled ? pool_.address() + blasOffset_[c] : perBlas_[c].address();
+            OptixAccelEmitDesc emit{compactSizes_.address() + c * sizeof(std::uint64_t), OPTIX_PROPERTY_TYPE_COMPACTED_SIZE};
+            OPTIX_CHECK(optixAccelBuild(context_, stream, &opts, &in, 1, temp_.address(), temp_.bytes(), out,
+                                        outputBytes_[c], &handles_[c], compact ? &emit : nullptr, compact ? 1 : 0));
+        }
+    }
+    stats_.blasBytes = 0;
+    for (std::size_t c = 0; c < C; ++c) stats_.blasBytes += outputBytes_[c];
+    if (compact) {
+        GpuScope s(timer, "compactBlas");
+        std::vector<std::uint64_t> sizes = compactSizes_.download<std::uint64_t>(C);  // synchronises
+        std::vector<std::size_t> at(C);
+        std::size_t pool = 0;
+        for (std::size_t c = 0; c < C; ++c) {
+            at[c] = pool;
+            pool = alignUp(pool + sizes[c], kPoolAlignment);
+        }
+        compactPool_.reserve(pool);
+        stats_.blasBytes = 0;
+        for (std::size_t c = 0; c < C; ++c) {
+            OPTIX_CHECK(optixAccelCompact(context_, stream, handles_[c], compactPool_.address() + at[c], sizes[c], &handles_[c]));
+            stats_.blasBytes += sizes[c];
+        }
+        stats_.poolBytes = compactPool_.bytes();
+    }
+    {
+        GpuScope s(timer, "buildTlas");
+        buildTlas(stream);
+    }
+    stats_.clusters = C;
+    stats_.triangles = 2 * std::size_t(offset_.back());
+    stats_.rebuiltClusters = count;
+    stats_.refitted = refit;
+    stats_.partial = keep && policy == BuildPolicy::partial;
+}
+
+void ClusterAccel::buildTlas(cudaStream_t stream) {
+    const std::size_t C = handles_.size();
+    std::vector<OptixInstance> inst(C);
+    const float identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+    for (std::size_t c = 0; c < C; ++c) {
+        OptixInstance& i = inst[c];
+        std::memcpy(i.transform, identity, sizeof identity);
+        i.instanceId = static_cast<unsigned>(c);
+        i.sbtOffset = 0;
+        i.visibilityMask = 255;
+        i.flags = OPTIX_INSTANCE_FLAG_NONE;
+        i.traversableHandle = handles_[c];
+    }
+    instances_.reserve(C * sizeof(OptixInstance));
+    CUDA_CHECK(cudaMemcpyAsync(instances_.as<void>(), inst.data(), C * sizeof(OptixInstance), cudaMemcpyHostToDevice, stream));
+    OptixBuildInput in{};
+    in.type = OPTIX_BUILD_INPUT_TYPE_INSTANCES;
+    in.instanceArray.instances = instances_.address();
+    in.instanceArray.numInstances = static_cast<unsigned>(C);
+    const OptixAccelBuildOptions opts{OPTIX_BUILD_FLAG_PREFER_FAST_BUILD, OPTIX_BUILD_OPERATION_BUILD, {}};
+    OptixAccelBufferSizes s{};
+    OPTIX_CHECK(optixAccelComputeMemoryUsage(context_, &opts, &in, 1, &s));
+    tlasBuffer_.reserve(s.outputSizeInBytes);
+    tlasTemp_.reserve(s.tempSizeInBytes);
+    OPTIX_CHECK(optixAccelBuild(context_, stream, &opts, &in, 1, tlasTemp_.address(), tlasTemp_.bytes(), tlasBuffer_.address(),
+                                tlasBuffer_.bytes(), &tlas_, nullptr, 0));
+    stats_.tlasBytes = s.outputSizeInBytes;
+}
+
+}  // namespace accretion::twin

@@ -1,0 +1,37 @@
+#pragma once
+// The twin's OptiX context, module (programs.cu as OptiX-IR), pipeline and
+// shader binding tables: one SBT per raygen program, the hit groups of the
+// two ray types shared by every BLAS (all instances use SBT offset 0).
+#include <filesystem>
+#include <string>
+
+#include "device_buffer.h"
+
+namespace accretion::twin {
+
+enum class Raygen { gbuffer, exact, count };
+
+class TwinPipeline {
+public:
+    /// programs: the OptiX-IR file built from programs.cu.
+    explicit TwinPipeline(const std::filesystem::path& programs, bool validation = false);
+    ~TwinPipeline();
+    TwinPipeline(const TwinPipeline&) = delete;
+    TwinPipeline& operator=(const TwinPipeline&) = delete;
+
+    OptixDeviceContext context() const { return context_; }
+    /// Launch raygen `r` over width x height with the params at `params` (device).
+    void launch(Raygen r, CUdeviceptr params, std::size_t paramsBytes, unsigned width, unsigned height,
+                cudaStream_t stream) const;
+
+private:
+    OptixDeviceContext context_ = nullptr;
+    OptixModule module_ = nullptr;
+    OptixProgramGroup raygen_[int(Raygen::count)] = {};
+    OptixProgramGroup miss_ = nullptr, hitPrimary_ = nullptr, hitShadow_ = nullptr;
+    OptixPipeline pipeline_ = nullptr;
+    DeviceBuffer raygenRecords_, missRecords_, hitRecords_;
+    OptixShaderBindingTable sbt_[int(Raygen::count)] = {};
+};
+
+}  // namespace accretion::twin

@@ -1,0 +1,127 @@
+// The twin's OptiX programs (compiled to OptiX-IR): the G-buffer raygen,
+// the exact estimator's raygen, and the hit programs of its two ray types.
+//  - primary rays: closest hit; on disc-alpha billboards an any-hit runs the
+//    alpha test;
+//  - shadow rays (V(x, p_i), docs/MODEL.md section 3): an any-hit excludes the
+//    receiver j and the light i by identity (the particle of the candidate's
+//    instance and primitive), runs the alpha test, and ends the search at the
+//    first accepted blocker. No origin offset, no shortened far end.
+#include <optix.h>
+
+#include "accretion/lighting/shading.h"
+#include "launch_params.h"
+
+using namespace accretion;
+using namespace accretion::twin;
+
+extern "C" __constant__ LaunchParams params;
+
+namespace {
+
+// Shadow payload: 0 receiver, 1 light, 2 occluded, 3 any-hit count.
+// Primary payload: 0 instance, 1 primitive, 2-3 barycentrics, 4 t (0xffffffff instance: miss).
+
+__device__ Vec2 hitUv() {
+    const float2 b = optixGetTriangleBarycentrics();
+    return quadUv(optixGetPrimitiveIndex() & 1u, b.x, b.y);
+}
+
+/// true when the traced V(x, p_i) is 1 (counted into the thread's counters).
+__device__ bool visible(const ShadingPoint& sp, std::uint32_t light, const LightTerm& t, LaunchCounters& c) {
+    unsigned receiver = sp.self, lightId = light, occluded = 0, anyHits = 0;
+    const float3 o = make_float3(sp.x.x, sp.x.y, sp.x.z), d = make_float3(t.w.x, t.w.y, t.w.z);
+    if (!(t.dist > 0.0f)) return true;  // an empty interval sees the light (as on the CPU)
+    optixTrace(params.tlas, o, d, 0.0f, t.dist, 0.0f, OptixVisibilityMask(255),
+               OPTIX_RAY_FLAG_TERMINATE_ON_FIRST_HIT | OPTIX_RAY_FLAG_DISABLE_CLOSESTHIT, kShadowRay, kRayTypes,
+               kShadowRay, receiver, lightId, occluded, anyHits);
+    ++c.rays;
+    c.anyHits += anyHits;
+    c.occluded += occluded;
+    return occluded == 0;
+}
+
+__device__ void addCounters(const LaunchCounters& c) {
+    if (!params.counters) return;
+    if (c.rays) atomicAdd(&params.counters->rays, c.rays);
+    if (c.anyHits) atomicAdd(&params.counters->anyHits, c.anyHits);
+    if (c.occluded) atomicAdd(&params.counters->occluded, c.occluded);
+    if (c.lightTerms) atomicAdd(&params.counters->lightTerms, c.lightTerms);
+}
+
+template <ShadingModel M>
+__device__ DVec3 exactSum(const ShadingPoint& sp, LaunchCounters& c) {
+    DVec3 sum(0.0);
+    for (std::uint32_t i = 0; i < params.particleCount; ++i) {
+        if (i == sp.self) continue;
+        LightTerm t;
+        ++c.lightTerms;
+        if (!evalLight<M>(sp, params.position[i], params.emission[i], params.dmin2[i], t)) continue;
+        if (!params.shadows || visible(sp, i, t, c)) sum += DVec3(t.value);
+    }
+    return sum;
+}
+
+}  // namespace
+
+extern "C" __global__ void __raygen__gbuffer() {
+    const uint3 idx = optixGetLaunchIndex();
+    const Camera& cam = params.camera;
+    const std::uint32_t x = idx.x, y = idx.y;
+    const Vec3 dir = cam.pixelDirection(x, y);
+    unsigned inst = 0xffffffffu, prim = 0, b0 = 0, b1 = 0, tb = 0;
+    optixTrace(params.tlas, make_float3(cam.position.x, cam.position.y, cam.position.z), make_float3(dir.x, dir.y, dir.z),
+               0.0f, __int_as_float(0x7f800000), 0.0f, OptixVisibilityMask(255),
+               params.discAlpha ? OPTIX_RAY_FLAG_NONE : OPTIX_RAY_FLAG_DISABLE_ANYHIT, kPrimaryRay, kRayTypes, kPrimaryRay,
+               inst, prim, b0, b1, tb);
+    GBufferTexel g;
+    if (inst != 0xffffffffu) {
+        const std::uint32_t j = hitParticle(params, inst, prim);
+        const Vec2 uv = quadUv(prim & 1u, __uint_as_float(b0), __uint_as_float(b1));
+        g = billboardTexel(cam, x, y, dir, j, params.position[j], params.radius[j], params.frames[j], uv, params.model);
+    }
+    params.gbuffer[std::size_t(y) * cam.width + x] = g;
+    if (params.counters) atomicAdd(&params.counters->rays, 1ull);
+}
+
+extern "C" __global__ void __raygen__exact() {
+    const uint3 idx = optixGetLaunchIndex();
+    const std::size_t px = std::size_t(idx.y) * params.camera.width + idx.x;
+    const GBufferTexel g = params.gbuffer[px];
+    DVec3 sum(0.0);
+    LaunchCounters c;
+    if (g.hit()) {
+        const Vec3 centre = params.position[g.particle];
+        const ShadingPoint sp{centre + g.local, g.normal, g.geomNormal, params.albedo[g.particle], g.particle, centre, g.local};
+        switch (params.model) {
+        case ShadingModel::lambert: sum = exactSum<ShadingModel::lambert>(sp, c); break;
+        case ShadingModel::sphere: sum = exactSum<ShadingModel::sphere>(sp, c); break;
+        case ShadingModel::isotropic: sum = exactSum<ShadingModel::isotropic>(sp, c); break;
+        }
+    }
+    params.Lr[px] = Vec3(sum);
+    addCounters(c);
+}
+
+extern "C" __global__ void __closesthit__primary() {
+    const float2 b = optixGetTriangleBarycentrics();
+    optixSetPayload_0(optixGetInstanceId());
+    optixSetPayload_1(optixGetPrimitiveIndex());
+    optixSetPayload_2(__float_as_uint(b.x));
+    optixSetPayload_3(__float_as_uint(b.y));
+    optixSetPayload_4(__float_as_uint(optixGetRayTmax()));
+}
+
+extern "C" __global__ void __anyhit__primary() {
+    if (!insideDisc(hitUv())) optixIgnoreIntersection();
+}
+
+extern "C" __global__ void __anyhit__shadow() {
+    optixSetPayload_3(optixGetPayload_3() + 1);
+    const std::uint32_t j = hitParticle(params, optixGetInstanceId(), optixGetPrimitiveIndex());
+    if (j == optixGetPayload_0() || j == optixGetPayload_1()) optixIgnoreIntersection();
+    if (params.discAlpha && !insideDisc(hitUv())) optixIgnoreIntersection();
+    optixSetPayload_2(1);
+    optixTerminateRay();
+}
+
+extern "C" __global__ void __miss__none() {}

@@ -1,0 +1,278 @@
+// accretion-optix: the OptiX twin of the GPU pipeline (issue 16). It reads
+// the scene files, particle buffers and settings `accretion render` reads,
+// runs the pipeline on the GPU (per-frame cluster BLAS builds, TLAS,
+// G-buffer raygen, lighting) and writes per frame a .gpuframe (the layers
+// render writes; `accretion import-gpu` makes render's EXR of it), the
+// per-pass GPU times (CUDA events, median of --repeat launches) as
+// calibrate's timings CSV, and a stats JSON.
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <nlohmann/json.hpp>
+
+#include "accretion/core/atomic_file.h"
+#include "accretion/core/error.h"
+#include "accretion/core/version.h"
+#include "accretion/geometry/camera_track.h"
+#include "accretion/geometry/clustering.h"
+#include "accretion/io/gpu_frame_file.h"
+#include "accretion/particles/particle_source.h"
+#include "accretion/scene/scene_parser.h"
+#include "cluster_accel.h"
+#include "launch_params.h"
+#include "optix_pipeline.h"
+
+#ifndef ACCRETION_TWIN_PROGRAMS
+#define ACCRETION_TWIN_PROGRAMS "programs.optixir"
+#endif
+
+namespace accretion::twin {
+namespace {
+
+struct Args {
+    std::string scene;
+    std::vector<std::string> defines;
+    std::string frames, output, timings, config, programs = ACCRETION_TWIN_PROGRAMS;
+    unsigned repeat = 5;
+    bool perBlas = false, compact = false, quiet = false, validation = false;
+};
+
+double median(std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/// The settings the twin runs; anything else is refused by name.
+void requireSupported(const Settings& s) {
+    auto refuse = [](const std::string& what) {
+        throw InputError(fmt::format("accretion-optix does not run {} yet (the CPU renderer does)", what));
+    };
+    if (s.geometry.primitive != Primitive::billboard) refuse("geometry.primitive = \"sphere\"");
+    if (s.render.estimator != EstimatorKind::exact)
+        refuse(fmt::format("render.estimator = \"{}\"", enumName(s.render.estimator)));
+    if (s.render.visibility_rule != VisibilityRule::exact) refuse("render.visibility_rule = \"offset\"");
+    if (s.gpu.omm != OmmMode::off) refuse("gpu.omm");
+    if (!s.render.crop.empty()) refuse("render.crop");
+}
+
+/// The particle arrays the programs read, on the device.
+struct FrameBuffers {
+    DeviceBuffer position, emission, albedo, radius, dmin2, frames, gbuffer, Lr, counters, params;
+};
+
+int run(const Args& a) {
+    std::vector<FlagSetting> flags;
+    if (!a.frames.empty()) {
+        const auto colon = a.frames.find(':');
+        const std::uint32_t first = std::stoul(a.frames.substr(0, colon));
+        const std::uint32_t end = colon == std::string::npos ? first + 1 : std::stoul(a.frames.substr(colon + 1));
+        if (end <= first) throw InputError(fmt::format("command line --frames {}: expected A:B with A < B", a.frames));
+        flags.push_back({"render.frame_start", "--frames", [first](Settings& s) { s.render.frame_start = first; }});
+        flags.push_back({"render.frames", "--frames", [first, end](Settings& s) { s.render.frames = end - first; }});
+    }
+    if (!a.output.empty())
+        flags.push_back({"render.output", "-o " + a.output, [o = a.output](Settings& s) { s.render.output = o; }});
+    const Settings settings = loadScene(a.scene, a.defines, flags);
+    requireSupported(settings);
+    const std::string settingsToml = settingsToToml(settings);
+    const ParticleSource source(settings);
+    const CameraTrack cameras(settings.camera);
+    const std::uint32_t W = settings.camera.width, H = settings.camera.height;
+    const std::size_t pixels = std::size_t(W) * H;
+
+    cudaDeviceProp prop{};
+    CUDA_CHECK(cudaGetDeviceProperties(&prop, 0));
+    const std::string device = prop.name;
+    TwinPipeline pipeline(a.programs, a.validation);
+    cudaStream_t stream;
+    CUDA_CHECK(cudaStreamCreate(&stream));
+    GpuTimer timer(stream);
+    ClusterAccel accel(pipeline.context(), {settings.geometry.build, settings.geometry.rebuild_fraction, !a.perBlas, a.compact});
+    FrameBuffers buf;
+    buf.gbuffer.resize(pixels * sizeof(GBufferTexel));
+    buf.Lr.resize(pixels * sizeof(Vec3));
+    buf.counters.resize(sizeof(LaunchCounters));
+    buf.params.resize(sizeof(LaunchParams));
+
+    const BuildPolicy policy = settings.geometry.build;
+    const bool persistent = policy == BuildPolicy::refit || policy == BuildPolicy::partial;
+    const bool statelessBuild = !persistent;
+    Vec3 origin(0.0f);
+    bool built = false;
+    std::string timingsCsv = "config,pass,ms\n";
+    nlohmann::json stats = {{"version", std::string(version())}, {"renderer", "accretion-optix"}, {"device", device},
+                            {"scene", settings.scenePath}, {"repeat", a.repeat}, {"allocation", a.perBlas ? "per_blas" : "pooled"},
+                            {"compact", a.compact}, {"frames", nlohmann::json::array()}};
+    const std::uint32_t first = settings.render.frame_start, end = first + settings.render.frames;
+    for (std::uint32_t frame = first; frame < end; ++frame) {
+        const auto wall0 = std::chrono::steady_clock::now();
+        const CameraPose pose = cameras.pose(frame);
+        const Camera world = Camera::fromPose(pose, W, H);
+        if (!built || !persistent) origin = world.position;
+        const Camera camera = world.rebased(origin);
+        Particles particles = source.frame(frame);
+        for (Vec3& p : particles.position) p -= origin;
+        const std::size_t n = particles.size();
+        std::vector<BillboardFrame> frames(n);
+        std::vector<float> dmin2(n);
+        const float dmin = static_cast<float>(settings.shading.dmin);
+        for (std::size_t i = 0; i < n; ++i) {
+            frames[i] = billboardFrame(settings.geometry.orientation, camera, particles.position[i], particles.velocity[i]);
+            const float d = std::max(particles.radius[i], dmin);
+            dmin2[i] = d * d;
+        }
+        buf.position.upload(particles.position);
+        buf.emission.upload(particles.emission);
+        buf.albedo.upload(particles.albedo);
+        buf.radius.upload(particles.radius);
+        buf.dmin2.upload(dmin2);
+        buf.frames.upload(frames);
+        const bool recluster = !built || !persistent;
+        const Clusters clusters = recluster ? clusterParticles(particles.position, settings.geometry.cluster_size) : Clusters{};
+
+        LaunchParams lp;
+        lp.camera = camera;
+        lp.model = settings.shading.model;
+        lp.discAlpha = settings.geometry.alpha == AlphaMode::disc;
+        lp.shadows = settings.shading.visibility;
+        lp.particleCount = static_cast<std::uint32_t>(n);
+        lp.position = buf.position.as<Vec3>();
+        lp.emission = buf.emission.as<Vec3>();
+        lp.albedo = buf.albedo.as<Vec3>();
+        lp.radius = buf.radius.as<float>();
+        lp.dmin2 = buf.dmin2.as<float>();
+        lp.frames = buf.frames.as<BillboardFrame>();
+        lp.gbuffer = buf.gbuffer.as<GBufferTexel>();
+        lp.Lr = buf.Lr.as<Vec3>();
+        lp.counters = buf.counters.as<LaunchCounters>();
+
+        // The frame's passes, `repeat` times (a refit or partial build
+        // changes state: it runs once per frame).
+        std::map<std::string, std::vector<double>> ms;
+        LaunchCounters counters{};
+        const DeviceParticles dp{lp.position, lp.radius, lp.frames};
+        for (unsigned r = 0; r < std::max(1u, a.repeat); ++r) {
+            if (r == 0 || statelessBuild) accel.build(clusters, dp, stream, timer);
+            lp.tlas = accel.tlas();
+            lp.clusterParticle = accel.clusterParticle();
+            lp.clusterOffset = accel.clusterOffset();
+            CUDA_CHECK(cudaMemcpyAsync(buf.params.as<void>(), &lp, sizeof lp, cudaMemcpyHostToDevice, stream));
+            CUDA_CHECK(cudaMemsetAsync(buf.counters.as<void>(), 0, sizeof(LaunchCounters), stream));
+            {
+                GpuScope s(timer, "traceGBuffer");
+                pipeline.launch(Raygen::gbuffer, buf.params.address(), sizeof lp, W, H, stream);
+            }
+            {
+                GpuScope s(timer, "estimateLighting");
+                pipeline.launch(Raygen::exact, buf.params.address(), sizeof lp, W, H, stream);
+            }
+            for (const auto& [pass, t] : timer.read()) ms[pass].push_back(t);
+            if (r == 0) counters = buf.counters.download<LaunchCounters>(1)[0];
+        }
+        built = true;
+
+        // Compose (L = Le + Lr, the background on a miss) as composeImage does.
+        const std::vector<GBufferTexel> gb = buf.gbuffer.download<GBufferTexel>(pixels);
+        GpuFrame out;
+        out.width = W;
+        out.height = H;
+        out.frame = frame;
+        out.camera = pose;
+        out.Lr = buf.Lr.download<Vec3>(pixels);
+        out.L.resize(pixels);
+        out.Le.assign(pixels, Vec3(0.0f));
+        out.normal.assign(pixels, Vec3(0.0f));
+        out.depth.resize(pixels);
+        out.particle.resize(pixels);
+        const float se = static_cast<float>(settings.shading.self_emission);
+        std::size_t hits = 0;
+        for (std::size_t px = 0; px < pixels; ++px) {
+            const GBufferTexel& g = gb[px];
+            out.particle[px] = g.particle;
+            if (!g.hit()) {
+                out.L[px] = settings.shading.background;
+                out.depth[px] = std::numeric_limits<float>::infinity();
+                out.Lr[px] = Vec3(0.0f);
+                continue;
+            }
+            ++hits;
+            out.Le[px] = se * particles.emission[g.particle];
+            out.L[px] = out.Le[px] + out.Lr[px];
+            out.depth[px] = g.depth;
+            out.normal[px] = g.normal;
+        }
+        nlohmann::json timing;
+        for (const auto& [pass, v] : ms) {
+            timing[pass] = {{"median_ms", median(v)}, {"ms", v}};
+            if (!a.config.empty()) timingsCsv += fmt::format("{},{},{:.6f}\n", a.config, pass, median(v));
+        }
+        const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+        out.metadata = {{"version", std::string(version())}, {"scene", settings.scenePath},
+                        {"frame", std::to_string(frame)}, {"estimator", std::string(enumName(settings.render.estimator))},
+                        {"samples", std::to_string(settings.render.samples)}, {"seed", std::to_string(settings.render.seed)},
+                        {"shard", ""}, {"render_time_s", fmt::format("{:.6f}", wall)}, {"settings", settingsToml},
+                        {"renderer", "accretion-optix"}, {"device", device},
+                        {"tonemap", std::string(enumName(settings.render.tonemap))}};
+        std::filesystem::path file = expandPattern(settings.render.output, settings.sceneName, frame);
+        file.replace_extension(".gpuframe");
+        if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+        writeGpuFrame(file, out);
+        const AccelStats& as = accel.stats();
+        stats["frames"].push_back({{"frame", frame}, {"output", file.string()}, {"particles", n}, {"hit_pixels", hits},
+                                   {"clusters", as.clusters}, {"triangles", as.triangles},
+                                   {"rebuilt_clusters", as.rebuiltClusters}, {"refitted", as.refitted}, {"partial", as.partial},
+                                   {"blas_bytes", as.blasBytes}, {"blas_memory_bytes", as.poolBytes},
+                                   {"scratch_bytes", as.tempBytes}, {"tlas_bytes", as.tlasBytes},
+                                   {"rays", counters.rays}, {"any_hits", counters.anyHits},
+                                   {"shadow_occluded", counters.occluded}, {"light_terms", counters.lightTerms},
+                                   {"gpu_ms", timing}, {"wall_s", wall}});
+        if (!a.quiet) {
+            std::string line;
+            for (const auto& [pass, v] : ms) line += fmt::format(" {} {:.3f}", pass, median(v));
+            fmt::print(stderr, "frame {}: {} ({} clusters; ms:{})\n", frame, file.string(), as.clusters, line);
+        }
+    }
+    const std::filesystem::path first_ = expandPattern(settings.render.output, settings.sceneName, first);
+    const std::string stem = (first_.parent_path() / first_.stem()).string();
+    writeFileAtomic(stem + ".gpu_stats.json", stats.dump(2));
+    if (!a.timings.empty()) writeFileAtomic(a.timings, timingsCsv);
+    CUDA_CHECK(cudaStreamDestroy(stream));
+    return 0;
+}
+
+}  // namespace
+}  // namespace accretion::twin
+
+int main(int argc, char** argv) {
+    accretion::twin::Args a;
+    CLI::App app{"accretion-optix: the OptiX twin of the GPU pipeline (exact lighting; frames as .gpuframe)"};
+    app.add_option("scene", a.scene, "Scene file (TOML)")->required()->check(CLI::ExistingFile);
+    app.add_option("-D,--define", a.defines, "Override a setting: section.key=value");
+    app.add_option("--frames", a.frames, "Frames A:B (half-open) = render.frame_start, render.frames");
+    app.add_option("-o,--output", a.output, "Output pattern ({scene}, {frame}; the extension becomes .gpuframe) = render.output");
+    app.add_option("--repeat", a.repeat, "Launches per pass for the median GPU time");
+    app.add_option("--timings", a.timings, "Write the median GPU ms per pass as calibrate's timings CSV (config,pass,ms)");
+    app.add_option("--config", a.config, "Configuration name of the timings rows");
+    app.add_option("--programs", a.programs, "The OptiX-IR of programs.cu");
+    app.add_flag("--per-blas", a.perBlas, "One cudaMalloc per BLAS instead of one 256-B-aligned pool");
+    app.add_flag("--compact", a.compact, "Compact every BLAS after its build");
+    app.add_flag("--validation", a.validation, "OptiX validation mode");
+    app.add_flag("-q,--quiet", a.quiet, "No progress on stderr");
+    CLI11_PARSE(app, argc, argv);
+    try {
+        return accretion::twin::run(a);
+    } catch (const accretion::InputError& e) {
+        fmt::print(stderr, "error: {}\n", e.what());
+        return 2;
+    } catch (const std::exception& e) {
+        fmt::print(stderr, "error: {}\n", e.what());
+        return 1;
+    }
+}
