@@ -39,7 +39,7 @@ struct Args {
     std::vector<std::string> defines;
     std::string frames, output, timings, config, programs = ACCRETION_TWIN_PROGRAMS;
     unsigned repeat = 5;
-    bool perBlas = false, compact = false, quiet = false, validation = false;
+    bool perBlas = false, compact = false, quiet = false, validation = false, skipLighting = false;
 };
 
 double median(std::vector<double> v) {
@@ -169,9 +169,11 @@ int run(const Args& a) {
                 GpuScope s(timer, "traceGBuffer");
                 pipeline.launch(Raygen::gbuffer, buf.params.address(), sizeof lp, W, H, stream);
             }
-            {
+            if (!a.skipLighting) {
                 GpuScope s(timer, "estimateLighting");
                 pipeline.launch(Raygen::exact, buf.params.address(), sizeof lp, W, H, stream);
+            } else {
+                CUDA_CHECK(cudaMemsetAsync(buf.Lr.as<void>(), 0, pixels * sizeof(Vec3), stream));
             }
             for (const auto& [pass, t] : timer.read()) ms[pass].push_back(t);
             if (r == 0) counters = buf.counters.download<LaunchCounters>(1)[0];
@@ -214,7 +216,7 @@ int run(const Args& a) {
             if (!a.config.empty()) timingsCsv += fmt::format("{},{},{:.6f}\n", a.config, pass, median(v));
         }
         const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-        out.metadata = {{"version", std::string(version())}, {"scene", settings.scenePath},
+        out.metadata = {{"lighting", a.skipLighting ? "skipped" : "exact"}, {"version", std::string(version())}, {"scene", settings.scenePath},
                         {"frame", std::to_string(frame)}, {"estimator", std::string(enumName(settings.render.estimator))},
                         {"samples", std::to_string(settings.render.samples)}, {"seed", std::to_string(settings.render.seed)},
                         {"shard", ""}, {"render_time_s", fmt::format("{:.6f}", wall)}, {"settings", settingsToml},
@@ -263,6 +265,7 @@ int main(int argc, char** argv) {
     app.add_option("--programs", a.programs, "The OptiX-IR of programs.cu");
     app.add_flag("--per-blas", a.perBlas, "One cudaMalloc per BLAS instead of one 256-B-aligned pool");
     app.add_flag("--compact", a.compact, "Compact every BLAS after its build");
+    app.add_flag("--skip-lighting", a.skipLighting, "Time the geometry passes only (Lr = 0 in the frame)");
     app.add_flag("--validation", a.validation, "OptiX validation mode");
     app.add_flag("-q,--quiet", a.quiet, "No progress on stderr");
     CLI11_PARSE(app, argc, argv);

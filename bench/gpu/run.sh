@@ -1,0 +1,71 @@
+#!/bin/bash
+# The OptiX twin's runs on a GPU machine (issue 16), from the repository root:
+#   bash bench/gpu/run.sh STEP...      steps: env build images builds
+# Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
+# machine: the header-only and small libraries the twin's host code uses,
+# the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
+set -uo pipefail
+OUT=${OUT:-$PWD/out/gpu}
+mkdir -p "$OUT"
+D=$PWD/.twin-deps
+S=$D/sysroot/usr
+L=$S/lib/x86_64-linux-gnu
+export LD_LIBRARY_PATH=$L${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
+BIN=$PWD/build-gpu/accretion-optix
+W=$OUT/work
+mkdir -p "$W"
+
+step_env() {
+    { nvidia-smi --query-gpu=name,driver_version,memory.total,clocks.max.sm --format=csv; nvcc --version | tail -2
+      g++ --version | head -1; cmake --version | head -1; nproc; cat "$D/commit"; } > "$OUT/env.txt" 2>&1
+    cat "$OUT/env.txt"
+}
+
+step_build() {
+    cmake -S . -B build-gpu -G Ninja -DCMAKE_BUILD_TYPE=Release -DACCRETION_CPU=OFF -DACCRETION_OPTIX=ON \
+        -DOptiX_INCLUDE="$D/optix/include" -DACCRETION_COMMIT="$(cat "$D/commit")" -DCMAKE_CUDA_ARCHITECTURES=90 \
+        -DTBB_DIR=$L/cmake/TBB -Dfmt_DIR=$L/cmake/fmt -Dtomlplusplus_DIR=$L/cmake/tomlplusplus \
+        -Dglm_DIR=$S/share/cmake/glm -Dnlohmann_json_DIR=$S/share/cmake/nlohmann_json -DCLI11_DIR=$S/share/cmake/CLI11 \
+        > "$OUT/build.log" 2>&1 && cmake --build build-gpu -j 16 >> "$OUT/build.log" 2>&1
+    local rc=$?
+    tail -30 "$OUT/build.log"
+    return $rc
+}
+
+# GPU exact frames for the image-agreement checks (compared on the CPU machine).
+step_images() {
+    local q=scenes/quickstart.toml small="-D camera.width=320 -D camera.height=180"
+    $BIN $q $small --frames 0:1 -o "$W/images/quickstart.{frame}.gpuframe" --repeat 3
+    $BIN $q $small --frames 0:1 -D geometry.alpha='"disc"' -o "$W/images/quickstart_disc.{frame}.gpuframe" --repeat 3
+    $BIN $q $small --frames 0:1 -D shading.model='"sphere"' -D geometry.orientation='"view_point"' \
+        -o "$W/images/quickstart_sphere.{frame}.gpuframe" --repeat 3
+    timeout 300 $BIN scenes/disk_100k.toml $small -D render.estimator='"exact"' --frames 0:1 \
+        -o "$W/images/disk_100k.{frame}.gpuframe" --repeat 1
+}
+
+# Seed 004's build questions: rebuild / refit / partial, pooled / per-BLAS,
+# compaction, cluster size 100 / 1000, at 100K particles and 1080p.
+step_builds() {
+    local s=scenes/disk_100k.toml f="-D camera.width=1920 -D camera.height=1080 --skip-lighting --repeat 7"
+    local t="$W/builds"
+    mkdir -p "$t"
+    run() { local name=$1; shift; $BIN $s $f -o "$t/$name.{frame}.gpuframe" --timings "$t/$name.csv" --config "$name" "$@"; }
+    run rebuild_k100 --frames 0:2
+    run rebuild_k1000 --frames 0:2 -D geometry.cluster_size=1000
+    run rebuild_k100_perblas --frames 0:2 --per-blas
+    run rebuild_k100_compact --frames 0:2 --compact
+    run fasttrace_k100 --frames 0:2 -D geometry.build='"fast_trace"'
+    run refit_k100 --frames 0:6 -D geometry.build='"refit"'
+    run partial_k100 --frames 0:6 -D geometry.build='"partial"'
+    run rebuild_k25 --frames 0:2 -D geometry.cluster_size=25
+    run rebuild_k1600 --frames 0:2 -D geometry.cluster_size=1600
+    rm -f "$t"/*.gpuframe
+}
+
+for s in "$@"; do
+    echo "== $s"
+    "step_$s" || { echo "step $s failed"; break; }
+done
+# What comes back: one archive (the device tool returns at most 8 files).
+tar czf "$OUT/results.tar.gz" -C "$W" . && rm -rf "$W"
+ls -la "$OUT"
