@@ -35,12 +35,12 @@ step_build() {
 # GPU exact frames for the image-agreement checks (compared on the CPU machine).
 step_images() {
     local q=scenes/quickstart.toml small="-D camera.width=320 -D camera.height=180"
-    $BIN $q $small --frames 0:1 -o "$W/images/quickstart.{frame}.gpuframe" --repeat 3
-    $BIN $q $small --frames 0:1 -D geometry.alpha='"disc"' -o "$W/images/quickstart_disc.{frame}.gpuframe" --repeat 3
+    $BIN $q $small --frames 0:1 -o "$W/images/quickstart.{frame}.exr" --repeat 3
+    $BIN $q $small --frames 0:1 -D geometry.alpha='"disc"' -o "$W/images/quickstart_disc.{frame}.exr" --repeat 3
     $BIN $q $small --frames 0:1 -D shading.model='"sphere"' -D geometry.orientation='"view_point"' \
-        -o "$W/images/quickstart_sphere.{frame}.gpuframe" --repeat 3
+        -o "$W/images/quickstart_sphere.{frame}.exr" --repeat 3
     timeout 300 $BIN scenes/disk_100k.toml $small -D render.estimator='"exact"' --frames 0:1 \
-        -o "$W/images/disk_100k.{frame}.gpuframe" --repeat 1
+        -o "$W/images/disk_100k.{frame}.exr" --repeat 1
 }
 
 # Seed 004's build questions: rebuild / refit / partial, pooled / per-BLAS,
@@ -49,7 +49,7 @@ step_builds() {
     local s=scenes/disk_100k.toml f="-D camera.width=1920 -D camera.height=1080 --skip-lighting --repeat 7"
     local t="$W/builds"
     mkdir -p "$t"
-    run() { local name=$1; shift; $BIN $s $f -o "$t/$name.{frame}.gpuframe" --timings "$t/$name.csv" --config "$name" "$@"; }
+    run() { local name=$1; shift; $BIN $s $f -o "$t/$name.{frame}.exr" --timings "$t/$name.csv" --config "$name" "$@"; }
     run rebuild_k100 --frames 0:2
     run rebuild_k1000 --frames 0:2 -D geometry.cluster_size=1000
     run rebuild_k100_perblas --frames 0:2 --per-blas
