@@ -34,12 +34,12 @@ step_build() {
 
 # GPU exact frames for the image-agreement checks (compared on the CPU machine).
 step_images() {
-    local q=scenes/quickstart.toml small="-D camera.width=320 -D camera.height=180"
+    local q=scenes/quickstart.toml small="-D camera.width=320 -D camera.height=180 -D render.estimator=\"exact\""
     $BIN $q $small --frames 0:1 -o "$W/images/quickstart.{frame}.exr" --repeat 3
     $BIN $q $small --frames 0:1 -D geometry.alpha='"disc"' -o "$W/images/quickstart_disc.{frame}.exr" --repeat 3
     $BIN $q $small --frames 0:1 -D shading.model='"sphere"' -D geometry.orientation='"view_point"' \
         -o "$W/images/quickstart_sphere.{frame}.exr" --repeat 3
-    timeout 300 $BIN scenes/disk_100k.toml $small -D render.estimator='"exact"' --frames 0:1 \
+    timeout 300 $BIN scenes/disk_100k.toml $small --frames 0:1 \
         -o "$W/images/disk_100k.{frame}.exr" --repeat 1
 }
 

@@ -50,12 +50,12 @@ double median(std::vector<double> v) {
 }
 
 /// The settings the twin runs; anything else is refused by name.
-void requireSupported(const Settings& s) {
+void requireSupported(const Settings& s, bool lighting) {
     auto refuse = [](const std::string& what) {
         throw InputError(fmt::format("accretion-optix does not run {} yet (the CPU renderer does)", what));
     };
     if (s.geometry.primitive != Primitive::billboard) refuse("geometry.primitive = \"sphere\"");
-    if (s.render.estimator != EstimatorKind::exact)
+    if (lighting && s.render.estimator != EstimatorKind::exact)
         refuse(fmt::format("render.estimator = \"{}\"", enumName(s.render.estimator)));
     if (s.render.visibility_rule != VisibilityRule::exact) refuse("render.visibility_rule = \"offset\"");
     if (s.gpu.omm != OmmMode::off) refuse("gpu.omm");
@@ -80,7 +80,7 @@ int run(const Args& a) {
     if (!a.output.empty())
         flags.push_back({"render.output", "-o " + a.output, [o = a.output](Settings& s) { s.render.output = o; }});
     const Settings settings = loadScene(a.scene, a.defines, flags);
-    requireSupported(settings);
+    requireSupported(settings, !a.skipLighting);
     const std::string settingsToml = settingsToToml(settings);
     const ParticleSource source(settings);
     const CameraTrack cameras(settings.camera);
