@@ -16,7 +16,7 @@ namespace accretion {
 namespace OIIO = OIIO_NAMESPACE;
 
 ErrorMetrics computeErrors(const std::vector<Vec3>& x, const std::vector<Vec3>& ref, const std::vector<Vec3>* refStderr,
-                           double eps) {
+                           double eps, double tolerance) {
     ACC_CHECK(x.size() == ref.size());
     ACC_CHECK(!refStderr || refStderr->size() == ref.size());
     ErrorMetrics m;
@@ -29,17 +29,21 @@ ErrorMetrics computeErrors(const std::vector<Vec3>& x, const std::vector<Vec3>& 
             if (m.nonFinite++ < ErrorMetrics::kNonFiniteListed) m.firstNonFinite.push_back(i);
             continue;
         }
+        m.identical += x[i] == ref[i];
+        bool within = true;
         for (int c = 0; c < 3; ++c) {
             const double r = ref[i][c];
             const double d = double(x[i][c]) - r;
             rel += d * d / (r * r + eps);
             mse += d * d;
             mape += std::fabs(d) / (std::fabs(r) + eps);
+            within = within && std::fabs(d) <= tolerance * std::fabs(r);
             if (refStderr) {
                 const double s = (*refStderr)[i][c];
                 floor += s * s / (r * r + eps);
             }
         }
+        m.withinTolerance += within;
     }
     m.pixels = x.size() - m.nonFinite;
     if (m.pixels == 0) return m;

@@ -35,6 +35,7 @@ struct CompareArgs {
     bool json = false;
     bool allowNonFinite = false;  ///< --allow-nonfinite: measure the finite pixels, exit 0
     bool strict = false;          ///< --strict: metadata that differ are an error
+    double tolerance = kAgreementTolerance;  ///< --tolerance: relative tolerance of the pixel agreement
 };
 
 /// The FLIP variant's name, as tables, maps and plots show it.
@@ -80,6 +81,8 @@ std::string nonFiniteOwner(const Pair& p, std::size_t q) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z) ? "the reference " + p.reference : p.image;
 }
 
+double fraction(std::size_t k, std::size_t n) { return n ? double(k) / double(n) : 0.0; }
+
 /// The metrics of one pair: relMSE, MSE, MAPE and FLIP over the finite pixels.
 struct Comparison {
     ErrorMetrics m;
@@ -90,7 +93,7 @@ struct Comparison {
 
 Comparison measure(const CompareArgs& a, const Pair& p) {
     Comparison c;
-    c.m = computeErrors(p.xs, p.rs);
+    c.m = computeErrors(p.xs, p.rs, nullptr, kRelMseEpsilon, a.tolerance);
     if (c.m.nonFinite > 0) {
         std::vector<std::string> at;  // (x, y) of the first few, and where the first is
         for (const std::size_t q : c.m.firstNonFinite) at.push_back(p.at(q));
@@ -268,10 +271,13 @@ void runCompareOne(const CompareArgs& a) {
     Table t({hidden("image"), hidden("reference"), hidden("layer"), {"relMSE", "relMSE", 0, "{:.9g}"},
              {"MSE", "MSE", 0, "{:.9g}"}, {"MAPE", "MAPE", 0, "{:.9g}"},
              {"flip", flipName(a), 0, "{:.6f}"}, hidden("flip_variant"), hidden("ppd"),
-             hidden("epsilon"), hidden("pixels"), hidden("nonfinite_pixels"), hidden("window")});
+             hidden("epsilon"), hidden("pixels"), hidden("nonfinite_pixels"), hidden("window"),
+             {"identical", "identical pixels (fraction)", 0, "{:.6f}"}, {"within_tolerance", "pixels within tolerance (fraction)", 0, "{:.6f}"},
+             hidden("tolerance")});
     t.add({a.image, a.reference, a.layer.empty() ? "RGB" : a.layer, c.m.relMSE, c.m.MSE, c.m.MAPE, c.flip, a.flip, a.ppd,
            kRelMseEpsilon, std::uint64_t(c.m.pixels), std::uint64_t(c.m.nonFinite),
-           fmt::format("{}x{}+{}+{}", p.w, p.h, p.x0, p.y0)});
+           fmt::format("{}x{}+{}+{}", p.w, p.h, p.x0, p.y0), fraction(c.m.identical, c.m.pixels),
+           fraction(c.m.withinTolerance, c.m.pixels), a.tolerance});
     if (!a.errorMap.empty()) writeErrorMaps(a, p, c);
     fmt::print("{}", a.json ? t.json()[0].dump(2) + "\n" : t.keyValues());
     if (a.flip == "hdr" && !a.json)
@@ -392,6 +398,9 @@ void addCompareCommand(CLI::App& app) {
                     "A:B: image and reference are {frame} patterns (e.g. 'gpu.{frame}.exr'); one row per frame, with the "
                     "frame-to-frame change of the error (flicker)");
     cmd->add_option("--csv", args->csv, "With --frames: the per-frame table (CSV), and a plot beside it (.png)");
+    cmd->add_option("--tolerance", args->tolerance,
+                    "Relative tolerance of the pixel agreement (pixels within tolerance: |x-ref| <= tol |ref| in each channel)")
+        ->check(CLI::Range(0.0, 1e30));
     cmd->add_flag("--strict", args->strict, "A different frame, scene, camera or scene settings is an error (else a warning)");
     cmd->add_flag("--json", args->json, "Machine-readable output");
     cmd->add_flag("--allow-nonfinite", args->allowNonFinite,

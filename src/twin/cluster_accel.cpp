@@ -1,12 +1,14 @@
 #include "cluster_accel.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <map>
 
 #include <optix_stubs.h>
 
+#include "accretion/core/error.h"
 #include "kernels.h"
 
 namespace accretion::twin {
@@ -102,11 +104,11 @@ void ClusterAccel::setClusters(const Clusters& clusters) {
     partialCursor_ = 0;
 }
 
-void ClusterAccel::build(const Clusters& clusters, const DeviceParticles& particles, cudaStream_t stream, GpuTimer& timer) {
+void ClusterAccel::build(const Clusters* clusters, const DeviceParticles& particles, cudaStream_t stream, GpuTimer& timer) {
     const BuildPolicy policy = options_.build;
-    const bool keep = (policy == BuildPolicy::refit || policy == BuildPolicy::partial) && built() &&
-                      clusters.particle.size() == offset_.back();
-    if (!keep) setClusters(clusters);
+    const bool keep = !clusters;
+    ACC_CHECK(clusters || (built() && (policy == BuildPolicy::refit || policy == BuildPolicy::partial)));
+    if (!keep) setClusters(*clusters);
     const std::size_t C = offset_.size() - 1;
     const bool refit = keep && policy == BuildPolicy::refit;
     std::size_t first = 0, count = C;
@@ -133,6 +135,7 @@ void ClusterAccel::build(const Clusters& clusters, const DeviceParticles& partic
     if (compact) compactSizes_.reserve(C * sizeof(std::uint64_t));
     {
         GpuScope s(timer, "buildBlas");
+        const auto host0 = std::chrono::steady_clock::now();
         OptixAccelBuildOptions opts{buildFlags(), refit ? OPTIX_BUILD_OPERATION_UPDATE : OPTIX_BUILD_OPERATION_BUILD, {}};
         for (std::size_t k = 0; k < count; ++k) {
             const std::size_t c = (first + k) % C;
@@ -142,6 +145,7 @@ void ClusterAccel::build(const Clusters& clusters, const DeviceParticles& partic
             OPTIX_CHECK(optixAccelBuild(context_, stream, &opts, &in, 1, temp_.address(), temp_.bytes(), out,
                                         outputBytes_[c], &handles_[c], compact ? &emit : nullptr, compact ? 1 : 0));
         }
+        stats_.blasEnqueueMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - host0).count();
     }
     stats_.blasBytes = 0;
     for (std::size_t c = 0; c < C; ++c) stats_.blasBytes += outputBytes_[c];

@@ -32,6 +32,7 @@ struct AccelStats {
     std::size_t poolBytes = 0;        ///< the BLAS memory held: the pool, or what the per-BLAS allocations took of the device (cudaMemGetInfo)
     std::size_t tempBytes = 0;        ///< the shared scratch buffer
     std::size_t tlasBytes = 0;
+    double blasEnqueueMs = 0.0;       ///< host time of the optixAccelBuild calls of the BLAS (launch overhead)
 };
 
 /// Device arrays of the frame's particles the build reads.
@@ -45,10 +46,10 @@ class ClusterAccel {
 public:
     ClusterAccel(OptixDeviceContext context, AccelOptions options);
 
-    /// Build the frame: `clusters` is used on the first build and on every
-    /// rebuild (refit and partial keep the first frame's clusters).
+    /// Build the frame. clusters: this frame's (rebuild, fast_trace, and the
+    /// first build), or null to keep the last ones (refit, partial).
     /// Passes timed: expandBillboards, buildBlas, compactBlas, buildTlas.
-    void build(const Clusters& clusters, const DeviceParticles& particles, cudaStream_t stream, GpuTimer& timer);
+    void build(const Clusters* clusters, const DeviceParticles& particles, cudaStream_t stream, GpuTimer& timer);
 
     OptixTraversableHandle tlas() const { return tlas_; }
     const std::uint32_t* clusterParticle() const { return clusterParticle_.as<std::uint32_t>(); }

@@ -63,6 +63,14 @@ TEST_CASE("compare measures the pixels both data windows hold, half or float", "
     // 9 of 15 pixels differ by 0.5: MSE = 9/15 * 0.25, relMSE = MSE / 1.01.
     CHECK(field(out, "MSE") == Approx(0.15).epsilon(1e-6));
     CHECK(field(out, "relMSE") == Approx(0.15 / 1.01).epsilon(1e-6));
+    // 6 of 15 equal the reference; the other 9 are 50% off: outside 1e-4, inside --tolerance 0.5.
+    CHECK(field(out, "identical pixels (fraction)") == Approx(6.0 / 15.0));
+    CHECK(field(out, "pixels within tolerance (fraction)") == Approx(6.0 / 15.0));
+    std::string loose;
+    REQUIRE(runCommand(kBin + " compare " + (dir / "gpu.exr").string() + " " + (dir / "ref.exr").string() +
+                           " --flip none --tolerance 0.5", loose) == 0);
+    CHECK(field(loose, "pixels within tolerance (fraction)") == Approx(1.0));
+    CHECK(field(loose, "identical pixels (fraction)") == Approx(6.0 / 15.0));
     // The error map is that window of the display window.
     auto in = OIIO::ImageInput::open((dir / "err.exr").string());
     REQUIRE(in);

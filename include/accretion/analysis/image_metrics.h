@@ -20,6 +20,10 @@ struct ErrorMetrics {
     /// adds to relMSE in expectation (0 without a stderr layer).
     double relMSEFloor = 0.0;
     std::size_t pixels = 0;      ///< pixels measured
+    /// Pixels (of those measured) equal to the reference in all three
+    /// channels, and within the relative tolerance of computeErrors in each
+    /// (|x - ref| <= tol |ref|): agreement of two renderers of one quantity.
+    std::size_t identical = 0, withinTolerance = 0;
     /// Pixels left out because a value of the image, the reference or its
     /// stderr is NaN or infinite, and the first few of them (row-major indices).
     std::size_t nonFinite = 0;
@@ -28,9 +32,11 @@ struct ErrorMetrics {
 };
 
 inline constexpr double kRelMseEpsilon = 1e-2;
+inline constexpr double kAgreementTolerance = 1e-4;
 
 ErrorMetrics computeErrors(const std::vector<Vec3>& x, const std::vector<Vec3>& ref,
-                           const std::vector<Vec3>* refStderr = nullptr, double eps = kRelMseEpsilon);
+                           const std::vector<Vec3>* refStderr = nullptr, double eps = kRelMseEpsilon,
+                           double tolerance = kAgreementTolerance);
 
 /// An RGB layer of an EXR file, read back with OpenImageIO (half or float
 /// channels, as floats): the pixels of its data window, which may be any
