@@ -50,3 +50,26 @@ TEST_CASE("uniformInt(IntBound) draws the numbers of pcg's bounded_rand", "[rng]
         for (int i = 0; i < 20; ++i) REQUIRE(x.uniformInt(b) == y.uniformInt(n));
     }
 }
+
+TEST_CASE("PortableRng (the GPU twin's stream) draws Rng's numbers", "[rng]") {
+    // Streams of many items, frames, passes and seeds, sub-streams included;
+    // raw words, uniforms and bounded integers (bounds with large rejection
+    // thresholds too) in one interleaved sequence each.
+    const std::uint32_t bounds[] = {1, 2, 3, 7, 100, 10000, 100003, 0x80000001u, 0xfffffffbu};
+    std::size_t draws = 0;
+    for (std::uint64_t item : {0ull, 1ull, 57599ull, 1ull << 40, ~0ull})
+        for (std::uint32_t frame : {0u, 3u, 0xffffffffu})
+            for (RngPass pass : {RngPass::lightSampling, RngPass::restirCandidates, RngPass::restirSpatial})
+                for (std::uint64_t seed : {0ull, 12345ull})
+                    for (std::uint64_t sub : {0ull, 9ull}) {
+                        Rng a(item, frame, pass, seed, sub);
+                        PortableRng b(item, frame, pass, seed, sub);
+                        for (int k = 0; k < 40; ++k, draws += 3) {
+                            REQUIRE(a.next() == b.next());
+                            REQUIRE(a.uniform() == b.uniform());
+                            const std::uint32_t n = bounds[k % 9];
+                            REQUIRE(a.uniformInt(n) == b.uniformInt(n));
+                        }
+                    }
+    CHECK(draws == 5 * 3 * 3 * 2 * 2 * 40 * 3);
+}

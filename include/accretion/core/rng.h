@@ -3,6 +3,8 @@
 
 #include <pcg_random.hpp>
 
+#include "accretion/core/math.h"
+
 namespace accretion {
 
 /// Fixed pass ids for random streams: a new pass never shifts another's numbers.
@@ -73,6 +75,38 @@ public:
 
 private:
     pcg32 pcg_;
+};
+
+/// The stream of Rng in plain 64-bit arithmetic, for GPU code (the OptiX
+/// twin, src/twin): PCG32 (XSH-RR, 64-bit state, the stream's odd increment)
+/// seeded as pcg-cpp seeds pcg32, with pcg-cpp's bounded_rand. It draws the
+/// same numbers as Rng (tests/core/rng_test.cpp checks it against pcg-cpp).
+class PortableRng {
+public:
+    ACC_HD PortableRng(std::uint64_t item, std::uint32_t frame, RngPass pass, std::uint64_t seed, std::uint64_t sub = 0)
+        : inc_((mix64(item ^ (std::uint64_t(frame) << 32)) << 1) | 1u) {
+        state_ = (streamKey(item, frame, pass, seed, sub) + inc_) * kMultiplier + inc_;
+    }
+    ACC_HD std::uint32_t next() {
+        const std::uint64_t old = state_;
+        state_ = old * kMultiplier + inc_;
+        const auto xorshifted = static_cast<std::uint32_t>(((old >> 18u) ^ old) >> 27u);
+        const auto rot = static_cast<std::uint32_t>(old >> 59u);
+        return (xorshifted >> rot) | (xorshifted << ((0u - rot) & 31u));
+    }
+    ACC_HD float uniform() { return static_cast<float>(next() >> 8) * 0x1p-24f; }
+    ACC_HD std::uint32_t uniformInt(std::uint32_t n) {
+        const std::uint32_t threshold = (0u - n) % n;
+        for (;;) {
+            const std::uint32_t r = next();
+            if (r >= threshold) return r % n;
+        }
+    }
+
+private:
+    static constexpr std::uint64_t kMultiplier = 6364136223846793005ull;
+    std::uint64_t inc_;
+    std::uint64_t state_;
 };
 
 }  // namespace accretion

@@ -19,7 +19,7 @@ namespace accretion::resampling {
 /// The neighbour test of temporal and spatial reuse: the neighbour's surface
 /// (normal nq, depth dq) faces like the receiver's (n, d) and lies at a
 /// similar depth, relative to the receiver's.
-inline bool similarSurface(const Vec3& n, float d, const Vec3& nq, float dq, float normalThreshold,
+ACC_HD inline bool similarSurface(const Vec3& n, float d, const Vec3& nq, float dq, float normalThreshold,
                            float depthThreshold) {
     return glm::dot(n, nq) >= normalThreshold && std::fabs(d - dq) <= depthThreshold * d;
 }
@@ -29,13 +29,13 @@ inline bool similarSurface(const Vec3& n, float d, const Vec3& nq, float dq, flo
 /// domain, whose confidence M_c is split over the k pairs.
 /// Term of neighbour j in the weight of a sample y held by the canonical
 /// reservoir: pj = p_j(y), pc = p_c(y).
-inline double pairwiseCanonicalTerm(double Mj, double pj, double Mc, double k, double pc, double Mtotal) {
+ACC_HD inline double pairwiseCanonicalTerm(double Mj, double pj, double Mc, double k, double pc, double Mtotal) {
     const double a = Mj * pj, b = Mc / k * pc;
     return (Mj + Mc / k) / Mtotal * (a + b > 0.0 ? b / (a + b) : 0.0);
 }
 
 /// Weight of a sample y held by neighbour i: pi = p_i(y), pc = p_c(y).
-inline double pairwiseNeighbourWeight(double Mi, double pi, double Mc, double k, double pc, double Mtotal) {
+ACC_HD inline double pairwiseNeighbourWeight(double Mi, double pi, double Mc, double k, double pc, double Mtotal) {
     const double a = Mi * pi, b = Mc / k * pc;
     return (Mi + Mc / k) / Mtotal * (a + b > 0.0 ? a / (a + b) : 0.0);
 }

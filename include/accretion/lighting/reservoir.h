@@ -2,9 +2,11 @@
 #include <cstdint>
 #include <limits>
 
+#include "accretion/core/math.h"
+
 namespace accretion {
 
-inline constexpr std::uint32_t kNoLight = std::numeric_limits<std::uint32_t>::max();
+inline constexpr std::uint32_t kNoLight = 0xffffffffu;
 
 /// Weighted reservoir of one light sample (Bitterli et al. 2020, Alg. 2):
 /// streams candidates, keeps y with probability w_y / w_sum.
@@ -18,7 +20,7 @@ struct Reservoir {
     float W = 0.0f;              ///< contribution weight (after finalize)
 
     /// Stream candidate x with resampling weight w and target p_hat_x; u uniform in [0,1).
-    bool update(std::uint32_t x, float w, float p_hat_x, float u) {
+    ACC_HD bool update(std::uint32_t x, float w, float p_hat_x, float u) {
         w_sum += w;
         ++M;
         if (w > 0.0f && u * w_sum < w) {
@@ -32,14 +34,14 @@ struct Reservoir {
     /// Merge a reservoir of M_other candidates whose sample x carries
     /// resampling weight w (p_hat(x) W M_other for a finalized one, docs/MODEL.md
     /// section 4): keeps x with probability w / w_sum.
-    bool merge(std::uint32_t x, float w, float p_hat_x, std::uint32_t M_other, float u) {
+    ACC_HD bool merge(std::uint32_t x, float w, float p_hat_x, std::uint32_t M_other, float u) {
         const bool kept = update(x, w, p_hat_x, u);
         M += M_other - 1;
         return kept;
     }
 
     /// W = w_sum / (M p_hat(y)), 0 when nothing was selected.
-    void finalize() { W = (y != kNoLight && p_hat > 0.0f && M > 0) ? w_sum / (float(M) * p_hat) : 0.0f; }
+    ACC_HD void finalize() { W = (y != kNoLight && p_hat > 0.0f && M > 0) ? w_sum / (float(M) * p_hat) : 0.0f; }
 };
 
 }  // namespace accretion
