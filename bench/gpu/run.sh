@@ -1,6 +1,6 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine (issue 16), from the repository root:
-#   bash bench/gpu/run.sh STEP...      steps: env build images builds
+#   bash bench/gpu/run.sh STEP...      steps: env build images restir builds
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -43,6 +43,17 @@ step_images() {
         -o "$W/images/disk_100k.{frame}.exr" --repeat 1
 }
 
+# GPU restir frames (quickstart, 320x180, 3 frames: temporal and spatial
+# reuse), for the per-pixel comparison with the CPU's restir.
+step_restir() {
+    local q=scenes/quickstart.toml small="-D camera.width=320 -D camera.height=180 -D render.estimator=\"restir\""
+    for bc in none basic pairwise; do
+        $BIN $q $small --frames 0:3 -D restir.bias_correction=\"$bc\" -o "$W/restir/$bc.{frame}.exr" --repeat 3
+    done
+    $BIN $q $small --frames 0:3 -D restir.bias_correction=\"basic\" -o "$W/restir/basic_reorder.{frame}.exr" --repeat 3 \
+        --shadow-rays reorder -D gpu.ser_hint_bits=8
+}
+
 # Seed 004's build questions: rebuild / refit / partial, pooled / per-BLAS,
 # compaction, cluster size 100 / 1000, at 100K particles and 1080p.
 step_builds() {
@@ -65,7 +76,7 @@ step_builds() {
 for s in "$@"; do
     echo "== $s"
     "step_$s" || { echo "step $s failed"; break; }
+    # What comes back: one archive per step (the device tool returns at most 8 files).
+    if [ -d "$W/$s" ]; then tar czf "$OUT/$s.tar.gz" -C "$W" "$s" && rm -rf "${W:?}/$s"; fi
 done
-# What comes back: one archive (the device tool returns at most 8 files).
-tar czf "$OUT/results.tar.gz" -C "$W" . && rm -rf "$W"
 ls -la "$OUT"

@@ -6,6 +6,7 @@
 #include <optix_types.h>
 
 #include "accretion/geometry/billboard.h"
+#include "accretion/lighting/reservoir_codec.h"
 #include "accretion/geometry/camera.h"
 #include "accretion/render/gbuffer_texel.h"
 #include "accretion/scene/settings.h"
@@ -21,6 +22,43 @@ struct LaunchCounters {
     unsigned long long anyHits = 0;      ///< any-hit invocations
     unsigned long long occluded = 0;     ///< shadow rays that found a blocker
     unsigned long long lightTerms = 0;   ///< unshadowed terms evaluated
+};
+
+/// The lights of one frame as the restir passes read them (this frame's, or
+/// the previous frame's for temporal reuse): frame coordinates of that frame.
+struct LightView {
+    std::uint32_t count = 0;
+    float uniformPdf = 0.0f;             ///< 1 / count, rounded as LightArrays does
+    const Vec3* position = nullptr;
+    const Vec3* emission = nullptr;
+    const Vec3* albedo = nullptr;
+    const float* dmin2 = nullptr;        ///< max(r_i, dmin)^2
+};
+
+/// ReSTIR DI (docs/MODEL.md section 4) as the CPU's passes run it.
+struct RestirParams {
+    std::uint32_t frame = 0;
+    std::uint64_t seed = 0;
+    std::uint32_t candidates = 16;
+    bool temporal = false;               ///< a history exists and temporal reuse is on
+    std::uint32_t neighbours = 0;
+    float radius = 30.0f;                ///< spatial disc radius (pixels, >= 1)
+    float normalThreshold = 0.9f, depthThreshold = 0.1f;
+    double mCap = 20.0;
+    BiasCorrection bias = BiasCorrection::basic;
+    bool visibilityReuse = false;
+    bool discardNonFinite = false;       ///< render.nonfinite = discard
+    bool reorder = false;                ///< shadeTraverse: optixReorder by the SER key first
+    std::uint32_t serHintBits = 0;       ///< the SER key's hint bits (the light's cluster)
+    const StoredReservoir* in = nullptr; ///< the pass's input reservoirs
+    StoredReservoir* out = nullptr;      ///< its output
+    std::uint32_t* rejected = nullptr;   ///< per pixel: non-finite values rejected
+    // The previous frame (temporal reuse).
+    LightView prevLights;
+    const GBufferTexel* prevGbuffer = nullptr;
+    const StoredReservoir* prevReservoirs = nullptr;
+    Camera prevCamera;
+    const std::uint32_t* particleCluster = nullptr; ///< BLAS of each particle (SER hint)
 };
 
 struct LaunchParams {
@@ -43,6 +81,9 @@ struct LaunchParams {
     // clusterParticle[clusterOffset[c] ..], two triangles each.
     const std::uint32_t* clusterParticle = nullptr;
     const std::uint32_t* clusterOffset = nullptr;
+
+    LightView lights;                    ///< this frame's lights (the same arrays as above)
+    RestirParams restir;
 
     // Outputs.
     GBufferTexel* gbuffer = nullptr;     ///< width x height

@@ -9,7 +9,11 @@
 
 namespace accretion::twin {
 
-enum class Raygen { gbuffer, exact, count };
+/// gbuffer: primary rays; exact: the exact estimator; shade: restir's
+/// traceShadowRays with optixTrace (pipeline); shadeTraverse: the same with
+/// optixTraverse and a hit object (the inline-like path), optionally after
+/// optixReorder (SER).
+enum class Raygen { gbuffer, exact, shade, shadeTraverse, count };
 
 class TwinPipeline {
 public:

@@ -10,6 +10,7 @@
 
 #include "accretion/lighting/shading.h"
 #include "launch_params.h"
+#include "restir_device.h"
 
 using namespace accretion;
 using namespace accretion::twin;
@@ -40,6 +41,27 @@ __device__ bool visible(const ShadingPoint& sp, std::uint32_t light, const Light
     return occluded == 0;
 }
 
+/// visible() as the inline path runs it (optixTraverse with a hit object);
+/// with reorder, the threads are first regrouped by the SER key (the
+/// light's BLAS, in `bits` low bits) with optixReorder.
+__device__ bool visibleTraverse(const ShadingPoint& sp, std::uint32_t light, const LightTerm& t, bool reorder, unsigned hint,
+                                unsigned bits, LaunchCounters& c) {
+    unsigned receiver = sp.self, lightId = light, occluded = 0, anyHits = 0;
+    const float3 o = make_float3(sp.x.x, sp.x.y, sp.x.z), d = make_float3(t.w.x, t.w.y, t.w.z);
+    if (!(t.dist > 0.0f)) return true;
+    if (reorder) {
+        optixMakeNopHitObject();
+        optixReorder(hint, bits);
+    }
+    optixTraverse(params.tlas, o, d, 0.0f, t.dist, 0.0f, OptixVisibilityMask(255),
+                  OPTIX_RAY_FLAG_TERMINATE_ON_FIRST_HIT | OPTIX_RAY_FLAG_DISABLE_CLOSESTHIT, kShadowRay, kRayTypes,
+                  kShadowRay, receiver, lightId, occluded, anyHits);
+    ++c.rays;
+    c.anyHits += anyHits;
+    c.occluded += occluded;
+    return occluded == 0;
+}
+
 __device__ void addCounters(const LaunchCounters& c) {
     if (!params.counters) return;
     if (c.rays) atomicAdd(&params.counters->rays, c.rays);
@@ -61,7 +83,57 @@ __device__ DVec3 exactSum(const ShadingPoint& sp, LaunchCounters& c) {
     return sum;
 }
 
+/// traceShadowRays (src/render/restir/trace_shadow_rays.cpp): one shadow ray
+/// for the kept sample of restir.out, Lr = f I G V W; with visibility reuse an
+/// occluded sample's W is zeroed in the stored reservoir.
+template <ShadingModel SM, bool Traverse>
+__device__ void shadePixel() {
+    const uint3 idx = optixGetLaunchIndex();
+    const std::size_t px = std::size_t(idx.y) * params.camera.width + idx.x;
+    const RestirParams& rp = params.restir;
+    params.Lr[px] = Vec3(0.0f);
+    const GBufferTexel g = params.gbuffer[px];
+    if (!g.hit()) return;
+    const StoredReservoir r = rp.out[px];
+    if (!(r.W > 0.0f)) return;
+    const ShadingPoint sp = shadingPointOf(g, params.lights);
+    LightTerm t;
+    LaunchCounters c;
+    ++c.lightTerms;
+    bool seen = true;
+    if (lightTerm<SM>(params.lights, sp, r.y, t)) {
+        if (params.shadows) {
+            if constexpr (Traverse) {
+                const unsigned mask = rp.serHintBits >= 32 ? 0xffffffffu : (1u << rp.serHintBits) - 1u;
+                seen = visibleTraverse(sp, r.y, t, rp.reorder, rp.particleCluster[r.y] & mask, rp.serHintBits, c);
+            } else {
+                seen = visible(sp, r.y, t, c);
+            }
+        }
+        if (!seen) {
+            if (rp.visibilityReuse) rp.out[px] = StoredReservoir{kNoLight, 0.0f, r.M, 0.0f};
+        } else {
+            const Vec3 value = t.value * r.W;
+            if (isfinite(value.x) && isfinite(value.y) && isfinite(value.z)) params.Lr[px] = value;
+            else if (rejectAt(rp, px)) rp.out[px] = StoredReservoir{};
+        }
+    }
+    addCounters(c);
+}
+
+template <bool Traverse>
+__device__ void shade() {
+    switch (params.model) {
+    case ShadingModel::lambert: shadePixel<ShadingModel::lambert, Traverse>(); break;
+    case ShadingModel::sphere: shadePixel<ShadingModel::sphere, Traverse>(); break;
+    case ShadingModel::isotropic: shadePixel<ShadingModel::isotropic, Traverse>(); break;
+    }
+}
+
 }  // namespace
+
+extern "C" __global__ void __raygen__shade() { shade<false>(); }
+extern "C" __global__ void __raygen__shadeTraverse() { shade<true>(); }
 
 extern "C" __global__ void __raygen__gbuffer() {
     const uint3 idx = optixGetLaunchIndex();

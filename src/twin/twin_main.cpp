@@ -26,6 +26,7 @@
 #include "cluster_accel.h"
 #include "launch_params.h"
 #include "optix_pipeline.h"
+#include "restir_kernels.h"
 
 #ifndef ACCRETION_TWIN_PROGRAMS
 #define ACCRETION_TWIN_PROGRAMS "programs.optixir"
@@ -38,6 +39,7 @@ struct Args {
     std::string scene;
     std::vector<std::string> defines;
     std::string frames, output, timings, config, programs = ACCRETION_TWIN_PROGRAMS;
+    std::string shadowRays = "trace";
     unsigned repeat = 5;
     bool perBlas = false, compact = false, quiet = false, validation = false, skipLighting = false;
 };
@@ -55,8 +57,16 @@ void requireSupported(const Settings& s, bool lighting) {
         throw InputError(fmt::format("accretion-optix does not run {} yet (the CPU renderer does)", what));
     };
     if (s.geometry.primitive != Primitive::billboard) refuse("geometry.primitive = \"sphere\"");
-    if (lighting && s.render.estimator != EstimatorKind::exact)
+    if (lighting && s.render.estimator != EstimatorKind::exact && s.render.estimator != EstimatorKind::restir)
         refuse(fmt::format("render.estimator = \"{}\"", enumName(s.render.estimator)));
+    if (lighting && s.render.estimator == EstimatorKind::restir) {
+        const RestirSettings& r = s.restir;
+        if (s.render.source != LightSource::uniform) refuse("render.source = \"power\" in restir");
+        if (r.layout != ReservoirLayout::full) refuse("restir.layout = \"packed\"");
+        if (r.resolution_scale != 1.0) refuse("restir.resolution_scale < 1");
+        if (r.basic_visibility) refuse("restir.basic_visibility");
+        if (r.candidate_visibility) refuse("restir.candidate_visibility");
+    }
     if (s.render.visibility_rule != VisibilityRule::exact) refuse("render.visibility_rule = \"offset\"");
     if (s.gpu.omm != OmmMode::off) refuse("gpu.omm");
     if (!s.render.crop.empty()) refuse("render.crop");
@@ -65,7 +75,60 @@ void requireSupported(const Settings& s, bool lighting) {
 /// The particle arrays the programs read, on the device.
 struct FrameBuffers {
     DeviceBuffer position, emission, albedo, radius, dmin2, frames, gbuffer, Lr, counters, params;
+    // restir: two reservoir buffers, rejections, the BLAS of each particle,
+    // and the previous frame (temporal reuse).
+    DeviceBuffer resA, resB, rejected, particleCluster;
+    DeviceBuffer prevPosition, prevEmission, prevAlbedo, prevDmin2, prevGbuffer, prevReservoirs;
 };
+
+void copyDevice(DeviceBuffer& to, const DeviceBuffer& from, std::size_t bytes, cudaStream_t stream) {
+    to.reserve(bytes);
+    CUDA_CHECK(cudaMemcpyAsync(to.as<void>(), from.as<void>(), bytes, cudaMemcpyDeviceToDevice, stream));
+}
+
+/// The restir passes of a frame after the G-buffer (the CPU's runPasses):
+/// generateCandidates, temporalResampling (with a history),
+/// spatialResampling x iterations, traceShadowRays. Returns the final
+/// reservoirs (the next frame's history).
+StoredReservoir* runRestir(LaunchParams& lp, FrameBuffers& buf, const Settings& s, Raygen shade, const TwinPipeline& pipeline,
+                           cudaStream_t stream, GpuTimer& timer, std::size_t pixels) {
+    RestirParams& rp = lp.restir;
+    StoredReservoir* a = buf.resA.as<StoredReservoir>();
+    StoredReservoir* b = buf.resB.as<StoredReservoir>();
+    CUDA_CHECK(cudaMemsetAsync(buf.rejected.as<void>(), 0, pixels * sizeof(std::uint32_t), stream));
+    {
+        GpuScope t(timer, "generateCandidates");
+        rp.in = nullptr;
+        rp.out = a;
+        generateCandidates(lp, stream);
+    }
+    if (rp.temporal) {
+        GpuScope t(timer, "temporalResampling");
+        rp.in = a;
+        rp.out = b;
+        temporalResampling(lp, stream);
+        std::swap(a, b);
+    }
+    const std::uint32_t iterations = s.restir.spatial_neighbours > 0 ? s.restir.spatial_iterations : 0;
+    if (iterations > 0) {
+        GpuScope t(timer, "spatialResampling");
+        for (std::uint32_t it = 0; it < iterations; ++it) {
+            rp.in = a;
+            rp.out = b;
+            spatialResampling(lp, it, stream);
+            std::swap(a, b);
+        }
+    }
+    {
+        GpuScope t(timer, "traceShadowRays");
+        rp.in = nullptr;
+        rp.out = a;
+        CUDA_CHECK(cudaMemcpyAsync(buf.params.as<void>(), &lp, sizeof lp, cudaMemcpyHostToDevice, stream));
+        pipeline.launch(shade, buf.params.address(), sizeof lp, s.camera.width, s.camera.height, stream);
+    }
+    CUDA_CHECK(cudaGetLastError());
+    return a;
+}
 
 int run(const Args& a) {
     std::vector<FlagSetting> flags;
@@ -101,6 +164,21 @@ int run(const Args& a) {
     buf.counters.resize(sizeof(LaunchCounters));
     buf.params.resize(sizeof(LaunchParams));
 
+    const bool restir = !a.skipLighting && settings.render.estimator == EstimatorKind::restir;
+    const bool keepHistory = restir && settings.restir.temporal && settings.render.frames > 1;
+    Raygen shade = Raygen::shade;
+    if (a.shadowRays == "traverse" || a.shadowRays == "reorder") shade = Raygen::shadeTraverse;
+    else if (a.shadowRays != "trace")
+        throw InputError(fmt::format("command line --shadow-rays {}: expected trace, traverse or reorder", a.shadowRays));
+    if (restir) {
+        buf.resA.resize(pixels * sizeof(StoredReservoir));
+        buf.resB.resize(pixels * sizeof(StoredReservoir));
+        buf.rejected.resize(pixels * sizeof(std::uint32_t));
+    }
+    bool history = false;
+    Camera prevCamera{};
+    std::uint32_t prevCount = 0;
+    Clusters current;
     const BuildPolicy policy = settings.geometry.build;
     const bool persistent = policy == BuildPolicy::refit || policy == BuildPolicy::partial;
     const bool statelessBuild = !persistent;
@@ -136,6 +214,13 @@ int run(const Args& a) {
         buf.frames.upload(frames);
         const bool recluster = !built || !persistent;
         const Clusters clusters = recluster ? clusterParticles(particles.position, settings.geometry.cluster_size) : Clusters{};
+        if (recluster) current = clusters;
+        if (restir && (recluster || frame == first)) {  // the SER hint: each particle's BLAS
+            std::vector<std::uint32_t> of(n, 0);
+            for (std::size_t c = 0; c < current.count(); ++c)
+                for (std::uint32_t i : current.members(c)) of[i] = static_cast<std::uint32_t>(c);
+            buf.particleCluster.upload(of);
+        }
 
         LaunchParams lp;
         lp.camera = camera;
@@ -152,11 +237,38 @@ int run(const Args& a) {
         lp.gbuffer = buf.gbuffer.as<GBufferTexel>();
         lp.Lr = buf.Lr.as<Vec3>();
         lp.counters = buf.counters.as<LaunchCounters>();
+        lp.lights = {static_cast<std::uint32_t>(n), n ? 1.0f / float(n) : 0.0f, lp.position, lp.emission, lp.albedo, lp.dmin2};
+        if (restir) {
+            RestirParams& rp = lp.restir;
+            const RestirSettings& rs = settings.restir;
+            rp.frame = frame;
+            rp.seed = settings.render.seed;
+            rp.candidates = settings.render.candidates;
+            rp.temporal = keepHistory && history;
+            rp.neighbours = rs.spatial_neighbours;
+            rp.radius = std::max(1.0f, float(rs.spatial_radius) * 1.0f);
+            rp.normalThreshold = float(rs.normal_threshold);
+            rp.depthThreshold = float(rs.depth_threshold);
+            rp.mCap = rs.m_cap;
+            rp.bias = rs.bias_correction;
+            rp.visibilityReuse = rs.visibility_reuse;
+            rp.discardNonFinite = settings.render.nonfinite == NonFinitePolicy::discard;
+            rp.reorder = a.shadowRays == "reorder";
+            rp.serHintBits = settings.gpu.ser_hint_bits;
+            rp.rejected = buf.rejected.as<std::uint32_t>();
+            rp.particleCluster = buf.particleCluster.as<std::uint32_t>();
+            rp.prevLights = {prevCount, prevCount ? 1.0f / float(prevCount) : 0.0f, buf.prevPosition.as<Vec3>(),
+                             buf.prevEmission.as<Vec3>(), buf.prevAlbedo.as<Vec3>(), buf.prevDmin2.as<float>()};
+            rp.prevGbuffer = buf.prevGbuffer.as<GBufferTexel>();
+            rp.prevReservoirs = buf.prevReservoirs.as<StoredReservoir>();
+            rp.prevCamera = prevCamera;
+        }
 
         // The frame's passes, `repeat` times (a refit or partial build
         // changes state: it runs once per frame).
         std::map<std::string, std::vector<double>> ms;
         LaunchCounters counters{};
+        StoredReservoir* finalReservoirs = nullptr;
         const DeviceParticles dp{lp.position, lp.radius, lp.frames};
         for (unsigned r = 0; r < std::max(1u, a.repeat); ++r) {
             if (r == 0 || statelessBuild) accel.build(recluster ? &clusters : nullptr, dp, stream, timer);
@@ -169,7 +281,9 @@ int run(const Args& a) {
                 GpuScope s(timer, "traceGBuffer");
                 pipeline.launch(Raygen::gbuffer, buf.params.address(), sizeof lp, W, H, stream);
             }
-            if (!a.skipLighting) {
+            if (restir) {
+                finalReservoirs = runRestir(lp, buf, settings, shade, pipeline, stream, timer, pixels);
+            } else if (!a.skipLighting) {
                 GpuScope s(timer, "estimateLighting");
                 pipeline.launch(Raygen::exact, buf.params.address(), sizeof lp, W, H, stream);
             } else {
@@ -179,6 +293,20 @@ int run(const Args& a) {
             if (r == 0) counters = buf.counters.download<LaunchCounters>(1)[0];
         }
         built = true;
+        if (keepHistory) {  // this frame becomes the previous one
+            copyDevice(buf.prevPosition, buf.position, n * sizeof(Vec3), stream);
+            copyDevice(buf.prevEmission, buf.emission, n * sizeof(Vec3), stream);
+            copyDevice(buf.prevAlbedo, buf.albedo, n * sizeof(Vec3), stream);
+            copyDevice(buf.prevDmin2, buf.dmin2, n * sizeof(float), stream);
+            copyDevice(buf.prevGbuffer, buf.gbuffer, pixels * sizeof(GBufferTexel), stream);
+            buf.prevReservoirs.reserve(pixels * sizeof(StoredReservoir));
+            CUDA_CHECK(cudaMemcpyAsync(buf.prevReservoirs.as<void>(), finalReservoirs, pixels * sizeof(StoredReservoir),
+                                       cudaMemcpyDeviceToDevice, stream));
+            CUDA_CHECK(cudaStreamSynchronize(stream));
+            prevCamera = camera;
+            prevCount = static_cast<std::uint32_t>(n);
+            history = true;
+        }
 
         // Compose (L = Le + Lr, the background on a miss) as composeImage does.
         const std::vector<GBufferTexel> gb = buf.gbuffer.download<GBufferTexel>(pixels);
@@ -216,7 +344,8 @@ int run(const Args& a) {
             if (!a.config.empty()) timingsCsv += fmt::format("{},{},{:.6f}\n", a.config, pass, median(v));
         }
         const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-        out.metadata = {{"lighting", a.skipLighting ? "skipped" : "exact"}, {"version", std::string(version())}, {"scene", settings.scenePath},
+        out.metadata = {{"lighting", a.skipLighting ? "skipped" : std::string(enumName(settings.render.estimator))},
+                        {"shadow_rays", a.shadowRays}, {"version", std::string(version())}, {"scene", settings.scenePath},
                         {"frame", std::to_string(frame)}, {"estimator", std::string(enumName(settings.render.estimator))},
                         {"samples", std::to_string(settings.render.samples)}, {"seed", std::to_string(settings.render.seed)},
                         {"shard", ""}, {"render_time_s", fmt::format("{:.6f}", wall)}, {"settings", settingsToml},
@@ -254,7 +383,7 @@ int run(const Args& a) {
 
 int main(int argc, char** argv) {
     accretion::twin::Args a;
-    CLI::App app{"accretion-optix: the OptiX twin of the GPU pipeline (exact lighting; frames as .gpuframe)"};
+    CLI::App app{"accretion-optix: the OptiX twin of the GPU pipeline (exact and restir lighting; frames as .gpuframe)"};
     app.add_option("scene", a.scene, "Scene file (TOML)")->required()->check(CLI::ExistingFile);
     app.add_option("-D,--define", a.defines, "Override a setting: section.key=value");
     app.add_option("--frames", a.frames, "Frames A:B (half-open) = render.frame_start, render.frames");
@@ -263,6 +392,9 @@ int main(int argc, char** argv) {
     app.add_option("--timings", a.timings, "Write the median GPU ms per pass as calibrate's timings CSV (config,pass,ms)");
     app.add_option("--config", a.config, "Configuration name of the timings rows");
     app.add_option("--programs", a.programs, "The OptiX-IR of programs.cu");
+    app.add_option("--shadow-rays", a.shadowRays,
+                   "restir's traceShadowRays: trace (optixTrace, pipeline), traverse (optixTraverse + hit object, "
+                   "inline-like) or reorder (traverse after optixReorder by the SER key: gpu.ser_hint_bits of the light's BLAS)");
     app.add_flag("--per-blas", a.perBlas, "One cudaMalloc per BLAS instead of one 256-B-aligned pool");
     app.add_flag("--compact", a.compact, "Compact every BLAS after its build");
     app.add_flag("--skip-lighting", a.skipLighting, "Time the geometry passes only (Lr = 0 in the frame)");

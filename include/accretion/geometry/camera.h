@@ -75,7 +75,7 @@ struct Camera {
     /// that a jittered frame's own samples project to pixel centres) and
     /// camera-space depth of a world point; false when it is not in front of
     /// the camera.
-    bool project(const Vec3& p, float& px, float& py, float& depth) const {
+    ACC_HD bool project(const Vec3& p, float& px, float& py, float& depth) const {
         const Vec3 d = p - position;
         depth = glm::dot(d, forward);
         if (!(depth > 0.0f)) return false;

@@ -1,0 +1,153 @@
+#include "restir_kernels.h"
+
+#include "restir_device.h"
+
+namespace accretion::twin {
+namespace {
+
+__device__ inline bool pixelOf(const LaunchParams& p, std::uint32_t& x, std::uint32_t& y, std::size_t& px) {
+    x = blockIdx.x * blockDim.x + threadIdx.x;
+    y = blockIdx.y * blockDim.y + threadIdx.y;
+    px = std::size_t(y) * p.camera.width + x;
+    return x < p.camera.width && y < p.camera.height;
+}
+
+/// generateCandidates: RIS of `candidates` uniform lights with target p_hat.
+template <ShadingModel SM>
+__global__ void generateCandidatesKernel(LaunchParams p) {
+    std::uint32_t x, y;
+    std::size_t px;
+    if (!pixelOf(p, x, y, px)) return;
+    const RestirParams& rp = p.restir;
+    const GBufferTexel g = p.gbuffer[px];
+    rp.out[px] = StoredReservoir{};
+    if (!g.hit()) return;
+    const ShadingPoint sp = shadingPointOf(g, p.lights);
+    PortableRng rng(px, rp.frame, RngPass::restirCandidates, rp.seed);
+    Reservoir r;
+    bool discard = false;
+    for (std::uint32_t m = 0; m < rp.candidates; ++m) {
+        const std::uint32_t i = rng.uniformInt(p.lights.count);
+        float p_hat = targetPdf<SM>(p.lights, sp, i);
+        float w = p_hat / p.lights.uniformPdf;
+        if (!finiteF(w) || !finiteF(p_hat)) {
+            discard = rejectAt(rp, px) || discard;
+            w = p_hat = 0.0f;
+        }
+        r.update(i, w, p_hat, rng.uniform());
+    }
+    r.finalize();
+    if (!finiteF(r.w_sum) || !finiteF(r.W)) {
+        discard = rejectAt(rp, px) || discard;
+        r.W = 0.0f;
+    }
+    if (discard) return;
+    StoredReservoir s;
+    s.M = r.M;
+    if (r.W > 0.0f) {
+        s.y = r.y;
+        s.W = r.W;
+        s.p_hat = r.p_hat;
+    }
+    rp.out[px] = s;
+}
+
+/// temporalResampling: last frame's reservoir at the reprojected point.
+template <ShadingModel SM>
+__global__ void temporalResamplingKernel(LaunchParams p) {
+    std::uint32_t x, y;
+    std::size_t px;
+    if (!pixelOf(p, x, y, px)) return;
+    const RestirParams& rp = p.restir;
+    const GBufferTexel g = p.gbuffer[px];
+    const StoredReservoir cur = rp.in[px];
+    rp.out[px] = cur;
+    if (!g.hit()) return;
+    const std::uint32_t j = g.particle;
+    if (j >= rp.prevLights.count) return;
+    const Vec3 xPrev = rp.prevLights.position[j] + g.local;
+    float fx, fy, depth;
+    bool ok = rp.prevCamera.project(xPrev, fx, fy, depth);
+    const float lx = fx, ly = fy;
+    const std::uint32_t W = p.camera.width, H = p.camera.height;
+    ok = ok && lx >= 0.0f && ly >= 0.0f && lx < float(W) && ly < float(H);
+    std::size_t q = 0;
+    if (ok) {
+        q = std::size_t(ly) * W + std::size_t(lx);
+        const GBufferTexel gp = rp.prevGbuffer[q];
+        ok = gp.particle == j &&
+             resampling::similarSurface(g.normal, depth, gp.normal, gp.depth, rp.normalThreshold, rp.depthThreshold);
+    }
+    if (!ok) return;
+    Offer offers[2];
+    offers[0] = {cur, shadingPointOf(g, p.lights), &p.lights};
+    StoredReservoir prev = rp.prevReservoirs[q];
+    const double cap = rp.mCap * double(cur.M > 1u ? cur.M : 1u);
+    const double capped = floor(cap);
+    prev.M = static_cast<std::uint32_t>(double(prev.M) < capped ? double(prev.M) : capped);
+    offers[1] = {prev, shadingPointOf(rp.prevGbuffer[q], rp.prevLights), &rp.prevLights};
+    PortableRng rng(px, rp.frame, RngPass::restirTemporal, rp.seed);
+    rp.out[px] = sanitize(rp, combineReservoirs<SM>(offers, 2, p.lights, rp.bias, rng), px);
+}
+
+/// spatialResampling: k neighbours uniform in a disc of the radius.
+template <ShadingModel SM>
+__global__ void spatialResamplingKernel(LaunchParams p, std::uint32_t iteration) {
+    std::uint32_t x, y;
+    std::size_t px;
+    if (!pixelOf(p, x, y, px)) return;
+    const RestirParams& rp = p.restir;
+    const GBufferTexel g = p.gbuffer[px];
+    rp.out[px] = rp.in[px];
+    if (!g.hit()) return;
+    const std::uint32_t W = p.camera.width, H = p.camera.height;
+    PortableRng rng(px ^ (std::uint64_t(iteration) << 40), rp.frame, RngPass::restirSpatial, rp.seed);
+    Offer offers[kMaxOffers];
+    std::uint32_t n = 0;
+    offers[n++] = {rp.in[px], shadingPointOf(g, p.lights), &p.lights};
+    for (std::uint32_t s = 0; s < rp.neighbours; ++s) {
+        const float r = rp.radius * sqrtf(rng.uniform());
+        const float phi = 6.28318530718f * rng.uniform();
+        const long nx = lroundf(float(x) + r * cosf(phi));
+        const long ny = lroundf(float(y) + r * sinf(phi));
+        if (nx < 0 || ny < 0 || nx >= long(W) || ny >= long(H) || (nx == long(x) && ny == long(y))) continue;
+        const std::size_t q = std::size_t(ny) * W + std::size_t(nx);
+        const GBufferTexel gn = p.gbuffer[q];
+        if (!gn.hit() ||
+            !resampling::similarSurface(g.normal, g.depth, gn.normal, gn.depth, rp.normalThreshold, rp.depthThreshold))
+            continue;
+        offers[n++] = {rp.in[q], shadingPointOf(gn, p.lights), &p.lights};
+    }
+    rp.out[px] = sanitize(rp, combineReservoirs<SM>(offers, n, p.lights, rp.bias, rng), px);
+}
+
+dim3 blocks(const LaunchParams& p) { return dim3((p.camera.width + 7) / 8, (p.camera.height + 7) / 8); }
+const dim3 kGroup(8, 8);
+
+}  // namespace
+
+void generateCandidates(const LaunchParams& p, cudaStream_t stream) {
+    switch (p.model) {
+    case ShadingModel::lambert: generateCandidatesKernel<ShadingModel::lambert><<<blocks(p), kGroup, 0, stream>>>(p); break;
+    case ShadingModel::sphere: generateCandidatesKernel<ShadingModel::sphere><<<blocks(p), kGroup, 0, stream>>>(p); break;
+    case ShadingModel::isotropic: generateCandidatesKernel<ShadingModel::isotropic><<<blocks(p), kGroup, 0, stream>>>(p); break;
+    }
+}
+
+void temporalResampling(const LaunchParams& p, cudaStream_t stream) {
+    switch (p.model) {
+    case ShadingModel::lambert: temporalResamplingKernel<ShadingModel::lambert><<<blocks(p), kGroup, 0, stream>>>(p); break;
+    case ShadingModel::sphere: temporalResamplingKernel<ShadingModel::sphere><<<blocks(p), kGroup, 0, stream>>>(p); break;
+    case ShadingModel::isotropic: temporalResamplingKernel<ShadingModel::isotropic><<<blocks(p), kGroup, 0, stream>>>(p); break;
+    }
+}
+
+void spatialResampling(const LaunchParams& p, std::uint32_t iteration, cudaStream_t stream) {
+    switch (p.model) {
+    case ShadingModel::lambert: spatialResamplingKernel<ShadingModel::lambert><<<blocks(p), kGroup, 0, stream>>>(p, iteration); break;
+    case ShadingModel::sphere: spatialResamplingKernel<ShadingModel::sphere><<<blocks(p), kGroup, 0, stream>>>(p, iteration); break;
+    case ShadingModel::isotropic: spatialResamplingKernel<ShadingModel::isotropic><<<blocks(p), kGroup, 0, stream>>>(p, iteration); break;
+    }
+}
+
+}  // namespace accretion::twin

@@ -1,0 +1,15 @@
+#pragma once
+// The twin's restir passes that trace no ray, as CUDA kernels in 8x8 blocks
+// (generateCandidates, temporalResampling, spatialResampling); the shadow
+// rays are OptiX raygens (programs.cu). Each reads the launch's params.
+#include <cuda_runtime.h>
+
+#include "launch_params.h"
+
+namespace accretion::twin {
+
+void generateCandidates(const LaunchParams& p, cudaStream_t stream);
+void temporalResampling(const LaunchParams& p, cudaStream_t stream);
+void spatialResampling(const LaunchParams& p, std::uint32_t iteration, cudaStream_t stream);
+
+}  // namespace accretion::twin
