@@ -1,6 +1,6 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine (issue 16), from the repository root:
-#   bash bench/gpu/run.sh STEP...      steps: env build images restir builds
+#   bash bench/gpu/run.sh STEP...      steps: env build images restir builds frame ncu
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -71,6 +71,39 @@ step_builds() {
     run rebuild_k25 --frames 0:2 -D geometry.cluster_size=25
     run rebuild_k1600 --frames 0:2 -D geometry.cluster_size=1600
     rm -f "$t"/*.gpuframe
+}
+
+# Seed 004's frame: 100K particles, restir at 1080p, per-pass GPU ms, with
+# the three shadow-ray paths and cluster sizes 100 and 1000; lighting at
+# 0.75x and 0.5x as the whole frame at that resolution (the twin has no
+# upsampling pass yet).
+step_frame() {
+    local s=scenes/disk_100k.toml r="-D render.estimator=\"restir\" --frames 0:3 --repeat 7"
+    local t="$W/frame"
+    mkdir -p "$t"
+    run() { local name=$1; shift; $BIN $s $r -o "$t/$name.{frame}.exr" --timings "$t/$name.csv" --config "$name" "$@"; }
+    run k100_trace -D camera.width=1920 -D camera.height=1080
+    run k100_traverse -D camera.width=1920 -D camera.height=1080 --shadow-rays traverse
+    run k100_reorder -D camera.width=1920 -D camera.height=1080 --shadow-rays reorder -D gpu.ser_hint_bits=8
+    run k1000_trace -D camera.width=1920 -D camera.height=1080 -D geometry.cluster_size=1000
+    run k100_trace_075 -D camera.width=1440 -D camera.height=810
+    run k100_trace_050 -D camera.width=960 -D camera.height=540
+    rm -f "$t"/*.gpuframe
+}
+
+# Nsight Compute: average active threads per executed instruction of every
+# kernel of a restir frame (quickstart, 320x180, frame 1: temporal reuse).
+step_ncu() {
+    local t="$W/ncu"
+    mkdir -p "$t"
+    timeout 400 ncu --metrics smsp__thread_inst_executed_per_inst_executed.ratio,gpu__time_duration.sum --csv \
+        --log-file "$t/ncu.log" -o "$t/profile" \
+        $BIN scenes/quickstart.toml -D camera.width=320 -D camera.height=180 -D render.estimator=\"restir\" \
+        --frames 0:2 --repeat 1 -o "$t/q.{frame}.exr" > "$t/run.log" 2>&1
+    ncu --import "$t/profile.ncu-rep" --csv --page raw \
+        --metrics smsp__thread_inst_executed_per_inst_executed.ratio,gpu__time_duration.sum > "$t/ncu.csv" 2>&1
+    rm -f "$t"/*.gpuframe
+    head -5 "$t/ncu.csv"
 }
 
 for s in "$@"; do
