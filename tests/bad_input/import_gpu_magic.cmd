@@ -1,0 +1,1 @@
+import-gpu not_gpuframe.gpuframe -o import_out

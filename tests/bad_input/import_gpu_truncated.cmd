@@ -1,0 +1,1 @@
+import-gpu truncated.gpuframe -o import_out

@@ -1,0 +1,98 @@
+// The twin's frame file: a round trip, refusal of damaged files, and
+// import-gpu's EXR read back with OpenImageIO.
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+
+#include <OpenImageIO/imageio.h>
+
+#include "accretion/core/error.h"
+#include "accretion/io/gpu_frame_file.h"
+#include "support/cli.h"
+#include "support/test_scenes.h"
+
+using namespace accretion;
+using namespace accretion::test;
+
+namespace {
+
+GpuFrame sampleFrame() {
+    GpuFrame f;
+    f.width = 5;
+    f.height = 3;
+    f.frame = 7;
+    f.camera = CameraPose::lookAt(DVec3(1, 2, 3), DVec3(0, 0, 0), DVec3(0, 1, 0), 40.0);
+    f.camera.jitterX = 0.25;
+    f.metadata = {{"renderer", "accretion-optix"}, {"frame", "7"}, {"estimator", "exact"}};
+    for (std::uint32_t k = 0; k < 15; ++k) {
+        const float v = 0.5f * float(k) + 0.125f;
+        f.Lr.push_back(Vec3(v, 2.0f * v, 3.0f * v));
+        f.Le.push_back(Vec3(k % 3 ? 1.0f : 0.0f));
+        f.L.push_back(f.Le.back() + f.Lr.back());
+        f.normal.push_back(Vec3(0.0f, 0.0f, 1.0f));
+        f.depth.push_back(float(k));
+        f.particle.push_back(k == 4 ? 0xffffffffu : 100u + k);
+    }
+    return f;
+}
+
+}  // namespace
+
+TEST_CASE("a GPU frame file reads back bit for bit; damaged files are refused", "[io][gpu]") {
+    const auto dir = scratchDir("gpu_frame");
+    const GpuFrame f = sampleFrame();
+    writeGpuFrame(dir / "f.gpuframe", f);
+    const GpuFrame g = readGpuFrame(dir / "f.gpuframe");
+    CHECK(g.width == 5);
+    CHECK(g.height == 3);
+    CHECK(g.frame == 7);
+    CHECK(g.camera.eye == f.camera.eye);
+    CHECK(g.camera.forward == f.camera.forward);
+    CHECK(g.camera.jitterX == 0.25);
+    CHECK(g.metadata == f.metadata);
+    CHECK(g.L == f.L);
+    CHECK(g.Le == f.Le);
+    CHECK(g.Lr == f.Lr);
+    CHECK(g.normal == f.normal);
+    CHECK(g.depth == f.depth);
+    CHECK(g.particle == f.particle);
+
+    // Cut short by one byte, or one byte too long: refused, naming the file.
+    const auto size = std::filesystem::file_size(dir / "f.gpuframe");
+    std::filesystem::copy_file(dir / "f.gpuframe", dir / "short.gpuframe");
+    std::filesystem::resize_file(dir / "short.gpuframe", size - 1);
+    CHECK_THROWS_WITH(readGpuFrame(dir / "short.gpuframe"), Catch::Contains("short.gpuframe: truncated in plane particle"));
+    std::filesystem::copy_file(dir / "f.gpuframe", dir / "long.gpuframe");
+    std::ofstream(dir / "long.gpuframe", std::ios::app) << 'x';
+    CHECK_THROWS_WITH(readGpuFrame(dir / "long.gpuframe"), Catch::Contains("trailing bytes"));
+}
+
+TEST_CASE("import-gpu writes render's EXR layers of a GPU frame", "[io][gpu][cli]") {
+    const auto dir = scratchDir("gpu_import");
+    const GpuFrame f = sampleFrame();
+    writeGpuFrame(dir / "g.gpuframe", f);
+    std::string out;
+    REQUIRE(runCommand(kBin + " import-gpu " + (dir / "g.gpuframe").string(), out) == 0);
+    INFO(out);
+    auto in = OIIO::ImageInput::open((dir / "g.exr").string());
+    REQUIRE(in);
+    const OIIO::ImageSpec& spec = in->spec();
+    CHECK(spec.width == 5);
+    CHECK(spec.height == 3);
+    CHECK(spec.get_string_attribute("accretion:renderer") == "accretion-optix");
+    CHECK(spec.get_string_attribute("accretion:frame") == "7");
+    std::vector<float> px(std::size_t(spec.width) * spec.height * spec.nchannels);
+    REQUIRE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, px.data()));
+    const int lr = spec.channelindex("Lr.R"), lb = spec.channelindex("Lr.B"), r = spec.channelindex("R");
+    REQUIRE(lr >= 0);
+    REQUIRE(lb >= 0);
+    REQUIRE(r >= 0);
+    for (std::size_t k = 0; k < 15; ++k) {
+        CHECK(px[k * spec.nchannels + lr] == f.Lr[k].x);
+        CHECK(px[k * spec.nchannels + lb] == f.Lr[k].z);
+        CHECK(px[k * spec.nchannels + r] == f.L[k].x);
+    }
+    CHECK(std::filesystem::exists(dir / "g.png"));
+    CHECK(std::filesystem::exists(dir / "g.Lr.png"));
+}
