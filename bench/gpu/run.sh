@@ -70,6 +70,10 @@ step_builds() {
     run partial_k100 --frames 0:6 -D geometry.build='"partial"'
     run rebuild_k25 --frames 0:2 -D geometry.cluster_size=25
     run rebuild_k1600 --frames 0:2 -D geometry.cluster_size=1600
+    run rebuild_k100_streams4 --frames 0:2 --build-streams 4
+    run rebuild_k100_streams16 --frames 0:2 --build-streams 16
+    run rebuild_k25_streams16 --frames 0:2 -D geometry.cluster_size=25 --build-streams 16
+    run refit_k100_streams16 --frames 0:6 -D geometry.build='"refit"' --build-streams 16
     rm -f "$t"/*.gpuframe
 }
 

@@ -21,7 +21,21 @@ const unsigned kGeometryFlags = OPTIX_GEOMETRY_FLAG_NONE;  // any-hit allowed: i
 
 }  // namespace
 
-ClusterAccel::ClusterAccel(OptixDeviceContext context, AccelOptions options) : context_(context), options_(options) {}
+ClusterAccel::ClusterAccel(OptixDeviceContext context, AccelOptions options) : context_(context), options_(options) {
+    options_.streams = std::max(1u, options_.streams);
+    temp_.resize(options_.streams);
+    buildStreams_.resize(options_.streams - 1);
+    join_.resize(options_.streams - 1);
+    for (cudaStream_t& s : buildStreams_) CUDA_CHECK(cudaStreamCreateWithFlags(&s, cudaStreamNonBlocking));
+    for (cudaEvent_t& e : join_) CUDA_CHECK(cudaEventCreateWithFlags(&e, cudaEventDisableTiming));
+    CUDA_CHECK(cudaEventCreateWithFlags(&fork_, cudaEventDisableTiming));
+}
+
+ClusterAccel::~ClusterAccel() {
+    for (cudaStream_t s : buildStreams_) cudaStreamDestroy(s);
+    for (cudaEvent_t e : join_) cudaEventDestroy(e);
+    if (fork_) cudaEventDestroy(fork_);
+}
 
 unsigned ClusterAccel::buildFlags() const {
     unsigned f = options_.build == BuildPolicy::fast_trace ? OPTIX_BUILD_FLAG_PREFER_FAST_TRACE : OPTIX_BUILD_FLAG_PREFER_FAST_BUILD;
@@ -85,8 +99,11 @@ void ClusterAccel::setClusters(const Clusters& clusters) {
         blasOffset_[c] = pool;
         pool = alignUp(pool + outputBytes_[c], kPoolAlignment);
     }
-    temp_.reserve(tempBytes);
-    stats_.tempBytes = temp_.bytes();
+    stats_.tempBytes = 0;
+    for (DeviceBuffer& t : temp_) {
+        t.reserve(tempBytes);
+        stats_.tempBytes += t.bytes();
+    }
     perBlas_.clear();
     if (options_.pooled) {
         pool_.reserve(pool);
@@ -136,14 +153,27 @@ void ClusterAccel::build(const Clusters* clusters, const DeviceParticles& partic
     {
         GpuScope s(timer, "buildBlas");
         const auto host0 = std::chrono::steady_clock::now();
+        // The builds of one stream run one after another; with more streams
+        // (forked from and joined to the frame's) they may overlap.
+        const unsigned S = options_.streams;
+        if (S > 1) {
+            CUDA_CHECK(cudaEventRecord(fork_, stream));
+            for (cudaStream_t bs : buildStreams_) CUDA_CHECK(cudaStreamWaitEvent(bs, fork_, 0));
+        }
         OptixAccelBuildOptions opts{buildFlags(), refit ? OPTIX_BUILD_OPERATION_UPDATE : OPTIX_BUILD_OPERATION_BUILD, {}};
         for (std::size_t k = 0; k < count; ++k) {
             const std::size_t c = (first + k) % C;
+            const unsigned lane = unsigned(k % S);
+            const cudaStream_t bs = lane == 0 ? stream : buildStreams_[lane - 1];
             const OptixBuildInput in = triangles(c);
             const CUdeviceptr out = options_.pooled ? pool_.address() + blasOffset_[c] : perBlas_[c].address();
             OptixAccelEmitDesc emit{compactSizes_.address() + c * sizeof(std::uint64_t), OPTIX_PROPERTY_TYPE_COMPACTED_SIZE};
-            OPTIX_CHECK(optixAccelBuild(context_, stream, &opts, &in, 1, temp_.address(), temp_.bytes(), out,
+            OPTIX_CHECK(optixAccelBuild(context_, bs, &opts, &in, 1, temp_[lane].address(), temp_[lane].bytes(), out,
                                         outputBytes_[c], &handles_[c], compact ? &emit : nullptr, compact ? 1 : 0));
+        }
+        for (unsigned l = 1; l < S; ++l) {
+            CUDA_CHECK(cudaEventRecord(join_[l - 1], buildStreams_[l - 1]));
+            CUDA_CHECK(cudaStreamWaitEvent(stream, join_[l - 1], 0));
         }
         stats_.blasEnqueueMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - host0).count();
     }

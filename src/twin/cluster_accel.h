@@ -21,6 +21,7 @@ struct AccelOptions {
     double rebuildFraction = 0.7;
     bool pooled = true;    ///< one pool (256-B-aligned offsets) rather than one cudaMalloc per BLAS
     bool compact = false;  ///< compact each BLAS after its build (rebuild, fast_trace)
+    unsigned streams = 1;  ///< BLAS builds spread round robin over this many streams (each its own scratch)
 };
 
 /// What one frame's build did and holds.
@@ -45,6 +46,9 @@ struct DeviceParticles {
 class ClusterAccel {
 public:
     ClusterAccel(OptixDeviceContext context, AccelOptions options);
+    ~ClusterAccel();
+    ClusterAccel(const ClusterAccel&) = delete;
+    ClusterAccel& operator=(const ClusterAccel&) = delete;
 
     /// Build the frame. clusters: this frame's (rebuild, fast_trace, and the
     /// first build), or null to keep the last ones (refit, partial).
@@ -69,7 +73,11 @@ private:
     DeviceBuffer clusterParticle_, clusterOffset_, vertices_, indices_;
     std::vector<CUdeviceptr> vertexPointers_;  ///< per cluster (build inputs point at them)
     std::vector<std::size_t> outputBytes_, blasOffset_;
-    DeviceBuffer pool_, temp_, compactPool_, compactSizes_;
+    DeviceBuffer pool_, compactPool_, compactSizes_;
+    std::vector<DeviceBuffer> temp_;           ///< one scratch buffer per build stream
+    std::vector<cudaStream_t> buildStreams_;   ///< streams beside the frame's (options_.streams - 1)
+    cudaEvent_t fork_ = nullptr;
+    std::vector<cudaEvent_t> join_;
     std::vector<DeviceBuffer> perBlas_;
     std::vector<OptixTraversableHandle> handles_;
     DeviceBuffer instances_, tlasBuffer_, tlasTemp_;

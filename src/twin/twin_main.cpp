@@ -40,7 +40,7 @@ struct Args {
     std::vector<std::string> defines;
     std::string frames, output, timings, config, programs = ACCRETION_TWIN_PROGRAMS;
     std::string shadowRays = "trace";
-    unsigned repeat = 5;
+    unsigned repeat = 5, buildStreams = 1;
     bool perBlas = false, compact = false, quiet = false, validation = false, skipLighting = false;
 };
 
@@ -157,7 +157,7 @@ int run(const Args& a) {
     cudaStream_t stream;
     CUDA_CHECK(cudaStreamCreate(&stream));
     GpuTimer timer(stream);
-    ClusterAccel accel(pipeline.context(), {settings.geometry.build, settings.geometry.rebuild_fraction, !a.perBlas, a.compact});
+    ClusterAccel accel(pipeline.context(), {settings.geometry.build, settings.geometry.rebuild_fraction, !a.perBlas, a.compact, a.buildStreams});
     FrameBuffers buf;
     buf.gbuffer.resize(pixels * sizeof(GBufferTexel));
     buf.Lr.resize(pixels * sizeof(Vec3));
@@ -187,7 +187,7 @@ int run(const Args& a) {
     std::string timingsCsv = "config,pass,ms\n";
     nlohmann::json stats = {{"version", std::string(version())}, {"renderer", "accretion-optix"}, {"device", device},
                             {"scene", settings.scenePath}, {"repeat", a.repeat}, {"allocation", a.perBlas ? "per_blas" : "pooled"},
-                            {"compact", a.compact}, {"frames", nlohmann::json::array()}};
+                            {"compact", a.compact}, {"build_streams", a.buildStreams}, {"frames", nlohmann::json::array()}};
     const std::uint32_t first = settings.render.frame_start, end = first + settings.render.frames;
     for (std::uint32_t frame = first; frame < end; ++frame) {
         const auto wall0 = std::chrono::steady_clock::now();
@@ -395,6 +395,8 @@ int main(int argc, char** argv) {
     app.add_option("--shadow-rays", a.shadowRays,
                    "restir's traceShadowRays: trace (optixTrace, pipeline), traverse (optixTraverse + hit object, "
                    "inline-like) or reorder (traverse after optixReorder by the SER key: gpu.ser_hint_bits of the light's BLAS)");
+    app.add_option("--build-streams", a.buildStreams, "CUDA streams the BLAS builds are spread over (round robin)")
+        ->check(CLI::Range(1, 64));
     app.add_flag("--per-blas", a.perBlas, "One cudaMalloc per BLAS instead of one 256-B-aligned pool");
     app.add_flag("--compact", a.compact, "Compact every BLAS after its build");
     app.add_flag("--skip-lighting", a.skipLighting, "Time the geometry passes only (Lr = 0 in the frame)");
