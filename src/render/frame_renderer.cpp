@@ -1,3 +1,4 @@
+#include "accretion/render/compose_pixel.h"
 #include "accretion/render/frame_renderer.h"
 
 #include <chrono>
@@ -61,10 +62,8 @@ void composeImage(const GBuffer& gbuffer, const Particles& particles, const Shad
             continue;
         }
         ++hits;
-        img.Le[px] = se * particles.emission[g.particle];
-        img.L[px] = img.Le[px] + img.lighting.Lr[px];
-        if (!std::isfinite(img.L[px].x + img.L[px].y + img.L[px].z)) {  // float overflow: never in an output
-            img.Le[px] = img.L[px] = img.lighting.Lr[px] = img.lighting.Lr_stderr[px] = Vec3(0.0f);
+        if (!composeHit(se, particles.emission[g.particle], img.lighting.Lr[px], img.Le[px], img.L[px])) {
+            img.lighting.Lr_stderr[px] = Vec3(0.0f);
             img.lighting.rejected[px] += 1.0f;
             ++stats.nonFinite[std::string(pass::composeImage)];
         }

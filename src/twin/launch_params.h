@@ -18,7 +18,7 @@ enum RayType : unsigned { kPrimaryRay = 0, kShadowRay = 1, kRayTypes = 2 };
 
 /// Counters of one launch, summed with one atomic per thread.
 struct LaunchCounters {
-    unsigned long long rays = 0;         ///< optixTrace / optixTraverse calls
+    unsigned long long rays = 0;         ///< shadow rays (optixTrace / optixTraverse calls)
     unsigned long long anyHits = 0;      ///< any-hit invocations
     unsigned long long occluded = 0;     ///< shadow rays that found a blocker
     unsigned long long lightTerms = 0;   ///< unshadowed terms evaluated
@@ -88,7 +88,7 @@ struct LaunchParams {
     // Outputs.
     GBufferTexel* gbuffer = nullptr;     ///< width x height
     Vec3* Lr = nullptr;                  ///< width x height
-    LaunchCounters* counters = nullptr;
+    LaunchCounters* counters = nullptr;  ///< null: not counted (timed launches: the atomics would be timed too)
 };
 
 /// The particle of a hit: instance (cluster) and primitive (2 per particle).

@@ -77,22 +77,17 @@ TwinPipeline::TwinPipeline(const std::filesystem::path& programs, bool validatio
         d.miss.entryFunctionName = "__miss__none";
         miss_ = group(d);
     }
-    {
+    auto hitGroup = [&](const char* closestHit, const char* anyHit) {
         OptixProgramGroupDesc d{};
         d.kind = OPTIX_PROGRAM_GROUP_KIND_HITGROUP;
-        d.hitgroup.moduleCH = module_;
-        d.hitgroup.entryFunctionNameCH = "__closesthit__primary";
+        d.hitgroup.moduleCH = closestHit ? module_ : nullptr;
+        d.hitgroup.entryFunctionNameCH = closestHit;
         d.hitgroup.moduleAH = module_;
-        d.hitgroup.entryFunctionNameAH = "__anyhit__primary";
-        hitPrimary_ = group(d);
-    }
-    {
-        OptixProgramGroupDesc d{};
-        d.kind = OPTIX_PROGRAM_GROUP_KIND_HITGROUP;
-        d.hitgroup.moduleAH = module_;
-        d.hitgroup.entryFunctionNameAH = "__anyhit__shadow";
-        hitShadow_ = group(d);
-    }
+        d.hitgroup.entryFunctionNameAH = anyHit;
+        return group(d);
+    };
+    hitPrimary_ = hitGroup("__closesthit__primary", "__anyhit__primary");
+    hitShadow_ = hitGroup(nullptr, "__anyhit__shadow");
     std::vector<OptixProgramGroup> all(std::begin(raygen_), std::end(raygen_));
     all.insert(all.end(), {miss_, hitPrimary_, hitShadow_});
     OptixPipelineLinkOptions linkOptions{};

@@ -27,35 +27,28 @@ __device__ Vec2 hitUv() {
     return quadUv(optixGetPrimitiveIndex() & 1u, b.x, b.y);
 }
 
-/// true when the traced V(x, p_i) is 1 (counted into the thread's counters).
-__device__ bool visible(const ShadingPoint& sp, std::uint32_t light, const LightTerm& t, LaunchCounters& c) {
+/// V(x, p_i): true when no blocker is found (counted into the thread's
+/// counters). Trace: optixTrace (the pipeline path). Else optixTraverse
+/// with a hit object (the inline-like path), after optixReorder by the SER
+/// key (`hint`, `bits` low bits) when `reorder`.
+template <bool Trace>
+__device__ bool visible(const ShadingPoint& sp, std::uint32_t light, const LightTerm& t, LaunchCounters& c,
+                        bool reorder = false, unsigned hint = 0, unsigned bits = 0) {
     unsigned receiver = sp.self, lightId = light, occluded = 0, anyHits = 0;
     const float3 o = make_float3(sp.x.x, sp.x.y, sp.x.z), d = make_float3(t.w.x, t.w.y, t.w.z);
     if (!(t.dist > 0.0f)) return true;  // an empty interval sees the light (as on the CPU)
-    optixTrace(params.tlas, o, d, 0.0f, t.dist, 0.0f, OptixVisibilityMask(255),
-               OPTIX_RAY_FLAG_TERMINATE_ON_FIRST_HIT | OPTIX_RAY_FLAG_DISABLE_CLOSESTHIT, kShadowRay, kRayTypes,
-               kShadowRay, receiver, lightId, occluded, anyHits);
-    ++c.rays;
-    c.anyHits += anyHits;
-    c.occluded += occluded;
-    return occluded == 0;
-}
-
-/// visible() as the inline path runs it (optixTraverse with a hit object);
-/// with reorder, the threads are first regrouped by the SER key (the
-/// light's BLAS, in `bits` low bits) with optixReorder.
-__device__ bool visibleTraverse(const ShadingPoint& sp, std::uint32_t light, const LightTerm& t, bool reorder, unsigned hint,
-                                unsigned bits, LaunchCounters& c) {
-    unsigned receiver = sp.self, lightId = light, occluded = 0, anyHits = 0;
-    const float3 o = make_float3(sp.x.x, sp.x.y, sp.x.z), d = make_float3(t.w.x, t.w.y, t.w.z);
-    if (!(t.dist > 0.0f)) return true;
-    if (reorder) {
-        optixMakeNopHitObject();
-        optixReorder(hint, bits);
+    constexpr unsigned flags = OPTIX_RAY_FLAG_TERMINATE_ON_FIRST_HIT | OPTIX_RAY_FLAG_DISABLE_CLOSESTHIT;
+    if constexpr (Trace) {
+        optixTrace(params.tlas, o, d, 0.0f, t.dist, 0.0f, OptixVisibilityMask(255), flags, kShadowRay, kRayTypes,
+                   kShadowRay, receiver, lightId, occluded, anyHits);
+    } else {
+        if (reorder) {
+            optixMakeNopHitObject();
+            optixReorder(hint, bits);
+        }
+        optixTraverse(params.tlas, o, d, 0.0f, t.dist, 0.0f, OptixVisibilityMask(255), flags, kShadowRay, kRayTypes,
+                      kShadowRay, receiver, lightId, occluded, anyHits);
     }
-    optixTraverse(params.tlas, o, d, 0.0f, t.dist, 0.0f, OptixVisibilityMask(255),
-                  OPTIX_RAY_FLAG_TERMINATE_ON_FIRST_HIT | OPTIX_RAY_FLAG_DISABLE_CLOSESTHIT, kShadowRay, kRayTypes,
-                  kShadowRay, receiver, lightId, occluded, anyHits);
     ++c.rays;
     c.anyHits += anyHits;
     c.occluded += occluded;
@@ -78,7 +71,7 @@ __device__ DVec3 exactSum(const ShadingPoint& sp, LaunchCounters& c) {
         LightTerm t;
         ++c.lightTerms;
         if (!evalLight<M>(sp, params.position[i], params.emission[i], params.dmin2[i], t)) continue;
-        if (!params.shadows || visible(sp, i, t, c)) sum += DVec3(t.value);
+        if (!params.shadows || visible<true>(sp, i, t, c)) sum += DVec3(t.value);
     }
     return sum;
 }
@@ -105,9 +98,9 @@ __device__ void shadePixel() {
         if (params.shadows) {
             if constexpr (Traverse) {
                 const unsigned mask = rp.serHintBits >= 32 ? 0xffffffffu : (1u << rp.serHintBits) - 1u;
-                seen = visibleTraverse(sp, r.y, t, rp.reorder, rp.particleCluster[r.y] & mask, rp.serHintBits, c);
+                seen = visible<false>(sp, r.y, t, c, rp.reorder, rp.particleCluster[r.y] & mask, rp.serHintBits);
             } else {
-                seen = visible(sp, r.y, t, c);
+                seen = visible<true>(sp, r.y, t, c);
             }
         }
         if (!seen) {
@@ -152,7 +145,6 @@ extern "C" __global__ void __raygen__gbuffer() {
         g = billboardTexel(cam, x, y, dir, j, params.position[j], params.radius[j], params.frames[j], uv, params.model);
     }
     params.gbuffer[std::size_t(y) * cam.width + x] = g;
-    if (params.counters) atomicAdd(&params.counters->rays, 1ull);
 }
 
 extern "C" __global__ void __raygen__exact() {

@@ -42,14 +42,7 @@ __global__ void generateCandidatesKernel(LaunchParams p) {
         r.W = 0.0f;
     }
     if (discard) return;
-    StoredReservoir s;
-    s.M = r.M;
-    if (r.W > 0.0f) {
-        s.y = r.y;
-        s.W = r.W;
-        s.p_hat = r.p_hat;
-    }
-    rp.out[px] = s;
+    rp.out[px] = StoredReservoir::of(r);
 }
 
 /// temporalResampling: last frame's reservoir at the reprojected point.
@@ -124,30 +117,28 @@ __global__ void spatialResamplingKernel(LaunchParams p, std::uint32_t iteration)
 dim3 blocks(const LaunchParams& p) { return dim3((p.camera.width + 7) / 8, (p.camera.height + 7) / 8); }
 const dim3 kGroup(8, 8);
 
+/// launch.template operator()<SM>() with the frame's shading model.
+template <class Launch>
+void byModel(ShadingModel model, Launch&& launch) {
+    switch (model) {
+    case ShadingModel::lambert: launch.template operator()<ShadingModel::lambert>(); break;
+    case ShadingModel::sphere: launch.template operator()<ShadingModel::sphere>(); break;
+    case ShadingModel::isotropic: launch.template operator()<ShadingModel::isotropic>(); break;
+    }
+}
+
 }  // namespace
 
 void generateCandidates(const LaunchParams& p, cudaStream_t stream) {
-    switch (p.model) {
-    case ShadingModel::lambert: generateCandidatesKernel<ShadingModel::lambert><<<blocks(p), kGroup, 0, stream>>>(p); break;
-    case ShadingModel::sphere: generateCandidatesKernel<ShadingModel::sphere><<<blocks(p), kGroup, 0, stream>>>(p); break;
-    case ShadingModel::isotropic: generateCandidatesKernel<ShadingModel::isotropic><<<blocks(p), kGroup, 0, stream>>>(p); break;
-    }
+    byModel(p.model, [&]<ShadingModel SM>() { generateCandidatesKernel<SM><<<blocks(p), kGroup, 0, stream>>>(p); });
 }
 
 void temporalResampling(const LaunchParams& p, cudaStream_t stream) {
-    switch (p.model) {
-    case ShadingModel::lambert: temporalResamplingKernel<ShadingModel::lambert><<<blocks(p), kGroup, 0, stream>>>(p); break;
-    case ShadingModel::sphere: temporalResamplingKernel<ShadingModel::sphere><<<blocks(p), kGroup, 0, stream>>>(p); break;
-    case ShadingModel::isotropic: temporalResamplingKernel<ShadingModel::isotropic><<<blocks(p), kGroup, 0, stream>>>(p); break;
-    }
+    byModel(p.model, [&]<ShadingModel SM>() { temporalResamplingKernel<SM><<<blocks(p), kGroup, 0, stream>>>(p); });
 }
 
 void spatialResampling(const LaunchParams& p, std::uint32_t iteration, cudaStream_t stream) {
-    switch (p.model) {
-    case ShadingModel::lambert: spatialResamplingKernel<ShadingModel::lambert><<<blocks(p), kGroup, 0, stream>>>(p, iteration); break;
-    case ShadingModel::sphere: spatialResamplingKernel<ShadingModel::sphere><<<blocks(p), kGroup, 0, stream>>>(p, iteration); break;
-    case ShadingModel::isotropic: spatialResamplingKernel<ShadingModel::isotropic><<<blocks(p), kGroup, 0, stream>>>(p, iteration); break;
-    }
+    byModel(p.model, [&]<ShadingModel SM>() { spatialResamplingKernel<SM><<<blocks(p), kGroup, 0, stream>>>(p, iteration); });
 }
 
 }  // namespace accretion::twin

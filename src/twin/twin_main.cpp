@@ -17,11 +17,13 @@
 
 #include "accretion/core/atomic_file.h"
 #include "accretion/core/error.h"
+#include "accretion/core/parse.h"
 #include "accretion/core/version.h"
 #include "accretion/geometry/camera_track.h"
 #include "accretion/geometry/clustering.h"
 #include "accretion/io/gpu_frame_file.h"
 #include "accretion/particles/particle_source.h"
+#include "accretion/render/compose_pixel.h"
 #include "accretion/scene/scene_parser.h"
 #include "cluster_accel.h"
 #include "launch_params.h"
@@ -134,9 +136,13 @@ int run(const Args& a) {
     std::vector<FlagSetting> flags;
     if (!a.frames.empty()) {
         const auto colon = a.frames.find(':');
-        const std::uint32_t first = std::stoul(a.frames.substr(0, colon));
-        const std::uint32_t end = colon == std::string::npos ? first + 1 : std::stoul(a.frames.substr(colon + 1));
-        if (end <= first) throw InputError(fmt::format("command line --frames {}: expected A:B with A < B", a.frames));
+        const std::optional<std::uint64_t> f0 = parseUnsigned(std::string_view(a.frames).substr(0, colon), 1e9);
+        const std::optional<std::uint64_t> f1 =
+            colon == std::string::npos ? (f0 ? std::optional<std::uint64_t>(*f0 + 1) : std::nullopt)
+                                       : parseUnsigned(std::string_view(a.frames).substr(colon + 1), 1e9);
+        if (!f0 || !f1 || *f1 <= *f0)
+            throw InputError(fmt::format("command line --frames {}: expected A:B (frames A <= f < B) or A", a.frames));
+        const auto first = static_cast<std::uint32_t>(*f0), end = static_cast<std::uint32_t>(*f1);
         flags.push_back({"render.frame_start", "--frames", [first](Settings& s) { s.render.frame_start = first; }});
         flags.push_back({"render.frames", "--frames", [first, end](Settings& s) { s.render.frames = end - first; }});
     }
@@ -236,7 +242,6 @@ int run(const Args& a) {
         lp.frames = buf.frames.as<BillboardFrame>();
         lp.gbuffer = buf.gbuffer.as<GBufferTexel>();
         lp.Lr = buf.Lr.as<Vec3>();
-        lp.counters = buf.counters.as<LaunchCounters>();
         lp.lights = {static_cast<std::uint32_t>(n), n ? 1.0f / float(n) : 0.0f, lp.position, lp.emission, lp.albedo, lp.dmin2};
         if (restir) {
             RestirParams& rp = lp.restir;
@@ -264,13 +269,17 @@ int run(const Args& a) {
             rp.prevCamera = prevCamera;
         }
 
-        // The frame's passes, `repeat` times (a refit or partial build
-        // changes state: it runs once per frame).
-        std::map<std::string, std::vector<double>> ms;
+        // The frame's passes: one counting run (its atomics would be timed too),
+        // then `repeat` timed runs when repeat > 1. A refit or partial build
+        // changes state: it runs once per frame, in the first run, whose time
+        // it keeps.
+        std::map<std::string, std::vector<double>> ms, counted;
         LaunchCounters counters{};
         StoredReservoir* finalReservoirs = nullptr;
         const DeviceParticles dp{lp.position, lp.radius, lp.frames};
-        for (unsigned r = 0; r < std::max(1u, a.repeat); ++r) {
+        const unsigned runs = a.repeat > 1 ? a.repeat + 1 : 1;
+        for (unsigned r = 0; r < runs; ++r) {
+            lp.counters = r == 0 ? buf.counters.as<LaunchCounters>() : nullptr;
             if (r == 0 || statelessBuild) accel.build(recluster ? &clusters : nullptr, dp, stream, timer);
             lp.tlas = accel.tlas();
             lp.clusterParticle = accel.clusterParticle();
@@ -289,9 +298,11 @@ int run(const Args& a) {
             } else {
                 CUDA_CHECK(cudaMemsetAsync(buf.Lr.as<void>(), 0, pixels * sizeof(Vec3), stream));
             }
-            for (const auto& [pass, t] : timer.read()) ms[pass].push_back(t);
+            for (const auto& [pass, t] : timer.read()) (r == 0 ? counted : ms)[pass].push_back(t);
             if (r == 0) counters = buf.counters.download<LaunchCounters>(1)[0];
         }
+        for (auto& [pass, t] : counted)
+            if (!ms.count(pass)) ms[pass] = t;  // single run, or a pass only the first run has
         built = true;
         if (keepHistory) {  // this frame becomes the previous one
             copyDevice(buf.prevPosition, buf.position, n * sizeof(Vec3), stream);
@@ -308,7 +319,7 @@ int run(const Args& a) {
             history = true;
         }
 
-        // Compose (L = Le + Lr, the background on a miss) as composeImage does.
+        // Compose (L = Le + Lr, the background on a miss) by composeImage's rule.
         const std::vector<GBufferTexel> gb = buf.gbuffer.download<GBufferTexel>(pixels);
         GpuFrame out;
         out.width = W;
@@ -322,7 +333,7 @@ int run(const Args& a) {
         out.depth.resize(pixels);
         out.particle.resize(pixels);
         const float se = static_cast<float>(settings.shading.self_emission);
-        std::size_t hits = 0;
+        std::size_t hits = 0, nonFinite = 0;
         for (std::size_t px = 0; px < pixels; ++px) {
             const GBufferTexel& g = gb[px];
             out.particle[px] = g.particle;
@@ -333,8 +344,7 @@ int run(const Args& a) {
                 continue;
             }
             ++hits;
-            out.Le[px] = se * particles.emission[g.particle];
-            out.L[px] = out.Le[px] + out.Lr[px];
+            nonFinite += !composeHit(se, particles.emission[g.particle], out.Lr[px], out.Le[px], out.L[px]);
             out.depth[px] = g.depth;
             out.normal[px] = g.normal;
         }
@@ -361,7 +371,8 @@ int run(const Args& a) {
                                    {"rebuilt_clusters", as.rebuiltClusters}, {"refitted", as.refitted}, {"partial", as.partial},
                                    {"blas_bytes", as.blasBytes}, {"blas_memory_bytes", as.poolBytes},
                                    {"scratch_bytes", as.tempBytes}, {"blas_enqueue_ms", as.blasEnqueueMs}, {"tlas_bytes", as.tlasBytes},
-                                   {"rays", counters.rays}, {"any_hits", counters.anyHits},
+                                   {"primary_rays", pixels}, {"shadow_rays", counters.rays}, {"any_hits", counters.anyHits},
+                                   {"compose_nonfinite", nonFinite},
                                    {"shadow_occluded", counters.occluded}, {"light_terms", counters.lightTerms},
                                    {"gpu_ms", timing}, {"wall_s", wall}});
         if (!a.quiet) {
@@ -388,7 +399,9 @@ int main(int argc, char** argv) {
     app.add_option("-D,--define", a.defines, "Override a setting: section.key=value");
     app.add_option("--frames", a.frames, "Frames A:B (half-open) = render.frame_start, render.frames");
     app.add_option("-o,--output", a.output, "Output pattern ({scene}, {frame}; the extension becomes .gpuframe) = render.output");
-    app.add_option("--repeat", a.repeat, "Launches per pass for the median GPU time");
+    app.add_option("--repeat", a.repeat,
+                   "Timed runs of the frame's passes for the median GPU time (with more than 1, an untimed "
+                   "counting run comes first)")->check(CLI::Range(1, 1000));
     app.add_option("--timings", a.timings, "Write the median GPU ms per pass as calibrate's timings CSV (config,pass,ms)");
     app.add_option("--config", a.config, "Configuration name of the timings rows");
     app.add_option("--programs", a.programs, "The OptiX-IR of programs.cu");

@@ -17,6 +17,18 @@ struct StoredReservoir {
     float W = 0.0f;
     std::uint32_t M = 0;
     float p_hat = 0.0f;
+
+    /// The stored form of a finalized reservoir: its M always, its sample only when W > 0.
+    ACC_HD static StoredReservoir of(const Reservoir& r) {
+        StoredReservoir s;
+        s.M = r.M;
+        if (r.W > 0.0f) {
+            s.y = r.y;
+            s.W = r.W;
+            s.p_hat = r.p_hat;
+        }
+        return s;
+    }
 };
 
 /// The GPU buffer layout of a stored reservoir. `full`: 16 bytes, exact.

@@ -54,14 +54,7 @@ LightingCounters generateCandidatesKernel(const FrameContext& f, std::vector<Sto
                 }
             }
         }
-        StoredReservoir s;
-        s.M = r.M;
-        if (r.W > 0.0f) {
-            s.y = r.y;
-            s.W = r.W;
-            s.p_hat = r.p_hat;
-        }
-        out[px] = f.codec.roundTrip(s);
+        out[px] = f.codec.roundTrip(StoredReservoir::of(r));
     });
 }
 
