@@ -39,7 +39,7 @@ GpuFrame sampleFrame() {
 
 }  // namespace
 
-TEST_CASE("a GPU frame file reads back bit for bit; damaged files are refused", "[io][gpu]") {
+TEST_CASE("a GPU frame file reads back bit for bit, and damaged files are refused", "[io][gpu]") {
     const auto dir = scratchDir("gpu_frame");
     const GpuFrame f = sampleFrame();
     writeGpuFrame(dir / "f.gpuframe", f);
