@@ -13,9 +13,11 @@
 #include "accretion/analysis/experiment.h"
 #include "accretion/analysis/image_metrics.h"
 #include "accretion/core/error.h"
+#include "accretion/core/parse.h"
 #include "accretion/core/version.h"
 #include "accretion/core/atomic_file.h"
 #include "accretion/io/exr_output.h"
+#include "accretion/io/gpu_frame_file.h"
 #include "accretion/io/plot.h"
 #include "accretion/io/report_table.h"
 #include "accretion/io/stats_writer.h"
@@ -31,6 +33,7 @@ struct BiasArgs : ExperimentArgs {
         seeds = 64;
     }
     double zCritical = 3.29;  ///< two-sided 99.9%
+    std::string gpuFrames;    ///< read each seed's image from these .gpuframe files instead of rendering it
 };
 
 struct BiasRow {
@@ -105,6 +108,31 @@ std::string biasMapName(const EstimatorSpec& spec) {
     return safe;
 }
 
+/// --gpu-frames: the pattern's {estimator} and {seed} filled in.
+std::string gpuFramePath(std::string pattern, const std::string& estimator, std::uint64_t seed) {
+    for (const auto& [key, value] : {std::pair<std::string, std::string>{"{estimator}", estimator}, {"{seed}", std::to_string(seed)}})
+        for (std::size_t at; (at = pattern.find(key)) != std::string::npos;) pattern.replace(at, key.size(), value);
+    return pattern;
+}
+
+/// Lr of seed `seed`'s frame as the OptiX twin rendered it (accretion-optix
+/// --seeds), checked against what bias expects of it.
+ExperimentRender readGpuRender(const std::string& file, const Settings& s, std::uint32_t frame, const BiasReference& ref) {
+    GpuFrame g = readGpuFrame(file);
+    auto meta = [&](const char* key) { return g.metadata.count(key) ? g.metadata.at(key) : std::string(); };
+    if (g.width != ref.image.width || g.height != ref.image.height)
+        throw InputError(fmt::format("{}: {}x{}, the reference is {}x{}", file, g.width, g.height, ref.image.width, ref.image.height));
+    if (g.frame != frame) throw InputError(fmt::format("{}: frame {}, bias measures frame {}", file, g.frame, frame));
+    if (meta("seed") != std::to_string(s.render.seed))
+        throw InputError(fmt::format("{}: seed {}, expected {}", file, meta("seed"), s.render.seed));
+    if (meta("estimator") != enumName(s.render.estimator))
+        throw InputError(fmt::format("{}: estimator {}, expected {}", file, meta("estimator"), enumName(s.render.estimator)));
+    ExperimentRender r;
+    r.image.lighting.Lr = std::move(g.Lr);
+    r.totalSeconds = parseNumber(meta("render_time_s")).value_or(0.0);
+    return r;
+}
+
 /// One estimator over the seeds: its row, and its bias map at prefix.<estimator>.exr.
 BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vector<FlagSetting>& base,
                     const ParticleSource& source, std::uint32_t frame, const BiasReference& ref, const std::string& prefix) {
@@ -116,7 +144,9 @@ BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vec
     for (std::uint32_t k = 0; k < a.seeds; ++k) {
         Settings s = specBase;
         s.render.seed = specBase.render.seed + k;
-        const ExperimentRender r = renderForExperiment(s, source, frame, a.history);
+        const ExperimentRender r = a.gpuFrames.empty()
+                                       ? renderForExperiment(s, source, frame, a.history)
+                                       : readGpuRender(gpuFramePath(a.gpuFrames, biasMapName(spec), s.render.seed), s, frame, ref);
         seconds += r.totalSeconds;
         double e = 0.0;
         for (std::size_t p = 0; p < pixels; ++p) {
@@ -144,7 +174,8 @@ BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vec
     row.biased = std::fabs(row.z) > a.zCritical;
     writeBiasMap(prefix + "." + biasMapName(spec) + ".exr", s1, s2, S, ref,
                  {{"version", std::string(version())}, {"estimator", spec.label}, {"seeds", std::to_string(a.seeds)},
-                  {"reference", a.reference}, {"settings", settingsToToml(specBase)}});
+                  {"reference", a.reference}, {"settings", settingsToToml(specBase)},
+                  {"renderer", a.gpuFrames.empty() ? "accretion" : "accretion-optix (" + a.gpuFrames + ")"}});
     return row;
 }
 
@@ -213,6 +244,9 @@ void addBiasCommand(CLI::App& app) {
                          "Output prefix (default out/<scene>.bias): .csv, .png, .json, bias-map EXRs");
     cmd->add_option("--seeds", args->seeds, "Independent renders per estimator")->check(CLI::Range(2u, 1000000u));
     cmd->add_option("--z", args->zCritical, "Two-sided critical |z| for the verdict (3.29: 99.9%)");
+    cmd->add_option("--gpu-frames", args->gpuFrames,
+                    "Read each seed's frame from the OptiX twin's .gpuframe files instead of rendering it: a pattern "
+                    "with {estimator} (the spec, file-safe) and {seed} (render.seed + k)");
     cmd->callback([args] { runBias(*args); });
 }
 

@@ -53,7 +53,12 @@ ToneMap toneOf(const GpuFrame& g) {
 void runImport(const ImportArgs& a) {
     // Every input read and checked before anything is written.
     std::vector<GpuFrame> frames;
-    for (const std::string& in : a.inputs) frames.push_back(readGpuFrame(in));
+    for (const std::string& in : a.inputs) {
+        frames.push_back(readGpuFrame(in));
+        if (!frames.back().complete())
+            throw InputError(fmt::format("{}: holds Lr alone (accretion-optix --lr-only, a frame for `bias --gpu-frames`); "
+                                         "import-gpu needs every plane", in));
+    }
     OutputGuard guard;
     for (const std::string& in : a.inputs) guard.addInput(in);
     std::vector<std::string> outputs;

@@ -1,5 +1,6 @@
 #include "accretion/io/gpu_frame_file.h"
 
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 
@@ -23,30 +24,41 @@ void append(std::string& out, const std::vector<T>& plane) {
     out.append(reinterpret_cast<const char*>(plane.data()), plane.size() * sizeof(T));
 }
 
+/// The planes in file order, each applied to `f` by `visit(name, plane)`.
+template <class Frame, class Visit>
+void forEachPlane(Frame& f, Visit&& visit) {
+    visit("L", f.L);
+    visit("Le", f.Le);
+    visit("Lr", f.Lr);
+    visit("normal", f.normal);
+    visit("depth", f.depth);
+    visit("particle", f.particle);
+}
+
 }  // namespace
 
 void writeGpuFrame(const std::filesystem::path& file, const GpuFrame& f) {
     const std::size_t n = std::size_t(f.width) * f.height;
-    ACC_CHECK(f.L.size() == n && f.Le.size() == n && f.Lr.size() == n && f.normal.size() == n && f.depth.size() == n &&
-              f.particle.size() == n);
+    ACC_CHECK(f.Lr.size() == n);
+    nlohmann::json planes = nlohmann::json::array();
+    forEachPlane(f, [&](const char* name, const auto& plane) {
+        ACC_CHECK(plane.empty() || plane.size() == n);
+        if (!plane.empty()) planes.push_back(name);
+    });
     const nlohmann::json header = {
         {"width", f.width}, {"height", f.height}, {"frame", f.frame},
         {"camera", {{"eye", vec(f.camera.eye)}, {"forward", vec(f.camera.forward)}, {"right", vec(f.camera.right)},
                     {"up", vec(f.camera.up)}, {"tan_half_fov", f.camera.tanHalfFov},
                     {"jitter", {f.camera.jitterX, f.camera.jitterY}}}},
         {"metadata", f.metadata},
+        {"planes", planes},
     };
     const std::string text = header.dump();
     std::string bytes(kMagic, sizeof kMagic);
     const std::uint64_t len = text.size();
     bytes.append(reinterpret_cast<const char*>(&len), sizeof len);
     bytes += text;
-    append(bytes, f.L);
-    append(bytes, f.Le);
-    append(bytes, f.Lr);
-    append(bytes, f.normal);
-    append(bytes, f.depth);
-    append(bytes, f.particle);
+    forEachPlane(f, [&](const char*, const auto& plane) { append(bytes, plane); });
     writeFileAtomic(file, bytes);
 }
 
@@ -63,6 +75,7 @@ GpuFrame readGpuFrame(const std::filesystem::path& file) {
     std::string text(len, '\0');
     if (!in.read(text.data(), std::streamsize(len))) throw InputError(fmt::format("{}: truncated header", name));
     GpuFrame f;
+    std::vector<std::string> planes = {"L", "Le", "Lr", "normal", "depth", "particle"};  // files without "planes": all
     try {
         const nlohmann::json h = nlohmann::json::parse(text);
         f.width = h.at("width").get<std::uint32_t>();
@@ -77,6 +90,7 @@ GpuFrame readGpuFrame(const std::filesystem::path& file) {
         f.camera.jitterX = c.at("jitter").at(0).get<double>();
         f.camera.jitterY = c.at("jitter").at(1).get<double>();
         f.metadata = h.at("metadata").get<std::map<std::string, std::string>>();
+        if (h.contains("planes")) planes = h.at("planes").get<std::vector<std::string>>();
     } catch (const nlohmann::json::exception& e) {
         throw InputError(fmt::format("{}: bad header: {}", name, e.what()));
     }
@@ -88,12 +102,14 @@ GpuFrame readGpuFrame(const std::filesystem::path& file) {
         if (!in.read(reinterpret_cast<char*>(plane.data()), std::streamsize(n * sizeof(plane[0]))))
             throw InputError(fmt::format("{}: truncated in plane {}", name, what));
     };
-    read(f.L, "L");
-    read(f.Le, "Le");
-    read(f.Lr, "Lr");
-    read(f.normal, "normal");
-    read(f.depth, "depth");
-    read(f.particle, "particle");
+    std::size_t known = 0;
+    forEachPlane(f, [&](const char* what, auto& plane) {
+        if (std::find(planes.begin(), planes.end(), what) == planes.end()) return;
+        ++known;
+        read(plane, what);
+    });
+    if (known != planes.size() || f.Lr.empty())
+        throw InputError(fmt::format("{}: bad plane list (known planes: L, Le, Lr, normal, depth, particle; Lr required)", name));
     if (in.peek() != std::ifstream::traits_type::eof()) throw InputError(fmt::format("{}: trailing bytes", name));
     return f;
 }

@@ -6,9 +6,11 @@
 #include <cstring>
 #include <map>
 
+#include <optix_micromap.h>
 #include <optix_stubs.h>
 
 #include "accretion/core/error.h"
+#include "accretion/geometry/opacity_micromap.h"
 #include "kernels.h"
 
 namespace accretion::twin {
@@ -59,6 +61,15 @@ OptixBuildInput ClusterAccel::triangles(std::size_t c) const {
     t.indexBuffer = indices_.address();  // the same local indices in every cluster
     t.flags = &kGeometryFlags;
     t.numSbtRecords = 1;
+    if (options_.omm != OmmMode::off) {
+        OptixBuildInputOpacityMicromap& m = t.opacityMicromap;
+        m.indexingMode = OPTIX_OPACITY_MICROMAP_ARRAY_INDEXING_MODE_INDEXED;
+        m.opacityMicromapArray = ommArray_.address();
+        m.indexBuffer = ommIndices_.address();  // 0, 1, 0, 1, ...: the same in every cluster
+        m.indexSizeInBytes = 2;
+        m.numMicromapUsageCounts = 1;
+        m.micromapUsageCounts = &ommUsage_;
+    }
     return in;
 }
 
@@ -76,6 +87,12 @@ void ClusterAccel::setClusters(const Clusters& clusters) {
         std::copy(q, q + 6, idx.begin() + 6 * k);
     }
     indices_.upload(idx);
+    if (options_.omm != OmmMode::off) {
+        std::vector<std::int16_t> tri(2 * std::size_t(largest));
+        for (std::size_t k = 0; k < tri.size(); ++k) tri[k] = std::int16_t(k & 1);
+        ommIndices_.upload(tri);
+        if (!ommArray_.bytes()) buildMicromaps(nullptr);
+    }
     vertexPointers_.resize(C);
     for (std::size_t c = 0; c < C; ++c) vertexPointers_[c] = vertices_.address() + 4 * std::size_t(offset_[c]) * sizeof(Vec3);
 
@@ -89,6 +106,7 @@ void ClusterAccel::setClusters(const Clusters& clusters) {
         const std::uint32_t n = offset_[c + 1] - offset_[c];
         auto it = bySize.find(n);
         if (it == bySize.end()) {
+            ommUsage_.count = 2 * n;
             const OptixBuildInput in = triangles(c);
             OptixAccelBufferSizes s{};
             OPTIX_CHECK(optixAccelComputeMemoryUsage(context_, &opts, &in, 1, &s));
@@ -165,6 +183,7 @@ void ClusterAccel::build(const Clusters* clusters, const DeviceParticles& partic
             const std::size_t c = (first + k) % C;
             const unsigned lane = unsigned(k % S);
             const cudaStream_t bs = lane == 0 ? stream : buildStreams_[lane - 1];
+            ommUsage_.count = 2 * (offset_[c + 1] - offset_[c]);
             const OptixBuildInput in = triangles(c);
             const CUdeviceptr out = options_.pooled ? pool_.address() + blasOffset_[c] : perBlas_[c].address();
             OptixAccelEmitDesc emit{compactSizes_.address() + c * sizeof(std::uint64_t), OPTIX_PROPERTY_TYPE_COMPACTED_SIZE};
@@ -205,6 +224,54 @@ void ClusterAccel::build(const Clusters* clusters, const DeviceParticles& partic
     stats_.rebuiltClusters = count;
     stats_.refitted = refit;
     stats_.partial = keep && policy == BuildPolicy::partial;
+}
+
+void ClusterAccel::buildMicromaps(cudaStream_t stream) {
+    // The CPU's classification (docs/MODEL.md section 6) of both uv triangles,
+    // looked up at the centroid of each OptiX micro-triangle (OptiX numbers
+    // them along a space-filling curve, the CPU row by row). 4-state keeps
+    // unknown, as unknown-opaque where the 2-state map says opaque.
+    const std::uint32_t L = options_.ommLevel;
+    const bool four = options_.omm == OmmMode::four_state;
+    const OpacityMicromap fourMap(L, true), twoMap(L, false);
+    const std::uint32_t micro = 1u << (2 * L), bits = four ? 2 : 1;
+    const std::size_t stride = alignUp((std::size_t(micro) * bits + 7) / 8, 16);
+    std::vector<std::uint8_t> data(2 * stride, 0);
+    for (std::uint32_t tri = 0; tri < 2; ++tri)
+        for (std::uint32_t k = 0; k < micro; ++k) {
+            float2 b0, b1, b2;
+            optixMicromapIndexToBaseBarycentrics(k, L, b0, b1, b2);
+            const float u = (b0.x + b1.x + b2.x) / 3.0f, v = (b0.y + b1.y + b2.y) / 3.0f;
+            const OmmState s = fourMap.lookup(tri, u, v), s2 = twoMap.lookup(tri, u, v);
+            std::uint32_t state = s2 == OmmState::opaque ? OPTIX_OPACITY_MICROMAP_STATE_OPAQUE : OPTIX_OPACITY_MICROMAP_STATE_TRANSPARENT;
+            if (four && s == OmmState::unknown)
+                state = s2 == OmmState::opaque ? OPTIX_OPACITY_MICROMAP_STATE_UNKNOWN_OPAQUE : OPTIX_OPACITY_MICROMAP_STATE_UNKNOWN_TRANSPARENT;
+            const std::size_t bit = std::size_t(k) * bits;
+            data[tri * stride + bit / 8] |= std::uint8_t(state << (bit % 8));
+        }
+    const OptixOpacityMicromapFormat format = four ? OPTIX_OPACITY_MICROMAP_FORMAT_4_STATE : OPTIX_OPACITY_MICROMAP_FORMAT_2_STATE;
+    std::vector<OptixOpacityMicromapDesc> desc(2);
+    for (std::uint32_t tri = 0; tri < 2; ++tri)
+        desc[tri] = {static_cast<unsigned>(tri * stride), static_cast<unsigned short>(L), static_cast<unsigned short>(format)};
+    DeviceBuffer input, descs, temp;
+    input.upload(data);
+    descs.upload(desc);
+    const OptixOpacityMicromapHistogramEntry histogram{2, L, format};
+    OptixOpacityMicromapArrayBuildInput in{};
+    in.flags = OPTIX_OPACITY_MICROMAP_FLAG_PREFER_FAST_TRACE;
+    in.inputBuffer = input.address();
+    in.perMicromapDescBuffer = descs.address();
+    in.numMicromapHistogramEntries = 1;
+    in.micromapHistogramEntries = &histogram;
+    OptixMicromapBufferSizes sizes{};
+    OPTIX_CHECK(optixOpacityMicromapArrayComputeMemoryUsage(context_, &in, &sizes));
+    ommArray_.reserve(sizes.outputSizeInBytes);
+    temp.reserve(sizes.tempSizeInBytes);
+    const OptixMicromapBuffers buffers{ommArray_.address(), sizes.outputSizeInBytes, temp.address(), sizes.tempSizeInBytes};
+    OPTIX_CHECK(optixOpacityMicromapArrayBuild(context_, stream, &in, &buffers));
+    CUDA_CHECK(cudaStreamSynchronize(stream));
+    stats_.ommBytes = sizes.outputSizeInBytes;
+    ommUsage_ = {0, L, format};
 }
 
 void ClusterAccel::buildTlas(cudaStream_t stream) {

@@ -4,7 +4,10 @@
 // billboard), built every frame by its policy (rebuild with fast build,
 // refit, fast_trace, partial: a round-robin window of the clusters), in one
 // 256-B-aligned pool or one allocation per BLAS, optionally compacted; a TLAS
-// of one instance per cluster (instance id = cluster).
+// of one instance per cluster (instance id = cluster). With gpu.omm, every
+// triangle carries one of two opacity micromaps of the disc (the quad's two
+// uv triangles; the CPU's OpacityMicromap classification, reordered to
+// OptiX's micro-triangle order).
 #include <cstdint>
 #include <vector>
 
@@ -22,6 +25,8 @@ struct AccelOptions {
     bool pooled = true;    ///< one pool (256-B-aligned offsets) rather than one cudaMalloc per BLAS
     bool compact = false;  ///< compact each BLAS after its build (rebuild, fast_trace)
     unsigned streams = 1;  ///< BLAS builds spread round robin over this many streams (each its own scratch)
+    OmmMode omm = OmmMode::off;  ///< opacity micromaps of the disc alpha (gpu.omm; disc-alpha billboards only)
+    std::uint32_t ommLevel = 4;  ///< their subdivision level (gpu.omm_level)
 };
 
 /// What one frame's build did and holds.
@@ -33,6 +38,7 @@ struct AccelStats {
     std::size_t poolBytes = 0;        ///< the BLAS memory held: the pool, or what the per-BLAS allocations took of the device (cudaMemGetInfo)
     std::size_t tempBytes = 0;        ///< the shared scratch buffer
     std::size_t tlasBytes = 0;
+    std::size_t ommBytes = 0;         ///< the opacity micromap array (two micromaps every BLAS shares)
     double blasEnqueueMs = 0.0;       ///< host time of the optixAccelBuild calls of the BLAS (launch overhead)
 };
 
@@ -66,11 +72,14 @@ private:
     OptixBuildInput triangles(std::size_t c) const;
     unsigned buildFlags() const;
     void buildTlas(cudaStream_t stream);
+    void buildMicromaps(cudaStream_t stream);
 
     OptixDeviceContext context_;
     AccelOptions options_;
     std::vector<std::uint32_t> offset_;       ///< host copy of the cluster offsets
     DeviceBuffer clusterParticle_, clusterOffset_, vertices_, indices_;
+    DeviceBuffer ommArray_, ommIndices_;           ///< the micromap array; per triangle 0 or 1 (its uv triangle)
+    OptixOpacityMicromapUsageCount ommUsage_{};
     std::vector<CUdeviceptr> vertexPointers_;  ///< per cluster (build inputs point at them)
     std::vector<std::size_t> outputBytes_, blasOffset_;
     DeviceBuffer pool_, compactPool_, compactSizes_;

@@ -9,6 +9,7 @@
 #include "accretion/lighting/reservoir_codec.h"
 #include "accretion/geometry/camera.h"
 #include "accretion/render/gbuffer_texel.h"
+#include "accretion/render/shadow_query.h"
 #include "accretion/scene/settings.h"
 
 namespace accretion::twin {
@@ -22,6 +23,7 @@ struct LaunchCounters {
     unsigned long long anyHits = 0;      ///< any-hit invocations
     unsigned long long occluded = 0;     ///< shadow rays that found a blocker
     unsigned long long lightTerms = 0;   ///< unshadowed terms evaluated
+    unsigned long long retests = 0;      ///< shadow rays traced again past an excluded billboard (opacity micromaps)
 };
 
 /// The lights of one frame as the restir passes read them (this frame's, or
@@ -40,9 +42,15 @@ struct RestirParams {
     std::uint32_t frame = 0;
     std::uint64_t seed = 0;
     std::uint32_t candidates = 16;
+    // The lighting grid every restir pass runs on: the image at
+    // restir.resolution_scale (the image itself at 1), its G-buffer and Lr.
+    std::uint32_t width = 0, height = 0;
+    float scale = 1.0f;                  ///< lighting / image resolution
+    const GBufferTexel* gbuffer = nullptr;
+    Vec3* Lr = nullptr;
     bool temporal = false;               ///< a history exists and temporal reuse is on
     std::uint32_t neighbours = 0;
-    float radius = 30.0f;                ///< spatial disc radius (pixels, >= 1)
+    float radius = 30.0f;                ///< spatial disc radius (lighting texels, >= 1)
     float normalThreshold = 0.9f, depthThreshold = 0.1f;
     double mCap = 20.0;
     BiasCorrection bias = BiasCorrection::basic;
@@ -55,7 +63,7 @@ struct RestirParams {
     std::uint32_t* rejected = nullptr;   ///< per pixel: non-finite values rejected
     // The previous frame (temporal reuse).
     LightView prevLights;
-    const GBufferTexel* prevGbuffer = nullptr;
+    const GBufferTexel* prevGbuffer = nullptr;  ///< the previous lighting grid's
     const StoredReservoir* prevReservoirs = nullptr;
     Camera prevCamera;
     const std::uint32_t* particleCluster = nullptr; ///< BLAS of each particle (SER hint)
@@ -67,6 +75,8 @@ struct LaunchParams {
     ShadingModel model = ShadingModel::lambert;
     bool discAlpha = false;              ///< the disc alpha test (any-hit) on every ray
     bool shadows = true;                 ///< shading.visibility
+    VisibilityOptions visibility;        ///< render.visibility_rule and its offsets
+    bool omm = false;                    ///< BLAS with opacity micromaps (shadow rays re-test excluded hits)
 
     // Particles, frame coordinates (struct-of-arrays, as on the CPU).
     std::uint32_t particleCount = 0;

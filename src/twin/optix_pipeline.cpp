@@ -30,7 +30,7 @@ void logCallback(unsigned level, const char* tag, const char* message, void*) {
 
 }  // namespace
 
-TwinPipeline::TwinPipeline(const std::filesystem::path& programs, bool validation) {
+TwinPipeline::TwinPipeline(const std::filesystem::path& programs, bool validation, bool opacityMicromaps) {
     CUDA_CHECK(cudaFree(nullptr));  // the primary context
     OPTIX_CHECK(optixInit());
     OptixDeviceContextOptions options{};
@@ -50,6 +50,7 @@ TwinPipeline::TwinPipeline(const std::filesystem::path& programs, bool validatio
     pipelineOptions.exceptionFlags = OPTIX_EXCEPTION_FLAG_NONE;
     pipelineOptions.pipelineLaunchParamsVariableName = "params";
     pipelineOptions.usesPrimitiveTypeFlags = OPTIX_PRIMITIVE_TYPE_FLAGS_TRIANGLE;
+    pipelineOptions.allowOpacityMicromaps = opacityMicromaps ? 1 : 0;
     const std::string ir = readBinary(programs);
     char log[4096];
     size_t logSize = sizeof log;
@@ -87,7 +88,7 @@ TwinPipeline::TwinPipeline(const std::filesystem::path& programs, bool validatio
         return group(d);
     };
     hitPrimary_ = hitGroup("__closesthit__primary", "__anyhit__primary");
-    hitShadow_ = hitGroup(nullptr, "__anyhit__shadow");
+    hitShadow_ = hitGroup("__closesthit__shadow", "__anyhit__shadow");
     std::vector<OptixProgramGroup> all(std::begin(raygen_), std::end(raygen_));
     all.insert(all.end(), {miss_, hitPrimary_, hitShadow_});
     OptixPipelineLinkOptions linkOptions{};

@@ -17,8 +17,9 @@ enum class Raygen { gbuffer, exact, shade, shadeTraverse, count };
 
 class TwinPipeline {
 public:
-    /// programs: the OptiX-IR file built from programs.cu.
-    explicit TwinPipeline(const std::filesystem::path& programs, bool validation = false);
+    /// programs: the OptiX-IR file built from programs.cu; opacityMicromaps:
+    /// the BLAS may carry opacity micromaps.
+    TwinPipeline(const std::filesystem::path& programs, bool validation, bool opacityMicromaps);
     ~TwinPipeline();
     TwinPipeline(const TwinPipeline&) = delete;
     TwinPipeline& operator=(const TwinPipeline&) = delete;

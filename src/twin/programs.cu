@@ -4,11 +4,13 @@
 //    alpha test;
 //  - shadow rays (V(x, p_i), docs/MODEL.md section 3): an any-hit excludes the
 //    receiver j and the light i by identity (the particle of the candidate's
-//    instance and primitive), runs the alpha test, and ends the search at the
-//    first accepted blocker. No origin offset, no shortened far end.
+//    instance and primitive; none under the offset rule), runs the alpha
+//    test, and ends the search at the first accepted blocker; with opacity
+//    micromaps a closest-hit reports that blocker for the exact re-test.
 #include <optix.h>
 
 #include "accretion/lighting/shading.h"
+#include "accretion/render/shadow_query.h"
 #include "launch_params.h"
 #include "restir_device.h"
 
@@ -27,32 +29,62 @@ __device__ Vec2 hitUv() {
     return quadUv(optixGetPrimitiveIndex() & 1u, b.x, b.y);
 }
 
-/// V(x, p_i): true when no blocker is found (counted into the thread's
-/// counters). Trace: optixTrace (the pipeline path). Else optixTraverse
-/// with a hit object (the inline-like path), after optixReorder by the SER
-/// key (`hint`, `bits` low bits) when `reorder`.
+/// V(x, p_i) by render.visibility_rule (the CPU's shadowQuery): true when
+/// no blocker is found (counted into the thread's counters). Trace:
+/// optixTrace (the pipeline path). Else optixTraverse with a hit object (the
+/// inline-like path), after optixReorder by the SER key (`hint`, `bits` low
+/// bits) when `reorder`.
+///
+/// With opacity micromaps an opaque micro-triangle accepts a hit without the
+/// any-hit, so the identity exclusion cannot run there. The first accepted
+/// hit is then reported (closest-hit or hit object), and when it is the
+/// receiver's or the light's own billboard (a ray from centre to centre can
+/// meet them only at t = 0 and t = D) the ray is traced again past that hit:
+/// the exact re-test. It differs from the identity rule only for a blocker
+/// within one float step of either end.
 template <bool Trace>
 __device__ bool visible(const ShadingPoint& sp, std::uint32_t light, const LightTerm& t, LaunchCounters& c,
                         bool reorder = false, unsigned hint = 0, unsigned bits = 0) {
-    unsigned receiver = sp.self, lightId = light, occluded = 0, anyHits = 0;
-    const float3 o = make_float3(sp.x.x, sp.x.y, sp.x.z), d = make_float3(t.w.x, t.w.y, t.w.z);
-    if (!(t.dist > 0.0f)) return true;  // an empty interval sees the light (as on the CPU)
-    constexpr unsigned flags = OPTIX_RAY_FLAG_TERMINATE_ON_FIRST_HIT | OPTIX_RAY_FLAG_DISABLE_CLOSESTHIT;
-    if constexpr (Trace) {
-        optixTrace(params.tlas, o, d, 0.0f, t.dist, 0.0f, OptixVisibilityMask(255), flags, kShadowRay, kRayTypes,
-                   kShadowRay, receiver, lightId, occluded, anyHits);
-    } else {
-        if (reorder) {
-            optixMakeNopHitObject();
-            optixReorder(hint, bits);
+    const ShadowQuery q = shadowQuery<Primitive::billboard>(params.visibility, sp, light, params.position[light],
+                                                            params.radius[light], t);
+    if (!(q.tfar > q.tnear)) return true;  // an empty interval sees the light (as on the CPU)
+    float tnear = q.tnear, tfar = q.tfar;
+    const float3 o = make_float3(q.o.x, q.o.y, q.o.z), d = make_float3(q.d.x, q.d.y, q.d.z);
+    const unsigned flags = OPTIX_RAY_FLAG_TERMINATE_ON_FIRST_HIT | (params.omm ? 0u : OPTIX_RAY_FLAG_DISABLE_CLOSESTHIT);
+    for (int attempt = 0; attempt < 6; ++attempt) {
+        unsigned hitId = q.exclude.receiver, lightId = q.exclude.light, occluded = 0, anyHits = 0, tBits = 0;
+        bool hit;
+        if constexpr (Trace) {
+            optixTrace(params.tlas, o, d, tnear, tfar, 0.0f, OptixVisibilityMask(255), flags, kShadowRay, kRayTypes,
+                       kShadowRay, hitId, lightId, occluded, anyHits, tBits);
+            hit = occluded != 0;
+        } else {
+            if (reorder && attempt == 0) {
+                optixMakeNopHitObject();
+                optixReorder(hint, bits);
+            }
+            optixTraverse(params.tlas, o, d, tnear, tfar, 0.0f, OptixVisibilityMask(255), flags, kShadowRay, kRayTypes,
+                          kShadowRay, hitId, lightId, occluded, anyHits, tBits);
+            hit = optixHitObjectIsHit();
+            if (hit && params.omm) {
+                hitId = hitParticle(params, optixHitObjectGetInstanceId(), optixHitObjectGetPrimitiveIndex());
+                tBits = __float_as_uint(optixHitObjectGetRayTmax());
+            }
         }
-        optixTraverse(params.tlas, o, d, 0.0f, t.dist, 0.0f, OptixVisibilityMask(255), flags, kShadowRay, kRayTypes,
-                      kShadowRay, receiver, lightId, occluded, anyHits);
+        ++c.rays;
+        c.anyHits += anyHits;
+        if (!hit) return true;
+        if (!params.omm || (hitId != q.exclude.receiver && hitId != q.exclude.light)) {
+            ++c.occluded;
+            return false;
+        }
+        ++c.retests;  // an excluded billboard's opaque micro-triangle: past it
+        const float th = __uint_as_float(tBits);
+        if (th < 0.5f * (tnear + tfar)) tnear = nextafterf(th, tfar);
+        else tfar = nextafterf(th, tnear);
+        if (!(tfar > tnear)) return true;
     }
-    ++c.rays;
-    c.anyHits += anyHits;
-    c.occluded += occluded;
-    return occluded == 0;
+    return true;
 }
 
 __device__ void addCounters(const LaunchCounters& c) {
@@ -61,6 +93,7 @@ __device__ void addCounters(const LaunchCounters& c) {
     if (c.anyHits) atomicAdd(&params.counters->anyHits, c.anyHits);
     if (c.occluded) atomicAdd(&params.counters->occluded, c.occluded);
     if (c.lightTerms) atomicAdd(&params.counters->lightTerms, c.lightTerms);
+    if (c.retests) atomicAdd(&params.counters->retests, c.retests);
 }
 
 template <ShadingModel M>
@@ -82,10 +115,10 @@ __device__ DVec3 exactSum(const ShadingPoint& sp, LaunchCounters& c) {
 template <ShadingModel SM, bool Traverse>
 __device__ void shadePixel() {
     const uint3 idx = optixGetLaunchIndex();
-    const std::size_t px = std::size_t(idx.y) * params.camera.width + idx.x;
     const RestirParams& rp = params.restir;
-    params.Lr[px] = Vec3(0.0f);
-    const GBufferTexel g = params.gbuffer[px];
+    const std::size_t px = std::size_t(idx.y) * rp.width + idx.x;  // the lighting grid's texel
+    rp.Lr[px] = Vec3(0.0f);
+    const GBufferTexel g = rp.gbuffer[px];
     if (!g.hit()) return;
     const StoredReservoir r = rp.out[px];
     if (!(r.W > 0.0f)) return;
@@ -107,7 +140,7 @@ __device__ void shadePixel() {
             if (rp.visibilityReuse) rp.out[px] = StoredReservoir{kNoLight, 0.0f, r.M, 0.0f};
         } else {
             const Vec3 value = t.value * r.W;
-            if (isfinite(value.x) && isfinite(value.y) && isfinite(value.z)) params.Lr[px] = value;
+            if (isfinite(value.x) && isfinite(value.y) && isfinite(value.z)) rp.Lr[px] = value;
             else if (rejectAt(rp, px)) rp.out[px] = StoredReservoir{};
         }
     }
@@ -177,6 +210,14 @@ extern "C" __global__ void __closesthit__primary() {
 
 extern "C" __global__ void __anyhit__primary() {
     if (!insideDisc(hitUv())) optixIgnoreIntersection();
+}
+
+/// A shadow ray's first accepted hit (opacity micromaps only: otherwise
+/// closest-hit is disabled): its particle and t, for the exact re-test.
+extern "C" __global__ void __closesthit__shadow() {
+    optixSetPayload_0(hitParticle(params, optixGetInstanceId(), optixGetPrimitiveIndex()));
+    optixSetPayload_2(1);
+    optixSetPayload_4(__float_as_uint(optixGetRayTmax()));
 }
 
 extern "C" __global__ void __anyhit__shadow() {

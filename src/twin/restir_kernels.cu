@@ -1,15 +1,17 @@
 #include "restir_kernels.h"
 
+#include "accretion/render/upsample_pixel.h"
 #include "restir_device.h"
 
 namespace accretion::twin {
 namespace {
 
+/// The thread's texel of the lighting grid.
 __device__ inline bool pixelOf(const LaunchParams& p, std::uint32_t& x, std::uint32_t& y, std::size_t& px) {
     x = blockIdx.x * blockDim.x + threadIdx.x;
     y = blockIdx.y * blockDim.y + threadIdx.y;
-    px = std::size_t(y) * p.camera.width + x;
-    return x < p.camera.width && y < p.camera.height;
+    px = std::size_t(y) * p.restir.width + x;
+    return x < p.restir.width && y < p.restir.height;
 }
 
 /// generateCandidates: RIS of `candidates` uniform lights with target p_hat.
@@ -19,7 +21,7 @@ __global__ void generateCandidatesKernel(LaunchParams p) {
     std::size_t px;
     if (!pixelOf(p, x, y, px)) return;
     const RestirParams& rp = p.restir;
-    const GBufferTexel g = p.gbuffer[px];
+    const GBufferTexel g = rp.gbuffer[px];
     rp.out[px] = StoredReservoir{};
     if (!g.hit()) return;
     const ShadingPoint sp = shadingPointOf(g, p.lights);
@@ -52,7 +54,7 @@ __global__ void temporalResamplingKernel(LaunchParams p) {
     std::size_t px;
     if (!pixelOf(p, x, y, px)) return;
     const RestirParams& rp = p.restir;
-    const GBufferTexel g = p.gbuffer[px];
+    const GBufferTexel g = rp.gbuffer[px];
     const StoredReservoir cur = rp.in[px];
     rp.out[px] = cur;
     if (!g.hit()) return;
@@ -61,8 +63,8 @@ __global__ void temporalResamplingKernel(LaunchParams p) {
     const Vec3 xPrev = rp.prevLights.position[j] + g.local;
     float fx, fy, depth;
     bool ok = rp.prevCamera.project(xPrev, fx, fy, depth);
-    const float lx = fx, ly = fy;
-    const std::uint32_t W = p.camera.width, H = p.camera.height;
+    const float lx = fx * rp.scale, ly = fy * rp.scale;
+    const std::uint32_t W = rp.width, H = rp.height;
     ok = ok && lx >= 0.0f && ly >= 0.0f && lx < float(W) && ly < float(H);
     std::size_t q = 0;
     if (ok) {
@@ -90,10 +92,10 @@ __global__ void spatialResamplingKernel(LaunchParams p, std::uint32_t iteration)
     std::size_t px;
     if (!pixelOf(p, x, y, px)) return;
     const RestirParams& rp = p.restir;
-    const GBufferTexel g = p.gbuffer[px];
+    const GBufferTexel g = rp.gbuffer[px];
     rp.out[px] = rp.in[px];
     if (!g.hit()) return;
-    const std::uint32_t W = p.camera.width, H = p.camera.height;
+    const std::uint32_t W = rp.width, H = rp.height;
     PortableRng rng(px ^ (std::uint64_t(iteration) << 40), rp.frame, RngPass::restirSpatial, rp.seed);
     Offer offers[kMaxOffers];
     std::uint32_t n = 0;
@@ -105,7 +107,7 @@ __global__ void spatialResamplingKernel(LaunchParams p, std::uint32_t iteration)
         const long ny = lroundf(float(y) + r * sinf(phi));
         if (nx < 0 || ny < 0 || nx >= long(W) || ny >= long(H) || (nx == long(x) && ny == long(y))) continue;
         const std::size_t q = std::size_t(ny) * W + std::size_t(nx);
-        const GBufferTexel gn = p.gbuffer[q];
+        const GBufferTexel gn = rp.gbuffer[q];
         if (!gn.hit() ||
             !resampling::similarSurface(g.normal, g.depth, gn.normal, gn.depth, rp.normalThreshold, rp.depthThreshold))
             continue;
@@ -114,7 +116,7 @@ __global__ void spatialResamplingKernel(LaunchParams p, std::uint32_t iteration)
     rp.out[px] = sanitize(rp, combineReservoirs<SM>(offers, n, p.lights, rp.bias, rng), px);
 }
 
-dim3 blocks(const LaunchParams& p) { return dim3((p.camera.width + 7) / 8, (p.camera.height + 7) / 8); }
+dim3 blocks(const LaunchParams& p) { return dim3((p.restir.width + 7) / 8, (p.restir.height + 7) / 8); }
 const dim3 kGroup(8, 8);
 
 /// launch.template operator()<SM>() with the frame's shading model.
@@ -127,7 +129,36 @@ void byModel(ShadingModel model, Launch&& launch) {
     }
 }
 
+/// The lighting grid's G-buffer: each texel the image pixel containing its centre.
+__global__ void reduceGBufferKernel(LaunchParams p, GBufferTexel* grid) {
+    std::uint32_t x, y;
+    std::size_t px;
+    if (!pixelOf(p, x, y, px)) return;
+    std::uint32_t fx, fy;
+    reducedTexelSource(x, y, p.restir.scale, p.camera.width, p.camera.height, fx, fy);
+    grid[px] = p.gbuffer[std::size_t(fy) * p.camera.width + fx];
+}
+
+/// upsampleLighting: Lr of every image pixel from the lighting grid's.
+__global__ void upsampleLightingKernel(LaunchParams p) {
+    const std::uint32_t x = blockIdx.x * blockDim.x + threadIdx.x, y = blockIdx.y * blockDim.y + threadIdx.y;
+    if (x >= p.camera.width || y >= p.camera.height) return;
+    const std::size_t px = std::size_t(y) * p.camera.width + x;
+    const RestirParams& rp = p.restir;
+    p.Lr[px] = upsamplePixel(p.gbuffer[px], x, y, rp.scale, rp.gbuffer, rp.width, rp.height, rp.Lr, p.albedo,
+                             rp.normalThreshold, rp.depthThreshold);
+}
+
 }  // namespace
+
+void reduceGBuffer(const LaunchParams& p, GBufferTexel* grid, cudaStream_t stream) {
+    reduceGBufferKernel<<<blocks(p), kGroup, 0, stream>>>(p, grid);
+}
+
+void upsampleLighting(const LaunchParams& p, cudaStream_t stream) {
+    const dim3 b((p.camera.width + 7) / 8, (p.camera.height + 7) / 8);
+    upsampleLightingKernel<<<b, kGroup, 0, stream>>>(p);
+}
 
 void generateCandidates(const LaunchParams& p, cudaStream_t stream) {
     byModel(p.model, [&]<ShadingModel SM>() { generateCandidatesKernel<SM><<<blocks(p), kGroup, 0, stream>>>(p); });

@@ -1,6 +1,7 @@
 #pragma once
 // The twin's restir passes that trace no ray, as CUDA kernels in 8x8 blocks
-// (generateCandidates, temporalResampling, spatialResampling); the shadow
+// (generateCandidates, temporalResampling, spatialResampling, and the
+// reduction and upsampling of reduced-resolution lighting); the shadow
 // rays are OptiX raygens (programs.cu). Each reads the launch's params.
 #include <cuda_runtime.h>
 
@@ -11,5 +12,10 @@ namespace accretion::twin {
 void generateCandidates(const LaunchParams& p, cudaStream_t stream);
 void temporalResampling(const LaunchParams& p, cudaStream_t stream);
 void spatialResampling(const LaunchParams& p, std::uint32_t iteration, cudaStream_t stream);
+/// restir.resolution_scale < 1: the lighting grid's G-buffer from the image's
+/// (p.restir.width x height texels into `grid`), and upsampleLighting (the
+/// CPU's bilateral rule, upsamplePixel) from p.restir.Lr into p.Lr.
+void reduceGBuffer(const LaunchParams& p, GBufferTexel* grid, cudaStream_t stream);
+void upsampleLighting(const LaunchParams& p, cudaStream_t stream);
 
 }  // namespace accretion::twin

@@ -42,8 +42,8 @@ struct Args {
     std::vector<std::string> defines;
     std::string frames, output, timings, config, programs = ACCRETION_TWIN_PROGRAMS;
     std::string shadowRays = "trace";
-    unsigned repeat = 5, buildStreams = 1;
-    bool perBlas = false, compact = false, quiet = false, validation = false, skipLighting = false;
+    unsigned repeat = 5, buildStreams = 1, seeds = 1;
+    bool perBlas = false, compact = false, quiet = false, validation = false, skipLighting = false, lrOnly = false;
 };
 
 double median(std::vector<double> v) {
@@ -51,6 +51,15 @@ double median(std::vector<double> v) {
     std::sort(v.begin(), v.end());
     const std::size_t n = v.size();
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/// The pass of `accretion cost` a timed pass belongs to (calibrate joins on
+/// it): the acceleration-structure work of the frame is buildClusters, the
+/// lighting grid's reduction belongs to upsampleLighting.
+std::string costPassOf(const std::string& pass) {
+    if (pass == "expandBillboards" || pass == "buildBlas" || pass == "compactBlas" || pass == "buildTlas") return "buildClusters";
+    if (pass == "reduceGBuffer") return "upsampleLighting";
+    return pass;
 }
 
 /// The settings the twin runs; anything else is refused by name.
@@ -65,12 +74,9 @@ void requireSupported(const Settings& s, bool lighting) {
         const RestirSettings& r = s.restir;
         if (s.render.source != LightSource::uniform) refuse("render.source = \"power\" in restir");
         if (r.layout != ReservoirLayout::full) refuse("restir.layout = \"packed\"");
-        if (r.resolution_scale != 1.0) refuse("restir.resolution_scale < 1");
         if (r.basic_visibility) refuse("restir.basic_visibility");
         if (r.candidate_visibility) refuse("restir.candidate_visibility");
     }
-    if (s.render.visibility_rule != VisibilityRule::exact) refuse("render.visibility_rule = \"offset\"");
-    if (s.gpu.omm != OmmMode::off) refuse("gpu.omm");
     if (!s.render.crop.empty()) refuse("render.crop");
 }
 
@@ -80,6 +86,7 @@ struct FrameBuffers {
     // restir: two reservoir buffers, rejections, the BLAS of each particle,
     // and the previous frame (temporal reuse).
     DeviceBuffer resA, resB, rejected, particleCluster;
+    DeviceBuffer gridGbuffer, gridLr;  // restir.resolution_scale < 1: the lighting grid
     DeviceBuffer prevPosition, prevEmission, prevAlbedo, prevDmin2, prevGbuffer, prevReservoirs;
 };
 
@@ -93,8 +100,14 @@ void copyDevice(DeviceBuffer& to, const DeviceBuffer& from, std::size_t bytes, c
 /// spatialResampling x iterations, traceShadowRays. Returns the final
 /// reservoirs (the next frame's history).
 StoredReservoir* runRestir(LaunchParams& lp, FrameBuffers& buf, const Settings& s, Raygen shade, const TwinPipeline& pipeline,
-                           cudaStream_t stream, GpuTimer& timer, std::size_t pixels) {
+                           cudaStream_t stream, GpuTimer& timer) {
     RestirParams& rp = lp.restir;
+    const std::size_t pixels = std::size_t(rp.width) * rp.height;
+    const bool upsample = rp.width != s.camera.width || rp.height != s.camera.height;
+    if (upsample) {
+        GpuScope t(timer, "reduceGBuffer");
+        reduceGBuffer(lp, buf.gridGbuffer.as<GBufferTexel>(), stream);
+    }
     StoredReservoir* a = buf.resA.as<StoredReservoir>();
     StoredReservoir* b = buf.resB.as<StoredReservoir>();
     CUDA_CHECK(cudaMemsetAsync(buf.rejected.as<void>(), 0, pixels * sizeof(std::uint32_t), stream));
@@ -126,7 +139,11 @@ StoredReservoir* runRestir(LaunchParams& lp, FrameBuffers& buf, const Settings& 
         rp.in = nullptr;
         rp.out = a;
         CUDA_CHECK(cudaMemcpyAsync(buf.params.as<void>(), &lp, sizeof lp, cudaMemcpyHostToDevice, stream));
-        pipeline.launch(shade, buf.params.address(), sizeof lp, s.camera.width, s.camera.height, stream);
+        pipeline.launch(shade, buf.params.address(), sizeof lp, rp.width, rp.height, stream);
+    }
+    if (upsample) {
+        GpuScope t(timer, "upsampleLighting");
+        upsampleLighting(lp, stream);
     }
     CUDA_CHECK(cudaGetLastError());
     return a;
@@ -159,11 +176,13 @@ int run(const Args& a) {
     cudaDeviceProp prop{};
     CUDA_CHECK(cudaGetDeviceProperties(&prop, 0));
     const std::string device = prop.name;
-    TwinPipeline pipeline(a.programs, a.validation);
+    const bool omm = settings.geometry.alpha == AlphaMode::disc && settings.gpu.omm != OmmMode::off;
+    TwinPipeline pipeline(a.programs, a.validation, omm);
     cudaStream_t stream;
     CUDA_CHECK(cudaStreamCreate(&stream));
     GpuTimer timer(stream);
-    ClusterAccel accel(pipeline.context(), {settings.geometry.build, settings.geometry.rebuild_fraction, !a.perBlas, a.compact, a.buildStreams});
+    ClusterAccel accel(pipeline.context(), {settings.geometry.build, settings.geometry.rebuild_fraction, !a.perBlas, a.compact,
+                                            a.buildStreams, omm ? settings.gpu.omm : OmmMode::off, settings.gpu.omm_level});
     FrameBuffers buf;
     buf.gbuffer.resize(pixels * sizeof(GBufferTexel));
     buf.Lr.resize(pixels * sizeof(Vec3));
@@ -176,10 +195,20 @@ int run(const Args& a) {
     if (a.shadowRays == "traverse" || a.shadowRays == "reorder") shade = Raygen::shadeTraverse;
     else if (a.shadowRays != "trace")
         throw InputError(fmt::format("command line --shadow-rays {}: expected trace, traverse or reorder", a.shadowRays));
+    // The lighting grid (the CPU's Restir::render): the image at resolution_scale.
+    const float scale = static_cast<float>(settings.restir.resolution_scale);
+    const bool upsample = restir && scale < 1.0f;
+    const std::uint32_t gridW = upsample ? std::max(1u, std::uint32_t(std::lround(W * scale))) : W;
+    const std::uint32_t gridH = upsample ? std::max(1u, std::uint32_t(std::lround(H * scale))) : H;
+    const std::size_t gridPixels = std::size_t(gridW) * gridH;
     if (restir) {
-        buf.resA.resize(pixels * sizeof(StoredReservoir));
-        buf.resB.resize(pixels * sizeof(StoredReservoir));
-        buf.rejected.resize(pixels * sizeof(std::uint32_t));
+        buf.resA.resize(gridPixels * sizeof(StoredReservoir));
+        buf.resB.resize(gridPixels * sizeof(StoredReservoir));
+        buf.rejected.resize(gridPixels * sizeof(std::uint32_t));
+        if (upsample) {
+            buf.gridGbuffer.resize(gridPixels * sizeof(GBufferTexel));
+            buf.gridLr.resize(gridPixels * sizeof(Vec3));
+        }
     }
     bool history = false;
     Camera prevCamera{};
@@ -193,9 +222,16 @@ int run(const Args& a) {
     std::string timingsCsv = "config,pass,ms\n";
     nlohmann::json stats = {{"version", std::string(version())}, {"renderer", "accretion-optix"}, {"device", device},
                             {"scene", settings.scenePath}, {"repeat", a.repeat}, {"allocation", a.perBlas ? "per_blas" : "pooled"},
-                            {"compact", a.compact}, {"build_streams", a.buildStreams}, {"frames", nlohmann::json::array()}};
-    const std::uint32_t first = settings.render.frame_start, end = first + settings.render.frames;
-    for (std::uint32_t frame = first; frame < end; ++frame) {
+                            {"compact", a.compact}, {"build_streams", a.buildStreams}, {"seeds", a.seeds}, {"frames", nlohmann::json::array()}};
+    const std::uint32_t first = settings.render.frame_start, frameCount = settings.render.frames;
+    // --seeds: the frames again per seed (render.seed + k), each run from scratch.
+    for (std::uint64_t step = 0; step < std::uint64_t(a.seeds) * frameCount; ++step) {
+        const std::uint32_t frame = first + std::uint32_t(step % frameCount);
+        const std::uint64_t seed = settings.render.seed + step / frameCount;
+        if (frame == first) {
+            history = built = false;
+            prevCount = 0;
+        }
         const auto wall0 = std::chrono::steady_clock::now();
         const CameraPose pose = cameras.pose(frame);
         const Camera world = Camera::fromPose(pose, W, H);
@@ -233,6 +269,8 @@ int run(const Args& a) {
         lp.model = settings.shading.model;
         lp.discAlpha = settings.geometry.alpha == AlphaMode::disc;
         lp.shadows = settings.shading.visibility;
+        lp.visibility = VisibilityOptions::from(settings.render);
+        lp.omm = omm;
         lp.particleCount = static_cast<std::uint32_t>(n);
         lp.position = buf.position.as<Vec3>();
         lp.emission = buf.emission.as<Vec3>();
@@ -247,11 +285,16 @@ int run(const Args& a) {
             RestirParams& rp = lp.restir;
             const RestirSettings& rs = settings.restir;
             rp.frame = frame;
-            rp.seed = settings.render.seed;
+            rp.seed = seed;
             rp.candidates = settings.render.candidates;
+            rp.width = gridW;
+            rp.height = gridH;
+            rp.scale = upsample ? float(gridW) / float(W) : 1.0f;
+            rp.gbuffer = upsample ? buf.gridGbuffer.as<GBufferTexel>() : lp.gbuffer;
+            rp.Lr = upsample ? buf.gridLr.as<Vec3>() : lp.Lr;
             rp.temporal = keepHistory && history;
             rp.neighbours = rs.spatial_neighbours;
-            rp.radius = std::max(1.0f, float(rs.spatial_radius) * 1.0f);
+            rp.radius = std::max(1.0f, float(rs.spatial_radius) * rp.scale);
             rp.normalThreshold = float(rs.normal_threshold);
             rp.depthThreshold = float(rs.depth_threshold);
             rp.mCap = rs.m_cap;
@@ -291,7 +334,7 @@ int run(const Args& a) {
                 pipeline.launch(Raygen::gbuffer, buf.params.address(), sizeof lp, W, H, stream);
             }
             if (restir) {
-                finalReservoirs = runRestir(lp, buf, settings, shade, pipeline, stream, timer, pixels);
+                finalReservoirs = runRestir(lp, buf, settings, shade, pipeline, stream, timer);
             } else if (!a.skipLighting) {
                 GpuScope s(timer, "estimateLighting");
                 pipeline.launch(Raygen::exact, buf.params.address(), sizeof lp, W, H, stream);
@@ -309,9 +352,9 @@ int run(const Args& a) {
             copyDevice(buf.prevEmission, buf.emission, n * sizeof(Vec3), stream);
             copyDevice(buf.prevAlbedo, buf.albedo, n * sizeof(Vec3), stream);
             copyDevice(buf.prevDmin2, buf.dmin2, n * sizeof(float), stream);
-            copyDevice(buf.prevGbuffer, buf.gbuffer, pixels * sizeof(GBufferTexel), stream);
-            buf.prevReservoirs.reserve(pixels * sizeof(StoredReservoir));
-            CUDA_CHECK(cudaMemcpyAsync(buf.prevReservoirs.as<void>(), finalReservoirs, pixels * sizeof(StoredReservoir),
+            copyDevice(buf.prevGbuffer, upsample ? buf.gridGbuffer : buf.gbuffer, gridPixels * sizeof(GBufferTexel), stream);
+            buf.prevReservoirs.reserve(gridPixels * sizeof(StoredReservoir));
+            CUDA_CHECK(cudaMemcpyAsync(buf.prevReservoirs.as<void>(), finalReservoirs, gridPixels * sizeof(StoredReservoir),
                                        cudaMemcpyDeviceToDevice, stream));
             CUDA_CHECK(cudaStreamSynchronize(stream));
             prevCamera = camera;
@@ -349,21 +392,33 @@ int run(const Args& a) {
             out.normal[px] = g.normal;
         }
         nlohmann::json timing;
+        std::map<std::string, double> calibrated;  // by the pass names of `accretion cost`
         for (const auto& [pass, v] : ms) {
             timing[pass] = {{"median_ms", median(v)}, {"ms", v}};
-            if (!a.config.empty()) timingsCsv += fmt::format("{},{},{:.6f}\n", a.config, pass, median(v));
+            calibrated[costPassOf(pass)] += median(v);
         }
+        timingsCsv = "config,pass,ms\n";  // the last frame's
+        if (!a.config.empty())
+            for (const auto& [pass, t] : calibrated) timingsCsv += fmt::format("{},{},{:.6f}\n", a.config, pass, t);
         const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
         out.metadata = {{"lighting", a.skipLighting ? "skipped" : std::string(enumName(settings.render.estimator))},
                         {"shadow_rays", a.shadowRays}, {"version", std::string(version())}, {"scene", settings.scenePath},
                         {"frame", std::to_string(frame)}, {"estimator", std::string(enumName(settings.render.estimator))},
-                        {"samples", std::to_string(settings.render.samples)}, {"seed", std::to_string(settings.render.seed)},
+                        {"samples", std::to_string(settings.render.samples)}, {"seed", std::to_string(seed)},
                         {"shard", ""}, {"render_time_s", fmt::format("{:.6f}", wall)}, {"settings", settingsToml},
                         {"renderer", "accretion-optix"}, {"device", device},
                         {"tonemap", std::string(enumName(settings.render.tonemap))}};
         std::filesystem::path file = expandPattern(settings.render.output, settings.sceneName, frame);
-        file.replace_extension(".gpuframe");
+        file = file.parent_path() /
+               (file.stem().string() + (a.seeds > 1 ? fmt::format(".seed{}", seed) : std::string()) + ".gpuframe");
         if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+        if (a.lrOnly) {
+            out.L.clear();
+            out.Le.clear();
+            out.normal.clear();
+            out.depth.clear();
+            out.particle.clear();
+        }
         writeGpuFrame(file, out);
         const AccelStats& as = accel.stats();
         stats["frames"].push_back({{"frame", frame}, {"output", file.string()}, {"particles", n}, {"hit_pixels", hits},
@@ -374,6 +429,7 @@ int run(const Args& a) {
                                    {"primary_rays", pixels}, {"shadow_rays", counters.rays}, {"any_hits", counters.anyHits},
                                    {"compose_nonfinite", nonFinite},
                                    {"shadow_occluded", counters.occluded}, {"light_terms", counters.lightTerms},
+                                   {"shadow_retests", counters.retests}, {"seed", seed}, {"omm_bytes", as.ommBytes},
                                    {"gpu_ms", timing}, {"wall_s", wall}});
         if (!a.quiet) {
             std::string line;
@@ -402,7 +458,11 @@ int main(int argc, char** argv) {
     app.add_option("--repeat", a.repeat,
                    "Timed runs of the frame's passes for the median GPU time (with more than 1, an untimed "
                    "counting run comes first)")->check(CLI::Range(1, 1000));
-    app.add_option("--timings", a.timings, "Write the median GPU ms per pass as calibrate's timings CSV (config,pass,ms)");
+    app.add_option("--timings", a.timings,
+                   "Write the last frame's median GPU ms per pass as calibrate's timings CSV (config,pass,ms)");
+    app.add_option("--seeds", a.seeds,
+                   "Run the frames once per seed render.seed + k, k < N (outputs get .seed<S> before the extension)")
+        ->check(CLI::Range(1, 100000));
     app.add_option("--config", a.config, "Configuration name of the timings rows");
     app.add_option("--programs", a.programs, "The OptiX-IR of programs.cu");
     app.add_option("--shadow-rays", a.shadowRays,
@@ -412,6 +472,7 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(1, 64));
     app.add_flag("--per-blas", a.perBlas, "One cudaMalloc per BLAS instead of one 256-B-aligned pool");
     app.add_flag("--compact", a.compact, "Compact every BLAS after its build");
+    app.add_flag("--lr-only", a.lrOnly, "Frames hold Lr alone (for `accretion bias --gpu-frames`; import-gpu refuses them)");
     app.add_flag("--skip-lighting", a.skipLighting, "Time the geometry passes only (Lr = 0 in the frame)");
     app.add_flag("--validation", a.validation, "OptiX validation mode");
     app.add_flag("-q,--quiet", a.quiet, "No progress on stderr");

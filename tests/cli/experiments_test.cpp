@@ -6,9 +6,11 @@
 #include <sstream>
 
 #include <OpenImageIO/imageio.h>
+#include <fmt/format.h>
 
 #include "accretion/analysis/image_metrics.h"
 #include "accretion/io/exr_output.h"
+#include "accretion/io/gpu_frame_file.h"
 #include "support/cli.h"
 
 using namespace accretion;
@@ -209,4 +211,48 @@ TEST_CASE("compare: error maps in closed form, a GPU frame's channel names, meta
     CHECK(runCommand(kBin + " compare " + (dir / "gpu.exr").string() + " " + (dir / "ref.exr").string() +
                          " --channels color.r,color.g,color.b --error-map " + (dir / "ref.exr").string(), out) == 1);
     CHECK_THAT(out, Contains("an input of this run"));
+}
+
+TEST_CASE("bias --gpu-frames: frames read from files give the figures of rendering them", "[cli][experiments][gpu]") {
+    // The OptiX twin's frames reach bias as .gpuframe files holding Lr alone.
+    // Written here from the CPU's own restir renders of the same seeds, they
+    // must give bias's figures to the last digit: the files are read, not
+    // re-rendered, and nothing of the twin is needed.
+    const auto dir = accretion::test::scratchDir("bias_gpu_frames");
+    std::string out;
+    REQUIRE(runCommand(kBin + " render " + tinyScene() + " --quiet --estimator exact -o " + (dir / "exact.exr").string(), out) == 0);
+    for (int seed = 5; seed < 9; ++seed) {
+        const auto exr = dir / fmt::format("r{}.0002.exr", seed);
+        REQUIRE(runCommand(kBin + " render " + tinyScene() + " --quiet --estimator restir --frames 0:3 -D render.seed=" +
+                               std::to_string(seed) + " -o " + (dir / fmt::format("r{}.{{frame}}.exr", seed)).string(), out) == 0);
+        const RgbLayer lr = readExrLayer(exr.string(), "Lr");
+        GpuFrame g;
+        g.width = lr.width;
+        g.height = lr.height;
+        g.frame = 2;
+        g.Lr = lr.rgb;
+        g.metadata = {{"seed", std::to_string(seed)}, {"estimator", "restir"}, {"render_time_s", "0.5"}};
+        writeGpuFrame(dir / fmt::format("restir_basic.{}.gpuframe", seed), g);
+    }
+    const std::string common = " bias " + tinyScene() + " --quiet -D render.seed=5 --reference " + (dir / "exact.exr").string() +
+                               " --estimators restir:basic --seeds 4 --frame 2 --history 2 -o ";
+    REQUIRE(runCommand(kBin + common + (dir / "rendered").string(), out) == 0);
+    INFO(out);
+    REQUIRE(runCommand(kBin + common + (dir / "read").string() + " --gpu-frames " + (dir / "{estimator}.{seed}.gpuframe").string(),
+                       out) == 0);
+    const auto rendered = readCsv(dir / "rendered.csv"), read = readCsv(dir / "read.csv");
+    REQUIRE(rendered.size() == 2);
+    REQUIRE(read.size() == 2);
+    for (int col : {2, 3, 4, 5}) CHECK(read[1][col] == rendered[1][col]);  // mean error, stderr, z, energy loss
+
+    // A frame of another seed, or a missing one, is refused naming the file.
+    std::filesystem::rename(dir / "restir_basic.8.gpuframe", dir / "restir_basic.9.gpuframe");
+    CHECK(runCommand(kBin + common + (dir / "x").string() + " --gpu-frames " + (dir / "{estimator}.{seed}.gpuframe").string(), out) == 1);
+    CHECK_THAT(out, Contains("restir_basic.8.gpuframe"));
+    std::filesystem::copy_file(dir / "restir_basic.5.gpuframe", dir / "restir_basic.8.gpuframe");
+    CHECK(runCommand(kBin + common + (dir / "x").string() + " --gpu-frames " + (dir / "{estimator}.{seed}.gpuframe").string(), out) == 1);
+    CHECK_THAT(out, Contains("restir_basic.8.gpuframe: seed 5, expected 8"));
+    // Lr alone cannot be imported as render's EXR.
+    CHECK(runCommand(kBin + " import-gpu " + (dir / "restir_basic.5.gpuframe").string(), out) == 1);
+    CHECK_THAT(out, Contains("holds Lr alone"));
 }

@@ -96,3 +96,21 @@ TEST_CASE("import-gpu writes render's EXR layers of a GPU frame", "[io][gpu][cli
     CHECK(std::filesystem::exists(dir / "g.png"));
     CHECK(std::filesystem::exists(dir / "g.Lr.png"));
 }
+
+TEST_CASE("a GPU frame of Lr alone reads back, and says it is incomplete", "[io][gpu]") {
+    const auto dir = scratchDir("gpu_frame_lr");
+    GpuFrame f = sampleFrame();
+    f.L.clear();
+    f.Le.clear();
+    f.normal.clear();
+    f.depth.clear();
+    f.particle.clear();
+    writeGpuFrame(dir / "lr.gpuframe", f);
+    CHECK(std::filesystem::file_size(dir / "lr.gpuframe") < 15 * sizeof(Vec3) + 1024);
+    const GpuFrame g = readGpuFrame(dir / "lr.gpuframe");
+    CHECK(g.Lr == f.Lr);
+    CHECK(g.L.empty());
+    CHECK(g.particle.empty());
+    CHECK_FALSE(g.complete());
+    CHECK(sampleFrame().complete());
+}

@@ -7,6 +7,7 @@
 
 #include "accretion/geometry/billboard.h"
 #include "accretion/geometry/clustering.h"
+#include "accretion/geometry/exclusion.h"
 #include "accretion/geometry/embree_device.h"
 #include "accretion/geometry/opacity_micromap.h"
 #include "accretion/counters/thread_counters.h"
@@ -45,16 +46,6 @@ struct SurfaceHit {
 /// opaque and transparent micro-triangles without invoking it.
 struct AlphaTest {
     const OpacityMicromap* omm = nullptr;
-};
-
-inline constexpr std::uint32_t kNotExcluded = 0xffffffffu;
-
-/// The primitives an occlusion query ignores by identity (docs/MODEL.md section
-/// 3): the receiver j and the light i of V(x, p_i), whatever the geometry
-/// of either crosses; no epsilon is involved.
-struct Exclusion {
-    std::uint32_t receiver = kNotExcluded;
-    std::uint32_t light = kNotExcluded;
 };
 
 /// The GPU's acceleration structure on Embree (docs/MODEL.md section 2): one BLAS

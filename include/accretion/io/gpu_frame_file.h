@@ -15,9 +15,11 @@ namespace accretion {
 /// with what made them. `accretion import-gpu` turns it into render's EXR.
 ///
 /// File: "ACCGPUF1", a little-endian uint64 header length, the header (JSON:
-/// width, height, frame, camera, metadata), then the planes in this order,
-/// each width x height, row-major, little-endian: L, Le, Lr, normal (float3),
-/// depth (float), particle (uint32).
+/// width, height, frame, camera, metadata, planes), then the planes the
+/// header lists, in this order, each width x height, row-major,
+/// little-endian: L, Le, Lr, normal (float3), depth (float), particle
+/// (uint32). Lr is always there; a frame written for `bias` (accretion-optix
+/// --lr-only) holds Lr alone. A header without "planes" holds all six.
 struct GpuFrame {
     std::uint32_t width = 0, height = 0, frame = 0;
     CameraPose camera;                           ///< world space, jitter included
@@ -25,9 +27,13 @@ struct GpuFrame {
     std::vector<Vec3> L, Le, Lr, normal;
     std::vector<float> depth;
     std::vector<std::uint32_t> particle;         ///< kNoParticle (0xffffffff) on a miss
+
+    /// Every plane present (what import-gpu needs).
+    bool complete() const { return !L.empty() && !Le.empty() && !normal.empty() && !depth.empty() && !particle.empty(); }
 };
 
-/// Write atomically (no half-written file is ever left at `file`).
+/// Write atomically (no half-written file is ever left at `file`); empty
+/// planes (except Lr) are left out.
 void writeGpuFrame(const std::filesystem::path& file, const GpuFrame& frame);
 /// Read; a truncated, foreign or inconsistent file is an InputError naming it.
 GpuFrame readGpuFrame(const std::filesystem::path& file);

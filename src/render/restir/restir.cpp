@@ -2,6 +2,7 @@
 #include "accretion/render/restir.h"
 
 #include "accretion/core/error.h"
+#include "accretion/render/upsample_pixel.h"
 #include "restir_pass.h"
 
 namespace accretion {
@@ -72,8 +73,8 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
         reduced.texels.resize(std::size_t(reduced.width) * reduced.height);
         for (std::uint32_t y = 0; y < reduced.height; ++y)
             for (std::uint32_t x = 0; x < reduced.width; ++x) {
-                const auto fx = std::min(full.width - 1, std::uint32_t((float(x) + 0.5f) / scale));
-                const auto fy = std::min(full.height - 1, std::uint32_t((float(y) + 0.5f) / scale));
+                std::uint32_t fx, fy;
+                reducedTexelSource(x, y, scale, full.width, full.height, fx, fy);
                 reduced.texels[std::size_t(y) * reduced.width + x] = full.at(fx, fy);
             }
         lg = &reduced;
