@@ -26,9 +26,9 @@ step_build() {
         -DOptiX_INCLUDE="$D/optix/include" -DACCRETION_COMMIT="$(cat "$D/commit")" -DCMAKE_CUDA_ARCHITECTURES=90 \
         -DTBB_DIR=$L/cmake/TBB -Dfmt_DIR=$L/cmake/fmt -Dtomlplusplus_DIR=$L/cmake/tomlplusplus \
         -Dglm_DIR=$S/share/cmake/glm -Dnlohmann_json_DIR=$S/share/cmake/nlohmann_json -DCLI11_DIR=$S/share/cmake/CLI11 \
-        > "$OUT/build.log" 2>&1 && cmake --build build-gpu -j 16 >> "$OUT/build.log" 2>&1
+        > "$W/build.log" 2>&1 && cmake --build build-gpu -j 16 >> "$W/build.log" 2>&1
     local rc=$?
-    tail -30 "$OUT/build.log"
+    tail -30 "$W/build.log"
     return $rc
 }
 
@@ -41,6 +41,15 @@ step_images() {
         -o "$W/images/quickstart_sphere.{frame}.exr" --repeat 3
     timeout 300 $BIN scenes/disk_100k.toml $small --frames 0:1 \
         -o "$W/images/disk_100k.{frame}.exr" --repeat 1
+    # Opacity micromaps: 4-state (the any-hit's image), 2-state (the CPU's
+    # 2-state image), on primary and shadow rays; the offset visibility rule.
+    local disc="-D geometry.alpha=disc"
+    for m in 4state:2 4state:4 4state:6 2state:4; do
+        $BIN $q $small $disc -D gpu.omm=${m%:*} -D gpu.omm_level=${m#*:} --frames 0:1 --repeat 3 \
+            -o "$W/images/quickstart_omm${m%:*}_l${m#*:}.{frame}.exr"
+    done
+    $BIN $q $small -D render.visibility_rule=offset --frames 0:1 --repeat 3 -o "$W/images/quickstart_offset.{frame}.exr"
+    $BIN $q $small $disc -D render.visibility_rule=offset --frames 0:1 --repeat 3 -o "$W/images/quickstart_disc_offset.{frame}.exr"
 }
 
 # GPU restir frames (quickstart, 320x180, 3 frames: temporal and spatial
@@ -52,6 +61,46 @@ step_restir() {
     done
     $BIN $q $small --frames 0:3 -D restir.bias_correction=\"basic\" -o "$W/restir/basic_reorder.{frame}.exr" --repeat 3 \
         --shadow-rays reorder -D gpu.ser_hint_bits=8
+    # Lighting at 0.5x and 0.75x with the upsampling pass; disc alpha with a
+    # 4-state micromap on both shadow-ray paths.
+    for sc in 0.5 0.75; do
+        $BIN $q $small --frames 0:3 -D restir.resolution_scale=$sc -o "$W/restir/basic_scale$sc.{frame}.exr" --repeat 3
+    done
+    $BIN $q $small --frames 0:3 -D geometry.alpha=disc -D gpu.omm=4state -D gpu.omm_level=4 \
+        -o "$W/restir/basic_omm4.{frame}.exr" --repeat 3
+    $BIN $q $small --frames 0:3 -D geometry.alpha=disc -D gpu.omm=4state -D gpu.omm_level=4 --shadow-rays traverse \
+        -o "$W/restir/basic_omm4_traverse.{frame}.exr" --repeat 3
+}
+
+# restir over 64 seeds for `accretion bias --gpu-frames` (quickstart, 160x90,
+# frame 2 after two history frames; Lr alone; one archive per estimator).
+step_seeds() {
+    local q=scenes/quickstart.toml
+    for bc in none basic pairwise; do
+        local t="$W/seeds_$bc"
+        mkdir -p "$t"
+        $BIN $q -D camera.width=160 -D camera.height=90 -D render.estimator=restir -D restir.bias_correction=$bc \
+            --frames 0:3 --seeds 64 --lr-only --repeat 1 -q -o "$t/restir_$bc.{frame}.exr" || return 1
+        rm -f "$t"/*.0000.seed*.gpuframe "$t"/*.0001.seed*.gpuframe
+        tar czf "$OUT/seeds_$bc.tar.gz" -C "$W" "seeds_$bc" && rm -rf "$t"
+    done
+}
+
+# The cost-model sweep (bench/gpu/sweep.txt): per configuration the median
+# GPU ms per pass of frame 1 (temporal reuse on), in cost's pass names.
+step_sweep() {
+    local t="$W/sweep"
+    mkdir -p "$t"
+    grep -v '^#' bench/gpu/sweep.txt | while read -r name args; do
+        [ -z "$name" ] && continue
+        # shellcheck disable=SC2086  # the overrides are words
+        timeout 150 $BIN scenes/disk_100k.toml -D render.estimator=restir $args --frames 0:2 --repeat 5 -q \
+            -o "$t/$name.{frame}.exr" --timings "$t/$name.timings.csv" --config "$name" < /dev/null \
+            || echo "sweep: $name failed"
+        rm -f "$t"/*.gpuframe
+        echo "sweep: $name done"
+    done
+    { echo config,pass,ms; for f in "$t"/*.timings.csv; do tail -n +2 "$f"; done; } > "$t/timings.csv"
 }
 
 # Seed 004's build questions: rebuild / refit / partial, pooled / per-BLAS,
