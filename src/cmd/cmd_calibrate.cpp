@@ -1,7 +1,9 @@
 // accretion calibrate: fit the cost model's coefficients (non-negative
 // least squares) to GPU timings the user measured, one row per pass per
 // configuration, against the counters `accretion cost` wrote.
+#include <map>
 #include <memory>
+#include <optional>
 
 #include <fmt/core.h>
 
@@ -17,7 +19,26 @@ namespace {
 struct CalibrateArgs {
     std::vector<std::string> files;  ///< counters.csv... timings.csv
     std::string output = "out/cost_coefficients.json";
+    CostModelForm form = CostModelForm::shared;
+    std::optional<double> holdout;   ///< fraction of the configurations fitted; the rest predicted
+    std::uint64_t splitSeed = 1;
 };
+
+const char* formName(CostModelForm f) { return f == CostModelForm::shared ? "shared" : "per_pass"; }
+
+/// Held-out errors of both forms side by side, per pass.
+nlohmann::json reportHoldout(const std::vector<CostRow>& rows, double fraction, std::uint64_t seed) {
+    const Holdout a = holdout(rows, CostModelForm::shared, fraction, seed);
+    const Holdout b = holdout(rows, CostModelForm::per_pass, fraction, seed);
+    fmt::print("held out: fitted on {} configurations, predicted {} (split seed {}); relative error of the predicted:\n",
+               a.fitted.size(), a.predicted.size(), seed);
+    fmt::print("{:<22} {:>5}  {:>14} {:>14}  {:>14} {:>14}\n", "pass", "rows", "shared median", "shared worst",
+               "per_pass median", "per_pass worst");
+    for (std::size_t k = 0; k < a.passes.size() && k < b.passes.size(); ++k)
+        fmt::print("{:<22} {:>5}  {:>13.1f}% {:>13.1f}%  {:>14.1f}% {:>13.1f}%\n", a.passes[k].pass, a.passes[k].rows,
+                   100 * a.passes[k].median, 100 * a.passes[k].worst, 100 * b.passes[k].median, 100 * b.passes[k].worst);
+    return {{"fraction", fraction}, {"split_seed", seed}, {"shared", a.toJson()}, {"per_pass", b.toJson()}};
+}
 
 void runCalibrate(const CalibrateArgs& args) {
     struct {
@@ -33,10 +54,16 @@ void runCalibrate(const CalibrateArgs& args) {
         rows.insert(rows.end(), r.begin(), r.end());
     }
     joinTimings(a.timings, rows);
-    const Calibration c = calibrate(rows);
-    fmt::print("fitted on {} timed passes (non-negative least squares):\n", rows.size());
+    const Calibration c = calibrate(rows, args.form);
+    fmt::print("fitted on {} timed passes (non-negative least squares, form {}):\n", rows.size(), formName(args.form));
     for (std::size_t k = 0; k < kCostFeatures.size(); ++k)
         fmt::print("  {:<14} {:>12.6g} ns\n", kCostFeatures[k], c.coefficients.ns[k]);
+    for (const auto& [pass, ns] : c.coefficients.perPass) {
+        std::string line;
+        for (std::size_t k = 0; k < kCostFeatures.size(); ++k)
+            if (ns[k] > 0.0) line += fmt::format(" {} {:.4g}", kCostFeatures[k], ns[k]);
+        fmt::print("  {:<22} ns:{}\n", pass, line);
+    }
     fmt::print("{:<14} {:<22} {:>12} {:>12} {:>12}\n", "config", "pass", "measured ms", "predicted", "residual");
     for (std::size_t i = 0; i < c.rows.size(); ++i)
         fmt::print("{:<14} {:<22} {:>12.4f} {:>12.4f} {:>+12.4f}\n", c.rows[i].config, c.rows[i].pass, c.rows[i].measuredMs,
@@ -46,6 +73,8 @@ void runCalibrate(const CalibrateArgs& args) {
     doc["version"] = std::string(version());
     doc["counters"] = a.counters;
     doc["timings"] = a.timings;
+    doc["form"] = formName(args.form);
+    if (args.holdout) doc["holdout"] = reportHoldout(rows, *args.holdout, args.splitSeed);
     writeJson(a.output, doc);
     fmt::print("coefficients: {} (use with -D gpu.coefficients=\"{}\")\n", a.output, a.output);
 }
@@ -61,6 +90,16 @@ void addCalibrateCommand(CLI::App& app) {
         ->required()
         ->expected(2, -1);
     cmd->add_option("-o,--output", args->output, "Coefficients JSON for gpu.coefficients");
+    cmd->add_option("--form", args->form,
+                    "Model form: shared (one coefficient per counter for all passes, least squares on ms) or per_pass "
+                    "(each pass its own, launches included, on relative error)")
+        ->transform(CLI::CheckedTransformer(std::map<std::string, CostModelForm>{{"shared", CostModelForm::shared},
+                                                                                 {"per_pass", CostModelForm::per_pass}}));
+    cmd->add_option("--holdout", args->holdout,
+                    "Also fit both forms on this fraction of the configurations (at random) and report the relative "
+                    "error of predicting the others, per pass")
+        ->check(CLI::Range(0.05, 0.95));
+    cmd->add_option("--split-seed", args->splitSeed, "Seed of --holdout's split");
     cmd->callback([args] { runCalibrate(*args); });
 }
 

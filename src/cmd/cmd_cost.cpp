@@ -103,7 +103,7 @@ Table passTable(const GpuReport& r, const CostCoefficients& coef, const std::str
     totalMs = 0.0;
     for (const PassReport& p : r.passes) {
         const CostFeatures f = costFeatures(p);
-        const double ms = coef.predictMs(f);
+        const double ms = coef.predictMs(p.pass, f);
         totalMs += ms;
         std::vector<Cell> row{config, p.pass, p.threads, p.trips, p.rays, p.perRay(p.blasEntries), p.perRay(p.anyHits),
                               p.perRay(p.proceeds), 1e-6 * double(p.bytesRead), 1e-6 * double(p.bytesWritten),
@@ -343,7 +343,8 @@ void runCost(const CostArgs& a) {
         if (p.rays > 0) fmt::print("  {}: {} ({})\n", p.pass, p.rayModel, p.reason);
 
     nlohmann::json doc = toJson(r);
-    for (std::size_t k = 0; k < r.passes.size(); ++k) doc["passes"][k]["predicted_ms"] = coef.predictMs(costFeatures(r.passes[k]));
+    for (std::size_t k = 0; k < r.passes.size(); ++k) doc["passes"][k]["predicted_ms"] =
+        coef.predictMs(r.passes[k].pass, costFeatures(r.passes[k]));
     doc["ser_sweep"] = reportSerSweep(run, main);
     doc["any_hit_omm"] = reportOmm(run, main);
     doc["blas_memory_by_cluster_size"] = reportBlasMemory(run);

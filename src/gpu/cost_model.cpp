@@ -1,8 +1,10 @@
 #include "accretion/gpu/cost_model.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <random>
 #include <sstream>
 
 #include <Eigen/Dense>
@@ -14,13 +16,14 @@
 namespace accretion {
 
 CostFeatures costFeatures(const PassReport& p) {
-    return {double(p.threads), double(p.warpSteps()), double(p.rays), double(p.blasEntries), double(p.anyHits),
-            double(p.bytesRead + p.bytesWritten)};
+    return {double(p.threads),     double(p.warpSteps()), double(p.rays),
+            double(p.blasEntries), double(p.anyHits),     double(p.bytesRead + p.bytesWritten),
+            double(p.dispatches),  double(p.blasBuilds),  double(p.blasRefits)};
 }
 
 CostCoefficients CostCoefficients::defaults() {
     CostCoefficients c;
-    c.ns = {0.02, 0.5, 0.5, 0.2, 1.0, 0.002};
+    c.ns = {0.02, 0.5, 0.5, 0.2, 1.0, 0.002, 0.0, 0.0, 0.0};  // launches: not in the uncalibrated guess
     c.source = "defaults (uncalibrated)";
     return c;
 }
@@ -38,13 +41,25 @@ CostCoefficients CostCoefficients::load(const std::string& path) {
     if (!c || !c->is_object()) throw InputError(fmt::format("{}: no \"coefficients_ns\" object", path));
     CostCoefficients out;
     out.source = path;
-    for (std::size_t k = 0; k < kCostFeatures.size(); ++k) {
-        const std::string name(kCostFeatures[k]);
-        if (!c->contains(name) || !(*c)[name].is_number())
-            throw InputError(fmt::format("{}: coefficients_ns.{} missing or not a number", path, name));
-        out.ns[k] = (*c)[name].get<double>();
-        if (!std::isfinite(out.ns[k]) || out.ns[k] < 0.0)
-            throw InputError(fmt::format("{}: coefficients_ns.{} must be finite and >= 0", path, name));
+    // The launch coefficients are optional (files of the first form lack them).
+    auto read = [&](const nlohmann::json& obj, const std::string& where, CostFeatures& into) {
+        for (std::size_t k = 0; k < kCostFeatures.size(); ++k) {
+            const std::string name(kCostFeatures[k]);
+            if (!obj.contains(name) && k >= kBaseCostFeatures) continue;
+            if (!obj.contains(name) || !obj[name].is_number())
+                throw InputError(fmt::format("{}: {}.{} missing or not a number", path, where, name));
+            into[k] = obj[name].get<double>();
+            if (!std::isfinite(into[k]) || into[k] < 0.0)
+                throw InputError(fmt::format("{}: {}.{} must be finite and >= 0", path, where, name));
+        }
+    };
+    read(*c, "coefficients_ns", out.ns);
+    if (j.contains("per_pass_ns")) {
+        if (!j["per_pass_ns"].is_object()) throw InputError(fmt::format("{}: per_pass_ns is not an object", path));
+        for (const auto& [pass, obj] : j["per_pass_ns"].items()) {
+            if (!obj.is_object()) throw InputError(fmt::format("{}: per_pass_ns.{} is not an object", path, pass));
+            read(obj, "per_pass_ns." + pass, out.perPass[pass]);
+        }
     }
     return out;
 }
@@ -52,12 +67,28 @@ CostCoefficients CostCoefficients::load(const std::string& path) {
 nlohmann::json CostCoefficients::toJson() const {
     nlohmann::json c;
     for (std::size_t k = 0; k < kCostFeatures.size(); ++k) c[std::string(kCostFeatures[k])] = ns[k];
-    return {{"coefficients_ns", c}, {"source", source}};
+    nlohmann::json j = {{"coefficients_ns", c}, {"source", source}};
+    for (const auto& [pass, f] : perPass)
+        for (std::size_t k = 0; k < kCostFeatures.size(); ++k) j["per_pass_ns"][pass][std::string(kCostFeatures[k])] = f[k];
+    return j;
 }
 
 double CostCoefficients::predictMs(const CostFeatures& f) const {
     double ms = 0.0;
     for (std::size_t k = 0; k < f.size(); ++k) ms += ns[k] * f[k] * 1e-6;
+    return ms;
+}
+
+std::string passFamily(const std::string& pass) {
+    const auto bracket = pass.find('[');
+    return bracket == std::string::npos ? pass : pass.substr(0, bracket);
+}
+
+double CostCoefficients::predictMs(const std::string& pass, const CostFeatures& f) const {
+    const auto it = perPass.find(passFamily(pass));
+    if (it == perPass.end()) return predictMs(f);
+    double ms = 0.0;
+    for (std::size_t k = 0; k < f.size(); ++k) ms += it->second[k] * f[k] * 1e-6;
     return ms;
 }
 
@@ -162,13 +193,15 @@ std::vector<std::pair<int, std::map<std::string, std::string>>> readCsv(const st
 
 std::vector<CostRow> readCounterCsv(const std::string& path) {
     std::vector<std::string> required{"config", "pass"};
-    for (std::string_view f : kCostFeatures) required.emplace_back(f);
+    for (std::size_t k = 0; k < kBaseCostFeatures; ++k) required.emplace_back(kCostFeatures[k]);
     std::vector<CostRow> rows;
     for (auto& [lineNo, r] : readCsv(path, required)) {
         CostRow row{r["config"], r["pass"], {}, 0.0};
-        for (std::size_t k = 0; k < kCostFeatures.size(); ++k)
-            row.features[k] = parseNumber(r[std::string(kCostFeatures[k])],
-                                          fmt::format("{}:{}: {}", path, lineNo, kCostFeatures[k]));
+        for (std::size_t k = 0; k < kCostFeatures.size(); ++k) {
+            const auto cell = r.find(std::string(kCostFeatures[k]));
+            if (cell == r.end()) continue;  // a launch counter of a CSV of the first form: 0
+            row.features[k] = parseNumber(cell->second, fmt::format("{}:{}: {}", path, lineNo, kCostFeatures[k]));
+        }
         rows.push_back(std::move(row));
     }
     if (rows.empty()) throw InputError(fmt::format("{}: no counter rows", path));
@@ -197,31 +230,67 @@ void joinTimings(const std::string& path, std::vector<CostRow>& rows) {
     rows = std::move(joined);
 }
 
-Calibration calibrate(const std::vector<CostRow>& rows) {
-    if (rows.size() < kCostFeatures.size())
-        throw InputError(fmt::format("calibrate: {} timed passes for {} coefficients: time more passes or configurations",
-                                     rows.size(), kCostFeatures.size()));
-    // Scale each feature column to unit maximum so the fit is well conditioned.
+namespace {
+
+/// NNLS of one set of rows over `features` (the others held at 0); with
+/// `relative`, each row weighted by 1 / its measured time.
+CostFeatures fitRows(const std::vector<const CostRow*>& rows, std::size_t features, bool relative) {
     CostFeatures scale{};
-    for (const CostRow& r : rows)
-        for (std::size_t k = 0; k < scale.size(); ++k) scale[k] = std::max(scale[k], r.features[k]);
+    for (const CostRow* r : rows)
+        for (std::size_t k = 0; k < features; ++k) scale[k] = std::max(scale[k], r->features[k]);
     std::vector<CostFeatures> A;
     std::vector<double> b;
-    for (const CostRow& r : rows) {
+    for (const CostRow* r : rows) {
+        const double w = relative && r->measuredMs > 0.0 ? 1.0 / r->measuredMs : 1.0;
         CostFeatures f{};
-        for (std::size_t k = 0; k < f.size(); ++k) f[k] = scale[k] > 0.0 ? r.features[k] / scale[k] : 0.0;
+        for (std::size_t k = 0; k < features; ++k) f[k] = scale[k] > 0.0 ? w * r->features[k] / scale[k] : 0.0;
         A.push_back(f);
-        b.push_back(r.measuredMs);
+        b.push_back(w * r->measuredMs);
     }
     const std::vector<double> x = nonNegativeLeastSquares(A, b);
+    CostFeatures ns{};
+    for (std::size_t k = 0; k < features; ++k) ns[k] = scale[k] > 0.0 ? x[k] / scale[k] * 1e6 : 0.0;
+    return ns;
+}
+
+CostCoefficients fit(const std::vector<CostRow>& rows, CostModelForm form) {
+    CostCoefficients c;
+    std::vector<const CostRow*> all;
+    for (const CostRow& r : rows) all.push_back(&r);
+    if (form == CostModelForm::shared) {
+        c.ns = fitRows(all, kBaseCostFeatures, false);
+        c.source = "calibrated (shared)";
+        return c;
+    }
+    c.ns = fitRows(all, kCostFeatures.size(), true);  // for a pass no row has
+    std::map<std::string, std::vector<const CostRow*>> byPass;
+    for (const CostRow& r : rows) byPass[passFamily(r.pass)].push_back(&r);
+    for (const auto& [pass, rs] : byPass) c.perPass[pass] = fitRows(rs, kCostFeatures.size(), true);
+    c.source = "calibrated (per_pass)";
+    return c;
+}
+
+double median(std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+}  // namespace
+
+Calibration calibrate(const std::vector<CostRow>& rows, CostModelForm form) {
+    const std::size_t unknowns = form == CostModelForm::shared ? kBaseCostFeatures : kCostFeatures.size();
+    if (rows.size() < unknowns)
+        throw InputError(fmt::format("calibrate: {} timed passes for {} coefficients: time more passes or configurations",
+                                     rows.size(), unknowns));
     Calibration c;
     c.rows = rows;
-    c.coefficients.source = "calibrated";
-    for (std::size_t k = 0; k < scale.size(); ++k) c.coefficients.ns[k] = scale[k] > 0.0 ? x[k] / scale[k] * 1e6 : 0.0;
+    c.coefficients = fit(rows, form);
     double mean = 0.0, ssTot = 0.0, ssRes = 0.0;
     for (const CostRow& r : rows) mean += r.measuredMs / double(rows.size());
     for (const CostRow& r : rows) {
-        const double p = c.coefficients.predictMs(r.features);
+        const double p = c.coefficients.predictMs(r.pass, r.features);
         c.predictedMs.push_back(p);
         ssRes += (p - r.measuredMs) * (p - r.measuredMs);
         ssTot += (r.measuredMs - mean) * (r.measuredMs - mean);
@@ -230,6 +299,62 @@ Calibration calibrate(const std::vector<CostRow>& rows) {
     c.rmsMs = std::sqrt(ssRes / double(rows.size()));
     c.r2 = ssTot > 0.0 ? 1.0 - ssRes / ssTot : 1.0;
     return c;
+}
+
+Holdout holdout(const std::vector<CostRow>& rows, CostModelForm form, double fraction, std::uint64_t seed) {
+    std::vector<std::string> configs;
+    for (const CostRow& r : rows)
+        if (std::find(configs.begin(), configs.end(), r.config) == configs.end()) configs.push_back(r.config);
+    std::sort(configs.begin(), configs.end());
+    if (configs.size() < 2) throw InputError("calibrate --holdout: at least 2 configurations are needed");
+    std::mt19937_64 rng(seed);  // its numbers are fixed by the standard; the shuffle is ours
+    for (std::size_t i = configs.size() - 1; i > 0; --i) std::swap(configs[i], configs[rng() % (i + 1)]);
+    const std::size_t nFit =
+        std::clamp<std::size_t>(static_cast<std::size_t>(std::lround(fraction * double(configs.size()))), 1, configs.size() - 1);
+    Holdout h;
+    h.form = form;
+    h.fitted.assign(configs.begin(), configs.begin() + std::ptrdiff_t(nFit));
+    h.predicted.assign(configs.begin() + std::ptrdiff_t(nFit), configs.end());
+    std::sort(h.fitted.begin(), h.fitted.end());
+    std::sort(h.predicted.begin(), h.predicted.end());
+    auto in = [](const std::vector<std::string>& v, const std::string& x) { return std::binary_search(v.begin(), v.end(), x); };
+    std::vector<CostRow> train;
+    for (const CostRow& r : rows)
+        if (in(h.fitted, r.config)) train.push_back(r);
+    const CostCoefficients c = fit(train, form);
+    std::map<std::string, std::vector<std::pair<double, std::string>>> errors;
+    for (const CostRow& r : rows) {
+        if (!in(h.predicted, r.config) || !(r.measuredMs > 0.0)) continue;
+        const double e = std::abs(c.predictMs(r.pass, r.features) - r.measuredMs) / r.measuredMs;
+        errors[passFamily(r.pass)].push_back({e, r.config});
+        errors["all passes"].push_back({e, r.config});
+    }
+    auto summary = [](const std::string& pass, const std::vector<std::pair<double, std::string>>& es) {
+        HoldoutError he{pass, es.size(), 0.0, 0.0, ""};
+        std::vector<double> v;
+        for (const auto& [e, config] : es) {
+            v.push_back(e);
+            if (e >= he.worst) {
+                he.worst = e;
+                he.worstConfig = config;
+            }
+        }
+        he.median = median(v);
+        return he;
+    };
+    for (const auto& [pass, es] : errors)
+        if (pass != "all passes") h.passes.push_back(summary(pass, es));
+    if (errors.count("all passes")) h.passes.push_back(summary("all passes", errors["all passes"]));
+    return h;
+}
+
+nlohmann::json Holdout::toJson() const {
+    nlohmann::json p = nlohmann::json::array();
+    for (const HoldoutError& e : passes)
+        p.push_back({{"pass", e.pass}, {"rows", e.rows}, {"median_relative_error", e.median},
+                     {"worst_relative_error", e.worst}, {"worst_config", e.worstConfig}});
+    return {{"form", form == CostModelForm::shared ? "shared" : "per_pass"}, {"fitted", fitted}, {"predicted", predicted},
+            {"passes", p}};
 }
 
 nlohmann::json Calibration::toJson() const {

@@ -47,6 +47,9 @@ PassReport summarise(const PassCounters& pc, const GpuSettings& gpu, const SerKe
     p.pass = pc.label();
     p.width = pc.width;
     p.height = pc.height;
+    p.dispatches = pc.dispatches;
+    p.blasBuilds = pc.blasBuilds;
+    p.blasRefits = pc.blasRefits;
     for (const ThreadCounters& t : pc.threads) {
         p.threads += t.active;
         p.hitThreads += t.hit;
@@ -118,6 +121,9 @@ nlohmann::json toJson(const PassReport& p) {
             {"height", p.height},
             {"threads", p.threads},
             {"hit_threads", p.hitThreads},
+            {"dispatches", p.dispatches},
+            {"blas_builds", p.blasBuilds},
+            {"blas_refits", p.blasRefits},
             {"trips", p.trips},
             {"max_trips", p.maxTrips},
             {"rays", p.rays},

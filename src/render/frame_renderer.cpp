@@ -17,6 +17,10 @@ namespace {
 void recordClusterBuild(const ParticleBvh& bvh, const Particles& particles, FrameCounters& counters) {
     const Clusters& clusters = bvh.clusters();
     PassCounters& pc = counters.add(pass::buildClusters, static_cast<std::uint32_t>(clusters.count()), 1);
+    // The GPU's launches: one build (or refit) per BLAS updated, the billboard expansion and the TLAS.
+    const BvhStats& s = bvh.stats();
+    pc.dispatches = 2;
+    (s.refitted ? pc.blasRefits : pc.blasBuilds) = s.rebuiltClusters;
     const bool billboards = bvh.settings().primitive == Primitive::billboard;
     for (std::size_t c = 0; c < clusters.count(); ++c) {
         ThreadCounters& t = pc.threads[c];

@@ -53,6 +53,9 @@ struct PassCounters {
     std::uint32_t run = 1;  ///< 1 for a pass's first run in the frame, 2 for its second (spatial iterations)...
     std::uint32_t width = 0, height = 0;
     std::vector<ThreadCounters> threads;
+    // Launches beside the threads (cost model features): kernel dispatches,
+    // and for buildClusters the BLAS built and refitted (one launch each).
+    std::uint64_t dispatches = 1, blasBuilds = 0, blasRefits = 0;
 
     PassCounters() = default;
     PassCounters(std::string_view name, std::uint32_t w, std::uint32_t h)

@@ -1,5 +1,7 @@
 #pragma once
 #include <array>
+#include <cstdint>
+#include <map>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -10,16 +12,29 @@
 
 namespace accretion {
 
-/// The counters a pass's predicted time is linear in (docs/MODEL.md section 6).
-inline constexpr std::array<std::string_view, 6> kCostFeatures = {"threads", "warp_steps", "rays",
-                                                                   "blas_entries", "any_hits", "bytes"};
+/// The counters a pass's predicted time is linear in (docs/MODEL.md section
+/// 6). The first six are the model's first form; the launches (kernel
+/// dispatches, BLAS builds and refits: a constant cost each) came with the
+/// GPU measurements of issue 16, where the number of builds, not their
+/// triangles, set the build time. Counter CSVs without them read as 0.
+inline constexpr std::array<std::string_view, 9> kCostFeatures = {
+    "threads", "warp_steps", "rays", "blas_entries", "any_hits", "bytes", "dispatches", "blas_builds", "blas_refits"};
+inline constexpr std::size_t kBaseCostFeatures = 6;
 using CostFeatures = std::array<double, kCostFeatures.size()>;
+
+/// The model's forms. shared: one coefficient per base counter for every
+/// pass, fitted by least squares on ms (the first form). per_pass: each
+/// pass its own coefficients over every counter, launches included, fitted
+/// on relative error (passes differ in what bounds them: builds by their
+/// launches, resampling by memory, shadow rays by traversal).
+enum class CostModelForm { shared, per_pass };
 
 CostFeatures costFeatures(const PassReport& pass);
 
 /// Nanoseconds per unit of each feature: predicted time = sum coefficient x counter.
 struct CostCoefficients {
     CostFeatures ns{};
+    std::map<std::string, CostFeatures> perPass;  ///< per_pass form: by pass name (spatialResampling[2] uses spatialResampling's)
     std::string source;  ///< "defaults (uncalibrated)" or the file read
 
     /// Order-of-magnitude defaults for a current desktop RTX GPU, for use
@@ -30,7 +45,10 @@ struct CostCoefficients {
     static CostCoefficients load(const std::string& path);
     nlohmann::json toJson() const;
 
+    /// With the shared coefficients.
     double predictMs(const CostFeatures& f) const;
+    /// With the pass's own coefficients when there are any, else the shared ones.
+    double predictMs(const std::string& pass, const CostFeatures& f) const;
 };
 
 /// Non-negative least squares, min |A x - b| subject to x >= 0 (Lawson &
@@ -58,7 +76,27 @@ struct Calibration {
     nlohmann::json toJson() const;
 };
 
-/// Fits the coefficients to the measured times (NNLS in ms, rescaled per feature).
-Calibration calibrate(const std::vector<CostRow>& rows);
+/// Fits the coefficients to the measured times (NNLS, features rescaled).
+Calibration calibrate(const std::vector<CostRow>& rows, CostModelForm form = CostModelForm::shared);
+
+/// The fit judged on configurations it has not seen: the configurations
+/// split at random (a seeded Fisher-Yates), `fraction` of them fitted, the
+/// rest predicted; per pass the median and worst relative error.
+struct HoldoutError {
+    std::string pass;
+    std::size_t rows = 0;
+    double median = 0.0, worst = 0.0;
+    std::string worstConfig;
+};
+struct Holdout {
+    CostModelForm form;
+    std::vector<std::string> fitted, predicted;  ///< configurations
+    std::vector<HoldoutError> passes;           ///< and last, "all passes"
+    nlohmann::json toJson() const;
+};
+Holdout holdout(const std::vector<CostRow>& rows, CostModelForm form, double fraction, std::uint64_t seed);
+
+/// "spatialResampling[2]" -> "spatialResampling": the pass a run belongs to.
+std::string passFamily(const std::string& pass);
 
 }  // namespace accretion
