@@ -72,7 +72,7 @@ step_restir() {
         -o "$W/restir/basic_omm4_traverse.{frame}.exr" --repeat 3
 }
 
-# restir over 64 seeds for `accretion bias --gpu-frames` (quickstart, 160x90,
+# restir over $SEEDS (64) seeds for `accretion bias --gpu-frames` (quickstart, 160x90,
 # frame 2 after two history frames; Lr alone; one archive per estimator).
 step_seeds() {
     local q=scenes/quickstart.toml
@@ -80,7 +80,7 @@ step_seeds() {
         local t="$W/seeds_$bc"
         mkdir -p "$t"
         $BIN $q -D camera.width=160 -D camera.height=90 -D render.estimator=restir -D restir.bias_correction=$bc \
-            --frames 0:3 --seeds 64 --lr-only --repeat 1 -q -o "$t/restir_$bc.{frame}.exr" || return 1
+            --frames 0:3 --seeds "${SEEDS:-64}" --lr-only --repeat 1 -q -o "$t/restir_$bc.{frame}.exr" || return 1
         rm -f "$t"/*.0000.seed*.gpuframe "$t"/*.0001.seed*.gpuframe
         tar czf "$OUT/seeds_$bc.tar.gz" -C "$W" "seeds_$bc" && rm -rf "$t"
     done
@@ -126,32 +126,40 @@ step_builds() {
     rm -f "$t"/*.gpuframe
 }
 
-# Seed 004's frame: 100K particles, restir at 1080p, per-pass GPU ms, with
-# the three shadow-ray paths and cluster sizes 100 and 1000; lighting at
-# 0.75x and 0.5x as the whole frame at that resolution (the twin has no
-# upsampling pass yet).
+# Seed 004's frame: 100K particles, restir at 1080p, per-pass GPU ms: the
+# three shadow-ray paths, cluster sizes 100 and 1000, lighting at 0.75x and
+# 0.5x (restir.resolution_scale, with the upsampling pass), disc alpha by
+# any-hit and by 4- and 2-state micromaps.
 step_frame() {
-    local s=scenes/disk_100k.toml r="-D render.estimator=\"restir\" --frames 0:3 --repeat 7"
+    local s=scenes/disk_100k.toml r="-D render.estimator=restir --frames 0:3 --repeat 7 -D camera.width=1920 -D camera.height=1080"
     local t="$W/frame"
     mkdir -p "$t"
+    # shellcheck disable=SC2086  # $r holds words
     run() { local name=$1; shift; $BIN $s $r -o "$t/$name.{frame}.exr" --timings "$t/$name.csv" --config "$name" "$@"; }
-    run k100_trace -D camera.width=1920 -D camera.height=1080
-    run k100_traverse -D camera.width=1920 -D camera.height=1080 --shadow-rays traverse
-    run k100_reorder -D camera.width=1920 -D camera.height=1080 --shadow-rays reorder -D gpu.ser_hint_bits=8
-    run k1000_trace -D camera.width=1920 -D camera.height=1080 -D geometry.cluster_size=1000
-    run k100_trace_075 -D camera.width=1440 -D camera.height=810
-    run k100_trace_050 -D camera.width=960 -D camera.height=540
+    run k100_trace
+    run k100_traverse --shadow-rays traverse
+    run k100_reorder --shadow-rays reorder -D gpu.ser_hint_bits=8
+    run k1000_trace -D geometry.cluster_size=1000
+    run k100_trace_scale075 -D restir.resolution_scale=0.75
+    run k100_trace_scale050 -D restir.resolution_scale=0.5
+    run k100_anyhit -D geometry.alpha=disc
+    run k100_omm4_l4 -D geometry.alpha=disc -D gpu.omm=4state -D gpu.omm_level=4
+    run k100_omm2_l4 -D geometry.alpha=disc -D gpu.omm=2state -D gpu.omm_level=4
+    run k100_anyhit_traverse -D geometry.alpha=disc --shadow-rays traverse
+    run k100_omm4_l4_traverse -D geometry.alpha=disc -D gpu.omm=4state -D gpu.omm_level=4 --shadow-rays traverse
     rm -f "$t"/*.gpuframe
 }
 
-# Nsight Compute: average active threads per executed instruction of every
-# kernel of a restir frame (quickstart, 320x180, frame 1: temporal reuse).
+# Nsight Compute: average active threads per executed instruction of the
+# lighting kernels of a restir frame (quickstart, 320x180, frames 0-1; the
+# BLAS builds, measured before, are left out: their replay is slow and
+# failed once). The OptiX launches alternate G-buffer and shadow rays.
 step_ncu() {
     local t="$W/ncu"
     mkdir -p "$t"
-    timeout 400 ncu --metrics smsp__thread_inst_executed_per_inst_executed.ratio,gpu__time_duration.sum --csv \
-        --log-file "$t/ncu.log" -o "$t/profile" \
-        $BIN scenes/quickstart.toml -D camera.width=320 -D camera.height=180 -D render.estimator=\"restir\" \
+    timeout 400 ncu --metrics smsp__thread_inst_executed_per_inst_executed.ratio,gpu__time_duration.sum \
+        --kernel-name regex:"Kernel|optixLaunch" --log-file "$t/ncu.log" -o "$t/profile" \
+        $BIN scenes/quickstart.toml -D camera.width=320 -D camera.height=180 -D render.estimator=restir \
         --frames 0:2 --repeat 1 -o "$t/q.{frame}.exr" > "$t/run.log" 2>&1
     ncu --import "$t/profile.ncu-rep" --csv --page raw \
         --metrics smsp__thread_inst_executed_per_inst_executed.ratio,gpu__time_duration.sum > "$t/ncu.csv" 2>&1
