@@ -147,6 +147,9 @@ step_frame() {
     run k100_omm2_l4 -D geometry.alpha=disc -D gpu.omm=2state -D gpu.omm_level=4
     run k100_anyhit_traverse -D geometry.alpha=disc --shadow-rays traverse
     run k100_omm4_l4_traverse -D geometry.alpha=disc -D gpu.omm=4state -D gpu.omm_level=4 --shadow-rays traverse
+    # Under the offset rule (what GPU code does) no ray is traced again past its own billboard.
+    run k100_anyhit_offset -D geometry.alpha=disc -D render.visibility_rule=offset
+    run k100_omm4_l4_offset -D geometry.alpha=disc -D gpu.omm=4state -D gpu.omm_level=4 -D render.visibility_rule=offset
     rm -f "$t"/*.gpuframe
 }
 

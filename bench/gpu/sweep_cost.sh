@@ -14,5 +14,24 @@ grep -v '^#' bench/gpu/sweep.txt | while read -r name args; do
         --cluster-sizes "" --omm-levels "" --ser-keys hit --config "$name" -q -o "$OUT/$name.cost.json" > /dev/null < /dev/null
     echo "cost: $name" >&2
 done
-{ head -1 "$(ls "$OUT"/*.cost.csv | head -1)"; for f in "$OUT"/*.cost.csv; do tail -n +2 "$f"; done; } > "$OUT/counters.csv"
+# The twin times a pass's runs together (spatialResampling over its
+# iterations): the counters of spatialResampling[2]... are added to spatialResampling's.
+python3 - "$OUT" <<'PY'
+import csv, glob, os, re, sys
+out = sys.argv[1]
+rows, header = {}, None
+for f in sorted(glob.glob(os.path.join(out, "*.cost.csv"))):
+    with open(f) as fh:
+        r = csv.reader(fh)
+        header = next(r)
+        for row in r:
+            key = (row[0], re.sub(r"\[\d+\]$", "", row[1]))
+            vals = [float(x) for x in row[2:]]
+            rows[key] = [a + b for a, b in zip(rows[key], vals)] if key in rows else vals
+with open(os.path.join(out, "counters.csv"), "w", newline="") as fh:
+    w = csv.writer(fh)
+    w.writerow(header)
+    for (config, p), vals in rows.items():
+        w.writerow([config, p] + [f"{v:.10g}" for v in vals])
+PY
 echo "$OUT/counters.csv"

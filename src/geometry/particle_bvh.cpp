@@ -44,6 +44,7 @@ inline bool passesAlpha(const AlphaTest& alpha, const RTCFilterFunctionNArgument
     // Embree's quad parametrisation is the billboard's uv.
     const Vec2 uv(RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i));
     if (alpha.omm) {
+        if (counters) ++counters->ommLookups;
         Vec2 bary;
         const unsigned tri = quadTriangle(uv, bary);
         const OmmState s = alpha.omm->lookup(tri, bary.x, bary.y);
@@ -119,7 +120,10 @@ void instanceIntersect(const RTCIntersectFunctionNArguments* args) {
     auto* ray = reinterpret_cast<RTCRayHit*>(args->rayhit);
     const float org[3] = {ray->ray.org_x, ray->ray.org_y, ray->ray.org_z}, dir[3] = {ray->ray.dir_x, ray->ray.dir_y, ray->ray.dir_z};
     if (!overlapsBounds(bvh->blasBounds(args->primID), org, dir, ray->ray.tnear, ray->ray.tfar)) return;
-    if (RayCounters* c = reinterpret_cast<QueryContext*>(args->context)->counters) ++c->blasEntries;
+    if (RayCounters* c = reinterpret_cast<QueryContext*>(args->context)->counters) {
+        ++c->blasEntries;
+        c->blasLevels += bvh->blasLevels(args->primID);
+    }
     auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
     const RTCHit saved = rh->hit;
     rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
@@ -136,7 +140,10 @@ void instanceOccluded(const RTCOccludedFunctionNArguments* args) {
     const auto* ray = reinterpret_cast<const RTCRay*>(args->ray);
     const float org[3] = {ray->org_x, ray->org_y, ray->org_z}, dir[3] = {ray->dir_x, ray->dir_y, ray->dir_z};
     if (!overlapsBounds(bvh->blasBounds(args->primID), org, dir, ray->tnear, ray->tfar)) return;
-    if (RayCounters* c = reinterpret_cast<QueryContext*>(args->context)->counters) ++c->blasEntries;
+    if (RayCounters* c = reinterpret_cast<QueryContext*>(args->context)->counters) {
+        ++c->blasEntries;
+        c->blasLevels += bvh->blasLevels(args->primID);
+    }
     args->context->instID[0] = args->primID;
     rtcOccluded1(bvh->blas(args->primID), args->context, reinterpret_cast<RTCRay*>(args->ray));
     args->context->instID[0] = RTC_INVALID_GEOMETRY_ID;

@@ -18,12 +18,13 @@ namespace accretion {
 CostFeatures costFeatures(const PassReport& p) {
     return {double(p.threads),     double(p.warpSteps()), double(p.rays),
             double(p.blasEntries), double(p.anyHits),     double(p.bytesRead + p.bytesWritten),
-            double(p.dispatches),  double(p.blasBuilds),  double(p.blasRefits)};
+            double(p.blasLevels),  double(p.ommLookups),  double(p.dispatches),
+            double(p.blasBuilds),  double(p.blasRefits)};
 }
 
 CostCoefficients CostCoefficients::defaults() {
     CostCoefficients c;
-    c.ns = {0.02, 0.5, 0.5, 0.2, 1.0, 0.002, 0.0, 0.0, 0.0};  // launches: not in the uncalibrated guess
+    c.ns = {0.02, 0.5, 0.5, 0.2, 1.0, 0.002, 0.0, 0.0, 0.0, 0.0, 0.0};  // the later counters: not in the uncalibrated guess
     c.source = "defaults (uncalibrated)";
     return c;
 }
@@ -325,7 +326,10 @@ Holdout holdout(const std::vector<CostRow>& rows, CostModelForm form, double fra
     std::map<std::string, std::vector<std::pair<double, std::string>>> errors;
     for (const CostRow& r : rows) {
         if (!in(h.predicted, r.config) || !(r.measuredMs > 0.0)) continue;
-        const double e = std::abs(c.predictMs(r.pass, r.features) - r.measuredMs) / r.measuredMs;
+        const double predicted = c.predictMs(r.pass, r.features);
+        h.rows.push_back(r);
+        h.predictedMs.push_back(predicted);
+        const double e = std::abs(predicted - r.measuredMs) / r.measuredMs;
         errors[passFamily(r.pass)].push_back({e, r.config});
         errors["all passes"].push_back({e, r.config});
     }
@@ -353,8 +357,12 @@ nlohmann::json Holdout::toJson() const {
     for (const HoldoutError& e : passes)
         p.push_back({{"pass", e.pass}, {"rows", e.rows}, {"median_relative_error", e.median},
                      {"worst_relative_error", e.worst}, {"worst_config", e.worstConfig}});
+    nlohmann::json rs = nlohmann::json::array();
+    for (std::size_t i = 0; i < rows.size(); ++i)
+        rs.push_back({{"config", rows[i].config}, {"pass", rows[i].pass}, {"measured_ms", rows[i].measuredMs},
+                      {"predicted_ms", predictedMs[i]}});
     return {{"form", form == CostModelForm::shared ? "shared" : "per_pass"}, {"fitted", fitted}, {"predicted", predicted},
-            {"passes", p}};
+            {"passes", p}, {"rows", rs}};
 }
 
 nlohmann::json Calibration::toJson() const {

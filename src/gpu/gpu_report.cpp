@@ -59,6 +59,8 @@ PassReport summarise(const PassCounters& pc, const GpuSettings& gpu, const SerKe
         p.proceeds += t.proceeds;
         p.blasEntries += t.blasEntries;
         p.anyHits += t.anyHits;
+        p.blasLevels += t.blasLevels;
+        p.ommLookups += t.ommLookups;
         p.bytesRead += t.bytesRead;
         p.bytesWritten += t.bytesWritten;
     }
@@ -121,6 +123,8 @@ nlohmann::json toJson(const PassReport& p) {
             {"height", p.height},
             {"threads", p.threads},
             {"hit_threads", p.hitThreads},
+            {"blas_levels", p.blasLevels},
+            {"omm_lookups", p.ommLookups},
             {"dispatches", p.dispatches},
             {"blas_builds", p.blasBuilds},
             {"blas_refits", p.blasRefits},

@@ -11,6 +11,8 @@ struct RayCounters {
     std::uint32_t blasEntries = 0;  ///< TLAS leaves entered (BLAS traversals started)
     std::uint32_t anyHits = 0;      ///< any-hit invocations (alpha-tested candidates)
     std::uint32_t candidates = 0;   ///< non-opaque candidates seen (RayQuery Proceed() returning true)
+    std::uint32_t blasLevels = 0;   ///< per BLAS entered, its depth: ceil(log2(primitives)) (traversal inside it)
+    std::uint32_t ommLookups = 0;   ///< candidate hits on micromapped triangles (the micromap looked up)
 };
 
 /// The work of one pixel's thread in one pass (docs/MODEL.md section 6). The
@@ -27,6 +29,8 @@ struct ThreadCounters {
     std::uint32_t proceeds = 0;     ///< RayQuery Proceed() iterations: candidates + 1 per ray
     std::uint32_t blasEntries = 0;  ///< BLAS instances entered, summed over the thread's rays
     std::uint32_t anyHits = 0;      ///< any-hit invocations
+    std::uint32_t blasLevels = 0;   ///< BLAS depths entered, summed over the thread's rays
+    std::uint32_t ommLookups = 0;   ///< micromap lookups, summed over the thread's rays
     std::uint32_t bytesRead = 0;    ///< G-buffer, reservoirs, particle records read
     std::uint32_t bytesWritten = 0; ///< G-buffer, reservoirs, radiance written
 
@@ -37,12 +41,16 @@ struct ThreadCounters {
         proceeds += r.candidates + n;
         blasEntries += r.blasEntries;
         anyHits += r.anyHits;
+        blasLevels += r.blasLevels;
+        ommLookups += r.ommLookups;
     }
     void addRay(const RayCounters& r) {
         ++rays;
         proceeds += r.candidates + 1;
         blasEntries += r.blasEntries;
         anyHits += r.anyHits;
+        blasLevels += r.blasLevels;
+        ommLookups += r.ommLookups;
     }
 };
 

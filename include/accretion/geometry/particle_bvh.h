@@ -1,4 +1,5 @@
 #pragma once
+#include <bit>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -93,6 +94,12 @@ public:
     RTCScene blas(std::size_t c) const { return blas_[c]; }
     /// World bounds of cluster c's BLAS in the current build.
     const RTCBounds& blasBounds(std::size_t c) const { return blasBounds_[c]; }
+    /// The depth of cluster c's BLAS as the GPU builds it: ceil(log2) of its
+    /// primitives (two triangles per billboard), the levels a ray entering it may descend.
+    std::uint32_t blasLevels(std::size_t c) const {
+        const auto n = static_cast<std::uint32_t>(clusters_.members(c).size()) * (settings_.primitive == Primitive::billboard ? 2u : 1u);
+        return n > 1 ? static_cast<std::uint32_t>(std::bit_width(n - 1)) : 0u;
+    }
 
     /// The billboard frame of a particle in the current build.
     const BillboardFrame& frame(std::uint32_t particle) const { return frames_[particle]; }

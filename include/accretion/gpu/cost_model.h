@@ -13,12 +13,15 @@
 namespace accretion {
 
 /// The counters a pass's predicted time is linear in (docs/MODEL.md section
-/// 6). The first six are the model's first form; the launches (kernel
-/// dispatches, BLAS builds and refits: a constant cost each) came with the
-/// GPU measurements of issue 16, where the number of builds, not their
-/// triangles, set the build time. Counter CSVs without them read as 0.
-inline constexpr std::array<std::string_view, 9> kCostFeatures = {
-    "threads", "warp_steps", "rays", "blas_entries", "any_hits", "bytes", "dispatches", "blas_builds", "blas_refits"};
+/// 6). The first six are the model's first form; the others came with the
+/// GPU measurements of issue 16: the traversal inside the BLAS entered
+/// (their depths), micromap lookups (software on a GPU without RT cores),
+/// and the launches (kernel dispatches, BLAS builds and refits: a constant
+/// cost each; the number of builds, not their triangles, set the build
+/// time). Counter CSVs without them read as 0.
+inline constexpr std::array<std::string_view, 11> kCostFeatures = {
+    "threads",     "warp_steps",  "rays",       "blas_entries", "any_hits",   "bytes",
+    "blas_levels", "omm_lookups", "dispatches", "blas_builds",  "blas_refits"};
 inline constexpr std::size_t kBaseCostFeatures = 6;
 using CostFeatures = std::array<double, kCostFeatures.size()>;
 
@@ -92,6 +95,8 @@ struct Holdout {
     CostModelForm form;
     std::vector<std::string> fitted, predicted;  ///< configurations
     std::vector<HoldoutError> passes;           ///< and last, "all passes"
+    std::vector<CostRow> rows;                  ///< the predicted rows (measuredMs) ...
+    std::vector<double> predictedMs;            ///< ... and their predictions
     nlohmann::json toJson() const;
 };
 Holdout holdout(const std::vector<CostRow>& rows, CostModelForm form, double fraction, std::uint64_t seed);

@@ -20,6 +20,7 @@ struct PassReport {
     std::uint64_t threads = 0, hitThreads = 0;
     std::uint64_t trips = 0, rays = 0, proceeds = 0, blasEntries = 0, anyHits = 0;
     std::uint64_t bytesRead = 0, bytesWritten = 0;
+    std::uint64_t blasLevels = 0, ommLookups = 0;                 ///< BLAS depths entered, micromap lookups
     std::uint64_t dispatches = 1, blasBuilds = 0, blasRefits = 0;  ///< launches beside the threads (PassCounters)
     std::uint32_t maxTrips = 0;
     SerReport ser;
