@@ -2,7 +2,9 @@
 // counters' effect on rendering (none), as real processes.
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -175,4 +177,39 @@ TEST_CASE("calibrate recovers the coefficients that made the timings of real cos
     CHECK(runCommand(kBin + " calibrate " + csvs[0] + " " + (dir / "bad2.csv").string() + " -o " + (dir / "x.json").string(), out) == 1);
     CHECK_THAT(out, Contains("bad2.csv:2: ms: 'fast' is not a finite non-negative number"));
     CHECK_FALSE(std::filesystem::exists(dir / "x.json"));
+}
+
+TEST_CASE("cost counts the launches of the builds: one per BLAS rebuilt, refitted or partly rebuilt", "[cli][gpu]") {
+    const auto dir = accretion::test::scratchDir("cost_launches");
+    std::string out;
+    // Moving particles (a static scene builds once); restir, so that cost
+    // renders frame 0 before the measured frame 1.
+    std::map<std::string, std::map<std::string, double>> build;  // policy -> column -> value of buildClusters
+    for (const std::string policy : {"rebuild", "refit", "partial"}) {
+        const std::string run = kBin + " cost " + tinyScene() + " --quiet --frames 1 --history 1 --overhead 0 --cluster-sizes \"\" " +
+                                "--omm-levels \"\" -D render.estimator=\\\"restir\\\" -D particles.gm=20 -D particles.time_step=0.02 -D geometry.build=\\\"" + policy + "\\\" -o " + (dir / (policy + ".json")).string();
+        INFO(run);
+        REQUIRE(runCommand(run, out) == 0);
+        std::ifstream csv(dir / (policy + ".csv"));
+        std::string header, line;
+        REQUIRE(std::getline(csv, header));
+        std::vector<std::string> names;
+        for (std::stringstream ss(header); std::getline(ss, line, ',');) names.push_back(line);
+        while (std::getline(csv, line)) {
+            std::vector<std::string> cells;
+            for (std::stringstream ss(line); std::getline(ss, header, ',');) cells.push_back(header);
+            REQUIRE(cells.size() == names.size());
+            if (cells[1] != "buildClusters") continue;
+            for (std::size_t k = 2; k < cells.size(); ++k) build[policy][names[k]] = std::stod(cells[k]);
+        }
+    }
+    const double clusters = build["rebuild"]["threads"];
+    REQUIRE(clusters > 2);
+    CHECK(build["rebuild"]["blas_builds"] == clusters);
+    CHECK(build["rebuild"]["blas_refits"] == 0);
+    CHECK(build["refit"]["blas_builds"] == 0);  // frame 1 refits what frame 0 built
+    CHECK(build["refit"]["blas_refits"] == build["refit"]["threads"]);
+    CHECK(build["partial"]["blas_builds"] == std::ceil(0.7 * build["partial"]["threads"]));  // geometry.rebuild_fraction
+    CHECK(build["partial"]["blas_refits"] == 0);
+    for (const auto& [policy, columns] : build) CHECK(columns.at("dispatches") == 2);
 }

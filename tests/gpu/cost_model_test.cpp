@@ -3,6 +3,8 @@
 // stated tolerance with noise; negative solutions are clamped.
 #include <catch2/catch.hpp>
 
+#include <filesystem>
+#include <fstream>
 #include <random>
 
 #include "accretion/gpu/cost_model.h"
@@ -89,5 +91,63 @@ TEST_CASE("NNLS clamps what unconstrained least squares would make negative", "[
             g += A[i][j] * r;
         }
         CHECK(g <= 1e-9);
+    }
+}
+
+TEST_CASE("the per-pass form predicts held-out configurations its form made exactly, the shared form cannot", "[gpu][cost]") {
+    // Two passes whose times the shared form cannot express: builds at a
+    // constant per BLAS, traced rays whose cost grows with the BLAS depths.
+    CostCoefficients truth;
+    truth.perPass["buildClusters"] = {};
+    truth.perPass["buildClusters"][8] = 5000.0;    // dispatches
+    truth.perPass["buildClusters"][9] = 75000.0;   // blas_builds
+    truth.perPass["traceShadowRays"] = {};
+    truth.perPass["traceShadowRays"][2] = 1.5;     // rays
+    truth.perPass["traceShadowRays"][6] = 0.03;    // blas_levels
+    truth.perPass["traceShadowRays"][8] = 10000.0; // dispatches
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    std::vector<CostRow> rows;
+    for (int c = 0; c < 20; ++c) {
+        const double builds = 100.0 + 5000.0 * u(rng), pixels = 2e5 + 2e6 * u(rng);
+        CostRow b{"c" + std::to_string(c), "buildClusters", {}, 0.0};
+        b.features[0] = builds;
+        b.features[5] = 8000.0 * 1e5 / builds;  // bytes: the same particles in more or fewer clusters
+        b.features[8] = 2.0;
+        b.features[9] = builds;
+        CostRow t{b.config, "traceShadowRays", {}, 0.0};
+        t.features[0] = pixels;
+        t.features[2] = pixels * (0.2 + 0.3 * u(rng));
+        t.features[3] = t.features[2] * (2.0 + 6.0 * u(rng));
+        t.features[6] = t.features[3] * (4.0 + 8.0 * u(rng));
+        t.features[8] = 1.0;
+        for (CostRow* r : {&b, &t}) {
+            r->measuredMs = truth.predictMs(r->pass, r->features);
+            rows.push_back(*r);
+        }
+    }
+    const Holdout perPass = holdout(rows, CostModelForm::per_pass, 0.5, 1);
+    REQUIRE(perPass.passes.size() == 3);  // two passes, then all passes
+    CHECK(perPass.fitted.size() == 10);
+    CHECK(perPass.predicted.size() == 10);
+    for (const HoldoutError& e : perPass.passes) {
+        INFO(e.pass);
+        CHECK(e.worst < 1e-6);
+    }
+    const Holdout shared = holdout(rows, CostModelForm::shared, 0.5, 1);
+    CHECK(shared.passes.back().worst > 0.3);
+    // The split is the seed's: the same seed, the same halves; another, others.
+    CHECK(holdout(rows, CostModelForm::per_pass, 0.5, 1).fitted == perPass.fitted);
+    CHECK(holdout(rows, CostModelForm::per_pass, 0.5, 2).fitted != perPass.fitted);
+
+    // Fitted on all rows, the per-pass coefficients survive a save and load,
+    // and spatialResampling[2]-style run labels use their pass's coefficients.
+    const Calibration all = calibrate(rows, CostModelForm::per_pass);
+    const auto file = std::filesystem::temp_directory_path() / "accretion_per_pass_coefficients.json";
+    std::ofstream(file) << all.coefficients.toJson().dump();
+    const CostCoefficients loaded = CostCoefficients::load(file.string());
+    for (const CostRow& r : rows) {
+        CHECK(loaded.predictMs(r.pass, r.features) == Approx(r.measuredMs).epsilon(1e-6));
+        CHECK(loaded.predictMs(r.pass + "[2]", r.features) == Approx(r.measuredMs).epsilon(1e-6));
     }
 }
