@@ -24,8 +24,6 @@ struct CalibrateArgs {
     std::uint64_t splitSeed = 1;
 };
 
-const char* formName(CostModelForm f) { return f == CostModelForm::shared ? "shared" : "per_pass"; }
-
 /// Held-out errors of both forms side by side, per pass.
 nlohmann::json reportHoldout(const std::vector<CostRow>& rows, double fraction, std::uint64_t seed) {
     const Holdout a = holdout(rows, CostModelForm::shared, fraction, seed);
@@ -55,7 +53,7 @@ void runCalibrate(const CalibrateArgs& args) {
     }
     joinTimings(a.timings, rows);
     const Calibration c = calibrate(rows, args.form);
-    fmt::print("fitted on {} timed passes (non-negative least squares, form {}):\n", rows.size(), formName(args.form));
+    fmt::print("fitted on {} timed passes (non-negative least squares, form {}):\n", rows.size(), costModelFormName(args.form));
     for (std::size_t k = 0; k < kCostFeatures.size(); ++k)
         fmt::print("  {:<14} {:>12.6g} ns\n", kCostFeatures[k], c.coefficients.ns[k]);
     for (const auto& [pass, ns] : c.coefficients.perPass) {
@@ -73,7 +71,7 @@ void runCalibrate(const CalibrateArgs& args) {
     doc["version"] = std::string(version());
     doc["counters"] = a.counters;
     doc["timings"] = a.timings;
-    doc["form"] = formName(args.form);
+    doc["form"] = costModelFormName(args.form);
     if (args.holdout) doc["holdout"] = reportHoldout(rows, *args.holdout, args.splitSeed);
     writeJson(a.output, doc);
     fmt::print("coefficients: {} (use with -D gpu.coefficients=\"{}\")\n", a.output, a.output);

@@ -12,6 +12,7 @@
 #include "accretion/geometry/camera_track.h"
 #include "accretion/analysis/image_metrics.h"
 #include "accretion/core/error.h"
+#include "accretion/core/median.h"
 #include "accretion/core/parse.h"
 #include "accretion/core/version.h"
 #include "accretion/geometry/particle_bvh.h"
@@ -69,11 +70,6 @@ CountedFrame renderCounted(const Settings& s, const ParticleSource& source, std:
     }
     if (s.gpu.counters) out.report = makeGpuReport(out.image.counters, s, out.stats.reservoirBytes);
     return out;
-}
-
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v.empty() ? 0.0 : v[v.size() / 2];
 }
 
 /// What the sections of a cost report read.

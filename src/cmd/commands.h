@@ -38,13 +38,6 @@ void addExperimentOptions(CLI::App* cmd, ExperimentArgs& args, const std::string
 /// Thrown by batch when some job did not succeed (exit code 4).
 struct BatchFailed {};
 
-/// Parse `A:B` (half-open, 0 <= A < B) or `A` (= A:A+1) of a command-line
-/// option; InputError names the option.
-std::pair<std::uint64_t, std::uint64_t> parseHalfOpen(const std::string& text, const char* option);
-
-/// `--frames A:B` as the settings it sets (render.frame_start, render.frames).
-std::vector<FlagSetting> frameFlags(const std::string& frames);
-
 /// The command's scene: the file, its -D overrides, --frames, then `flags`.
 Settings loadSceneArgs(const SceneArgs& args, const std::vector<FlagSetting>& flags = {});
 

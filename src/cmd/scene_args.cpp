@@ -10,29 +10,6 @@
 
 namespace accretion::cmd {
 
-std::pair<std::uint64_t, std::uint64_t> parseHalfOpen(const std::string& text, const char* option) {
-    const auto colon = text.find(':');
-    auto number = [&](const std::string& s) -> std::uint64_t {
-        const std::optional<std::uint64_t> v = parseUnsigned(s);
-        if (!v) throw InputError(fmt::format("command line {} {}: expected A:B with 0 <= A < B", option, text));
-        return *v;
-    };
-    const std::uint64_t a = number(text.substr(0, colon));
-    const std::uint64_t b = colon == std::string::npos ? a + 1 : number(text.substr(colon + 1));
-    if (b <= a)
-        throw InputError(fmt::format("command line {} {}: end must be greater than start (half-open A:B)", option, text));
-    return {a, b};
-}
-
-std::vector<FlagSetting> frameFlags(const std::string& frames) {
-    if (frames.empty()) return {};
-    const auto [a, b] = parseHalfOpen(frames, "--frames");
-    if (b > 0xffffffffull) throw InputError(fmt::format("command line --frames {}: frames are 32-bit numbers", frames));
-    const std::string flag = "--frames " + frames;
-    return {{"render.frame_start", flag, [a = a](Settings& s) { s.render.frame_start = std::uint32_t(a); }},
-            {"render.frames", flag, [n = b - a](Settings& s) { s.render.frames = std::uint32_t(n); }}};
-}
-
 Settings loadSceneArgs(const SceneArgs& a, const std::vector<FlagSetting>& flags) {
     std::vector<FlagSetting> all = frameFlags(a.frames);
     all.insert(all.end(), flags.begin(), flags.end());

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "accretion/core/error.h"
+#include "accretion/core/median.h"
 #include "accretion/core/parse.h"
 
 namespace accretion {
@@ -42,7 +43,7 @@ CostCoefficients CostCoefficients::load(const std::string& path) {
     if (!c || !c->is_object()) throw InputError(fmt::format("{}: no \"coefficients_ns\" object", path));
     CostCoefficients out;
     out.source = path;
-    // The launch coefficients are optional (files of the first form lack them).
+    // The counters after the first six are optional (files of the first form lack them).
     auto read = [&](const nlohmann::json& obj, const std::string& where, CostFeatures& into) {
         for (std::size_t k = 0; k < kCostFeatures.size(); ++k) {
             const std::string name(kCostFeatures[k]);
@@ -74,11 +75,18 @@ nlohmann::json CostCoefficients::toJson() const {
     return j;
 }
 
-double CostCoefficients::predictMs(const CostFeatures& f) const {
+namespace {
+
+/// sum coefficient (ns) x counter, in ms.
+double dotMs(const CostFeatures& ns, const CostFeatures& f) {
     double ms = 0.0;
     for (std::size_t k = 0; k < f.size(); ++k) ms += ns[k] * f[k] * 1e-6;
     return ms;
 }
+
+}  // namespace
+
+double CostCoefficients::predictMs(const CostFeatures& f) const { return dotMs(ns, f); }
 
 std::string passFamily(const std::string& pass) {
     const auto bracket = pass.find('[');
@@ -87,10 +95,7 @@ std::string passFamily(const std::string& pass) {
 
 double CostCoefficients::predictMs(const std::string& pass, const CostFeatures& f) const {
     const auto it = perPass.find(passFamily(pass));
-    if (it == perPass.end()) return predictMs(f);
-    double ms = 0.0;
-    for (std::size_t k = 0; k < f.size(); ++k) ms += it->second[k] * f[k] * 1e-6;
-    return ms;
+    return dotMs(it == perPass.end() ? ns : it->second, f);
 }
 
 std::vector<double> nonNegativeLeastSquares(const std::vector<CostFeatures>& rows, const std::vector<double>& b) {
@@ -200,7 +205,7 @@ std::vector<CostRow> readCounterCsv(const std::string& path) {
         CostRow row{r["config"], r["pass"], {}, 0.0};
         for (std::size_t k = 0; k < kCostFeatures.size(); ++k) {
             const auto cell = r.find(std::string(kCostFeatures[k]));
-            if (cell == r.end()) continue;  // a launch counter of a CSV of the first form: 0
+            if (cell == r.end()) continue;  // a later counter, absent from a CSV of the first form: 0
             row.features[k] = parseNumber(cell->second, fmt::format("{}:{}: {}", path, lineNo, kCostFeatures[k]));
         }
         rows.push_back(std::move(row));
@@ -271,13 +276,6 @@ CostCoefficients fit(const std::vector<CostRow>& rows, CostModelForm form) {
     return c;
 }
 
-double median(std::vector<double> v) {
-    if (v.empty()) return 0.0;
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 }  // namespace
 
 Calibration calibrate(const std::vector<CostRow>& rows, CostModelForm form) {
@@ -323,17 +321,19 @@ Holdout holdout(const std::vector<CostRow>& rows, CostModelForm form, double fra
     for (const CostRow& r : rows)
         if (in(h.fitted, r.config)) train.push_back(r);
     const CostCoefficients c = fit(train, form);
-    std::map<std::string, std::vector<std::pair<double, std::string>>> errors;
+    using Errors = std::vector<std::pair<double, std::string>>;  // relative error, configuration
+    std::map<std::string, Errors> byPass;
+    Errors all;
     for (const CostRow& r : rows) {
         if (!in(h.predicted, r.config) || !(r.measuredMs > 0.0)) continue;
         const double predicted = c.predictMs(r.pass, r.features);
         h.rows.push_back(r);
         h.predictedMs.push_back(predicted);
         const double e = std::abs(predicted - r.measuredMs) / r.measuredMs;
-        errors[passFamily(r.pass)].push_back({e, r.config});
-        errors["all passes"].push_back({e, r.config});
+        byPass[passFamily(r.pass)].push_back({e, r.config});
+        all.push_back({e, r.config});
     }
-    auto summary = [](const std::string& pass, const std::vector<std::pair<double, std::string>>& es) {
+    auto summary = [](const std::string& pass, const Errors& es) {
         HoldoutError he{pass, es.size(), 0.0, 0.0, ""};
         std::vector<double> v;
         for (const auto& [e, config] : es) {
@@ -346,9 +346,8 @@ Holdout holdout(const std::vector<CostRow>& rows, CostModelForm form, double fra
         he.median = median(v);
         return he;
     };
-    for (const auto& [pass, es] : errors)
-        if (pass != "all passes") h.passes.push_back(summary(pass, es));
-    if (errors.count("all passes")) h.passes.push_back(summary("all passes", errors["all passes"]));
+    for (const auto& [pass, es] : byPass) h.passes.push_back(summary(pass, es));
+    if (!all.empty()) h.passes.push_back(summary("all passes", all));
     return h;
 }
 
@@ -361,7 +360,7 @@ nlohmann::json Holdout::toJson() const {
     for (std::size_t i = 0; i < rows.size(); ++i)
         rs.push_back({{"config", rows[i].config}, {"pass", rows[i].pass}, {"measured_ms", rows[i].measuredMs},
                       {"predicted_ms", predictedMs[i]}});
-    return {{"form", form == CostModelForm::shared ? "shared" : "per_pass"}, {"fitted", fitted}, {"predicted", predicted},
+    return {{"form", costModelFormName(form)}, {"fitted", fitted}, {"predicted", predicted},
             {"passes", p}, {"rows", rs}};
 }
 

@@ -1,4 +1,3 @@
-#include "accretion/render/compose_pixel.h"
 #include "accretion/render/frame_renderer.h"
 
 #include <chrono>
@@ -8,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "accretion/counters/gpu_layouts.h"
+#include "accretion/render/compose_pixel.h"
 
 namespace accretion {
 namespace {

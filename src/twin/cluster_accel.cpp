@@ -46,7 +46,7 @@ unsigned ClusterAccel::buildFlags() const {
     return f;
 }
 
-OptixBuildInput ClusterAccel::triangles(std::size_t c) const {
+OptixBuildInput ClusterAccel::triangles(std::size_t c, OptixOpacityMicromapUsageCount& usage) const {
     const std::uint32_t n = offset_[c + 1] - offset_[c];
     OptixBuildInput in{};
     in.type = OPTIX_BUILD_INPUT_TYPE_TRIANGLES;
@@ -68,7 +68,8 @@ OptixBuildInput ClusterAccel::triangles(std::size_t c) const {
         m.indexBuffer = ommIndices_.address();  // 0, 1, 0, 1, ...: the same in every cluster
         m.indexSizeInBytes = 2;
         m.numMicromapUsageCounts = 1;
-        m.micromapUsageCounts = &ommUsage_;
+        usage = {2 * n, options_.ommLevel, ommFormat_};  // every triangle uses one of the two micromaps
+        m.micromapUsageCounts = &usage;
     }
     return in;
 }
@@ -106,8 +107,8 @@ void ClusterAccel::setClusters(const Clusters& clusters) {
         const std::uint32_t n = offset_[c + 1] - offset_[c];
         auto it = bySize.find(n);
         if (it == bySize.end()) {
-            ommUsage_.count = 2 * n;
-            const OptixBuildInput in = triangles(c);
+            OptixOpacityMicromapUsageCount usage;
+            const OptixBuildInput in = triangles(c, usage);
             OptixAccelBufferSizes s{};
             OPTIX_CHECK(optixAccelComputeMemoryUsage(context_, &opts, &in, 1, &s));
             it = bySize.emplace(n, s).first;
@@ -183,8 +184,8 @@ void ClusterAccel::build(const Clusters* clusters, const DeviceParticles& partic
             const std::size_t c = (first + k) % C;
             const unsigned lane = unsigned(k % S);
             const cudaStream_t bs = lane == 0 ? stream : buildStreams_[lane - 1];
-            ommUsage_.count = 2 * (offset_[c + 1] - offset_[c]);
-            const OptixBuildInput in = triangles(c);
+            OptixOpacityMicromapUsageCount usage;
+            const OptixBuildInput in = triangles(c, usage);
             const CUdeviceptr out = options_.pooled ? pool_.address() + blasOffset_[c] : perBlas_[c].address();
             OptixAccelEmitDesc emit{compactSizes_.address() + c * sizeof(std::uint64_t), OPTIX_PROPERTY_TYPE_COMPACTED_SIZE};
             OPTIX_CHECK(optixAccelBuild(context_, bs, &opts, &in, 1, temp_[lane].address(), temp_[lane].bytes(), out,
@@ -271,7 +272,7 @@ void ClusterAccel::buildMicromaps(cudaStream_t stream) {
     OPTIX_CHECK(optixOpacityMicromapArrayBuild(context_, stream, &in, &buffers));
     CUDA_CHECK(cudaStreamSynchronize(stream));
     stats_.ommBytes = sizes.outputSizeInBytes;
-    ommUsage_ = {0, L, format};
+    ommFormat_ = format;
 }
 
 void ClusterAccel::buildTlas(cudaStream_t stream) {

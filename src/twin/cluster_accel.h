@@ -69,7 +69,8 @@ public:
 
 private:
     void setClusters(const Clusters& clusters);
-    OptixBuildInput triangles(std::size_t c) const;
+    /// Cluster c's build input; `usage` (which it points at) receives its micromap usage.
+    OptixBuildInput triangles(std::size_t c, OptixOpacityMicromapUsageCount& usage) const;
     unsigned buildFlags() const;
     void buildTlas(cudaStream_t stream);
     void buildMicromaps(cudaStream_t stream);
@@ -79,7 +80,7 @@ private:
     std::vector<std::uint32_t> offset_;       ///< host copy of the cluster offsets
     DeviceBuffer clusterParticle_, clusterOffset_, vertices_, indices_;
     DeviceBuffer ommArray_, ommIndices_;           ///< the micromap array; per triangle 0 or 1 (its uv triangle)
-    OptixOpacityMicromapUsageCount ommUsage_{};
+    OptixOpacityMicromapFormat ommFormat_ = OPTIX_OPACITY_MICROMAP_FORMAT_NONE;
     std::vector<CUdeviceptr> vertexPointers_;  ///< per cluster (build inputs point at them)
     std::vector<std::size_t> outputBytes_, blasOffset_;
     DeviceBuffer pool_, compactPool_, compactSizes_;

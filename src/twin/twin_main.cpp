@@ -17,6 +17,7 @@
 
 #include "accretion/core/atomic_file.h"
 #include "accretion/core/error.h"
+#include "accretion/core/median.h"
 #include "accretion/core/parse.h"
 #include "accretion/core/version.h"
 #include "accretion/geometry/camera_track.h"
@@ -24,6 +25,7 @@
 #include "accretion/io/gpu_frame_file.h"
 #include "accretion/particles/particle_source.h"
 #include "accretion/render/compose_pixel.h"
+#include "accretion/render/upsample_pixel.h"
 #include "accretion/scene/scene_parser.h"
 #include "cluster_accel.h"
 #include "launch_params.h"
@@ -45,13 +47,6 @@ struct Args {
     unsigned repeat = 5, buildStreams = 1, seeds = 1;
     bool perBlas = false, compact = false, quiet = false, validation = false, skipLighting = false, lrOnly = false;
 };
-
-double median(std::vector<double> v) {
-    if (v.empty()) return 0.0;
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 /// The pass of `accretion cost` a timed pass belongs to (calibrate joins on
 /// it): the acceleration-structure work of the frame is buildClusters, the
@@ -150,19 +145,7 @@ StoredReservoir* runRestir(LaunchParams& lp, FrameBuffers& buf, const Settings& 
 }
 
 int run(const Args& a) {
-    std::vector<FlagSetting> flags;
-    if (!a.frames.empty()) {
-        const auto colon = a.frames.find(':');
-        const std::optional<std::uint64_t> f0 = parseUnsigned(std::string_view(a.frames).substr(0, colon), 1e9);
-        const std::optional<std::uint64_t> f1 =
-            colon == std::string::npos ? (f0 ? std::optional<std::uint64_t>(*f0 + 1) : std::nullopt)
-                                       : parseUnsigned(std::string_view(a.frames).substr(colon + 1), 1e9);
-        if (!f0 || !f1 || *f1 <= *f0)
-            throw InputError(fmt::format("command line --frames {}: expected A:B (frames A <= f < B) or A", a.frames));
-        const auto first = static_cast<std::uint32_t>(*f0), end = static_cast<std::uint32_t>(*f1);
-        flags.push_back({"render.frame_start", "--frames", [first](Settings& s) { s.render.frame_start = first; }});
-        flags.push_back({"render.frames", "--frames", [first, end](Settings& s) { s.render.frames = end - first; }});
-    }
+    std::vector<FlagSetting> flags = frameFlags(a.frames);
     if (!a.output.empty())
         flags.push_back({"render.output", "-o " + a.output, [o = a.output](Settings& s) { s.render.output = o; }});
     const Settings settings = loadScene(a.scene, a.defines, flags);
@@ -198,8 +181,8 @@ int run(const Args& a) {
     // The lighting grid (the CPU's Restir::render): the image at resolution_scale.
     const float scale = static_cast<float>(settings.restir.resolution_scale);
     const bool upsample = restir && scale < 1.0f;
-    const std::uint32_t gridW = upsample ? std::max(1u, std::uint32_t(std::lround(W * scale))) : W;
-    const std::uint32_t gridH = upsample ? std::max(1u, std::uint32_t(std::lround(H * scale))) : H;
+    const std::uint32_t gridW = upsample ? lightingGridExtent(W, scale) : W;
+    const std::uint32_t gridH = upsample ? lightingGridExtent(H, scale) : H;
     const std::size_t gridPixels = std::size_t(gridW) * gridH;
     if (restir) {
         buf.resA.resize(gridPixels * sizeof(StoredReservoir));
@@ -224,6 +207,14 @@ int run(const Args& a) {
                             {"scene", settings.scenePath}, {"repeat", a.repeat}, {"allocation", a.perBlas ? "per_blas" : "pooled"},
                             {"compact", a.compact}, {"build_streams", a.buildStreams}, {"seeds", a.seeds}, {"frames", nlohmann::json::array()}};
     const std::uint32_t first = settings.render.frame_start, frameCount = settings.render.frames;
+    // With --seeds every seed runs the same frames: their particles are loaded once.
+    std::map<std::uint32_t, Particles> loaded;
+    auto loadParticles = [&](std::uint32_t f) {
+        if (a.seeds == 1) return source.frame(f);
+        auto it = loaded.find(f);
+        if (it == loaded.end()) it = loaded.emplace(f, source.frame(f)).first;
+        return it->second;  // a copy: rebased below
+    };
     // --seeds: the frames again per seed (render.seed + k), each run from scratch.
     for (std::uint64_t step = 0; step < std::uint64_t(a.seeds) * frameCount; ++step) {
         const std::uint32_t frame = first + std::uint32_t(step % frameCount);
@@ -237,7 +228,7 @@ int run(const Args& a) {
         const Camera world = Camera::fromPose(pose, W, H);
         if (!built || !persistent) origin = world.position;
         const Camera camera = world.rebased(origin);
-        Particles particles = source.frame(frame);
+        Particles particles = loadParticles(frame);
         for (Vec3& p : particles.position) p -= origin;
         const std::size_t n = particles.size();
         std::vector<BillboardFrame> frames(n);

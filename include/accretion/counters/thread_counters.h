@@ -44,14 +44,7 @@ struct ThreadCounters {
         blasLevels += r.blasLevels;
         ommLookups += r.ommLookups;
     }
-    void addRay(const RayCounters& r) {
-        ++rays;
-        proceeds += r.candidates + 1;
-        blasEntries += r.blasEntries;
-        anyHits += r.anyHits;
-        blasLevels += r.blasLevels;
-        ommLookups += r.ommLookups;
-    }
+    void addRay(const RayCounters& r) { addRays(r, 1); }
 };
 
 /// One pass's dispatch: a width x height grid of threads (pixels; for

@@ -31,6 +31,7 @@ using CostFeatures = std::array<double, kCostFeatures.size()>;
 /// on relative error (passes differ in what bounds them: builds by their
 /// launches, resampling by memory, shadow rays by traversal).
 enum class CostModelForm { shared, per_pass };
+inline const char* costModelFormName(CostModelForm f) { return f == CostModelForm::shared ? "shared" : "per_pass"; }
 
 CostFeatures costFeatures(const PassReport& pass);
 

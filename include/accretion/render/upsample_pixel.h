@@ -10,6 +10,12 @@
 
 namespace accretion {
 
+/// The lighting grid's width (height) for an image width (height) at `scale`.
+inline std::uint32_t lightingGridExtent(std::uint32_t full, float scale) {
+    const auto n = static_cast<std::uint32_t>(std::lround(float(full) * scale));
+    return n > 1u ? n : 1u;
+}
+
 /// The lighting-grid texel of reduced texel (x, y): the image pixel that
 /// contains its centre.
 ACC_HD inline void reducedTexelSource(std::uint32_t x, std::uint32_t y, float scale, std::uint32_t width, std::uint32_t height,

@@ -1,8 +1,10 @@
 #pragma once
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "accretion/scene/settings.h"
@@ -25,6 +27,13 @@ Settings loadScene(const std::filesystem::path& file, const std::vector<std::str
 /// Same, from text; `sourceName` is used in error messages.
 Settings parseScene(std::string_view text, std::string_view sourceName,
                     const std::vector<std::string>& overrides = {}, const std::vector<FlagSetting>& flags = {});
+
+/// Parse `A:B` (half-open, 0 <= A < B) or `A` (= A:A+1) of a command-line
+/// option; InputError names the option.
+std::pair<std::uint64_t, std::uint64_t> parseHalfOpen(const std::string& text, const char* option);
+
+/// `--frames A:B` as the settings it sets (render.frame_start, render.frames).
+std::vector<FlagSetting> frameFlags(const std::string& frames);
 
 /// The effective settings as a TOML document (every key, defaults included).
 std::string settingsToToml(const Settings& settings);

@@ -68,8 +68,8 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
     GBuffer reduced;
     const GBuffer* lg = &full;
     if (in.plan.upsample) {
-        reduced.width = std::max(1u, std::uint32_t(std::lround(full.width * scale)));
-        reduced.height = std::max(1u, std::uint32_t(std::lround(full.height * scale)));
+        reduced.width = lightingGridExtent(full.width, scale);
+        reduced.height = lightingGridExtent(full.height, scale);
         reduced.texels.resize(std::size_t(reduced.width) * reduced.height);
         for (std::uint32_t y = 0; y < reduced.height; ++y)
             for (std::uint32_t x = 0; x < reduced.width; ++x) {
