@@ -1,6 +1,6 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine (issue 16), from the repository root:
-#   bash bench/gpu/run.sh STEP...      steps: env build images restir builds frame ncu
+#   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -72,6 +72,25 @@ step_restir() {
         -o "$W/restir/basic_omm4_traverse.{frame}.exr" --repeat 3
 }
 
+# The Monte Carlo estimators (uniform, power: each chunk of 8 samples its own
+# stream, as on the CPU; adaptive sampling by rounds) and restir's candidates
+# drawn by power, for the per-pixel comparison with the CPU's frames; the
+# GPU time of power at 64 spp on disk_100k.
+step_sampling() {
+    local q=scenes/quickstart.toml small="-D camera.width=320 -D camera.height=180"
+    local t="$W/sampling"
+    mkdir -p "$t"
+    $BIN $q $small -D render.estimator=power -D render.samples=16 --frames 0:1 --repeat 3 -o "$t/power.{frame}.exr"
+    $BIN $q $small -D render.estimator=uniform -D render.samples=20 --frames 0:1 --repeat 3 -o "$t/uniform.{frame}.exr"
+    $BIN $q $small -D render.estimator=power -D render.samples=8 -D render.target_stderr=0.05 -D render.max_samples=256 \
+        --frames 0:1 --repeat 3 -o "$t/power_adaptive.{frame}.exr"
+    $BIN $q $small -D render.estimator=power -D render.samples=16 -D geometry.alpha=disc --frames 0:1 --repeat 3 \
+        -o "$t/power_disc.{frame}.exr"
+    $BIN $q $small -D render.estimator=restir -D render.source=power --frames 0:3 --repeat 3 -o "$t/restir_power.{frame}.exr"
+    $BIN scenes/disk_100k.toml --frames 0:1 --repeat 5 -o "$t/disk_100k_power64.{frame}.exr" \
+        --timings "$t/disk_100k_power64.csv" --config power64
+}
+
 # restir over $SEEDS (64) seeds for `accretion bias --gpu-frames` (quickstart, 160x90,
 # frame 2 after two history frames; Lr alone; one archive per estimator).
 step_seeds() {
@@ -88,11 +107,15 @@ step_seeds() {
 
 # The cost-model sweep (bench/gpu/sweep.txt): per configuration the median
 # GPU ms per pass of frame 1 (temporal reuse on), in cost's pass names.
+# SWEEP_PART=i/n runs the i-th of n parts (1-based; the configurations in
+# turn), so that a part fits one device call.
 step_sweep() {
-    local t="$W/sweep"
+    local t="$W/sweep" part=${SWEEP_PART:-1/1} k=0
     mkdir -p "$t"
     grep -v '^#' bench/gpu/sweep.txt | while read -r name args; do
         [ -z "$name" ] && continue
+        k=$((k + 1))
+        [ $(((k - 1) % ${part#*/})) -eq $((${part%/*} - 1)) ] || continue
         # shellcheck disable=SC2086  # the overrides are words
         timeout 150 $BIN scenes/disk_100k.toml -D render.estimator=restir $args --frames 0:2 --repeat 5 -q \
             -o "$t/$name.{frame}.exr" --timings "$t/$name.timings.csv" --config "$name" < /dev/null \
@@ -100,7 +123,7 @@ step_sweep() {
         rm -f "$t"/*.gpuframe
         echo "sweep: $name done"
     done
-    { echo config,pass,ms; for f in "$t"/*.timings.csv; do tail -n +2 "$f"; done; } > "$t/timings.csv"
+    { echo config,pass,ms; for f in "$t"/*.timings.csv; do tail -n +2 "$f"; done; } > "$t/timings_${part%/*}.csv"
 }
 
 # Seed 004's build questions: rebuild / refit / partial, pooled / per-BLAS,

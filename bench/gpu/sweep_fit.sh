@@ -1,8 +1,8 @@
 #!/bin/bash
 # The cost model against the sweep: `accretion calibrate --holdout 0.5` over
 # split seeds 1-5 (half the configurations fitted, the other half predicted),
-# both model forms, per pass the median and worst relative error; and the
-# per_pass coefficients fitted on every configuration.
+# every model form (shared, per_pass, selected), per pass the median and worst relative error; and the
+# per_pass and selected coefficients fitted on every configuration.
 #   bash bench/gpu/sweep_fit.sh COUNTERS.csv TIMINGS.csv OUT_DIR
 set -euo pipefail
 counters=$1 timings=$2 out=$3
@@ -13,7 +13,7 @@ trap 'rm -rf "$T"' EXIT
 echo "split_seed,form,pass,rows,median_relative_error,worst_relative_error,worst_config" > "$out/holdout.csv"
 for seed in 1 2 3 4 5; do
     $A calibrate "$counters" "$timings" --holdout 0.5 --split-seed $seed -o "$T/c$seed.json" > /dev/null
-    for form in shared per_pass; do
+    for form in shared per_pass selected; do
         jq -r --arg s $seed --arg f $form '.holdout[$f].passes[] |
             [$s, $f, .pass, .rows, .median_relative_error, .worst_relative_error, .worst_config] | @csv' "$T/c$seed.json" |
             tr -d '"' >> "$out/holdout.csv"
@@ -21,17 +21,19 @@ for seed in 1 2 3 4 5; do
 done
 $A calibrate "$counters" "$timings" --form per_pass -o "$out/coefficients_per_pass.json" > "$out/calibrate_per_pass.txt"
 $A calibrate "$counters" "$timings" --form shared -o "$out/coefficients_shared.json" > "$out/calibrate_shared.txt"
+$A calibrate "$counters" "$timings" --form selected -o "$out/coefficients_selected.json" > "$out/calibrate_selected.txt"
 # Per pass over the five splits: the median of the medians and the worst of the worsts.
 python3 - "$out/holdout.csv" <<'PY'
 import csv, statistics, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
 passes = sorted({r["pass"] for r in rows}, key=lambda p: (p == "all passes", p))
-print(f"{'pass':<20} {'shared median':>14} {'shared worst':>13} {'per_pass median':>16} {'per_pass worst':>15}")
+forms = ("shared", "per_pass", "selected")
+print(f"{'pass':<20}" + "".join(f" {f + ' median':>16} {f + ' worst':>15}" for f in forms))
 for p in passes:
     cells = []
-    for f in ("shared", "per_pass"):
+    for f in forms:
         sel = [r for r in rows if r["pass"] == p and r["form"] == f]
         cells += [100 * statistics.median(float(r["median_relative_error"]) for r in sel),
                   100 * max(float(r["worst_relative_error"]) for r in sel)]
-    print(f"{p:<20} {cells[0]:>13.1f}% {cells[1]:>12.1f}% {cells[2]:>15.1f}% {cells[3]:>14.1f}%")
+    print(f"{p:<20}" + "".join(f" {c:>15.1f}%" for c in cells))
 PY

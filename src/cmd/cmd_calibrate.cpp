@@ -24,18 +24,27 @@ struct CalibrateArgs {
     std::uint64_t splitSeed = 1;
 };
 
-/// Held-out errors of both forms side by side, per pass.
+/// Held-out errors of every form side by side, per pass.
 nlohmann::json reportHoldout(const std::vector<CostRow>& rows, double fraction, std::uint64_t seed) {
-    const Holdout a = holdout(rows, CostModelForm::shared, fraction, seed);
-    const Holdout b = holdout(rows, CostModelForm::per_pass, fraction, seed);
+    const CostModelForm forms[] = {CostModelForm::shared, CostModelForm::per_pass, CostModelForm::selected};
+    std::vector<Holdout> h;
+    for (CostModelForm f : forms) h.push_back(holdout(rows, f, fraction, seed));
     fmt::print("held out: fitted on {} configurations, predicted {} (split seed {}); relative error of the predicted:\n",
-               a.fitted.size(), a.predicted.size(), seed);
-    fmt::print("{:<22} {:>5}  {:>14} {:>14}  {:>14} {:>14}\n", "pass", "rows", "shared median", "shared worst",
-               "per_pass median", "per_pass worst");
-    for (std::size_t k = 0; k < a.passes.size() && k < b.passes.size(); ++k)
-        fmt::print("{:<22} {:>5}  {:>13.1f}% {:>13.1f}%  {:>14.1f}% {:>13.1f}%\n", a.passes[k].pass, a.passes[k].rows,
-                   100 * a.passes[k].median, 100 * a.passes[k].worst, 100 * b.passes[k].median, 100 * b.passes[k].worst);
-    return {{"fraction", fraction}, {"split_seed", seed}, {"shared", a.toJson()}, {"per_pass", b.toJson()}};
+               h[0].fitted.size(), h[0].predicted.size(), seed);
+    std::string header = fmt::format("{:<22} {:>5}", "pass", "rows");
+    for (CostModelForm f : forms)
+        header += fmt::format("  {:>15} {:>15}", fmt::format("{} median", costModelFormName(f)),
+                              fmt::format("{} worst", costModelFormName(f)));
+    fmt::print("{}\n", header);
+    for (std::size_t k = 0; k < h[0].passes.size(); ++k) {
+        std::string line = fmt::format("{:<22} {:>5}", h[0].passes[k].pass, h[0].passes[k].rows);
+        for (const Holdout& x : h)
+            if (k < x.passes.size()) line += fmt::format("  {:>14.1f}% {:>14.1f}%", 100 * x.passes[k].median, 100 * x.passes[k].worst);
+        fmt::print("{}\n", line);
+    }
+    nlohmann::json j = {{"fraction", fraction}, {"split_seed", seed}};
+    for (std::size_t i = 0; i < h.size(); ++i) j[costModelFormName(forms[i])] = h[i].toJson();
+    return j;
 }
 
 void runCalibrate(const CalibrateArgs& args) {
@@ -89,12 +98,14 @@ void addCalibrateCommand(CLI::App& app) {
         ->expected(2, -1);
     cmd->add_option("-o,--output", args->output, "Coefficients JSON for gpu.coefficients");
     cmd->add_option("--form", args->form,
-                    "Model form: shared (one coefficient per counter for all passes, least squares on ms) or per_pass "
-                    "(each pass its own, launches included, on relative error)")
+                    "Model form: shared (one coefficient per counter for all passes, least squares on ms), per_pass "
+                    "(each pass its own, launches included, on relative error) or selected (per_pass over the counters "
+                    "chosen by leave-one-configuration-out error)")
         ->transform(CLI::CheckedTransformer(std::map<std::string, CostModelForm>{{"shared", CostModelForm::shared},
-                                                                                 {"per_pass", CostModelForm::per_pass}}));
+                                                                                 {"per_pass", CostModelForm::per_pass},
+                                                                                 {"selected", CostModelForm::selected}}));
     cmd->add_option("--holdout", args->holdout,
-                    "Also fit both forms on this fraction of the configurations (at random) and report the relative "
+                    "Also fit every form on this fraction of the configurations (at random) and report the relative "
                     "error of predicting the others, per pass")
         ->check(CLI::Range(0.05, 0.95));
     cmd->add_option("--split-seed", args->splitSeed, "Seed of --holdout's split");

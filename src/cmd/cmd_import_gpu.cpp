@@ -23,8 +23,9 @@ struct ImportArgs {
     std::string outDir;
 };
 
-/// render's frame image of a GPU frame: exact-style lighting (no standard
-/// error, no sample count: the GPU's estimate is what it is).
+/// render's frame image of a GPU frame: the Monte Carlo estimators' standard
+/// error, sample count and rejections where the frame has them (uniform,
+/// power), else exact-style lighting (restir's estimate is what it is).
 FrameImage frameImage(const GpuFrame& g) {
     FrameImage img;
     img.width = g.width;
@@ -38,9 +39,9 @@ FrameImage frameImage(const GpuFrame& g) {
     img.particle = g.particle;
     const std::size_t n = std::size_t(g.width) * g.height;
     img.lighting.Lr = g.Lr;
-    img.lighting.Lr_stderr.assign(n, Vec3(0.0f));
-    img.lighting.spp.assign(n, 0.0f);
-    img.lighting.rejected.assign(n, 0.0f);
+    img.lighting.Lr_stderr = g.Lr_stderr.empty() ? std::vector<Vec3>(n, Vec3(0.0f)) : g.Lr_stderr;
+    img.lighting.spp = g.spp.empty() ? std::vector<float>(n, 0.0f) : g.spp;
+    img.lighting.rejected = g.rejected.empty() ? std::vector<float>(n, 0.0f) : g.rejected;
     return img;
 }
 
@@ -76,7 +77,7 @@ void runImport(const ImportArgs& a) {
         const std::string& base = outputs[k];
         const PreviewTone tone = previewTone(img.L, toneOf(g), true, 0.0);
         meta["preview"] = tone.describe();
-        writeFrameExr(base + ".exr", img, false, meta);
+        writeFrameExr(base + ".exr", img, !g.Lr_stderr.empty(), meta);  // uniform / power: Lr_stderr and spp
         writePreviewPng(base + ".png", img.L, g.width, g.height, tone);
         writePreviewPng(base + ".Lr.png", img.lighting.Lr, g.width, g.height,
                         previewTone(img.lighting.Lr, toneOf(g), true, 0.0));

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <random>
 #include <sstream>
@@ -238,25 +239,101 @@ void joinTimings(const std::string& path, std::vector<CostRow>& rows) {
 
 namespace {
 
-/// NNLS of one set of rows over `features` (the others held at 0); with
-/// `relative`, each row weighted by 1 / its measured time.
-CostFeatures fitRows(const std::vector<const CostRow*>& rows, std::size_t features, bool relative) {
+using FeatureMask = std::array<bool, kCostFeatures.size()>;
+
+FeatureMask firstFeatures(std::size_t n) {
+    FeatureMask m{};
+    for (std::size_t k = 0; k < n; ++k) m[k] = true;
+    return m;
+}
+
+/// NNLS of one set of rows over the features of `mask` (the others held at
+/// 0); with `relative`, each row weighted by 1 / its measured time.
+CostFeatures fitRows(const std::vector<const CostRow*>& rows, const FeatureMask& mask, bool relative) {
     CostFeatures scale{};
     for (const CostRow* r : rows)
-        for (std::size_t k = 0; k < features; ++k) scale[k] = std::max(scale[k], r->features[k]);
+        for (std::size_t k = 0; k < mask.size(); ++k)
+            if (mask[k]) scale[k] = std::max(scale[k], r->features[k]);
     std::vector<CostFeatures> A;
     std::vector<double> b;
     for (const CostRow* r : rows) {
         const double w = relative && r->measuredMs > 0.0 ? 1.0 / r->measuredMs : 1.0;
         CostFeatures f{};
-        for (std::size_t k = 0; k < features; ++k) f[k] = scale[k] > 0.0 ? w * r->features[k] / scale[k] : 0.0;
+        for (std::size_t k = 0; k < mask.size(); ++k) f[k] = scale[k] > 0.0 ? w * r->features[k] / scale[k] : 0.0;
         A.push_back(f);
         b.push_back(w * r->measuredMs);
     }
     const std::vector<double> x = nonNegativeLeastSquares(A, b);
     CostFeatures ns{};
-    for (std::size_t k = 0; k < features; ++k) ns[k] = scale[k] > 0.0 ? x[k] / scale[k] * 1e6 : 0.0;
+    for (std::size_t k = 0; k < mask.size(); ++k) ns[k] = scale[k] > 0.0 ? x[k] / scale[k] * 1e6 : 0.0;
     return ns;
+}
+
+/// Root mean square relative error of predicting each configuration's rows
+/// from a fit (over `mask`) of the other configurations' rows.
+double leaveOneConfigOut(const std::vector<const CostRow*>& rows, const FeatureMask& mask) {
+    std::vector<std::string> configs;
+    for (const CostRow* r : rows) configs.push_back(r->config);
+    std::sort(configs.begin(), configs.end());
+    configs.erase(std::unique(configs.begin(), configs.end()), configs.end());
+    double sum = 0.0;
+    std::size_t n = 0;
+    for (const std::string& left : configs) {
+        std::vector<const CostRow*> train;
+        for (const CostRow* r : rows)
+            if (r->config != left) train.push_back(r);
+        const CostFeatures ns = fitRows(train, mask, true);
+        for (const CostRow* r : rows) {
+            if (r->config != left || !(r->measuredMs > 0.0)) continue;
+            const double e = (dotMs(ns, r->features) - r->measuredMs) / r->measuredMs;
+            sum += e * e;
+            ++n;
+        }
+    }
+    return n ? std::sqrt(sum / double(n)) : 0.0;
+}
+
+/// The selected form of one pass: the launch counters (a constant per
+/// dispatch, build and refit: always a cost where they occur, and a
+/// configuration of their own, such as the only refit, cannot vote for them
+/// when left out), then forward selection of the work counters, each step
+/// adding the one that lowers the leave-one-configuration-out error most,
+/// until none lowers it by more than its standard error; then the fit over
+/// the chosen counters. With
+/// fewer than 4 configurations, every counter (per_pass).
+CostFeatures fitSelected(const std::vector<const CostRow*>& rows) {
+    std::vector<std::string> configs;
+    for (const CostRow* r : rows) configs.push_back(r->config);
+    std::sort(configs.begin(), configs.end());
+    const std::size_t nConfigs = std::size_t(std::unique(configs.begin(), configs.end()) - configs.begin());
+    const FeatureMask all = firstFeatures(kCostFeatures.size());
+    if (nConfigs < 4) return fitRows(rows, all, true);
+    FeatureMask chosen{};
+    for (std::string_view launch : {"dispatches", "blas_builds", "blas_refits"})
+        chosen[std::size_t(std::find(kCostFeatures.begin(), kCostFeatures.end(), launch) - kCostFeatures.begin())] = true;
+    double best = leaveOneConfigOut(rows, chosen);
+    for (std::size_t step = 0; step < kCostFeatures.size() && step + 2 < nConfigs; ++step) {
+        std::size_t pick = kCostFeatures.size();
+        double pickError = best;
+        for (std::size_t k = 0; k < kCostFeatures.size(); ++k) {
+            if (chosen[k] || std::none_of(rows.begin(), rows.end(), [&](const CostRow* r) { return r->features[k] > 0.0; }))
+                continue;
+            FeatureMask m = chosen;
+            m[k] = true;
+            const double e = leaveOneConfigOut(rows, m);
+            if (e < pickError) {
+                pickError = e;
+                pick = k;
+            }
+        }
+        // One standard error (Breiman's rule; an RMS of n errors has a
+        // relative standard error of about 1 / sqrt(2 n)): a counter that
+        // gains less may have followed the noise of these configurations.
+        if (pick == kCostFeatures.size() || !(pickError < best * (1.0 - 1.0 / std::sqrt(2.0 * double(rows.size()))))) break;
+        chosen[pick] = true;
+        best = pickError;
+    }
+    return fitRows(rows, chosen, true);
 }
 
 CostCoefficients fit(const std::vector<CostRow>& rows, CostModelForm form) {
@@ -264,15 +341,16 @@ CostCoefficients fit(const std::vector<CostRow>& rows, CostModelForm form) {
     std::vector<const CostRow*> all;
     for (const CostRow& r : rows) all.push_back(&r);
     if (form == CostModelForm::shared) {
-        c.ns = fitRows(all, kBaseCostFeatures, false);
+        c.ns = fitRows(all, firstFeatures(kBaseCostFeatures), false);
         c.source = "calibrated (shared)";
         return c;
     }
-    c.ns = fitRows(all, kCostFeatures.size(), true);  // for a pass no row has
+    c.ns = fitRows(all, firstFeatures(kCostFeatures.size()), true);  // for a pass no row has
     std::map<std::string, std::vector<const CostRow*>> byPass;
     for (const CostRow& r : rows) byPass[passFamily(r.pass)].push_back(&r);
-    for (const auto& [pass, rs] : byPass) c.perPass[pass] = fitRows(rs, kCostFeatures.size(), true);
-    c.source = "calibrated (per_pass)";
+    for (const auto& [pass, rs] : byPass)
+        c.perPass[pass] = form == CostModelForm::selected ? fitSelected(rs) : fitRows(rs, firstFeatures(kCostFeatures.size()), true);
+    c.source = fmt::format("calibrated ({})", costModelFormName(form));
     return c;
 }
 

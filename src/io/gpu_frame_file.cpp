@@ -33,6 +33,9 @@ void forEachPlane(Frame& f, Visit&& visit) {
     visit("normal", f.normal);
     visit("depth", f.depth);
     visit("particle", f.particle);
+    visit("Lr_stderr", f.Lr_stderr);
+    visit("spp", f.spp);
+    visit("rejected", f.rejected);
 }
 
 }  // namespace
@@ -75,7 +78,7 @@ GpuFrame readGpuFrame(const std::filesystem::path& file) {
     std::string text(len, '\0');
     if (!in.read(text.data(), std::streamsize(len))) throw InputError(fmt::format("{}: truncated header", name));
     GpuFrame f;
-    std::vector<std::string> planes = {"L", "Le", "Lr", "normal", "depth", "particle"};  // files without "planes": all
+    std::vector<std::string> planes = {"L", "Le", "Lr", "normal", "depth", "particle"};  // files without "planes": the first six
     try {
         const nlohmann::json h = nlohmann::json::parse(text);
         f.width = h.at("width").get<std::uint32_t>();
@@ -109,7 +112,8 @@ GpuFrame readGpuFrame(const std::filesystem::path& file) {
         read(plane, what);
     });
     if (known != planes.size() || f.Lr.empty())
-        throw InputError(fmt::format("{}: bad plane list (known planes: L, Le, Lr, normal, depth, particle; Lr required)", name));
+        throw InputError(fmt::format("{}: bad plane list (known planes: L, Le, Lr, normal, depth, particle, Lr_stderr, spp, "
+                                     "rejected; Lr required)", name));
     if (in.peek() != std::ifstream::traits_type::eof()) throw InputError(fmt::format("{}: trailing bytes", name));
     return f;
 }

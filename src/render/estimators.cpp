@@ -14,6 +14,7 @@
 #include "accretion/lighting/light_sampler.h"
 #include "accretion/lighting/reservoir.h"
 #include "accretion/lighting/shading.h"
+#include "accretion/render/sample_sums.h"
 #include "accretion/render/visibility.h"
 
 namespace accretion {
@@ -51,43 +52,20 @@ DVec3 exactPixel(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoin
     return sum;
 }
 
-/// One test for three components: a NaN or Inf component makes the sum
-/// non-finite, and float-derived doubles cannot overflow a double sum.
-inline bool finite(const DVec3& v) { return std::isfinite(v.x + v.y + v.z); }
-
-/// One pixel's running sums and counters while its chunks run (loaded from
-/// and stored to the Accumulation, or resolved directly), with the
-/// non-finite policy applied to every sample added.
-struct PixelSums {
-    DVec3 sum{0.0}, sumSq{0.0};
-    std::uint32_t n = 0;
-    std::uint32_t rejected = 0;
+/// One pixel's running sums (SampleSums: the non-finite policy applied to
+/// every sample added) and counters while its chunks run, loaded from and
+/// stored to the Accumulation, or resolved directly.
+struct PixelSums : SampleSums {
     std::uint8_t done = 0;
-    NonFinitePolicy policy = NonFinitePolicy::zero_sample;
+    std::uint32_t rejectedBefore = 0;  ///< `rejected` when loaded: the sweep's rejections are the rest
     LightingCounters c;   ///< this pixel's work (added to its thread's when it finishes)
     PixelTrace* trace = nullptr;  ///< render --pixel: this is the pixel traced
 
-    /// Count a non-finite value; true if the policy discards it (else it counts as 0).
-    bool reject() {
-        ++rejected;
-        ++c.nonFinite;
-        return policy == NonFinitePolicy::discard;
-    }
-    void add(const DVec3& x) {
-        if (!finite(x)) {
-            if (!reject()) ++n;
-            return;
-        }
-        sum += x;
-        sumSq += x * x;
-        ++n;
-    }
-    void addZero() { ++n; }
     void load(const Accumulation& a, std::size_t px) {
         sum = a.sum[px];
         sumSq = a.sumSq[px];
         n = a.n[px];
-        rejected = a.rejected[px];
+        rejected = rejectedBefore = a.rejected[px];
         done = a.done[px];
     }
     void store(Accumulation& a, std::size_t px) const {
@@ -99,35 +77,11 @@ struct PixelSums {
     }
 };
 
-/// Mean and standard error of the mean of n samples with these sums (n > 0).
-void meanAndError(const DVec3& sum, const DVec3& sumSq, std::uint32_t n, DVec3& mean, DVec3& err) {
-    mean = sum / double(n);
-    const DVec3 var = n > 1 ? glm::max((sumSq - double(n) * mean * mean) / double(n - 1), DVec3(0.0)) : DVec3(0.0);
-    err = glm::sqrt(var / double(n));
-}
-
-/// Mean, standard error, spp and rejected count of one pixel's sums; a value
-/// that does not fit a float is zeroed and counted. Returns 1 if zeroed.
+/// Mean, standard error, spp and rejected count of one pixel's sums into
+/// `out` (resolveSums). Returns 1 if the value was zeroed.
 std::uint32_t resolvePixel(const DVec3& sum, const DVec3& sumSq, std::uint32_t n, std::uint32_t rejected, bool exact,
                            LightingImage& out, std::size_t px) {
-    Vec3 mean(0.0f), err(0.0f);
-    float spp = 0.0f;
-    if (exact) mean = Vec3(sum);
-    else if (n > 0) {
-        DVec3 m, e;
-        meanAndError(sum, sumSq, n, m, e);
-        mean = Vec3(m);
-        err = Vec3(e);
-        spp = float(n);
-    }
-    std::uint32_t zeroed = 0;
-    if (!finite(DVec3(mean)) || !finite(DVec3(err))) {  // float overflow of a finite double
-        mean = err = Vec3(0.0f);
-        zeroed = 1;
-    }
-    out.Lr[px] = mean;
-    out.Lr_stderr[px] = err;
-    out.spp[px] = spp;
+    const std::uint32_t zeroed = resolveSums(sum, sumSq, n, exact, out.Lr[px], out.Lr_stderr[px], out.spp[px]) ? 1 : 0;
     out.rejected[px] = float(rejected + zeroed);
     return zeroed;
 }
@@ -217,17 +171,6 @@ void risChunk(const ParticleBvh& bvh, const LightArrays& L, const AliasTable* ta
     }
 }
 
-/// Adaptive sampling: at the end of a round, stop a pixel whose relative
-/// standard error (of the luminance) reached the target, or whose next round
-/// would pass max_samples.
-bool roundDone(const DVec3& s1, const DVec3& s2, std::uint32_t n, std::uint32_t roundsTaken, const RenderSettings& rs) {
-    if (std::uint64_t(roundsTaken + 1) * rs.samples > rs.max_samples) return true;
-    if (n < 2) return false;
-    DVec3 m, err;
-    meanAndError(s1, s2, n, m, err);
-    return luminance(Vec3(err)) <= rs.target_stderr * luminance(Vec3(m));
-}
-
 /// One hit pixel of a group while its chunks run.
 struct GroupPixel {
     std::size_t px = 0;
@@ -294,7 +237,8 @@ void runChunks(const LightingInputs& in, const LightArrays& L, const LightingPla
         for (std::uint32_t k = 0; k < n; ++k) {
             PixelSums& s = pix[k].sums;
             if (!s.done && plan.adaptive && (chunk + 1) % plan.chunksPerRound == 0)
-                s.done = roundDone(s.sum, s.sumSq, s.n, static_cast<std::uint32_t>((chunk + 1) / plan.chunksPerRound), in.render);
+                s.done = roundDone(s.sum, s.sumSq, s.n, static_cast<std::uint32_t>((chunk + 1) / plan.chunksPerRound), in.render.samples,
+                                   in.render.max_samples, in.render.target_stderr);
             active = active || !s.done;
         }
         if (!active) return;
@@ -370,7 +314,7 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
                     GroupPixel& p = pix[k];
                     p.sp = shadingPoint(gb.texels[p.px], in.particles);
                     p.sums = PixelSums{};
-                    p.sums.policy = in.render.nonfinite;
+                    p.sums.discardNonFinite = in.render.nonfinite == NonFinitePolicy::discard;
                     p.rays = RayCounters{};
                     if (acc) p.sums.load(*acc, p.px);
                     if (in.trace && in.trace->px == p.px) [[unlikely]] p.sums.trace = in.trace;
@@ -380,7 +324,7 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
                         PixelSums& s = pix[k].sums;
                         const DVec3 v = s.trace ? exactPixel<M, P, true>(in.bvh, L, pix[k].sp, vis, shadows, s.c, Count ? &pix[k].rays : nullptr, s.trace)
                                               : exactPixel<M, P>(in.bvh, L, pix[k].sp, vis, shadows, s.c, Count ? &pix[k].rays : nullptr);
-                        if (finite(v)) s.sum = v;
+                        if (finiteSum(v)) s.sum = v;
                         else s.reject();  // exact has one value: 0 either way
                         s.n = 1;
                     }
@@ -398,6 +342,7 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
                     record(p.px, &p);
                     if (acc) p.sums.store(*acc, p.px);
                     else p.sums.c.nonFinite += resolvePixel(p.sums.sum, p.sums.sumSq, p.sums.n, p.sums.rejected, plan.exact, *out, p.px);
+                    p.sums.c.nonFinite += p.sums.rejected - p.sums.rejectedBefore;
                     c += p.sums.c;
                 }
             }

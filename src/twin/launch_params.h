@@ -6,6 +6,7 @@
 #include <optix_types.h>
 
 #include "accretion/geometry/billboard.h"
+#include "accretion/lighting/source_pmf.h"
 #include "accretion/lighting/reservoir_codec.h"
 #include "accretion/geometry/camera.h"
 #include "accretion/render/gbuffer_texel.h"
@@ -35,6 +36,24 @@ struct LightView {
     const Vec3* emission = nullptr;
     const Vec3* albedo = nullptr;
     const float* dmin2 = nullptr;        ///< max(r_i, dmin)^2
+};
+
+/// uniform and power (docs/MODEL.md section 4) as the CPU's LightingPlan runs
+/// them, one pixel per thread: chunks of up to 8 samples, each chunk its own
+/// stream; adaptive sampling stops a pixel at the end of a round.
+struct SamplingParams {
+    std::uint32_t frame = 0;
+    std::uint64_t seed = 0;
+    std::uint32_t samples = 16;          ///< per round (render.samples)
+    std::uint32_t chunksPerRound = 2;
+    std::uint32_t rounds = 1;            ///< adaptive: the most rounds a pixel can take
+    bool adaptive = false;               ///< render.target_stderr > 0
+    std::uint32_t maxSamples = 65536;
+    double targetStderr = 0.0;
+    bool discardNonFinite = false;       ///< render.nonfinite = discard
+    Vec3* Lr_stderr = nullptr;           ///< width x height, as Lr
+    float* spp = nullptr;
+    std::uint32_t* rejected = nullptr;
 };
 
 /// ReSTIR DI (docs/MODEL.md section 4) as the CPU's passes run it.
@@ -93,6 +112,8 @@ struct LaunchParams {
     const std::uint32_t* clusterOffset = nullptr;
 
     LightView lights;                    ///< this frame's lights (the same arrays as above)
+    SourcePmf source;                    ///< power's lights and restir's candidates (render.source) of this frame
+    SamplingParams sampling;
     RestirParams restir;
 
     // Outputs.

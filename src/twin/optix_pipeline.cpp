@@ -63,7 +63,8 @@ TwinPipeline::TwinPipeline(const std::filesystem::path& programs, bool validatio
         OPTIX_CHECK(optixProgramGroupCreate(context_, &desc, 1, &groupOptions, log, &size, &g));
         return g;
     };
-    const char* raygenNames[] = {"__raygen__gbuffer", "__raygen__exact", "__raygen__shade", "__raygen__shadeTraverse"};
+    const char* raygenNames[] = {"__raygen__gbuffer", "__raygen__exact", "__raygen__sample", "__raygen__shade",
+                                 "__raygen__shadeTraverse"};
     for (int r = 0; r < int(Raygen::count); ++r) {
         OptixProgramGroupDesc d{};
         d.kind = OPTIX_PROGRAM_GROUP_KIND_RAYGEN;

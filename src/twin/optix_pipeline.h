@@ -9,11 +9,12 @@
 
 namespace accretion::twin {
 
-/// gbuffer: primary rays; exact: the exact estimator; shade: restir's
+/// gbuffer: primary rays; exact: the exact estimator; sample: the uniform
+/// and power estimators; shade: restir's
 /// traceShadowRays with optixTrace (pipeline); shadeTraverse: the same with
 /// optixTraverse and a hit object (the inline-like path), optionally after
 /// optixReorder (SER).
-enum class Raygen { gbuffer, exact, shade, shadeTraverse, count };
+enum class Raygen { gbuffer, exact, sample, shade, shadeTraverse, count };
 
 class TwinPipeline {
 public:

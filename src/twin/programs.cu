@@ -1,5 +1,6 @@
 // The twin's OptiX programs (compiled to OptiX-IR): the G-buffer raygen,
-// the exact estimator's raygen, and the hit programs of its two ray types.
+// the exact estimator's raygen, the uniform / power estimators' raygen,
+// restir's shading raygens, and the hit programs of its two ray types.
 //  - primary rays: closest hit; on disc-alpha billboards an any-hit runs the
 //    alpha test;
 //  - shadow rays (V(x, p_i), docs/MODEL.md section 3): an any-hit excludes the
@@ -10,6 +11,7 @@
 #include <optix.h>
 
 #include "accretion/lighting/shading.h"
+#include "accretion/render/sample_sums.h"
 #include "accretion/render/shadow_query.h"
 #include "launch_params.h"
 #include "restir_device.h"
@@ -109,6 +111,36 @@ __device__ DVec3 exactSum(const ShadingPoint& sp, LaunchCounters& c) {
     return sum;
 }
 
+/// uniform / power (src/render/estimators.cpp, runChunks): per chunk of up
+/// to 8 samples a stream of its own (pixel, frame, lightSampling, seed,
+/// chunk + 1); each sample one light from the source pmf and one shadow ray,
+/// f I G V / p(i) added in double; adaptive sampling (render.target_stderr)
+/// stops the pixel at the end of a round. The CPU draws a chunk's lights
+/// before shading them: the stream's numbers are the same.
+template <ShadingModel M>
+__device__ void samplePixel(const ShadingPoint& sp, std::size_t px, SampleSums& s, LaunchCounters& c) {
+    const SamplingParams& plan = params.sampling;
+    const std::uint64_t chunks = std::uint64_t(plan.chunksPerRound) * plan.rounds;
+    for (std::uint64_t chunk = 0; chunk < chunks; ++chunk) {
+        PortableRng rng(px, plan.frame, RngPass::lightSampling, plan.seed, chunk + 1);
+        const std::uint32_t k = static_cast<std::uint32_t>(chunk % plan.chunksPerRound);
+        const std::uint32_t count = min(8u, plan.samples - k * 8u);  // LightingPlan::chunkSamples
+        for (std::uint32_t m = 0; m < count; ++m) {
+            const LightSample x = params.source.sample(rng);
+            LightTerm t;
+            ++c.lightTerms;
+            if (lightTerm<M>(params.lights, sp, x.i, t) && (!params.shadows || visible<true>(sp, x.i, t, c)))
+                s.add(DVec3(t.value) / double(x.pdf));
+            else
+                s.addZero();
+        }
+        if (plan.adaptive && (chunk + 1) % plan.chunksPerRound == 0 &&
+            roundDone(s.sum, s.sumSq, s.n, static_cast<std::uint32_t>((chunk + 1) / plan.chunksPerRound), plan.samples,
+                      plan.maxSamples, plan.targetStderr))
+            return;
+    }
+}
+
 /// traceShadowRays (src/render/restir/trace_shadow_rays.cpp): one shadow ray
 /// for the kept sample of restir.out, Lr = f I G V W; with visibility reuse an
 /// occluded sample's W is zeroed in the stored reservoir.
@@ -187,8 +219,7 @@ extern "C" __global__ void __raygen__exact() {
     DVec3 sum(0.0);
     LaunchCounters c;
     if (g.hit()) {
-        const Vec3 centre = params.position[g.particle];
-        const ShadingPoint sp{centre + g.local, g.normal, g.geomNormal, params.albedo[g.particle], g.particle, centre, g.local};
+        const ShadingPoint sp = shadingPointOf(g, params.lights);
         switch (params.model) {
         case ShadingModel::lambert: sum = exactSum<ShadingModel::lambert>(sp, c); break;
         case ShadingModel::sphere: sum = exactSum<ShadingModel::sphere>(sp, c); break;
@@ -196,6 +227,26 @@ extern "C" __global__ void __raygen__exact() {
         }
     }
     params.Lr[px] = Vec3(sum);
+    addCounters(c);
+}
+
+extern "C" __global__ void __raygen__sample() {
+    const uint3 idx = optixGetLaunchIndex();
+    const std::size_t px = std::size_t(idx.y) * params.camera.width + idx.x;
+    const GBufferTexel g = params.gbuffer[px];
+    SampleSums s;
+    s.discardNonFinite = params.sampling.discardNonFinite;
+    LaunchCounters c;
+    if (g.hit()) {
+        const ShadingPoint sp = shadingPointOf(g, params.lights);
+        switch (params.model) {
+        case ShadingModel::lambert: samplePixel<ShadingModel::lambert>(sp, px, s, c); break;
+        case ShadingModel::sphere: samplePixel<ShadingModel::sphere>(sp, px, s, c); break;
+        case ShadingModel::isotropic: samplePixel<ShadingModel::isotropic>(sp, px, s, c); break;
+        }
+    }
+    const bool zeroed = resolveSums(s.sum, s.sumSq, s.n, false, params.Lr[px], params.sampling.Lr_stderr[px], params.sampling.spp[px]);
+    params.sampling.rejected[px] = s.rejected + (zeroed ? 1u : 0u);
     addCounters(c);
 }
 

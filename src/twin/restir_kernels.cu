@@ -14,7 +14,7 @@ __device__ inline bool pixelOf(const LaunchParams& p, std::uint32_t& x, std::uin
     return x < p.restir.width && y < p.restir.height;
 }
 
-/// generateCandidates: RIS of `candidates` uniform lights with target p_hat.
+/// generateCandidates: RIS of `candidates` lights from the source pmf (render.source) with target p_hat.
 template <ShadingModel SM>
 __global__ void generateCandidatesKernel(LaunchParams p) {
     std::uint32_t x, y;
@@ -29,14 +29,14 @@ __global__ void generateCandidatesKernel(LaunchParams p) {
     Reservoir r;
     bool discard = false;
     for (std::uint32_t m = 0; m < rp.candidates; ++m) {
-        const std::uint32_t i = rng.uniformInt(p.lights.count);
-        float p_hat = targetPdf<SM>(p.lights, sp, i);
-        float w = p_hat / p.lights.uniformPdf;
+        const LightSample x = p.source.sample(rng);
+        float p_hat = targetPdf<SM>(p.lights, sp, x.i);
+        float w = p_hat / x.pdf;
         if (!finiteF(w) || !finiteF(p_hat)) {
             discard = rejectAt(rp, px) || discard;
             w = p_hat = 0.0f;
         }
-        r.update(i, w, p_hat, rng.uniform());
+        r.update(x.i, w, p_hat, rng.uniform());
     }
     r.finalize();
     if (!finiteF(r.w_sum) || !finiteF(r.W)) {

@@ -23,7 +23,9 @@
 #include "accretion/geometry/camera_track.h"
 #include "accretion/geometry/clustering.h"
 #include "accretion/io/gpu_frame_file.h"
+#include "accretion/lighting/light_sampler.h"
 #include "accretion/particles/particle_source.h"
+#include "accretion/render/accumulation.h"
 #include "accretion/render/compose_pixel.h"
 #include "accretion/render/upsample_pixel.h"
 #include "accretion/scene/scene_parser.h"
@@ -63,11 +65,12 @@ void requireSupported(const Settings& s, bool lighting) {
         throw InputError(fmt::format("accretion-optix does not run {} yet (the CPU renderer does)", what));
     };
     if (s.geometry.primitive != Primitive::billboard) refuse("geometry.primitive = \"sphere\"");
-    if (lighting && s.render.estimator != EstimatorKind::exact && s.render.estimator != EstimatorKind::restir)
-        refuse(fmt::format("render.estimator = \"{}\"", enumName(s.render.estimator)));
-    if (lighting && s.render.estimator == EstimatorKind::restir) {
+    const EstimatorKind e = s.render.estimator;
+    if (lighting && e != EstimatorKind::exact && e != EstimatorKind::uniform && e != EstimatorKind::power &&
+        e != EstimatorKind::restir)
+        refuse(fmt::format("render.estimator = \"{}\"", enumName(e)));
+    if (lighting && e == EstimatorKind::restir) {
         const RestirSettings& r = s.restir;
-        if (s.render.source != LightSource::uniform) refuse("render.source = \"power\" in restir");
         if (r.layout != ReservoirLayout::full) refuse("restir.layout = \"packed\"");
         if (r.basic_visibility) refuse("restir.basic_visibility");
         if (r.candidate_visibility) refuse("restir.candidate_visibility");
@@ -83,6 +86,8 @@ struct FrameBuffers {
     DeviceBuffer resA, resB, rejected, particleCluster;
     DeviceBuffer gridGbuffer, gridLr;  // restir.resolution_scale < 1: the lighting grid
     DeviceBuffer prevPosition, prevEmission, prevAlbedo, prevDmin2, prevGbuffer, prevReservoirs;
+    DeviceBuffer aliasProb, aliasAlias, aliasPmf;  // power: the alias table
+    DeviceBuffer Lr_stderr, spp, rejectedSamples;  // uniform / power
 };
 
 void copyDevice(DeviceBuffer& to, const DeviceBuffer& from, std::size_t bytes, cudaStream_t stream) {
@@ -173,6 +178,16 @@ int run(const Args& a) {
     buf.params.resize(sizeof(LaunchParams));
 
     const bool restir = !a.skipLighting && settings.render.estimator == EstimatorKind::restir;
+    const bool sampling = !a.skipLighting && (settings.render.estimator == EstimatorKind::uniform ||
+                                              settings.render.estimator == EstimatorKind::power);
+    const bool powerSource = !a.skipLighting && (settings.render.estimator == EstimatorKind::power ||
+                                                 (restir && settings.render.source == LightSource::power));
+    const LightingPlan plan = planLighting(settings.render, H);
+    if (sampling) {
+        buf.Lr_stderr.resize(pixels * sizeof(Vec3));
+        buf.spp.resize(pixels * sizeof(float));
+        buf.rejectedSamples.resize(pixels * sizeof(std::uint32_t));
+    }
     const bool keepHistory = restir && settings.restir.temporal && settings.render.frames > 1;
     Raygen shade = Raygen::shade;
     if (a.shadowRays == "traverse" || a.shadowRays == "reorder") shade = Raygen::shadeTraverse;
@@ -272,6 +287,31 @@ int run(const Args& a) {
         lp.gbuffer = buf.gbuffer.as<GBufferTexel>();
         lp.Lr = buf.Lr.as<Vec3>();
         lp.lights = {static_cast<std::uint32_t>(n), n ? 1.0f / float(n) : 0.0f, lp.position, lp.emission, lp.albedo, lp.dmin2};
+        if (powerSource) {  // buildPowerTable's arrays, as the CPU samples them
+            const AliasTable table = buildPowerTable(particles);
+            buf.aliasProb.upload(table.probabilities());
+            buf.aliasAlias.upload(table.aliases());
+            buf.aliasPmf.upload(table.pmfs());
+            lp.source.power = true;
+            lp.source.table = {buf.aliasProb.as<float>(), buf.aliasAlias.as<std::uint32_t>(), buf.aliasPmf.as<float>()};
+        }
+        lp.source.count = lp.lights.count;
+        lp.source.uniformPdf = lp.lights.uniformPdf;
+        if (sampling) {
+            SamplingParams& sp = lp.sampling;
+            sp.frame = frame;
+            sp.seed = seed;
+            sp.samples = settings.render.samples;
+            sp.chunksPerRound = plan.chunksPerRound;
+            sp.rounds = plan.rounds;
+            sp.adaptive = plan.adaptive;
+            sp.maxSamples = settings.render.max_samples;
+            sp.targetStderr = settings.render.target_stderr;
+            sp.discardNonFinite = settings.render.nonfinite == NonFinitePolicy::discard;
+            sp.Lr_stderr = buf.Lr_stderr.as<Vec3>();
+            sp.spp = buf.spp.as<float>();
+            sp.rejected = buf.rejectedSamples.as<std::uint32_t>();
+        }
         if (restir) {
             RestirParams& rp = lp.restir;
             const RestirSettings& rs = settings.restir;
@@ -328,7 +368,7 @@ int run(const Args& a) {
                 finalReservoirs = runRestir(lp, buf, settings, shade, pipeline, stream, timer);
             } else if (!a.skipLighting) {
                 GpuScope s(timer, "estimateLighting");
-                pipeline.launch(Raygen::exact, buf.params.address(), sizeof lp, W, H, stream);
+                pipeline.launch(sampling ? Raygen::sample : Raygen::exact, buf.params.address(), sizeof lp, W, H, stream);
             } else {
                 CUDA_CHECK(cudaMemsetAsync(buf.Lr.as<void>(), 0, pixels * sizeof(Vec3), stream));
             }
@@ -366,6 +406,12 @@ int run(const Args& a) {
         out.normal.assign(pixels, Vec3(0.0f));
         out.depth.resize(pixels);
         out.particle.resize(pixels);
+        if (sampling) {
+            out.Lr_stderr = buf.Lr_stderr.download<Vec3>(pixels);
+            out.spp = buf.spp.download<float>(pixels);
+            const std::vector<std::uint32_t> rejected = buf.rejectedSamples.download<std::uint32_t>(pixels);
+            out.rejected.assign(rejected.begin(), rejected.end());
+        }
         const float se = static_cast<float>(settings.shading.self_emission);
         std::size_t hits = 0, nonFinite = 0;
         for (std::size_t px = 0; px < pixels; ++px) {
@@ -378,7 +424,13 @@ int run(const Args& a) {
                 continue;
             }
             ++hits;
-            nonFinite += !composeHit(se, particles.emission[g.particle], out.Lr[px], out.Le[px], out.L[px]);
+            if (!composeHit(se, particles.emission[g.particle], out.Lr[px], out.Le[px], out.L[px])) {
+                ++nonFinite;
+                if (sampling) {  // as composeImage
+                    out.Lr_stderr[px] = Vec3(0.0f);
+                    out.rejected[px] += 1.0f;
+                }
+            }
             out.depth[px] = g.depth;
             out.normal[px] = g.normal;
         }
@@ -409,6 +461,9 @@ int run(const Args& a) {
             out.normal.clear();
             out.depth.clear();
             out.particle.clear();
+            out.Lr_stderr.clear();
+            out.spp.clear();
+            out.rejected.clear();
         }
         writeGpuFrame(file, out);
         const AccelStats& as = accel.stats();
@@ -441,7 +496,7 @@ int run(const Args& a) {
 
 int main(int argc, char** argv) {
     accretion::twin::Args a;
-    CLI::App app{"accretion-optix: the OptiX twin of the GPU pipeline (exact and restir lighting; frames as .gpuframe)"};
+    CLI::App app{"accretion-optix: the OptiX twin of the GPU pipeline (exact, uniform, power and restir lighting; frames as .gpuframe)"};
     app.add_option("scene", a.scene, "Scene file (TOML)")->required()->check(CLI::ExistingFile);
     app.add_option("-D,--define", a.defines, "Override a setting: section.key=value");
     app.add_option("--frames", a.frames, "Frames A:B (half-open) = render.frame_start, render.frames");

@@ -151,3 +151,43 @@ TEST_CASE("the per-pass form predicts held-out configurations its form made exac
         CHECK(loaded.predictMs(r.pass + "[2]", r.features) == Approx(r.measuredMs).epsilon(1e-6));
     }
 }
+
+TEST_CASE("the selected form keeps the counters that made the timings and drops unrelated ones", "[gpu][cost]") {
+    // traceShadowRays timed as 1.5 ns per ray + 0.03 ns per BLAS level +
+    // 300 us per dispatch, with 3% noise; five other counters vary at random,
+    // unrelated to the time. per_pass fits all eleven; selected must find the
+    // three that made the time (leave-one-configuration-out), and recover them.
+    CostFeatures truth{};
+    truth[2] = 1.5;      // rays
+    truth[6] = 0.03;     // blas_levels
+    truth[8] = 300000.0; // dispatches
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    std::normal_distribution<double> noise(0.0, 0.03);
+    std::vector<CostRow> rows;
+    for (int c = 0; c < 30; ++c) {
+        CostRow t{"c" + std::to_string(c), "traceShadowRays", {}, 0.0};
+        t.features[0] = 2e5 + 2e6 * u(rng);           // threads: unrelated here
+        t.features[1] = 1e4 + 1e5 * u(rng);           // warp_steps: unrelated
+        t.features[2] = 1e5 + 1e6 * u(rng);           // rays
+        t.features[4] = 1e5 * u(rng);                 // any_hits: unrelated
+        t.features[5] = 1e7 + 1e8 * u(rng);           // bytes: unrelated
+        t.features[6] = t.features[2] * (20.0 + 60.0 * u(rng));
+        t.features[7] = 1e5 * u(rng);                 // omm_lookups: unrelated
+        t.features[8] = 1.0;
+        double ms = 0.0;
+        for (std::size_t k = 0; k < truth.size(); ++k) ms += truth[k] * t.features[k] * 1e-6;
+        t.measuredMs = ms * (1.0 + noise(rng));
+        rows.push_back(t);
+    }
+    const Calibration c = calibrate(rows, CostModelForm::selected);
+    const CostFeatures& ns = c.coefficients.perPass.at("traceShadowRays");
+    for (std::size_t k : {2u, 6u, 8u}) {
+        INFO(kCostFeatures[k]);
+        CHECK(ns[k] == Approx(truth[k]).epsilon(0.15));
+    }
+    for (std::size_t k : {0u, 1u, 4u, 5u, 7u}) {
+        INFO(kCostFeatures[k]);
+        CHECK(ns[k] == 0.0);
+    }
+}

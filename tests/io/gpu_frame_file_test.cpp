@@ -114,3 +114,38 @@ TEST_CASE("a GPU frame of Lr alone reads back, and says it is incomplete", "[io]
     CHECK_FALSE(g.complete());
     CHECK(sampleFrame().complete());
 }
+
+TEST_CASE("a Monte Carlo GPU frame keeps its standard error, spp and rejections through import-gpu", "[io][gpu][cli]") {
+    const auto dir = scratchDir("gpu_frame_mc");
+    GpuFrame f = sampleFrame();
+    f.metadata["estimator"] = "power";
+    for (std::uint32_t k = 0; k < 15; ++k) {
+        f.Lr_stderr.push_back(Vec3(0.01f * float(k), 0.02f, 0.03f));
+        f.spp.push_back(float(16 + 8 * (k % 4)));
+        f.rejected.push_back(float(k % 5 == 0));
+    }
+    writeGpuFrame(dir / "mc.gpuframe", f);
+    const GpuFrame g = readGpuFrame(dir / "mc.gpuframe");
+    CHECK(g.Lr_stderr == f.Lr_stderr);
+    CHECK(g.spp == f.spp);
+    CHECK(g.rejected == f.rejected);
+    CHECK(g.complete());
+
+    std::string out;
+    REQUIRE(runCommand(kBin + " import-gpu " + (dir / "mc.gpuframe").string(), out) == 0);
+    INFO(out);
+    auto in = OIIO::ImageInput::open((dir / "mc.exr").string());
+    REQUIRE(in);
+    const OIIO::ImageSpec& spec = in->spec();
+    std::vector<float> px(std::size_t(spec.width) * spec.height * spec.nchannels);
+    REQUIRE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, px.data()));
+    const int se = spec.channelindex("Lr_stderr.R"), spp = spec.channelindex("spp"), rej = spec.channelindex("rejected");
+    REQUIRE(se >= 0);
+    REQUIRE(spp >= 0);
+    REQUIRE(rej >= 0);
+    for (std::size_t k = 0; k < 15; ++k) {
+        CHECK(px[k * spec.nchannels + se] == f.Lr_stderr[k].x);
+        CHECK(px[k * spec.nchannels + spp] == f.spp[k]);
+        CHECK(px[k * spec.nchannels + rej] == f.rejected[k]);
+    }
+}

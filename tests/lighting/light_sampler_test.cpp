@@ -6,6 +6,7 @@
 #include <catch2/catch.hpp>
 
 #include "accretion/lighting/light_sampler.h"
+#include "accretion/lighting/source_pmf.h"
 #include "accretion/particles/particle_source.h"
 #include "support/statistics.h"
 #include "support/test_scenes.h"
@@ -92,4 +93,30 @@ TEST_CASE("every light sampler draws in proportion to its pdf (one chi-square ha
                  N, emits);
     checkSampler({"tree", [&](Rng& rng) { return tree.sample(sp, rng); }, [&](std::uint32_t i) { return tree.pdf(sp, i); }},
                  N, lit);
+}
+
+TEST_CASE("SourcePmf (the GPU twin's sampler) with PortableRng draws sampleSource's lights and pdfs", "[lighting][sampler]") {
+    Settings s = accretion::test::smallDiskSettings();
+    s.particles.count = 1000;
+    Particles particles = ParticleSource(s).frame(0);
+    const LightArrays L(particles, s.shading);
+    const AliasTable power = buildPowerTable(particles);
+    for (const bool usePower : {false, true}) {
+        INFO("power " << usePower);
+        const SourcePmf pmf{usePower, usePower ? power.view() : AliasTableView{}, L.count, L.uniformPdf};
+        std::uint32_t differing = 0, powerMass = 0;
+        for (std::uint64_t px = 0; px < 64; ++px) {
+            Rng cpu(px, 3, RngPass::lightSampling, 5, 2);
+            PortableRng gpu(px, 3, RngPass::lightSampling, 5, 2);
+            for (int k = 0; k < 200; ++k) {
+                const LightSample a = usePower ? sampleSource<true>(L, &power, cpu) : sampleSource<false>(L, nullptr, cpu);
+                const LightSample b = pmf.sample(gpu);
+                differing += a.i != b.i || a.pdf != b.pdf;
+                powerMass += b.pdf != L.uniformPdf;
+            }
+        }
+        CHECK(differing == 0);
+        // The power table's pdf is not the uniform one: the two paths were both exercised.
+        CHECK((powerMass > 0) == usePower);
+    }
 }

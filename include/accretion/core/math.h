@@ -35,6 +35,15 @@ inline std::uint32_t indexBits(std::uint64_t n) {
 
 inline bool isFinite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
+/// std::isfinite on the host, CUDA's isfinite on the device.
+ACC_HD inline bool isFiniteNumber(double x) {
+#if defined(__CUDA_ARCH__)
+    return isfinite(x);
+#else
+    return std::isfinite(x);
+#endif
+}
+
 /// Orthonormal basis around a unit vector n (Duff et al. 2017, branchless).
 inline void orthonormalBasis(const Vec3& n, Vec3& t, Vec3& b) {
     const float sign = std::copysign(1.0f, n.z);

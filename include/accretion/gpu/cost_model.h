@@ -29,9 +29,15 @@ using CostFeatures = std::array<double, kCostFeatures.size()>;
 /// pass, fitted by least squares on ms (the first form). per_pass: each
 /// pass its own coefficients over every counter, launches included, fitted
 /// on relative error (passes differ in what bounds them: builds by their
-/// launches, resampling by memory, shadow rays by traversal).
-enum class CostModelForm { shared, per_pass };
-inline const char* costModelFormName(CostModelForm f) { return f == CostModelForm::shared ? "shared" : "per_pass"; }
+/// launches, resampling by memory, shadow rays by traversal). selected:
+/// per_pass over the counters that predict configurations left out of the
+/// fit (forward selection by leave-one-configuration-out error within the
+/// fitted rows): 11 counters fitted on 15 configurations follow their
+/// noise, and extrapolate badly.
+enum class CostModelForm { shared, per_pass, selected };
+inline const char* costModelFormName(CostModelForm f) {
+    return f == CostModelForm::shared ? "shared" : f == CostModelForm::per_pass ? "per_pass" : "selected";
+}
 
 CostFeatures costFeatures(const PassReport& pass);
 

@@ -18,8 +18,10 @@ namespace accretion {
 /// width, height, frame, camera, metadata, planes), then the planes the
 /// header lists, in this order, each width x height, row-major,
 /// little-endian: L, Le, Lr, normal (float3), depth (float), particle
-/// (uint32). Lr is always there; a frame written for `bias` (accretion-optix
-/// --lr-only) holds Lr alone. A header without "planes" holds all six.
+/// (uint32), and for the Monte Carlo estimators Lr_stderr (float3), spp
+/// (float) and rejected (float). Lr is always there; a frame written for
+/// `bias` (accretion-optix --lr-only) holds Lr alone. A header without
+/// "planes" holds the first six.
 struct GpuFrame {
     std::uint32_t width = 0, height = 0, frame = 0;
     CameraPose camera;                           ///< world space, jitter included
@@ -27,6 +29,8 @@ struct GpuFrame {
     std::vector<Vec3> L, Le, Lr, normal;
     std::vector<float> depth;
     std::vector<std::uint32_t> particle;         ///< kNoParticle (0xffffffff) on a miss
+    std::vector<Vec3> Lr_stderr;                 ///< uniform / power: the standard error of Lr (else empty)
+    std::vector<float> spp, rejected;            ///< uniform / power: samples taken, non-finite samples rejected
 
     /// Every plane present (what import-gpu needs).
     bool complete() const { return !L.empty() && !Le.empty() && !normal.empty() && !depth.empty() && !particle.empty(); }
