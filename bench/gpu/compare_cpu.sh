@@ -1,21 +1,26 @@
 #!/bin/bash
 # The image agreement of the OptiX twin with the CPU renderer (issue 16), on
-# this (CPU) machine: import the GPU frames that bench/gpu/run.sh's images
-# and restir steps brought back, render the same frames with `accretion
-# render`, and compare Lr per pixel (relMSE, identical pixels, pixels within
-# 1e-4 relative).
-#   bash bench/gpu/compare_cpu.sh IMAGES_DIR RESTIR_DIR OUT.csv
-# (IMAGES_DIR, RESTIR_DIR: the images/ and restir/ folders of the archives.)
+# this (CPU) machine: import the GPU frames that bench/gpu/run.sh's images,
+# restir and sampling steps brought back, render the same frames with
+# `accretion render`, and compare Lr per pixel (relMSE, identical pixels,
+# pixels within 1e-4 relative); for uniform and power also the standard
+# error and the samples taken (adaptive sampling's stops).
+#   bash bench/gpu/compare_cpu.sh OUT.csv DIR...
+# (DIR: the images/, restir/ or sampling/ folders of the archives; the cases
+# whose GPU frames are there are compared.)
 set -euo pipefail
-images=$1 restir=$2 csv=$3
+csv=$1
+shift
 A=${ACCRETION:-build/accretion}
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 small=(-D camera.width=320 -D camera.height=180)
 echo "case,frame,relMSE,identical,within_1e-4,gpu_frame,against" > "$csv"
-compare() {  # name frame gpu.exr other.exr
+compare() {  # name frame gpu.exr other.exr [compare's channel option]
     local j
-    j=$($A compare "$3" "$4" --layer Lr --flip none --json)
+    [ -f "$3" ] || return 0  # a case whose GPU frames were not brought
+    # shellcheck disable=SC2086  # the option is words
+    j=$($A compare "$3" "$4" ${5:---layer Lr} --flip none --json)
     echo "$1,$2,$(echo "$j" | jq -r '[.relMSE, .identical, .within_tolerance] | @csv'),$(basename "$3"),$(basename "$4")" >> "$csv"
 }
 cpu() {  # output-stem frames overrides...: the CPU's frames of the same settings
@@ -23,7 +28,7 @@ cpu() {  # output-stem frames overrides...: the CPU's frames of the same setting
     shift 2
     $A render scenes/quickstart.toml "${small[@]}" "$@" --frames "$frames" -o "$T/cpu_$stem.{frame}.exr" --quiet > /dev/null
 }
-cp "$images"/*.gpuframe "$restir"/*.gpuframe "$T"/
+for d in "$@"; do cp "$d"/*.gpuframe "$T"/; done
 $A import-gpu "$T"/*.gpuframe > /dev/null
 disc=(-D geometry.alpha=disc)
 
@@ -39,6 +44,7 @@ declare -A exact=(
     [quickstart_disc_offset]="${disc[*]} -D render.visibility_rule=offset")
 for name in quickstart quickstart_disc quickstart_sphere quickstart_omm4state_l2 quickstart_omm4state_l4 \
             quickstart_omm4state_l6 quickstart_omm2state_l4 quickstart_offset quickstart_disc_offset; do
+    [ -f "$T/$name.0000.exr" ] || continue
     # shellcheck disable=SC2086  # the overrides are words
     cpu "$name" 0:1 -D render.estimator=exact ${exact[$name]}
     compare "exact $name" 0 "$T/$name.0000.exr" "$T/cpu_$name.0000.exr"
@@ -53,6 +59,7 @@ compare "offset rule with disc alpha (GPU) vs exact rule (CPU)" 0 "$T/quickstart
 restir_case() {
     local gpu=$1 cpuStem=$2
     shift 2
+    [ -f "$T/$gpu.0000.exr" ] || return 0
     [ -f "$T/cpu_$cpuStem.0000.exr" ] || cpu "$cpuStem" 0:3 -D render.estimator=restir "$@"
     for f in 0 1 2; do compare "restir $gpu" $f "$T/$gpu.000$f.exr" "$T/cpu_$cpuStem.000$f.exr"; done
 }
@@ -62,4 +69,20 @@ restir_case basic_scale0.5 basic_scale0.5 -D restir.resolution_scale=0.5
 restir_case basic_scale0.75 basic_scale0.75 -D restir.resolution_scale=0.75
 restir_case basic_omm4 basic_omm4 "${disc[@]}" -D gpu.omm=4state -D gpu.omm_level=4
 restir_case basic_omm4_traverse basic_omm4
+restir_case restir_power restir_power -D render.source=power
+
+# uniform and power (one frame): Lr, its standard error and the samples taken.
+declare -A sampled=(
+    [power]="-D render.estimator=power -D render.samples=16"
+    [uniform]="-D render.estimator=uniform -D render.samples=20"
+    [power_adaptive]="-D render.estimator=power -D render.samples=8 -D render.target_stderr=0.05 -D render.max_samples=256"
+    [power_disc]="-D render.estimator=power -D render.samples=16 ${disc[*]}")
+for name in power uniform power_adaptive power_disc; do
+    [ -f "$T/$name.0000.exr" ] || continue
+    # shellcheck disable=SC2086  # the overrides are words
+    cpu "$name" 0:1 ${sampled[$name]}
+    compare "$name" 0 "$T/$name.0000.exr" "$T/cpu_$name.0000.exr"
+    compare "$name Lr_stderr" 0 "$T/$name.0000.exr" "$T/cpu_$name.0000.exr" "--layer Lr_stderr"
+    compare "$name spp" 0 "$T/$name.0000.exr" "$T/cpu_$name.0000.exr" "--layer spp"
+done
 column -s, -t "$csv"

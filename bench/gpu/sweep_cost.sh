@@ -27,7 +27,11 @@ for f in sorted(glob.glob(os.path.join(out, "*.cost.csv"))):
         for row in r:
             key = (row[0], re.sub(r"\[\d+\]$", "", row[1]))
             vals = [float(x) for x in row[2:]]
-            rows[key] = [a + b for a, b in zip(rows[key], vals)] if key in rows else vals
+            if key in rows:  # counters add up; a working set is the same data read again
+                rows[key] = [max(a, b) if h == "working_set_bytes" else a + b
+                             for h, a, b in zip(header[2:], rows[key], vals)]
+            else:
+                rows[key] = vals
 with open(os.path.join(out, "counters.csv"), "w", newline="") as fh:
     w = csv.writer(fh)
     w.writerow(header)

@@ -137,7 +137,13 @@ std::vector<std::uint32_t> readExrUintChannel(const std::filesystem::path& file,
 }
 
 RgbLayer readExrLayer(const std::filesystem::path& file, const std::string& layer) {
-    return readExrChannels(file, layerChannels(layer));
+    std::vector<std::string> names = layerChannels(layer);
+    if (!layer.empty())
+        if (auto in = OIIO::ImageInput::open(file.string())) {
+            const OIIO::ImageSpec& spec = in->spec();
+            if (spec.channelindex(names[0]) < 0 && spec.channelindex(layer) >= 0) names = {layer, layer, layer};  // spp, depth.Z
+        }
+    return readExrChannels(file, names);
 }
 
 std::map<std::string, std::string> readExrAttributes(const std::filesystem::path& file) {

@@ -65,6 +65,9 @@ void runCalibrate(const CalibrateArgs& args) {
     fmt::print("fitted on {} timed passes (non-negative least squares, form {}):\n", rows.size(), costModelFormName(args.form));
     for (std::size_t k = 0; k < kCostFeatures.size(); ++k)
         fmt::print("  {:<14} {:>12.6g} ns\n", kCostFeatures[k], c.coefficients.ns[k]);
+    if (args.form != CostModelForm::shared)
+        fmt::print("  cache of cold_work: {:g} MiB (chosen by leave-one-configuration-out error)\n",
+                   c.coefficients.cacheBytes / (1024.0 * 1024.0));
     for (const auto& [pass, ns] : c.coefficients.perPass) {
         std::string line;
         for (std::size_t k = 0; k < kCostFeatures.size(); ++k)

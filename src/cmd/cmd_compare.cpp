@@ -386,7 +386,7 @@ void addCompareCommand(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("compare", "Error metrics of an EXR against a reference EXR (the second image)");
     cmd->add_option("image", args->image, "Image (EXR: a GPU frame or an estimate)")->required();
     cmd->add_option("reference", args->reference, "Reference (EXR)")->required();
-    cmd->add_option("--layer", args->layer, "Channels compared: RGB (default) or a layer such as Lr");
+    cmd->add_option("--layer", args->layer, "Channels compared: RGB (default), a layer such as Lr, or one channel such as spp");
     cmd->add_option("--channels", args->channels, "The image's three channels, e.g. color.r,color.g,color.b (a GPU frame's names)");
     cmd->add_option("--error-map", args->errorMap,
                     "Write signed, relative and z errors to this EXR, and false-colour PNGs of each beside it");

@@ -94,11 +94,12 @@ Table passTable(const GpuReport& r, const CostCoefficients& coef, const std::str
                                 {"", "SIMTbr", 7, "{:>6.1f}%"}, {"", "SIMTlp", 7, "{:>6.1f}%"}, {"", "SER", 6, "{:>5.2f}x"},
                                 {"", "model", 9}};
     for (std::string_view f : kCostFeatures) columns.push_back({std::string(f), "", 0, "{}", "{}", false});
+    columns.push_back({"working_set_bytes", "", 0, "{}", "{}", false});
     columns.push_back({"predicted_ms", "pred. ms", 9, "{:.3f}", "{:.6g}"});
     Table t(columns);
     totalMs = 0.0;
     for (const PassReport& p : r.passes) {
-        const CostFeatures f = costFeatures(p);
+        const CostFeatures f = costFeatures(p, coef.cacheBytes);
         const double ms = coef.predictMs(p.pass, f);
         totalMs += ms;
         std::vector<Cell> row{config, p.pass, p.threads, p.trips, p.rays, p.perRay(p.blasEntries), p.perRay(p.anyHits),
@@ -106,6 +107,7 @@ Table passTable(const GpuReport& r, const CostCoefficients& coef, const std::str
                               100.0 * p.ser.branchBefore.efficiency, 100.0 * p.ser.loopBefore.efficiency,
                               p.ser.predictedSpeedup, p.rayModel};
         for (double v : f) row.push_back(v);
+        row.push_back(p.workingSetBytes);
         row.push_back(ms);
         t.add(row);
     }
@@ -340,7 +342,7 @@ void runCost(const CostArgs& a) {
 
     nlohmann::json doc = toJson(r);
     for (std::size_t k = 0; k < r.passes.size(); ++k) doc["passes"][k]["predicted_ms"] =
-        coef.predictMs(r.passes[k].pass, costFeatures(r.passes[k]));
+        coef.predictMs(r.passes[k].pass, costFeatures(r.passes[k], coef.cacheBytes));
     doc["ser_sweep"] = reportSerSweep(run, main);
     doc["any_hit_omm"] = reportOmm(run, main);
     doc["blas_memory_by_cluster_size"] = reportBlasMemory(run);

@@ -17,16 +17,22 @@
 
 namespace accretion {
 
-CostFeatures costFeatures(const PassReport& p) {
+double coldWork(double rays, double bytes, double workingSetBytes, double cacheBytes) {
+    if (!(workingSetBytes > cacheBytes) || !(cacheBytes > 0.0)) return 0.0;
+    return (rays > 0.0 ? rays : bytes) * std::log2(workingSetBytes / cacheBytes);
+}
+
+CostFeatures costFeatures(const PassReport& p, double cacheBytes) {
+    const double bytes = double(p.bytesRead + p.bytesWritten);
     return {double(p.threads),     double(p.warpSteps()), double(p.rays),
-            double(p.blasEntries), double(p.anyHits),     double(p.bytesRead + p.bytesWritten),
+            double(p.blasEntries), double(p.anyHits),     bytes,
             double(p.blasLevels),  double(p.ommLookups),  double(p.dispatches),
-            double(p.blasBuilds),  double(p.blasRefits)};
+            double(p.blasBuilds),  double(p.blasRefits),  coldWork(double(p.rays), bytes, p.workingSetBytes, cacheBytes)};
 }
 
 CostCoefficients CostCoefficients::defaults() {
     CostCoefficients c;
-    c.ns = {0.02, 0.5, 0.5, 0.2, 1.0, 0.002, 0.0, 0.0, 0.0, 0.0, 0.0};  // the later counters: not in the uncalibrated guess
+    c.ns = {0.02, 0.5, 0.5, 0.2, 1.0, 0.002, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};  // the later counters: not in the uncalibrated guess
     c.source = "defaults (uncalibrated)";
     return c;
 }
@@ -57,6 +63,11 @@ CostCoefficients CostCoefficients::load(const std::string& path) {
         }
     };
     read(*c, "coefficients_ns", out.ns);
+    if (j.contains("cache_bytes")) {
+        if (!j["cache_bytes"].is_number() || !(j["cache_bytes"].get<double>() > 0.0))
+            throw InputError(fmt::format("{}: cache_bytes must be a positive number", path));
+        out.cacheBytes = j["cache_bytes"].get<double>();
+    }
     if (j.contains("per_pass_ns")) {
         if (!j["per_pass_ns"].is_object()) throw InputError(fmt::format("{}: per_pass_ns is not an object", path));
         for (const auto& [pass, obj] : j["per_pass_ns"].items()) {
@@ -70,7 +81,7 @@ CostCoefficients CostCoefficients::load(const std::string& path) {
 nlohmann::json CostCoefficients::toJson() const {
     nlohmann::json c;
     for (std::size_t k = 0; k < kCostFeatures.size(); ++k) c[std::string(kCostFeatures[k])] = ns[k];
-    nlohmann::json j = {{"coefficients_ns", c}, {"source", source}};
+    nlohmann::json j = {{"coefficients_ns", c}, {"cache_bytes", cacheBytes}, {"source", source}};
     for (const auto& [pass, f] : perPass)
         for (std::size_t k = 0; k < kCostFeatures.size(); ++k) j["per_pass_ns"][pass][std::string(kCostFeatures[k])] = f[k];
     return j;
@@ -209,6 +220,8 @@ std::vector<CostRow> readCounterCsv(const std::string& path) {
             if (cell == r.end()) continue;  // a later counter, absent from a CSV of the first form: 0
             row.features[k] = parseNumber(cell->second, fmt::format("{}:{}: {}", path, lineNo, kCostFeatures[k]));
         }
+        if (const auto ws = r.find("working_set_bytes"); ws != r.end())
+            row.workingSetBytes = parseNumber(ws->second, fmt::format("{}:{}: working_set_bytes", path, lineNo));
         rows.push_back(std::move(row));
     }
     if (rows.empty()) throw InputError(fmt::format("{}: no counter rows", path));
@@ -336,19 +349,55 @@ CostFeatures fitSelected(const std::vector<const CostRow*>& rows) {
     return fitRows(rows, chosen, true);
 }
 
-CostCoefficients fit(const std::vector<CostRow>& rows, CostModelForm form) {
+/// The rows with cold_work for a cache of `cacheBytes`.
+std::vector<CostRow> withCache(std::vector<CostRow> rows, double cacheBytes) {
+    for (CostRow& r : rows) r.features[kColdWork] = coldWork(r.features[2], r.features[5], r.workingSetBytes, cacheBytes);
+    return rows;
+}
+
+std::map<std::string, std::vector<const CostRow*>> rowsByPass(const std::vector<CostRow>& rows) {
+    std::map<std::string, std::vector<const CostRow*>> byPass;
+    for (const CostRow& r : rows) byPass[passFamily(r.pass)].push_back(&r);
+    return byPass;
+}
+
+/// The cache of cold_work: of 128 KiB, 256 KiB ... 64 MiB, the one whose
+/// per-pass fits predict left-out configurations best (the sum over passes
+/// of the leave-one-configuration-out error). Rows without a working set
+/// keep the default.
+double chooseCache(const std::vector<CostRow>& rows) {
+    if (std::none_of(rows.begin(), rows.end(), [](const CostRow& r) { return r.workingSetBytes > 0.0; })) return kDefaultCacheBytes;
+    double best = kDefaultCacheBytes, bestError = std::numeric_limits<double>::infinity();
+    for (int k = -3; k <= 6; ++k) {
+        const double cache = std::ldexp(1024.0 * 1024.0, k);
+        const std::vector<CostRow> trial = withCache(rows, cache);
+        double error = 0.0;
+        for (const auto& [pass, rs] : rowsByPass(trial)) error += leaveOneConfigOut(rs, firstFeatures(kCostFeatures.size()));
+        if (error < bestError) {
+            bestError = error;
+            best = cache;
+        }
+    }
+    return best;
+}
+
+/// The coefficients of a form; per_pass and selected choose their cache
+/// first (chooseCache), and fit the rows' cold_work for it.
+CostCoefficients fit(const std::vector<CostRow>& input, CostModelForm form) {
     CostCoefficients c;
-    std::vector<const CostRow*> all;
-    for (const CostRow& r : rows) all.push_back(&r);
     if (form == CostModelForm::shared) {
+        std::vector<const CostRow*> all;
+        for (const CostRow& r : input) all.push_back(&r);
         c.ns = fitRows(all, firstFeatures(kBaseCostFeatures), false);
         c.source = "calibrated (shared)";
         return c;
     }
+    c.cacheBytes = chooseCache(input);
+    const std::vector<CostRow> rows = withCache(input, c.cacheBytes);
+    std::vector<const CostRow*> all;
+    for (const CostRow& r : rows) all.push_back(&r);
     c.ns = fitRows(all, firstFeatures(kCostFeatures.size()), true);  // for a pass no row has
-    std::map<std::string, std::vector<const CostRow*>> byPass;
-    for (const CostRow& r : rows) byPass[passFamily(r.pass)].push_back(&r);
-    for (const auto& [pass, rs] : byPass)
+    for (const auto& [pass, rs] : rowsByPass(rows))
         c.perPass[pass] = form == CostModelForm::selected ? fitSelected(rs) : fitRows(rs, firstFeatures(kCostFeatures.size()), true);
     c.source = fmt::format("calibrated ({})", costModelFormName(form));
     return c;
@@ -362,11 +411,11 @@ Calibration calibrate(const std::vector<CostRow>& rows, CostModelForm form) {
         throw InputError(fmt::format("calibrate: {} timed passes for {} coefficients: time more passes or configurations",
                                      rows.size(), unknowns));
     Calibration c;
-    c.rows = rows;
     c.coefficients = fit(rows, form);
+    c.rows = withCache(rows, c.coefficients.cacheBytes);
     double mean = 0.0, ssTot = 0.0, ssRes = 0.0;
-    for (const CostRow& r : rows) mean += r.measuredMs / double(rows.size());
-    for (const CostRow& r : rows) {
+    for (const CostRow& r : c.rows) mean += r.measuredMs / double(rows.size());
+    for (const CostRow& r : c.rows) {
         const double p = c.coefficients.predictMs(r.pass, r.features);
         c.predictedMs.push_back(p);
         ssRes += (p - r.measuredMs) * (p - r.measuredMs);
@@ -399,10 +448,11 @@ Holdout holdout(const std::vector<CostRow>& rows, CostModelForm form, double fra
     for (const CostRow& r : rows)
         if (in(h.fitted, r.config)) train.push_back(r);
     const CostCoefficients c = fit(train, form);
+    const std::vector<CostRow> priced = withCache(rows, c.cacheBytes);
     using Errors = std::vector<std::pair<double, std::string>>;  // relative error, configuration
     std::map<std::string, Errors> byPass;
     Errors all;
-    for (const CostRow& r : rows) {
+    for (const CostRow& r : priced) {
         if (!in(h.predicted, r.config) || !(r.measuredMs > 0.0)) continue;
         const double predicted = c.predictMs(r.pass, r.features);
         h.rows.push_back(r);

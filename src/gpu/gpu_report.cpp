@@ -6,6 +6,7 @@
 
 #include "accretion/core/pass_timer.h"
 #include "accretion/counters/gpu_layouts.h"
+#include "accretion/gpu/cost_model.h"
 
 namespace accretion {
 namespace {
@@ -91,6 +92,18 @@ GpuReport makeGpuReport(const FrameCounters& counters, const Settings& settings,
 
     const AccelCounters& accel = counters.accel;
     r.blas = blasMemory(accel.blasPrimitives, gpu, accel.embreeBytes);
+    // Working sets: the BLAS bytes for traced passes; the light records (and
+    // alias entries with power candidates) for the resampling passes.
+    std::uint64_t primitives = 0;
+    for (std::uint32_t n : accel.blasPrimitives) primitives += n;
+    const std::uint64_t lights = settings.geometry.primitive == Primitive::billboard ? primitives / 2 : primitives;
+    const double lightBytes = double(lights) * (gpu_layout::kParticleRecord +
+                                                (settings.render.source == LightSource::power ? gpu_layout::kAliasEntry : 0u));
+    for (PassReport& p : r.passes) {
+        if (p.rays > 0) p.workingSetBytes = double(r.blas.gpuBytes);
+        else if (p.pass == pass::generateCandidates || p.pass == pass::temporalResampling || passFamily(p.pass) == pass::spatialResampling)
+            p.workingSetBytes = lightBytes;
+    }
 
     const std::uint64_t pixels = std::uint64_t(settings.camera.width) * settings.camera.height;
     const double s = settings.render.estimator == EstimatorKind::restir ? settings.restir.resolution_scale : 1.0;
@@ -128,6 +141,7 @@ nlohmann::json toJson(const PassReport& p) {
             {"dispatches", p.dispatches},
             {"blas_builds", p.blasBuilds},
             {"blas_refits", p.blasRefits},
+            {"working_set_bytes", p.workingSetBytes},
             {"trips", p.trips},
             {"max_trips", p.maxTrips},
             {"rays", p.rays},

@@ -3,6 +3,7 @@
 // their per-frame CSV and plot; expected values in closed form.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 
@@ -159,4 +160,31 @@ TEST_CASE("compare a {frame} sequence: per-frame CSV with flicker, and a plot", 
     REQUIRE(runCommand(kBin + " compare " + (dir / "gpu.0000.exr").string() + " '" + (dir / "ref.{frame}.exr").string() +
                            "' --frames 0:4 --csv " + (dir / "x.csv").string(), out) == 1);
     CHECK_THAT(out, Contains("has no {frame} pattern"));
+}
+
+TEST_CASE("compare --layer of one channel (spp) reads it in all three components", "[cli][compare]") {
+    // Two power renders of 8 and 16 samples: spp is 8 or 16 on a hit pixel and
+    // 0 on a miss, so relMSE = hits / pixels * 8^2 / (16^2 + 1e-2), with the
+    // hit count counted here from the particle ids the render wrote.
+    const auto dir = scratchDir("compare_spp");
+    std::string out;
+    for (int spp : {8, 16})
+        REQUIRE(runCommand(kBin + " render " + kScenes + "/quickstart.toml -D camera.width=64 -D camera.height=36 " +
+                               "--estimator power --spp " + std::to_string(spp) + " --frames 0:1 --quiet -o " +
+                               (dir / ("s" + std::to_string(spp) + ".{frame}.exr")).string(),
+                           out) == 0);
+    const std::vector<std::uint32_t> ids = readExrUintChannel(dir / "s8.0000.exr", "particle.id");
+    REQUIRE(ids.size() == 64 * 36);
+    const double hits = double(std::count_if(ids.begin(), ids.end(), [](std::uint32_t id) { return id != 0xffffffffu; }));
+    REQUIRE(hits > 0.0);
+    const std::string cmd = kBin + " compare " + (dir / "s8.0000.exr").string() + " " + (dir / "s16.0000.exr").string() +
+                            " --layer spp --flip none";
+    REQUIRE(runCommand(cmd, out) == 0);
+    INFO(out);
+    CHECK(field(out, "relMSE") == Approx(hits / (64.0 * 36.0) * 64.0 / (256.0 + 1e-2)).epsilon(1e-9));
+    CHECK(field(out, "MSE") == Approx(hits / (64.0 * 36.0) * 64.0).epsilon(1e-7));  // printed to 9 digits
+    REQUIRE(runCommand(kBin + " compare " + (dir / "s8.0000.exr").string() + " " + (dir / "s8.0000.exr").string() +
+                           " --layer spp --flip none",
+                       out) == 0);
+    CHECK(field(out, "relMSE") == 0.0);
 }

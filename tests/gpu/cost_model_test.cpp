@@ -191,3 +191,38 @@ TEST_CASE("the selected form keeps the counters that made the timings and drops 
         CHECK(ns[k] == 0.0);
     }
 }
+
+TEST_CASE("calibrate finds the cache of the working-set term that made the timings", "[gpu][cost]") {
+    // traceGBuffer timed as 0.5 ns per ray + 2 ns per cold read, where cold
+    // reads are rays x log2(working set / 2 MiB) (0 below it), + 20 us per
+    // dispatch; the working set (the BLAS bytes) spans 0.5 MiB to 500 MiB.
+    const double cache = 2.0 * 1024 * 1024;
+    CHECK(coldWork(100.0, 7.0, 0.5 * cache, cache) == 0.0);        // fits: no misses
+    CHECK(coldWork(100.0, 7.0, 8.0 * cache, cache) == 300.0);      // 3 levels below the cache
+    CHECK(coldWork(0.0, 7.0, 8.0 * cache, cache) == 21.0);         // no rays: its bytes
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    std::vector<CostRow> rows;
+    for (int c = 0; c < 24; ++c) {
+        CostRow r{"c" + std::to_string(c), "traceGBuffer", {}, 0.0};
+        r.features[0] = r.features[2] = 2e5 + 2e6 * u(rng);  // threads = rays
+        r.features[8] = 1.0;
+        r.workingSetBytes = std::ldexp(0.5 * 1024 * 1024, c % 10);
+        const double cold = coldWork(r.features[2], 0.0, r.workingSetBytes, cache);
+        r.measuredMs = (0.5 * r.features[2] + 2.0 * cold + 20000.0) * 1e-6;
+        rows.push_back(r);
+    }
+    for (CostModelForm form : {CostModelForm::per_pass, CostModelForm::selected}) {
+        INFO(costModelFormName(form));
+        const Calibration cal = calibrate(rows, form);
+        CHECK(cal.coefficients.cacheBytes == cache);
+        const CostFeatures& ns = cal.coefficients.perPass.at("traceGBuffer");
+        CHECK(ns[kColdWork] == Approx(2.0).epsilon(1e-6));
+        CHECK(ns[2] + ns[0] == Approx(0.5).epsilon(1e-6));  // threads and rays are the same column here
+        CHECK(cal.maxRelativeError < 1e-6);
+    }
+    // The cache travels with the coefficients.
+    const auto file = std::filesystem::temp_directory_path() / "accretion_cache_coefficients.json";
+    std::ofstream(file) << calibrate(rows, CostModelForm::per_pass).coefficients.toJson().dump();
+    CHECK(CostCoefficients::load(file.string()).cacheBytes == cache);
+}

@@ -52,7 +52,8 @@ struct RgbLayer {
     std::vector<Vec3> window(int x, int y, std::uint32_t w, std::uint32_t h) const;
 };
 
-/// Read layer `layer` ("" = R,G,B; "Lr" = Lr.R, Lr.G, Lr.B; ...). Throws
+/// Read layer `layer` ("" = R,G,B; "Lr" = Lr.R, Lr.G, Lr.B; ...; a channel
+/// of its own such as "spp" or "depth.Z" in all three components). Throws
 /// InputError naming the file when it is not an OpenEXR file (by its magic:
 /// a PNG or JPEG is display-referred and 8-bit, not a measurement), cannot
 /// be read or lacks the channels.

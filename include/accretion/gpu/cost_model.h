@@ -16,14 +16,28 @@ namespace accretion {
 /// 6). The first six are the model's first form; the others came with the
 /// GPU measurements of issue 16: the traversal inside the BLAS entered
 /// (their depths), micromap lookups (software on a GPU without RT cores),
-/// and the launches (kernel dispatches, BLAS builds and refits: a constant
+/// the launches (kernel dispatches, BLAS builds and refits: a constant
 /// cost each; the number of builds, not their triangles, set the build
-/// time). Counter CSVs without them read as 0.
-inline constexpr std::array<std::string_view, 11> kCostFeatures = {
+/// time), and cold_work (coldWork: random reads of a working set larger
+/// than a cache). Counter CSVs without them read as 0.
+inline constexpr std::array<std::string_view, 12> kCostFeatures = {
     "threads",     "warp_steps",  "rays",       "blas_entries", "any_hits",   "bytes",
-    "blas_levels", "omm_lookups", "dispatches", "blas_builds",  "blas_refits"};
+    "blas_levels", "omm_lookups", "dispatches", "blas_builds",  "blas_refits", "cold_work"};
 inline constexpr std::size_t kBaseCostFeatures = 6;
+inline constexpr std::size_t kColdWork = 11;
 using CostFeatures = std::array<double, kCostFeatures.size()>;
+
+/// The cache the working-set term assumes before calibration (calibrate
+/// chooses its own by cross-validation).
+inline constexpr double kDefaultCacheBytes = 4.0 * 1024 * 1024;
+
+/// The reads that miss a cache of `cacheBytes`: a traced pass's rays (else
+/// its bytes) times the levels of a tree over the working set that the cache
+/// cannot hold, log2(working set / cache), 0 when it fits. A BVH keeps its
+/// top levels cached and misses below them; random reads of a table grow
+/// their misses as it outgrows the cache (the H100 sweep of bench/gpu: 1M
+/// particles cost the G-buffer 1.7x the rays of 100K, with fewer BLAS levels).
+double coldWork(double rays, double bytes, double workingSetBytes, double cacheBytes);
 
 /// The model's forms. shared: one coefficient per base counter for every
 /// pass, fitted by least squares on ms (the first form). per_pass: each
@@ -39,12 +53,13 @@ inline const char* costModelFormName(CostModelForm f) {
     return f == CostModelForm::shared ? "shared" : f == CostModelForm::per_pass ? "per_pass" : "selected";
 }
 
-CostFeatures costFeatures(const PassReport& pass);
+CostFeatures costFeatures(const PassReport& pass, double cacheBytes);
 
 /// Nanoseconds per unit of each feature: predicted time = sum coefficient x counter.
 struct CostCoefficients {
     CostFeatures ns{};
     std::map<std::string, CostFeatures> perPass;  ///< per_pass form: by pass name (spatialResampling[2] uses spatialResampling's)
+    double cacheBytes = kDefaultCacheBytes;       ///< the cache of cold_work
     std::string source;  ///< "defaults (uncalibrated)" or the file read
 
     /// Order-of-magnitude defaults for a current desktop RTX GPU, for use
@@ -70,9 +85,10 @@ struct CostRow {
     std::string config, pass;
     CostFeatures features{};
     double measuredMs = 0.0;
+    double workingSetBytes = 0.0;  ///< PassReport::workingSetBytes (cold_work is recomputed from it for a cache)
 };
 
-/// counters.csv as `accretion cost` writes it (config,pass,<features...>).
+/// counters.csv as `accretion cost` writes it (config,pass,<features...>,working_set_bytes).
 std::vector<CostRow> readCounterCsv(const std::string& path);
 /// timings.csv: config,pass,ms (one row per pass per configuration, as
 /// exported from Nsight); joined to the counters on (config, pass).

@@ -22,6 +22,11 @@ struct PassReport {
     std::uint64_t bytesRead = 0, bytesWritten = 0;
     std::uint64_t blasLevels = 0, ommLookups = 0;                 ///< BLAS depths entered, micromap lookups
     std::uint64_t dispatches = 1, blasBuilds = 0, blasRefits = 0;  ///< launches beside the threads (PassCounters)
+    /// Bytes of what the pass reads at random: the acceleration structures
+    /// (traced passes), the light records (restir's resampling passes), else
+    /// 0. With more of it than a cache holds, its reads miss (the cost model's
+    /// cold_work).
+    double workingSetBytes = 0.0;
     std::uint32_t maxTrips = 0;
     SerReport ser;
     std::string rayModel;  ///< "inline", "pipeline", or "-" (no rays)
