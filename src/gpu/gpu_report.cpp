@@ -97,8 +97,9 @@ GpuReport makeGpuReport(const FrameCounters& counters, const Settings& settings,
     std::uint64_t primitives = 0;
     for (std::uint32_t n : accel.blasPrimitives) primitives += n;
     const std::uint64_t lights = settings.geometry.primitive == Primitive::billboard ? primitives / 2 : primitives;
-    const double lightBytes = double(lights) * (gpu_layout::kParticleRecord +
-                                                (settings.render.source == LightSource::power ? gpu_layout::kAliasEntry : 0u));
+    const LightSource source = settings.render.source;
+    const double lightBytes = double(lights) * (gpu_layout::kParticleRecord + (source == LightSource::power ? gpu_layout::kAliasEntry : 0u) +
+                                                (source == LightSource::tree ? 2u * gpu_layout::kLightTreeNode : 0u));
     for (PassReport& p : r.passes) {
         if (p.rays > 0) p.workingSetBytes = double(r.blas.gpuBytes);
         else if (p.pass == pass::generateCandidates || p.pass == pass::temporalResampling || passFamily(p.pass) == pass::spatialResampling)

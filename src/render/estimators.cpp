@@ -127,22 +127,22 @@ void shadeSamples(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoi
 /// without visibility; the kept y gets one shadow ray, weighted by W. A
 /// non-finite candidate weight is rejected (zero_sample: the candidate gets
 /// weight 0; discard: the reservoir is dropped).
-template <ShadingModel M, Primitive P, bool Power, bool Traced = false>
-void risChunk(const ParticleBvh& bvh, const LightArrays& L, const AliasTable* table, const ShadingPoint& sp,
-              std::uint32_t count, std::uint32_t candidates, const VisibilityOptions& vis, bool shadows, Rng& rng, PixelSums& acc,
-              RayCounters* rc) {
+template <ShadingModel M, Primitive P, LightSource S, bool Traced = false>
+void risChunk(const ParticleBvh& bvh, const LightArrays& L, const AliasTable* table, const LightTree* tree,
+              const ShadingPoint& sp, std::uint32_t count, std::uint32_t candidates, const VisibilityOptions& vis, bool shadows,
+              Rng& rng, PixelSums& acc, RayCounters* rc) {
     LightingCounters& c = acc.c;
     for (std::uint32_t k = 0; k < count; ++k) {
         Reservoir r;
         LightTerm t_y{};
         bool discarded = false;
         for (std::uint32_t m = 0; m < candidates; ++m) {
-            const LightSample x = sampleSource<Power>(L, table, rng);
+            const LightSample x = sampleCandidate<S>(L, table, tree, sp, rng);
             LightTerm t{};
             float p_hat = 0.0f;
             ++c.lightTerms;
             if (L.term<M>(sp, x.i, t)) p_hat = luminance(t.value);
-            float w = p_hat / x.pdf;
+            float w = x.pdf > 0.0f ? p_hat / x.pdf : 0.0f;  // the tree drew no light: a zero candidate
             if (!std::isfinite(w) || !std::isfinite(p_hat)) {
                 discarded = acc.reject() || discarded;
                 w = p_hat = 0.0f;
@@ -194,19 +194,22 @@ void runChunk(const LightingInputs& in, const LightArrays& L, const VisibilityOp
         return Rng(p.px, in.frame, RngPass::lightSampling, in.render.seed, chunk + 1);
     };
     if constexpr (K == EstimatorKind::ris) {
-        const bool power = in.powerTable != nullptr;  // the plan built one: candidates in proportion to power
+        // The candidates' source: the plan built the power table or the light tree for it.
+        const auto chunk = [&]<LightSource S>(GroupPixel& p, Rng& rng, RayCounters* rc) {
+            if (p.sums.trace) [[unlikely]]  // render --pixel
+                risChunk<M, P, S, true>(in.bvh, L, in.powerTable, in.lightTree, p.sp, count, in.render.candidates, vis, shadows, rng, p.sums, rc);
+            else
+                risChunk<M, P, S>(in.bvh, L, in.powerTable, in.lightTree, p.sp, count, in.render.candidates, vis, shadows, rng, p.sums, rc);
+        };
         for (std::uint32_t k = 0; k < n; ++k) {
             GroupPixel& p = pix[k];
             if (p.sums.done) continue;
             Rng rng = stream(p);
             RayCounters* rc = Count ? &p.rays : nullptr;
-            if (p.sums.trace) [[unlikely]] {  // render --pixel
-                if (power) risChunk<M, P, true, true>(in.bvh, L, in.powerTable, p.sp, count, in.render.candidates, vis, shadows, rng, p.sums, rc);
-                else risChunk<M, P, false, true>(in.bvh, L, nullptr, p.sp, count, in.render.candidates, vis, shadows, rng, p.sums, rc);
-            } else if (power) {
-                risChunk<M, P, true>(in.bvh, L, in.powerTable, p.sp, count, in.render.candidates, vis, shadows, rng, p.sums, rc);
-            } else {
-                risChunk<M, P, false>(in.bvh, L, nullptr, p.sp, count, in.render.candidates, vis, shadows, rng, p.sums, rc);
+            switch (in.render.source) {
+            case LightSource::uniform: chunk.template operator()<LightSource::uniform>(p, rng, rc); break;
+            case LightSource::power: chunk.template operator()<LightSource::power>(p, rng, rc); break;
+            case LightSource::tree: chunk.template operator()<LightSource::tree>(p, rng, rc); break;
             }
         }
     } else {
@@ -405,6 +408,7 @@ LightingCounters accumulateLighting(const LightingInputs& in, const LightingPlan
     // ris draws its candidates in proportion to power exactly when given the table: it must be the configured source.
     ACC_CHECK(in.render.estimator != EstimatorKind::ris || (in.render.source == LightSource::power) == (in.powerTable != nullptr));
     ACC_CHECK(in.render.estimator != EstimatorKind::tree || in.lightTree);
+    ACC_CHECK(in.render.estimator != EstimatorKind::ris || in.render.source != LightSource::tree || in.lightTree);
     ACC_CHECK(in.render.estimator != EstimatorKind::restir);
     const LightArrays L(in.particles, in.shading);
     switch (in.shading.model) {
@@ -461,6 +465,7 @@ LightingCounters estimateLighting(const LightingInputs& in, LightingImage& out, 
     // ris draws its candidates in proportion to power exactly when given the table: it must be the configured source.
     ACC_CHECK(in.render.estimator != EstimatorKind::ris || (in.render.source == LightSource::power) == (in.powerTable != nullptr));
     ACC_CHECK(in.render.estimator != EstimatorKind::tree || in.lightTree);
+    ACC_CHECK(in.render.estimator != EstimatorKind::ris || in.render.source != LightSource::tree || in.lightTree);
     ACC_CHECK(in.render.estimator != EstimatorKind::restir);
     allocate(out, pixels);
     const LightingPlan plan = planLighting(in.render, in.gbuffer.height);

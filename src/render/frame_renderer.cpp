@@ -144,7 +144,7 @@ void FrameRenderer::lightFrame(std::uint32_t frame, const Camera& camera, const 
     }
     auto t = stats.timer.scope(pass::estimateLighting);
     if (plan.restir) {
-        RestirInputs in{*bvh_, particles, gbuffer, camera, settings_, plan, frame, powerTable,
+        RestirInputs in{*bvh_, particles, gbuffer, camera, settings_, plan, frame, powerTable, lightTree,
                         plan.previousBvh ? previousBvh_.get() : nullptr, plan.counting ? &img.counters : nullptr, trace};
         stats.lighting = restir_->render(in, img.lighting, img.reservoirs, stats.timer, stats.nonFinite);
         stats.reservoirBytes = restir_->reservoirBytes();

@@ -71,6 +71,7 @@ void requireSupported(const Settings& s, bool lighting) {
         refuse(fmt::format("render.estimator = \"{}\"", enumName(e)));
     if (lighting && e == EstimatorKind::restir) {
         const RestirSettings& r = s.restir;
+        if (s.render.source == LightSource::tree) refuse("render.source = \"tree\"");
         if (r.layout != ReservoirLayout::full) refuse("restir.layout = \"packed\"");
         if (r.basic_visibility) refuse("restir.basic_visibility");
         if (r.candidate_visibility) refuse("restir.candidate_visibility");

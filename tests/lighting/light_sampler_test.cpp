@@ -93,6 +93,13 @@ TEST_CASE("every light sampler draws in proportion to its pdf (one chi-square ha
                  N, emits);
     checkSampler({"tree", [&](Rng& rng) { return tree.sample(sp, rng); }, [&](std::uint32_t i) { return tree.pdf(sp, i); }},
                  N, lit);
+    // The candidate sources of ris / restir (render.source) through the same harness.
+    checkSampler({"candidates: power", [&](Rng& rng) { return sampleCandidate<LightSource::power>(L, &power, &tree, sp, rng); },
+                  [&](std::uint32_t i) { return candidatePdf<LightSource::power>(L, &power, &tree, sp, i); }},
+                 N, emits);
+    checkSampler({"candidates: tree", [&](Rng& rng) { return sampleCandidate<LightSource::tree>(L, &power, &tree, sp, rng); },
+                  [&](std::uint32_t i) { return candidatePdf<LightSource::tree>(L, &power, &tree, sp, i); }},
+                 N, lit);
 }
 
 TEST_CASE("SourcePmf (the GPU twin's sampler) with PortableRng draws sampleSource's lights and pdfs", "[lighting][sampler]") {

@@ -157,6 +157,8 @@ TEST_CASE("the plan is the frame: every frame's timed passes are exactly the pla
         {"power", [](Settings& s) { s.render.estimator = EstimatorKind::power; }},
         {"tree", [](Settings& s) { s.render.estimator = EstimatorKind::tree; }},
         {"ris power", [](Settings& s) { s.render.estimator = EstimatorKind::ris; s.render.source = LightSource::power; }},
+        {"ris tree", [](Settings& s) { s.render.estimator = EstimatorKind::ris; s.render.source = LightSource::tree; }},
+        {"restir tree", [](Settings& s) { s.render.estimator = EstimatorKind::restir; s.render.source = LightSource::tree; }},
         {"restir", [](Settings& s) { s.render.estimator = EstimatorKind::restir; }},
         {"restir temporal off", [](Settings& s) { s.render.estimator = EstimatorKind::restir; s.restir.temporal = false; }},
         {"restir no neighbours", [](Settings& s) { s.render.estimator = EstimatorKind::restir; s.restir.spatial_neighbours = 0; }},
@@ -188,4 +190,11 @@ TEST_CASE("the plan is the frame: every frame's timed passes are exactly the pla
     CHECK_FALSE(planFrame(s, FrameFacts{}).temporal);
     CHECK(planFrame(s, FrameFacts{false, true, true}).temporal);
     CHECK_FALSE(planFrame(s, FrameFacts{false, true, false}).lighting);
+    // The candidates' source decides the light sampler built.
+    for (const auto& [source, sampler] : {std::pair{LightSource::uniform, LightSamplerKind::none},
+                                          std::pair{LightSource::power, LightSamplerKind::power},
+                                          std::pair{LightSource::tree, LightSamplerKind::tree}}) {
+        s.render.source = source;
+        CHECK(planFrame(s, FrameFacts{false, true, true}).sampler == sampler);
+    }
 }

@@ -13,7 +13,8 @@ namespace accretion {
 /// The light samplers, each with `sample` beside `pdf`:
 /// - uniform: sampleSource<false>, sourcePdf<false> (1 / N);
 /// - power: sampleSource<true>, sourcePdf<true> (an alias table over luminance(I_i));
-/// - tree: LightTree::sample, LightTree::pdf (receiver-dependent, light_tree.h).
+/// - tree: LightTree::sample, LightTree::pdf (receiver-dependent, light_tree.h);
+/// - ris / restir candidates by render.source: sampleCandidate, candidatePdf.
 /// tests/lighting/light_sampler_test.cpp runs one chi-square harness over all of them.
 
 /// The light selection pmf of the `power` estimator (and of ris / restir with
@@ -38,6 +39,25 @@ template <bool Power>
 float sourcePdf(const LightArrays& L, const AliasTable* table, std::uint32_t i) {
     if constexpr (Power) return table->pmf(i);
     else return L.uniformPdf;
+}
+
+/// A candidate of ris / restir from render.source: uniform, power (alias
+/// table) or the light tree at the receiver. The tree may draw no light
+/// (kNoLightSample, pdf 0) where every light has zero importance: the
+/// caller counts it as a zero candidate.
+template <LightSource S>
+LightSample sampleCandidate(const LightArrays& L, const AliasTable* table, const LightTree* tree, const ShadingPoint& sp,
+                            Rng& rng) {
+    if constexpr (S == LightSource::tree) return tree->sample(sp, rng);
+    else return sampleSource<S == LightSource::power>(L, table, rng);
+}
+
+/// Probability that sampleCandidate<S> returns light i at the receiver.
+template <LightSource S>
+float candidatePdf(const LightArrays& L, const AliasTable* table, const LightTree* tree, const ShadingPoint& sp,
+                   std::uint32_t i) {
+    if constexpr (S == LightSource::tree) return tree->pdf(sp, i);
+    else return sourcePdf<S == LightSource::power>(L, table, i);
 }
 
 }  // namespace accretion

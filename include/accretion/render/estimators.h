@@ -56,7 +56,7 @@ struct LightingInputs {
     const RenderSettings& render;
     std::uint32_t frame = 0;
     const AliasTable* powerTable = nullptr;  ///< power (required); ris: candidates in proportion to power when given
-    const LightTree* lightTree = nullptr;    ///< required by `tree`
+    const LightTree* lightTree = nullptr;    ///< required by `tree`, and by ris with render.source = tree
     PassCounters* counters = nullptr;        ///< counting mode: one thread record per pixel (the BVH must count)
     PixelTrace* trace = nullptr;             ///< render --pixel: record the terms or samples of trace->px
 };

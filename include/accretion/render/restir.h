@@ -35,7 +35,8 @@ struct RestirInputs {
     const Settings& settings;
     const FramePlan& plan;       ///< the passes to run (temporal, spatial iterations, upsample)
     std::uint32_t frame = 0;
-    const AliasTable* powerTable = nullptr;  ///< candidates in proportion to power (the plan built it), else uniform
+    const AliasTable* powerTable = nullptr;  ///< candidates in proportion to power (the plan built it)
+    const LightTree* lightTree = nullptr;    ///< candidates from the light tree (the plan built it); neither: uniform
     const ParticleBvh* previousBvh = nullptr; ///< last frame's BVH (see needsPreviousBvh), else the current one is used
     FrameCounters* counters = nullptr;        ///< counting mode: each pass adds its thread records (the BVH must count)
     PixelTrace* trace = nullptr;              ///< render --pixel: the reservoir of trace->px after each pass

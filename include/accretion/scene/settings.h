@@ -42,7 +42,7 @@ enum class ShadingModel { lambert, sphere, isotropic };
 enum class EstimatorKind { exact, uniform, power, ris, restir, tree };
 enum class BiasCorrection { none, basic, pairwise };
 enum class ReservoirLayout { full, packed };
-enum class LightSource { uniform, power };
+enum class LightSource { uniform, power, tree };
 enum class OmmMode { off, two_state, four_state };
 enum class NonFinitePolicy { zero_sample, discard };
 enum class VisibilityRule { exact, offset };
@@ -60,7 +60,7 @@ ACC_ENUM_NAMES(ShadingModel, "lambert", "sphere", "isotropic");
 ACC_ENUM_NAMES(EstimatorKind, "exact", "uniform", "power", "ris", "restir", "tree");
 ACC_ENUM_NAMES(BiasCorrection, "none", "basic", "pairwise");
 ACC_ENUM_NAMES(ReservoirLayout, "full", "packed");
-ACC_ENUM_NAMES(LightSource, "uniform", "power");
+ACC_ENUM_NAMES(LightSource, "uniform", "power", "tree");
 ACC_ENUM_NAMES(OmmMode, "off", "2state", "4state");
 ACC_ENUM_NAMES(NonFinitePolicy, "zero_sample", "discard");
 ACC_ENUM_NAMES(VisibilityRule, "exact", "offset");
@@ -212,7 +212,7 @@ struct RenderSettings {
     EstimatorKind estimator = EstimatorKind::exact; ///< estimator of Lr
     std::uint32_t samples = 16;                  ///< light samples per pixel (Monte Carlo estimators)
     std::uint32_t candidates = 16;               ///< ris, restir: candidates M per reservoir (the GPU pipeline's: 16)
-    LightSource source = LightSource::uniform;   ///< ris, restir: source pdf of the candidates
+    LightSource source = LightSource::uniform;   ///< ris, restir: source pdf of the candidates (uniform, power, or the light tree at the receiver)
     double target_stderr = 0.0;                  ///< tree, uniform, power: relative standard error to reach per pixel (0: fixed samples)
     std::uint32_t max_samples = 65536;           ///< cap of the adaptive sampling of target_stderr
     std::uint64_t seed = 0;                      ///< render seed

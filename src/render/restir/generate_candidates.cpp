@@ -5,7 +5,7 @@
 namespace accretion::restir {
 namespace {
 
-template <ShadingModel SM, Primitive P, bool Power, bool Count>
+template <ShadingModel SM, Primitive P, LightSource S, bool Count>
 LightingCounters generateCandidatesKernel(const FrameContext& f, std::vector<StoredReservoir>& out) {
     const std::uint32_t Mc = f.in.settings.render.candidates;
     PassCounters* pc = passCounters<Count>(f, pass::generateCandidates);
@@ -17,16 +17,19 @@ LightingCounters generateCandidatesKernel(const FrameContext& f, std::vector<Sto
         out[px] = StoredReservoir{};
         if (!g.hit()) return;
         rec.trip(Mc);
-        rec.read(Mc * (gpu_layout::kParticleRecord + (Power ? gpu_layout::kAliasEntry : 0u)));
+        // Per candidate its light's record, and the source's reads: an alias
+        // entry, or both children at every level of the tree.
+        rec.read(Mc * (gpu_layout::kParticleRecord + (S == LightSource::power ? gpu_layout::kAliasEntry : 0u) +
+                       (S == LightSource::tree ? 2u * gpu_layout::kLightTreeNode * f.in.lightTree->depth() : 0u)));
         rec.write(R);
         const ShadingPoint sp = shadingPoint(g, f.in.particles);
         Rng rng(px, f.in.frame, RngPass::restirCandidates, f.in.settings.render.seed);
         Reservoir r;
         bool discard = false;
         for (std::uint32_t m = 0; m < Mc; ++m) {
-            const LightSample x = sampleSource<Power>(f.L, f.in.powerTable, rng);
+            const LightSample x = sampleCandidate<S>(f.L, f.in.powerTable, f.in.lightTree, sp, rng);
             float p_hat = f.L.targetPdf<SM>(sp, x.i);
-            float w = p_hat / x.pdf;
+            float w = x.pdf > 0.0f ? p_hat / x.pdf : 0.0f;  // the tree drew no light: a zero candidate
             ++c.lightTerms;
             if (!std::isfinite(w) || !std::isfinite(p_hat)) {  // render.nonfinite: a zero candidate, or no reservoir
                 discard = f.reject(px, c) || discard;
@@ -60,13 +63,18 @@ LightingCounters generateCandidatesKernel(const FrameContext& f, std::vector<Sto
 
 }  // namespace
 
-/// RIS of render.candidates lights from the source pmf (uniform, or power
-/// when the plan built a power table) with target p_hat (no visibility);
+/// RIS of render.candidates lights from the source pmf (render.source:
+/// uniform, power or the light tree) with target p_hat (no visibility);
 /// with candidate_visibility, an occluded winner is dropped before reuse.
 LightingCounters generateCandidates(const FrameContext& f, std::vector<StoredReservoir>& out) {
-    const bool power = f.in.powerTable != nullptr;
+    const LightSource source = f.in.settings.render.source;
     return dispatchKernel(f, [&]<ShadingModel SM, Primitive P, bool Count>() {
-        return power ? generateCandidatesKernel<SM, P, true, Count>(f, out) : generateCandidatesKernel<SM, P, false, Count>(f, out);
+        switch (source) {
+        case LightSource::power: return generateCandidatesKernel<SM, P, LightSource::power, Count>(f, out);
+        case LightSource::tree: return generateCandidatesKernel<SM, P, LightSource::tree, Count>(f, out);
+        case LightSource::uniform: break;
+        }
+        return generateCandidatesKernel<SM, P, LightSource::uniform, Count>(f, out);
     });
 }
 

@@ -84,6 +84,7 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
     const FramePlan& plan = in.plan;
     ACC_CHECK(plan.restir);
     ACC_CHECK((plan.sampler == LightSamplerKind::power) == (in.powerTable != nullptr));  // candidates from the planned source
+    ACC_CHECK((plan.sampler == LightSamplerKind::tree) == (in.lightTree != nullptr));
     ACC_CHECK(!plan.temporal || (history_ && history_->gbuffer.width == lg->width && history_->gbuffer.height == lg->height));
     const History* prev = plan.temporal ? history_.get() : nullptr;
     std::vector<std::uint32_t> lowRejected(lpixels, 0);
