@@ -85,12 +85,17 @@ bool exrHasLayer(const std::filesystem::path& file, const std::string& layer) {
     return true;
 }
 
-RgbLayer readExrChannels(const std::filesystem::path& file, const std::vector<std::string>& names) {
-    ACC_CHECK(names.size() == 3);
+namespace {
+
+/// The three channels `channels(spec)` names, read from one opening of the file.
+template <class Channels>
+RgbLayer readChannels(const std::filesystem::path& file, Channels&& channels) {
     requireExr(file);
     auto in = OIIO::ImageInput::open(file.string());
     if (!in) throw InputError(fmt::format("{}: cannot read image: {}", file.string(), OIIO::geterror()));
     const OIIO::ImageSpec& spec = in->spec();
+    const std::vector<std::string> names = channels(spec);
+    ACC_CHECK(names.size() == 3);
     RgbLayer out;
     out.width = static_cast<std::uint32_t>(spec.full_width);
     out.height = static_cast<std::uint32_t>(spec.full_height);
@@ -115,6 +120,12 @@ RgbLayer readExrChannels(const std::filesystem::path& file, const std::vector<st
     return out;
 }
 
+}  // namespace
+
+RgbLayer readExrChannels(const std::filesystem::path& file, const std::vector<std::string>& names) {
+    return readChannels(file, [&](const OIIO::ImageSpec&) { return names; });
+}
+
 std::vector<Vec3> RgbLayer::window(int x, int y, std::uint32_t w, std::uint32_t h) const {
     ACC_CHECK(x >= x0 && y >= y0 && x + int(w) <= x0 + int(dataWidth) && y + int(h) <= y0 + int(dataHeight));
     std::vector<Vec3> out;
@@ -137,13 +148,12 @@ std::vector<std::uint32_t> readExrUintChannel(const std::filesystem::path& file,
 }
 
 RgbLayer readExrLayer(const std::filesystem::path& file, const std::string& layer) {
-    std::vector<std::string> names = layerChannels(layer);
-    if (!layer.empty())
-        if (auto in = OIIO::ImageInput::open(file.string())) {
-            const OIIO::ImageSpec& spec = in->spec();
-            if (spec.channelindex(names[0]) < 0 && spec.channelindex(layer) >= 0) names = {layer, layer, layer};  // spp, depth.Z
-        }
-    return readExrChannels(file, names);
+    return readChannels(file, [&](const OIIO::ImageSpec& spec) {
+        std::vector<std::string> names = layerChannels(layer);
+        if (!layer.empty() && spec.channelindex(names[0]) < 0 && spec.channelindex(layer) >= 0)
+            names = {layer, layer, layer};  // a channel of its own: spp, depth.Z
+        return names;
+    });
 }
 
 std::map<std::string, std::string> readExrAttributes(const std::filesystem::path& file) {

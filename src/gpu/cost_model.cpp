@@ -282,16 +282,21 @@ CostFeatures fitRows(const std::vector<const CostRow*>& rows, const FeatureMask&
     return ns;
 }
 
-/// Root mean square relative error of predicting each configuration's rows
-/// from a fit (over `mask`) of the other configurations' rows.
-double leaveOneConfigOut(const std::vector<const CostRow*>& rows, const FeatureMask& mask) {
+/// The configurations of the rows, sorted, each once.
+std::vector<std::string> distinctConfigs(const std::vector<const CostRow*>& rows) {
     std::vector<std::string> configs;
     for (const CostRow* r : rows) configs.push_back(r->config);
     std::sort(configs.begin(), configs.end());
     configs.erase(std::unique(configs.begin(), configs.end()), configs.end());
+    return configs;
+}
+
+/// Root mean square relative error of predicting each configuration's rows
+/// from a fit (over `mask`) of the other configurations' rows.
+double leaveOneConfigOut(const std::vector<const CostRow*>& rows, const FeatureMask& mask) {
     double sum = 0.0;
     std::size_t n = 0;
-    for (const std::string& left : configs) {
+    for (const std::string& left : distinctConfigs(rows)) {
         std::vector<const CostRow*> train;
         for (const CostRow* r : rows)
             if (r->config != left) train.push_back(r);
@@ -312,13 +317,10 @@ double leaveOneConfigOut(const std::vector<const CostRow*>& rows, const FeatureM
 /// when left out), then forward selection of the work counters, each step
 /// adding the one that lowers the leave-one-configuration-out error most,
 /// until none lowers it by more than its standard error; then the fit over
-/// the chosen counters. With
-/// fewer than 4 configurations, every counter (per_pass).
+/// the chosen counters. With fewer than 4 configurations, every counter
+/// (per_pass).
 CostFeatures fitSelected(const std::vector<const CostRow*>& rows) {
-    std::vector<std::string> configs;
-    for (const CostRow* r : rows) configs.push_back(r->config);
-    std::sort(configs.begin(), configs.end());
-    const std::size_t nConfigs = std::size_t(std::unique(configs.begin(), configs.end()) - configs.begin());
+    const std::size_t nConfigs = distinctConfigs(rows).size();
     const FeatureMask all = firstFeatures(kCostFeatures.size());
     if (nConfigs < 4) return fitRows(rows, all, true);
     FeatureMask chosen{};

@@ -8,12 +8,6 @@
 
 namespace accretion {
 
-std::uint32_t LightingPlan::chunkSamples(std::uint64_t c) const {
-    if (exact) return 0;
-    const std::uint32_t k = static_cast<std::uint32_t>(c % chunksPerRound);
-    return std::min(kChunkSamples, samples - k * kChunkSamples);
-}
-
 LightingPlan planLighting(const RenderSettings& render, std::uint32_t height, Shard shard) {
     LightingPlan plan;
     plan.exact = render.estimator == EstimatorKind::exact;

@@ -8,6 +8,7 @@
 #include "accretion/geometry/billboard.h"
 #include "accretion/lighting/source_pmf.h"
 #include "accretion/lighting/reservoir_codec.h"
+#include "accretion/render/accumulation.h"
 #include "accretion/geometry/camera.h"
 #include "accretion/render/gbuffer_texel.h"
 #include "accretion/render/shadow_query.h"
@@ -38,16 +39,13 @@ struct LightView {
     const float* dmin2 = nullptr;        ///< max(r_i, dmin)^2
 };
 
-/// uniform and power (docs/MODEL.md section 4) as the CPU's LightingPlan runs
-/// them, one pixel per thread: chunks of up to 8 samples, each chunk its own
-/// stream; adaptive sampling stops a pixel at the end of a round.
+/// uniform and power (docs/MODEL.md section 4) as the CPU runs them, one
+/// pixel per thread: the CPU's LightingPlan (chunks of up to 8 samples, each
+/// chunk its own stream; adaptive sampling stops a pixel at the end of a round).
 struct SamplingParams {
     std::uint32_t frame = 0;
     std::uint64_t seed = 0;
-    std::uint32_t samples = 16;          ///< per round (render.samples)
-    std::uint32_t chunksPerRound = 2;
-    std::uint32_t rounds = 1;            ///< adaptive: the most rounds a pixel can take
-    bool adaptive = false;               ///< render.target_stderr > 0
+    LightingPlan plan;                   ///< planLighting of the frame (the whole frame: no shard)
     std::uint32_t maxSamples = 65536;
     double targetStderr = 0.0;
     bool discardNonFinite = false;       ///< render.nonfinite = discard

@@ -119,12 +119,11 @@ __device__ DVec3 exactSum(const ShadingPoint& sp, LaunchCounters& c) {
 /// before shading them: the stream's numbers are the same.
 template <ShadingModel M>
 __device__ void samplePixel(const ShadingPoint& sp, std::size_t px, SampleSums& s, LaunchCounters& c) {
-    const SamplingParams& plan = params.sampling;
-    const std::uint64_t chunks = std::uint64_t(plan.chunksPerRound) * plan.rounds;
-    for (std::uint64_t chunk = 0; chunk < chunks; ++chunk) {
-        PortableRng rng(px, plan.frame, RngPass::lightSampling, plan.seed, chunk + 1);
-        const std::uint32_t k = static_cast<std::uint32_t>(chunk % plan.chunksPerRound);
-        const std::uint32_t count = min(8u, plan.samples - k * 8u);  // LightingPlan::chunkSamples
+    const SamplingParams& sampling = params.sampling;
+    const LightingPlan& plan = sampling.plan;
+    for (std::uint64_t chunk = plan.begin; chunk < plan.end; ++chunk) {
+        PortableRng rng(px, sampling.frame, RngPass::lightSampling, sampling.seed, chunk + 1);
+        const std::uint32_t count = plan.chunkSamples(chunk);
         for (std::uint32_t m = 0; m < count; ++m) {
             const LightSample x = params.source.sample(rng);
             LightTerm t;
@@ -136,7 +135,7 @@ __device__ void samplePixel(const ShadingPoint& sp, std::size_t px, SampleSums& 
         }
         if (plan.adaptive && (chunk + 1) % plan.chunksPerRound == 0 &&
             roundDone(s.sum, s.sumSq, s.n, static_cast<std::uint32_t>((chunk + 1) / plan.chunksPerRound), plan.samples,
-                      plan.maxSamples, plan.targetStderr))
+                      sampling.maxSamples, sampling.targetStderr))
             return;
     }
 }

@@ -302,10 +302,7 @@ int run(const Args& a) {
             SamplingParams& sp = lp.sampling;
             sp.frame = frame;
             sp.seed = seed;
-            sp.samples = settings.render.samples;
-            sp.chunksPerRound = plan.chunksPerRound;
-            sp.rounds = plan.rounds;
-            sp.adaptive = plan.adaptive;
+            sp.plan = plan;
             sp.maxSamples = settings.render.max_samples;
             sp.targetStderr = settings.render.target_stderr;
             sp.discardNonFinite = settings.render.nonfinite == NonFinitePolicy::discard;

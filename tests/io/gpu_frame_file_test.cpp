@@ -37,6 +37,16 @@ GpuFrame sampleFrame() {
     return f;
 }
 
+/// An EXR as OpenImageIO reads it: its spec and every channel as float.
+std::pair<OIIO::ImageSpec, std::vector<float>> readImage(const std::filesystem::path& file) {
+    auto in = OIIO::ImageInput::open(file.string());
+    REQUIRE(in);
+    OIIO::ImageSpec spec = in->spec();
+    std::vector<float> px(std::size_t(spec.width) * spec.height * spec.nchannels);
+    REQUIRE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, px.data()));
+    return {spec, px};
+}
+
 }  // namespace
 
 TEST_CASE("a GPU frame file reads back bit for bit, and damaged files are refused", "[io][gpu]") {
@@ -75,15 +85,11 @@ TEST_CASE("import-gpu writes render's EXR layers of a GPU frame", "[io][gpu][cli
     std::string out;
     REQUIRE(runCommand(kBin + " import-gpu " + (dir / "g.gpuframe").string(), out) == 0);
     INFO(out);
-    auto in = OIIO::ImageInput::open((dir / "g.exr").string());
-    REQUIRE(in);
-    const OIIO::ImageSpec& spec = in->spec();
+    const auto [spec, px] = readImage(dir / "g.exr");
     CHECK(spec.width == 5);
     CHECK(spec.height == 3);
     CHECK(spec.get_string_attribute("accretion:renderer") == "accretion-optix");
     CHECK(spec.get_string_attribute("accretion:frame") == "7");
-    std::vector<float> px(std::size_t(spec.width) * spec.height * spec.nchannels);
-    REQUIRE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, px.data()));
     const int lr = spec.channelindex("Lr.R"), lb = spec.channelindex("Lr.B"), r = spec.channelindex("R");
     REQUIRE(lr >= 0);
     REQUIRE(lb >= 0);
@@ -134,11 +140,7 @@ TEST_CASE("a Monte Carlo GPU frame keeps its standard error, spp and rejections 
     std::string out;
     REQUIRE(runCommand(kBin + " import-gpu " + (dir / "mc.gpuframe").string(), out) == 0);
     INFO(out);
-    auto in = OIIO::ImageInput::open((dir / "mc.exr").string());
-    REQUIRE(in);
-    const OIIO::ImageSpec& spec = in->spec();
-    std::vector<float> px(std::size_t(spec.width) * spec.height * spec.nchannels);
-    REQUIRE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, px.data()));
+    const auto [spec, px] = readImage(dir / "mc.exr");
     const int se = spec.channelindex("Lr_stderr.R"), spp = spec.channelindex("spp"), rej = spec.channelindex("rejected");
     REQUIRE(se >= 0);
     REQUIRE(spp >= 0);

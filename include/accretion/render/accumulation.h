@@ -28,7 +28,12 @@ struct LightingPlan {
 
     std::uint64_t chunks() const { return end - begin; }
     /// Samples of chunk c (within its round).
-    std::uint32_t chunkSamples(std::uint64_t c) const;
+    ACC_HD std::uint32_t chunkSamples(std::uint64_t c) const {
+        if (exact) return 0;
+        const std::uint32_t k = static_cast<std::uint32_t>(c % chunksPerRound);
+        const std::uint32_t left = samples - k * kChunkSamples;
+        return left < kChunkSamples ? left : kChunkSamples;
+    }
 };
 
 /// The chunks of a frame for `render` at `height` rows, restricted to `shard`
