@@ -22,6 +22,7 @@
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
 
+#include "accretion/analysis/image_metrics.h"
 #include "accretion/core/rng.h"
 #include "accretion/core/version.h"
 #include "accretion/geometry/particle_bvh.h"
@@ -328,6 +329,66 @@ FrameTiming timeFrames(const Settings& s, const ParticleSource& source, std::uin
     return t;
 }
 
+/// An unbiased estimator's cost of a reference image: frame seconds a + b S
+/// at S samples per pixel and error v / S (relMSE against a reference, less
+/// the reference's own noise), fitted on two sample counts.
+struct ErrorCost {
+    double a = 0.0, b = 0.0, v = 0.0;
+    nlohmann::json points = nlohmann::json::array();
+    double secondsTo(double relMSE) const { return a + b * v / relMSE; }
+    nlohmann::json json(double target) const {
+        return {{"fixed_s", a}, {"s_per_sample", b}, {"relMSE_times_samples", v}, {"seconds_to_target", secondsTo(target)},
+                {"points", points}};
+    }
+};
+
+/// Renders frame 0 of each setting `runs` times in turn (side by side) and
+/// returns the images and median frame seconds.
+std::vector<std::pair<FrameImage, double>> renderInterleaved(const std::vector<Settings>& settings, const ParticleSource& src,
+                                                             int runs) {
+    std::vector<std::pair<FrameImage, double>> out(settings.size());
+    std::vector<std::vector<double>> t(settings.size());
+    for (int k = 0; k < runs; ++k)
+        for (std::size_t i = 0; i < settings.size(); ++i) {
+            FrameRenderer renderer(settings[i], src, RenderOptions{true});
+            FrameStats fs;
+            out[i].first = renderer.render(0, fs);
+            t[i].push_back(fs.seconds);
+        }
+    for (std::size_t i = 0; i < settings.size(); ++i) out[i].second = median(t[i]);
+    return out;
+}
+
+/// relMSE of an image against a reference, less the reference's own noise.
+double correctedRelMse(const FrameImage& img, const FrameImage& ref) {
+    const ErrorMetrics e = computeErrors(img.lighting.Lr, ref.lighting.Lr, &ref.lighting.Lr_stderr);
+    return e.relMSE - e.relMSEFloor;
+}
+
+/// The ErrorCost of each setting from renders at s1 and s2 samples per pixel, all side by side.
+std::vector<ErrorCost> measureErrorCosts(const std::vector<Settings>& settings, const ParticleSource& src, std::uint32_t s1,
+                                         std::uint32_t s2, const FrameImage& ref, int runs) {
+    std::vector<Settings> all;
+    for (const Settings& s : settings)
+        for (const std::uint32_t S : {s1, s2}) {
+            all.push_back(s);
+            all.back().render.samples = S;
+        }
+    const auto images = renderInterleaved(all, src, runs);
+    std::vector<ErrorCost> costs(settings.size());
+    for (std::size_t i = 0; i < settings.size(); ++i) {
+        const auto& [img1, t1] = images[2 * i];
+        const auto& [img2, t2] = images[2 * i + 1];
+        const double e1 = correctedRelMse(img1, ref), e2 = correctedRelMse(img2, ref);
+        ErrorCost& c = costs[i];
+        c.b = (t2 - t1) / double(s2 - s1);
+        c.a = std::max(0.0, t1 - c.b * s1);
+        c.v = 0.5 * (e1 * s1 + e2 * s2);  // the two agree when the error falls as 1 / S (both are reported)
+        c.points = {{{"samples", s1}, {"seconds", t1}, {"relMSE", e1}}, {{"samples", s2}, {"seconds", t2}, {"relMSE", e2}}};
+    }
+    return costs;
+}
+
 /// Runs a child process; true if it exits 0.
 bool runChild(const std::vector<std::string>& argv) {
     std::vector<char*> args;
@@ -373,6 +434,7 @@ struct Suite {
     void benchRays();
     void benchRestirFrame();
     void benchTreeReference();
+    void benchSplitReference();
     void benchScaling();
     void benchMemory();
     void benchPlanSkips();
@@ -522,6 +584,62 @@ void Suite::benchTreeReference() {
         tree.render.max_samples = 4096;
         const FrameTiming t = timeFrames(tree, diskSource, 8, 0, 1);
         figures["tree_to_1pct_100k_720p_s"] = t.frameSeconds;
+    }
+}
+
+/// split against tree (disk_100k) and against exact (the quickstart) at
+/// 320x180: the seconds each needs to reach relMSE 1e-3, from renders at
+/// two sample counts side by side (ErrorCost), against a reference that
+/// shares no sampling with them where one is affordable (exact, 10K) and a
+/// long split render otherwise (its noise subtracted).
+void Suite::benchSplitReference() {
+    constexpr double kTarget = 1e-3;
+    {
+        log("split against tree to relMSE 1e-3, 100K particles at 320x180 (minutes)");
+        Settings base = diskScene(scene, 100'000, 320, 180);
+        const ParticleSource src(base);
+        Settings ref = base;
+        ref.render.estimator = EstimatorKind::split;
+        ref.render.near_lights = 64;
+        ref.render.samples = quick ? 256 : 2048;
+        ref.render.seed = 1000;
+        FrameRenderer refRenderer(ref, src, RenderOptions{true});
+        FrameStats refStats;
+        const FrameImage reference = refRenderer.render(0, refStats);
+        Settings tree = base, split = base;
+        tree.render.estimator = EstimatorKind::tree;
+        split.render.estimator = EstimatorKind::split;
+        const auto c = measureErrorCosts({tree, split}, src, 8, 32, reference, quick ? 1 : 3);
+        const ErrorCost& t = c[0];
+        const ErrorCost& sp = c[1];
+        figures["split_vs_tree_100k_320x180"] = {
+            {"reference", {{"estimator", "split"}, {"near_lights", ref.render.near_lights}, {"samples", ref.render.samples},
+                           {"seconds", refStats.seconds},
+                           {"relMSE_floor", computeErrors(reference.lighting.Lr, reference.lighting.Lr, &reference.lighting.Lr_stderr).relMSEFloor}}},
+            {"near_lights", nearLightCount(split.render)},
+            {"tree", t.json(kTarget)},
+            {"split", sp.json(kTarget)},
+            {"tree_s_to_1e-2", t.secondsTo(1e-2)},
+            {"split_s_to_1e-2", sp.secondsTo(1e-2)}};
+        // Bar: split reaches 1e-3 at least 10x sooner than tree.
+        bars["split_vs_tree_to_1e-3"] = bar(sp.secondsTo(kTarget), t.secondsTo(kTarget), 0.1);
+    }
+    {
+        log("split against exact to relMSE 1e-3, quickstart (10K particles) at 320x180");
+        Settings base = loadScene((std::filesystem::path(scene).parent_path() / "quickstart.toml").string());
+        base.camera.width = 320;
+        base.camera.height = 180;
+        const ParticleSource src(base);
+        Settings exact = base;
+        exact.render.estimator = EstimatorKind::exact;
+        const auto ex = renderInterleaved({exact}, src, quick ? 1 : 3);
+        Settings split = base;
+        split.render.estimator = EstimatorKind::split;
+        const ErrorCost sp = measureErrorCosts({split}, src, 8, 32, ex[0].first, quick ? 1 : 3)[0];
+        figures["split_vs_exact_10k_320x180"] = {{"exact_s", ex[0].second}, {"split", sp.json(kTarget)},
+                                                 {"split_s_to_1e-4", sp.secondsTo(1e-4)}};
+        // Bar: where exact is cheaper than tree (below relMSE 3e-3 here), split is no slower than exact.
+        bars["split_vs_exact_to_1e-3"] = bar(sp.secondsTo(kTarget), ex[0].second, 1.0);
     }
 }
 
@@ -688,6 +806,7 @@ int main(int argc, char** argv) {
     suite.benchRays();
     suite.benchRestirFrame();
     if (!quick) suite.benchTreeReference();
+    suite.benchSplitReference();
     suite.benchScaling();
     suite.benchMemory();
     suite.benchPlanSkips();

@@ -21,7 +21,7 @@ std::vector<EstimatorSpec> parseEstimatorSpecs(const std::string& list, const st
         EstimatorSpec spec;
         spec.label = entry;
         if (!parseEnum(parts[0], spec.kind))
-            fail("unknown estimator (exact, uniform, power, tree, ris, restir)");
+            fail("unknown estimator (exact, uniform, power, tree, split, ris, restir)");
         const std::string flag = fmt::format("{} {}", option, entry);
         spec.settings.push_back({"render.estimator", flag, [k = spec.kind](Settings& s) { s.render.estimator = k; }});
         for (std::size_t k = 1; k < parts.size(); ++k) {

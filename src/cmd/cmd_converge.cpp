@@ -229,7 +229,8 @@ Table summaryTable(const std::vector<Point>& points, const std::vector<Estimator
     std::vector<Point> baseline;
     std::string baselineLabel;
     for (const EstimatorSpec& spec : specs)
-        if (spec.kind == EstimatorKind::uniform || spec.kind == EstimatorKind::power || spec.kind == EstimatorKind::tree) {
+        if (spec.kind == EstimatorKind::uniform || spec.kind == EstimatorKind::power || spec.kind == EstimatorKind::tree ||
+            spec.kind == EstimatorKind::split) {
             baselineLabel = spec.label;
             for (const Point& p : points)
                 if (p.label == spec.label) baseline.push_back(p);
@@ -342,7 +343,7 @@ void addConvergeCommand(CLI::App& app) {
     auto args = std::make_shared<ConvergeArgs>();
     CLI::App* cmd = app.add_subcommand("converge", "Error against time and rays per estimator, against a reference EXR");
     addExperimentOptions(cmd, *args, "Reference EXR with an Lr layer ({frame} pattern with --sequence)",
-                         "Comma-separated specs name[:option...]: uniform, power, tree, ris[:power], "
+                         "Comma-separated specs name[:option...]: uniform, power, tree, split, ris[:power], "
                          "restir[:none|basic|basic+vis|pairwise], options key=value override settings",
                          "Output prefix (default out/<scene>.converge): .csv, .png, .json");
     cmd->add_option("--budget", args->budget, "Time budget per estimator (e.g. 60s, 2m)");

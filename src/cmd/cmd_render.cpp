@@ -408,7 +408,7 @@ void addRenderCommand(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("render", "Render frames of a scene to EXR (+ PNG preview, stats.json)");
     addSceneOptions(cmd, *args, "Frames A:B, half-open (= render.frame_start, render.frames)");
     cmd->add_option("-o,--output", args->output, "EXR output path ({scene}, {frame} patterns) = render.output");
-    cmd->add_option("--estimator", args->estimator, "exact | uniform | power | tree | ris | restir  (= render.estimator)");
+    cmd->add_option("--estimator", args->estimator, "exact | uniform | power | tree | split | ris | restir  (= render.estimator)");
     cmd->add_option("--target-stderr", args->targetStderr,
                     "Sample each pixel until its relative standard error is below this (e.g. 0.5%; = render.target_stderr)");
     cmd->add_option("--spp", args->spp, "Light samples per pixel (= render.samples)");

@@ -63,6 +63,15 @@ void printSamples(const PixelTrace& t) {
     }
 }
 
+void printSplit(const PixelTrace& t) {
+    DVec3 visible(0.0), shadowed(0.0);
+    for (const auto& term : t.terms) (term.visible ? visible : shadowed) += DVec3(term.value);
+    fmt::print("split: the {} nearest lights summed exactly ({} with a non-zero term f I G): {} visible, {} shadowed\n",
+               t.lightsSeen, t.terms.size(), rgb(Vec3(visible)), rgb(Vec3(shadowed)));
+    fmt::print("each sample is that sum plus one far light's f I G V / p_far (the estimate column: the far part)\n");
+    printSamples(t);
+}
+
 void printRis(const PixelTrace& t) {
     fmt::print("{} reservoirs (RIS), the first {} listed:\n", t.reservoirs.size(), std::min(kReservoirsShown, t.reservoirs.size()));
     for (std::size_t k = 0; k < t.reservoirs.size() && k < kReservoirsShown; ++k) {
@@ -111,6 +120,7 @@ void explainPixel(const Settings& settings, std::uint32_t x, std::uint32_t y, bo
     if (restir) printRestir(trace);
     else if (settings.render.estimator == EstimatorKind::exact) printExact(trace, img.lighting.Lr[px]);
     else if (settings.render.estimator == EstimatorKind::ris) printRis(trace);
+    else if (settings.render.estimator == EstimatorKind::split) printSplit(trace);
     else printSamples(trace);
     fmt::print("value (shortest round-trip decimals: the EXR's floats of a full render, bit for bit):\n");
     fmt::print("  L = {}\n  Le = {}\n  Lr = {}\n", rgb(img.L[px]), rgb(img.Le[px]), rgb(img.lighting.Lr[px]));

@@ -27,8 +27,9 @@ void LightTree::build(std::uint32_t node, std::vector<std::uint32_t>& ids, std::
         const std::uint32_t i = ids[begin];
         const float dmin = std::max(particles.radius[i], dmin_);
         ACC_CHECK(depth < 64);
-        nodes_[node] = Node{particles.position[i], 0.0f, luminance(particles.emission[i]), dmin * dmin, i, 1};
-        trail_[i] = Trail{bits, depth};
+        nodes_[node] = Node{particles.position[i], 0.0f, luminance(particles.emission[i]), dmin * dmin, i, 1,
+                             particles.position[i], particles.position[i]};
+        trail_[i] = Trail{bits, depth, node};
         return;
     }
     Vec3 lo(std::numeric_limits<float>::infinity()), hi(-std::numeric_limits<float>::infinity());
@@ -48,15 +49,15 @@ void LightTree::build(std::uint32_t node, std::vector<std::uint32_t>& ids, std::
     // Conservative sphere: half the box diagonal, widened for float rounding.
     const float radius = 0.5f * glm::length(extent) * (1.0f + 1e-5f) + 1e-6f * glm::length(center);
     const auto child = static_cast<std::uint32_t>(nodes_.size());
-    nodes_[node] = Node{center, radius, static_cast<float>(power), 0.0f, child, 0};
+    nodes_[node] = Node{center, radius, static_cast<float>(power), 0.0f, child, end - begin, lo, hi};
     nodes_.resize(nodes_.size() + 2);
     build(child, ids, begin, mid, particles, bits, depth + 1);
     build(child + 1, ids, mid, end, particles, bits | (std::uint64_t(1) << depth), depth + 1);
 }
 
-float LightTree::importance(const Node& node, const ShadingPoint& sp) const {
-    if (node.leaf) {
-        if (node.child == sp.self || !(node.power > 0.0f)) return 0.0f;
+float LightTree::importance(const Node& node, float power, const ShadingPoint& sp, float minDist2) const {
+    if (node.count == 1) {
+        if (node.child == sp.self || !(power > 0.0f)) return 0.0f;
         const Vec3 delta = node.center - sp.x;
         const float d2 = glm::dot(delta, delta);
         float cosTerm = 1.0f;
@@ -65,9 +66,19 @@ float LightTree::importance(const Node& node, const ShadingPoint& sp) const {
             cosTerm = glm::dot(sp.n, delta) / std::sqrt(d2);
             if (!(cosTerm > 0.0f)) return 0.0f;
         }
-        return node.power * cosTerm / std::max(d2, node.dmin2);
+        return power * cosTerm / std::max(d2, node.dmin2);
     }
-    if (!(node.power > 0.0f)) return 0.0f;
+    if (!(power > 0.0f)) return 0.0f;
+    if (model_ != ShadingModel::isotropic) {
+        // The box behind the receiver's plane (n . (p - x) <= 0 at its
+        // farthest corner along n): no light below has a term. A slack of
+        // 1e-5 of the corner's scale keeps a light that rounds to the plane.
+        const Vec3 a = node.lo - sp.x, b = node.hi - sp.x;
+        const float front = std::max(sp.n.x * a.x, sp.n.x * b.x) + std::max(sp.n.y * a.y, sp.n.y * b.y) +
+                            std::max(sp.n.z * a.z, sp.n.z * b.z);
+        const float scale = glm::dot(glm::abs(sp.n), glm::max(glm::abs(a), glm::abs(b)));
+        if (!(front > -1e-5f * scale)) return 0.0f;
+    }
     const Vec3 delta = node.center - sp.x;
     const float d2 = glm::dot(delta, delta);
     const float r2 = node.radius * node.radius;
@@ -85,14 +96,14 @@ float LightTree::importance(const Node& node, const ShadingPoint& sp) const {
             if (!(cosBound > 0.0f)) return 0.0f;
         }
     }
-    return node.power * cosBound / std::max(d2, r2);
+    return power * cosBound / std::max(std::max(d2, r2), minDist2);
 }
 
 LightSample LightTree::sample(const ShadingPoint& sp, Rng& rng) const {
     if (nodes_.empty()) return {kNoLightSample, 0.0f};
     std::uint32_t n = 0;
     float pdf = 1.0f;
-    while (!nodes_[n].leaf) {
+    while (nodes_[n].count > 1) {
         const std::uint32_t c = nodes_[n].child;
         const float a = importance(nodes_[c], sp);
         const float b = importance(nodes_[c + 1], sp);

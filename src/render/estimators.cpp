@@ -1,6 +1,9 @@
 #include "accretion/render/estimators.h"
 
 #include <cmath>
+#include <optional>
+#include <ranges>
+#include <span>
 
 #include <tbb/blocked_range.h>
 #include <tbb/blocked_range2d.h>
@@ -12,6 +15,7 @@
 #include "accretion/counters/gpu_layouts.h"
 #include "accretion/lighting/light_arrays.h"
 #include "accretion/lighting/light_sampler.h"
+#include "accretion/lighting/near_field.h"
 #include "accretion/lighting/reservoir.h"
 #include "accretion/lighting/shading.h"
 #include "accretion/render/sample_sums.h"
@@ -32,15 +36,17 @@ inline bool seen(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoin
     return false;
 }
 
-/// exact: sum over every light i != j of f I G V, in double.
+/// The sum of f I G V over `lights` (every light i != j for exact; the near
+/// field for split), in double, one shadow ray per non-zero term.
 /// With a trace (render --pixel), every non-zero term and its V are recorded.
 /// (Traced is a template argument: the light loop of every other pixel has no trace test.)
-template <ShadingModel M, Primitive P, bool Traced = false>
-DVec3 exactPixel(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint& sp, const VisibilityOptions& vis, bool shadows,
-                LightingCounters& c, RayCounters* rc, PixelTrace* trace = nullptr) {
+template <ShadingModel M, Primitive P, bool Traced = false, class Lights>
+DVec3 sumTerms(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint& sp, const Lights& lights,
+               const VisibilityOptions& vis, bool shadows, LightingCounters& c, RayCounters* rc, PixelTrace* trace = nullptr) {
     DVec3 sum(0.0);
-    for (std::uint32_t i = 0; i < L.count; ++i) {
+    for (const std::uint32_t i : lights) {
         if (i == sp.self) continue;
+        if constexpr (Traced) ++trace->lightsSeen;
         LightTerm t;
         ++c.lightTerms;
         if (!evalLight<M>(sp, L.position[i], L.emission[i], L.packed[i].dmin2, t)) continue;
@@ -48,8 +54,14 @@ DVec3 exactPixel(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoin
         if (v) sum += DVec3(t.value);
         if constexpr (Traced) trace->terms.push_back({i, t.value, v});
     }
-    if constexpr (Traced) trace->lightsSeen = L.count - (sp.self < L.count ? 1 : 0);
     return sum;
+}
+
+/// exact: every light i != j.
+template <ShadingModel M, Primitive P, bool Traced = false>
+DVec3 exactPixel(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint& sp, const VisibilityOptions& vis, bool shadows,
+                 LightingCounters& c, RayCounters* rc, PixelTrace* trace = nullptr) {
+    return sumTerms<M, P, Traced>(bvh, L, sp, std::views::iota(0u, L.count), vis, shadows, c, rc, trace);
 }
 
 /// One pixel's running sums (SampleSums: the non-finite policy applied to
@@ -86,14 +98,15 @@ std::uint32_t resolvePixel(const DVec3& sum, const DVec3& sumSq, std::uint32_t n
     return zeroed;
 }
 
-/// The lights of one chunk of uniform / power / tree samples, in stream
-/// order, their records prefetched (a random light is a cache miss).
+/// The lights of one chunk of uniform / power / tree / split (far) samples,
+/// in stream order, their records prefetched (a random light is a cache miss).
 template <EstimatorKind K>
-void drawLights(const LightingInputs& in, const LightArrays& L, const ShadingPoint& sp, Rng& rng, std::uint32_t count,
-                LightSample* xs) {
+void drawLights(const LightingInputs& in, const LightArrays& L, const ShadingPoint& sp, const NearField& near, Rng& rng,
+                std::uint32_t count, LightSample* xs) {
     for (std::uint32_t k = 0; k < count; ++k) {
         if constexpr (K == EstimatorKind::power) xs[k] = sampleSource<true>(L, in.powerTable, rng);
         else if constexpr (K == EstimatorKind::tree) xs[k] = in.lightTree->sample(sp, rng);
+        else if constexpr (K == EstimatorKind::split) xs[k] = in.lightTree->sampleFar(sp, near, rng);
         else xs[k] = sampleSource<false>(L, nullptr, rng);
         if (xs[k].i < L.count) {
             __builtin_prefetch(&L.packed[xs[k].i]);
@@ -103,10 +116,13 @@ void drawLights(const LightingInputs& in, const LightArrays& L, const ShadingPoi
 }
 
 /// uniform / power / tree: the one-sample estimates f I G V / p(i) of drawn
-/// lights (a zero sample when no light or i = j).
+/// lights (a zero sample when no light or i = j); split: each sample is the
+/// near field's exact sum `near` plus the far light's f I G V / p_far(i).
 template <ShadingModel M, Primitive P, bool Traced = false>
 void shadeSamples(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint& sp, const LightSample* xs,
-                  std::uint32_t count, const VisibilityOptions& vis, bool shadows, PixelSums& acc, RayCounters* rc) {
+                  std::uint32_t count, const DVec3& near, const VisibilityOptions& vis, bool shadows, PixelSums& acc,
+                  RayCounters* rc) {
+    const bool hasNear = near != DVec3(0.0);
     LightingCounters& c = acc.c;
     for (std::uint32_t k = 0; k < count; ++k) {
         const LightSample& x = xs[k];
@@ -114,7 +130,8 @@ void shadeSamples(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoi
         ++c.lightTerms;
         const bool term = L.term<M>(sp, x.i, t);
         const bool v = term && seen<P>(bvh, L, sp, x.i, t, vis, shadows, c, rc);
-        if (v) acc.add(DVec3(t.value) / double(x.pdf));
+        if (v) acc.add(near + DVec3(t.value) / double(x.pdf));
+        else if (hasNear) acc.add(near);
         else acc.addZero();
         if constexpr (Traced)
             acc.trace->samples.push_back({x.i, x.pdf, term ? t.value : Vec3(0.0f), v,
@@ -178,6 +195,8 @@ struct GroupPixel {
     PixelSums sums;
     RayCounters rays;       ///< counting mode: its shadow rays' traversal
     LightSample xs[LightingPlan::kChunkSamples];  ///< a chunk's lights (chunkSamples() <= kChunkSamples)
+    NearField field;        ///< split: the near lights
+    DVec3 near{0.0};        ///< split: their exact sum
 };
 
 /// Pixels shaded together: up to this many of a tile row.
@@ -216,15 +235,15 @@ void runChunk(const LightingInputs& in, const LightArrays& L, const VisibilityOp
         for (std::uint32_t k = 0; k < n; ++k) {
             if (pix[k].sums.done) continue;
             Rng rng = stream(pix[k]);
-            drawLights<K>(in, L, pix[k].sp, rng, count, pix[k].xs);
+            drawLights<K>(in, L, pix[k].sp, pix[k].field, rng, count, pix[k].xs);
         }
         for (std::uint32_t k = 0; k < n; ++k) {
             GroupPixel& p = pix[k];
             if (p.sums.done) continue;
             if (p.sums.trace) [[unlikely]]  // render --pixel
-                shadeSamples<M, P, true>(in.bvh, L, p.sp, p.xs, count, vis, shadows, p.sums, Count ? &p.rays : nullptr);
+                shadeSamples<M, P, true>(in.bvh, L, p.sp, p.xs, count, p.near, vis, shadows, p.sums, Count ? &p.rays : nullptr);
             else
-                shadeSamples<M, P>(in.bvh, L, p.sp, p.xs, count, vis, shadows, p.sums, Count ? &p.rays : nullptr);
+                shadeSamples<M, P>(in.bvh, L, p.sp, p.xs, count, p.near, vis, shadows, p.sums, Count ? &p.rays : nullptr);
         }
     }
 }
@@ -248,6 +267,50 @@ void runChunks(const LightingInputs& in, const LightArrays& L, const LightingPla
     }
 }
 
+/// split: each pixel's near field (its lights) and the exact sum of its
+/// terms, found in the frame's first sweep that reaches the pixel and kept
+/// for its later sweeps (a chunk's samples each add the sum). Both are
+/// deterministic, so a restart that finds them again gets the same image.
+/// The lights are kept only while they take at most kMaxLightBytes (beyond,
+/// every sweep searches them again).
+struct NearCache {
+    static constexpr std::size_t kMaxLightBytes = std::size_t(256) << 20;
+    std::uint32_t stride = 0;              ///< lights kept per pixel (0: none kept)
+    std::vector<DVec3> sum;
+    std::vector<std::uint16_t> count;      ///< lights kept, +1 (0: not yet found)
+    std::vector<std::uint32_t> lights;
+    NearCache(std::size_t pixels, std::uint32_t nearLights) : sum(pixels), count(pixels, 0) {
+        const std::uint32_t perPixel = std::min(nearLights, NearField::kMaxNear) + 1;  // and the receiver's own
+        if (pixels * perPixel * sizeof(std::uint32_t) <= kMaxLightBytes) {
+            stride = perPixel;
+            lights.resize(pixels * perPixel);
+        }
+    }
+};
+
+/// split: the receiver's near field and the exact sum of its terms (from
+/// the cache when an earlier sweep found them).
+template <ShadingModel M, Primitive P, bool Count>
+void prepareNearField(const LightingInputs& in, const LightArrays& L, const VisibilityOptions& vis, bool shadows,
+                      NearCache* cache, GroupPixel& p) {
+    if (cache && cache->count[p.px]) {
+        p.near = cache->sum[p.px];
+        if (cache->stride) in.lightTree->nearField(p.sp, &cache->lights[p.px * cache->stride], cache->count[p.px] - 1u, p.field);
+        else in.lightTree->nearest(p.sp, nearLightCount(in.render), p.field);
+        return;
+    }
+    in.lightTree->nearest(p.sp, nearLightCount(in.render), p.field);
+    const std::span<const std::uint32_t> lights(p.field.light, p.field.count);
+    RayCounters* rc = Count ? &p.rays : nullptr;
+    p.near = p.sums.trace ? sumTerms<M, P, true>(in.bvh, L, p.sp, lights, vis, shadows, p.sums.c, rc, p.sums.trace)
+                          : sumTerms<M, P>(in.bvh, L, p.sp, lights, vis, shadows, p.sums.c, rc);
+    if (cache) {
+        cache->sum[p.px] = p.near;
+        cache->count[p.px] = static_cast<std::uint16_t>(p.field.count + 1);
+        if (cache->stride) std::copy(p.field.light, p.field.light + p.field.count, &cache->lights[p.px * cache->stride]);
+    }
+}
+
 /// Runs chunks [c0, c1) over every pixel in one parallel sweep, each pixel's
 /// sums in registers: loaded from and stored to `acc`, or (acc null: the
 /// whole frame in one sweep) resolved straight into `out`. Pixels run in
@@ -256,7 +319,7 @@ void runChunks(const LightingInputs& in, const LightArrays& L, const LightingPla
 /// counts, and bytes.
 template <ShadingModel M, Primitive P, bool Count>
 LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const LightingPlan& plan, Accumulation* acc,
-                       LightingImage* out, std::uint64_t c0, std::uint64_t c1, Progress* progress) {
+                       LightingImage* out, std::uint64_t c0, std::uint64_t c1, Progress* progress, NearCache* nearCache) {
     const GBuffer& gb = in.gbuffer;
     const VisibilityOptions vis = VisibilityOptions::from(in.render);
     const EstimatorKind kind = in.render.estimator;
@@ -337,6 +400,10 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
                     runChunks<M, P, Count, EstimatorKind::power>(in, L, plan, vis, shadows, c0, c1, pix, n);
                 } else if (kind == EstimatorKind::tree) {
                     runChunks<M, P, Count, EstimatorKind::tree>(in, L, plan, vis, shadows, c0, c1, pix, n);
+                } else if (kind == EstimatorKind::split) {
+                    for (std::uint32_t k = 0; k < n; ++k)
+                        if (!pix[k].sums.done) prepareNearField<M, P, Count>(in, L, vis, shadows, nearCache, pix[k]);
+                    runChunks<M, P, Count, EstimatorKind::split>(in, L, plan, vis, shadows, c0, c1, pix, n);
                 } else {
                     runChunks<M, P, Count, EstimatorKind::uniform>(in, L, plan, vis, shadows, c0, c1, pix, n);
                 }
@@ -365,15 +432,18 @@ template <ShadingModel M, Primitive P, bool Count>
 LightingCounters run(const LightingInputs& in, const LightArrays& L, const LightingPlan& plan, Accumulation& acc,
                      const ChunkHook& afterChunk, Progress* progress) {
     LightingCounters total;
+    std::optional<NearCache> near;
+    if (in.render.estimator == EstimatorKind::split) near.emplace(acc.pixels(), nearLightCount(in.render));
+    NearCache* cache = near ? &*near : nullptr;
     if (Count) {
-        total += sweep<M, P, Count>(in, L, plan, &acc, nullptr, acc.nextChunk, plan.end, progress);
+        total += sweep<M, P, Count>(in, L, plan, &acc, nullptr, acc.nextChunk, plan.end, progress, cache);
         acc.nextChunk = plan.end;
         if (afterChunk) afterChunk(acc);
         return total;
     }
     while (acc.nextChunk < plan.end) {
         const std::uint64_t c = acc.nextChunk;
-        total += sweep<M, P, Count>(in, L, plan, &acc, nullptr, c, c + 1, progress);
+        total += sweep<M, P, Count>(in, L, plan, &acc, nullptr, c, c + 1, progress, cache);
         acc.nextChunk = c + 1;
         // Adaptive: stop when every pixel is done at the end of a round.
         if (plan.adaptive && acc.nextChunk % plan.chunksPerRound == 0) {
@@ -400,6 +470,11 @@ LightingCounters dispatchPrimitive(const LightingInputs& in, const LightArrays& 
 
 }  // namespace
 
+std::uint32_t nearLightCount(const RenderSettings& render) {
+    constexpr std::uint32_t kAutomatic = 16;
+    return render.near_lights > 0 ? render.near_lights : kAutomatic;
+}
+
 LightingCounters accumulateLighting(const LightingInputs& in, const LightingPlan& plan, Accumulation& acc,
                                     const ChunkHook& afterChunk, Progress* progress) {
     ACC_CHECK(acc.width == in.gbuffer.width && acc.height == in.gbuffer.height);
@@ -407,7 +482,7 @@ LightingCounters accumulateLighting(const LightingInputs& in, const LightingPlan
     ACC_CHECK(in.render.estimator != EstimatorKind::power || in.powerTable);
     // ris draws its candidates in proportion to power exactly when given the table: it must be the configured source.
     ACC_CHECK(in.render.estimator != EstimatorKind::ris || (in.render.source == LightSource::power) == (in.powerTable != nullptr));
-    ACC_CHECK(in.render.estimator != EstimatorKind::tree || in.lightTree);
+    ACC_CHECK((in.render.estimator != EstimatorKind::tree && in.render.estimator != EstimatorKind::split) || in.lightTree);
     ACC_CHECK(in.render.estimator != EstimatorKind::ris || in.render.source != LightSource::tree || in.lightTree);
     ACC_CHECK(in.render.estimator != EstimatorKind::restir);
     const LightArrays L(in.particles, in.shading);
@@ -446,10 +521,10 @@ LightingCounters directPrimitive(const LightingInputs& in, const LightArrays& L,
     const bool spheres = in.bvh.settings().primitive == Primitive::sphere;
     const std::uint64_t c0 = plan.begin, c1 = plan.end;
     if (in.counters)
-        return spheres ? sweep<M, Primitive::sphere, true>(in, L, plan, nullptr, &out, c0, c1, p)
-                       : sweep<M, Primitive::billboard, true>(in, L, plan, nullptr, &out, c0, c1, p);
-    return spheres ? sweep<M, Primitive::sphere, false>(in, L, plan, nullptr, &out, c0, c1, p)
-                   : sweep<M, Primitive::billboard, false>(in, L, plan, nullptr, &out, c0, c1, p);
+        return spheres ? sweep<M, Primitive::sphere, true>(in, L, plan, nullptr, &out, c0, c1, p, nullptr)
+                       : sweep<M, Primitive::billboard, true>(in, L, plan, nullptr, &out, c0, c1, p, nullptr);
+    return spheres ? sweep<M, Primitive::sphere, false>(in, L, plan, nullptr, &out, c0, c1, p, nullptr)
+                   : sweep<M, Primitive::billboard, false>(in, L, plan, nullptr, &out, c0, c1, p, nullptr);
 }
 
 LightingCounters estimateLighting(const LightingInputs& in, LightingImage& out, Progress* progress) {
@@ -464,7 +539,7 @@ LightingCounters estimateLighting(const LightingInputs& in, LightingImage& out, 
     ACC_CHECK(in.render.estimator != EstimatorKind::power || in.powerTable);
     // ris draws its candidates in proportion to power exactly when given the table: it must be the configured source.
     ACC_CHECK(in.render.estimator != EstimatorKind::ris || (in.render.source == LightSource::power) == (in.powerTable != nullptr));
-    ACC_CHECK(in.render.estimator != EstimatorKind::tree || in.lightTree);
+    ACC_CHECK((in.render.estimator != EstimatorKind::tree && in.render.estimator != EstimatorKind::split) || in.lightTree);
     ACC_CHECK(in.render.estimator != EstimatorKind::ris || in.render.source != LightSource::tree || in.lightTree);
     ACC_CHECK(in.render.estimator != EstimatorKind::restir);
     allocate(out, pixels);

@@ -29,7 +29,7 @@ void planPasses(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
     plan.loadParticles = plan.buildClusters = !(plan.staticGeometry && facts.geometryBuilt);
     plan.lighting = facts.emissive && glm::length(s.shading.albedo) > 0.0f;
     plan.shadowRays = plan.lighting && s.shading.visibility;
-    if (plan.lighting && (est == EstimatorKind::tree || (resampling && s.render.source == LightSource::tree)))
+    if (plan.lighting && (est == EstimatorKind::tree || est == EstimatorKind::split || (resampling && s.render.source == LightSource::tree)))
         plan.sampler = LightSamplerKind::tree;
     if (plan.lighting && (est == EstimatorKind::power || (resampling && s.render.source == LightSource::power)))
         plan.sampler = LightSamplerKind::power;

@@ -100,6 +100,16 @@ TEST_CASE("every light sampler draws in proportion to its pdf (one chi-square ha
     checkSampler({"candidates: tree", [&](Rng& rng) { return sampleCandidate<LightSource::tree>(L, &power, &tree, sp, rng); },
                   [&](std::uint32_t i) { return candidatePdf<LightSource::tree>(L, &power, &tree, sp, i); }},
                  N, lit);
+    // split: the far lights, drawn with the 20 nearest taken out of the tree
+    // (a near light drawn would report a pdf that pdfFar gives as 0: a mismatch).
+    NearField near;
+    tree.nearest(sp, 20, near);
+    REQUIRE(near.count == 21);  // and the receiver's own
+    std::vector<bool> litFar = lit;
+    for (std::uint32_t k = 0; k < near.count; ++k) litFar[near.light[k]] = false;
+    checkSampler({"split: far lights", [&](Rng& rng) { return tree.sampleFar(sp, near, rng); },
+                  [&](std::uint32_t i) { return tree.pdfFar(sp, near, i); }},
+                 N, litFar);
 }
 
 TEST_CASE("SourcePmf (the GPU twin's sampler) with PortableRng draws sampleSource's lights and pdfs", "[lighting][sampler]") {

@@ -12,8 +12,8 @@ inline constexpr std::uint32_t kParticleRecord = 32;
 inline constexpr std::uint32_t kRadiance = 8;
 /// Alias-table entry (probability + alias) read per power-sampled candidate.
 inline constexpr std::uint32_t kAliasEntry = 8;
-/// A light-tree node (centre, radius, power, clamp, child, count): read twice per level of a tree traversal.
-inline constexpr std::uint32_t kLightTreeNode = 32;
+/// A light-tree node (centre, radius, power, clamp, child, count, box): read twice per level of a tree traversal.
+inline constexpr std::uint32_t kLightTreeNode = 56;
 /// Ray payloads of the pipeline (TraceRay) form: primary hit (t, instance,
 /// primitive, barycentrics) and shadow visibility.
 inline constexpr std::uint32_t kPrimaryPayload = 16;

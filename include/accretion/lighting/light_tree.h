@@ -5,6 +5,7 @@
 #include "accretion/core/math.h"
 #include "accretion/core/rng.h"
 #include "accretion/lighting/light_sample.h"
+#include "accretion/lighting/near_field.h"
 #include "accretion/particles/particles.h"
 #include "accretion/lighting/shading.h"
 #include "accretion/scene/settings.h"
@@ -29,6 +30,20 @@ public:
     /// Probability that sample() returns light i at this receiver.
     float pdf(const ShadingPoint& sp, std::uint32_t i) const;
 
+    /// The `split` estimator's near field: the min(k, N - 1) lights nearest
+    /// to the receiver other than its own particle (best-first on the
+    /// nodes' spheres), in tree order with their powers.
+    void nearest(const ShadingPoint& sp, std::uint32_t k, NearField& out) const;
+    /// The near field of these lights (nearest()'s out.light, in any order:
+    /// what a cache keeps of it).
+    void nearField(const ShadingPoint& sp, const std::uint32_t* lights, std::uint32_t count, NearField& out) const;
+    /// Draw a far light (not in `near`): sample()'s descent with each node's
+    /// power less the power of its near lights (a node of near lights only
+    /// has none), so the pdf is renormalised over the far lights exactly.
+    LightSample sampleFar(const ShadingPoint& sp, const NearField& near, Rng& rng) const;
+    /// Probability that sampleFar() returns light i (0 for a near light).
+    float pdfFar(const ShadingPoint& sp, const NearField& near, std::uint32_t i) const;
+
     std::size_t nodeCount() const { return nodes_.size(); }
     std::uint32_t depth() const { return depth_; }
     std::size_t bytes() const { return nodes_.size() * sizeof(Node) + trail_.size() * sizeof(Trail); }
@@ -40,16 +55,26 @@ private:
         float power;          ///< sum of luminance(I) below
         float dmin2;          ///< leaf: the light's squared distance clamp
         std::uint32_t child;  ///< interior: left child (right = child + 1); leaf: light index
-        std::uint32_t leaf;   ///< 1 for a leaf
+        std::uint32_t count;  ///< lights below (1: a leaf)
+        Vec3 lo, hi;          ///< box of the positions below (a leaf: its position)
     };
     struct Trail {
         std::uint64_t bits;   ///< bit k: went right at depth k
         std::uint32_t depth;
+        std::uint32_t leaf;   ///< its leaf node
     };
 
     void build(std::uint32_t node, std::vector<std::uint32_t>& ids, std::uint32_t begin, std::uint32_t end,
                const Particles& particles, std::uint64_t bits, std::uint32_t depth);
-    float importance(const Node& node, const ShadingPoint& sp) const;
+    /// The node's bound of the terms below it with `power` in place of its
+    /// own, every light below being at least sqrt(minDist2) away (split: the
+    /// far lights lie beyond the near field's farthest).
+    float importance(const Node& node, float power, const ShadingPoint& sp, float minDist2 = 0.0f) const;
+    float importance(const Node& node, const ShadingPoint& sp) const { return importance(node, node.power, sp); }
+    /// The power of a node's far lights (`nearCount` of its lights are near, with `nearPower`).
+    static float farPower(const Node& node, std::uint32_t nearCount, double nearPower);
+    /// A light's path from the root as a tree-order key (the first step in bit 63).
+    static std::uint64_t pathKey(const Trail& t);
 
     std::vector<Node> nodes_;
     std::vector<Trail> trail_;  ///< per light: path from the root

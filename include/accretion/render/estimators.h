@@ -75,9 +75,15 @@ LightingCounters accumulateLighting(const LightingInputs& in, const LightingPlan
 /// A value that is not finite in float is zeroed and counted in `rejected`.
 void resolveLighting(const Accumulation& acc, bool exact, LightingImage& out, std::uint64_t* nonFinite = nullptr);
 
+/// The lights summed exactly per receiver by `split`: render.near_lights,
+/// or when 0 the automatic choice (docs/MODEL.md section 4).
+std::uint32_t nearLightCount(const RenderSettings& render);
+
 /// estimateLighting (docs/MODEL.md sections 3-4): `exact` sums every light i != j
 /// with one shadow ray each; `uniform` / `power` / `tree` average one-sample
 /// estimates f I G V / p(i) (S per round, more rounds until target_stderr);
+/// `split` adds to each sample the exact sum over the receiver's nearest
+/// lights and draws the one light from the rest (LightTree::sampleFar);
 /// `ris` averages S one-reservoir RIS estimates of M candidates each. Monte
 /// Carlo estimators also give their standard error. (`restir` keeps history
 /// across frames: see lighting/restir.h.)

@@ -39,7 +39,7 @@ enum class Orientation { view_plane, view_point, velocity };
 enum class AlphaMode { opaque, disc };
 enum class BuildPolicy { rebuild, refit, fast_trace, partial };
 enum class ShadingModel { lambert, sphere, isotropic };
-enum class EstimatorKind { exact, uniform, power, ris, restir, tree };
+enum class EstimatorKind { exact, uniform, power, ris, restir, tree, split };
 enum class BiasCorrection { none, basic, pairwise };
 enum class ReservoirLayout { full, packed };
 enum class LightSource { uniform, power, tree };
@@ -57,7 +57,7 @@ ACC_ENUM_NAMES(Orientation, "view_plane", "view_point", "velocity");
 ACC_ENUM_NAMES(AlphaMode, "opaque", "disc");
 ACC_ENUM_NAMES(BuildPolicy, "rebuild", "refit", "fast_trace", "partial");
 ACC_ENUM_NAMES(ShadingModel, "lambert", "sphere", "isotropic");
-ACC_ENUM_NAMES(EstimatorKind, "exact", "uniform", "power", "ris", "restir", "tree");
+ACC_ENUM_NAMES(EstimatorKind, "exact", "uniform", "power", "ris", "restir", "tree", "split");
 ACC_ENUM_NAMES(BiasCorrection, "none", "basic", "pairwise");
 ACC_ENUM_NAMES(ReservoirLayout, "full", "packed");
 ACC_ENUM_NAMES(LightSource, "uniform", "power", "tree");
@@ -213,7 +213,8 @@ struct RenderSettings {
     std::uint32_t samples = 16;                  ///< light samples per pixel (Monte Carlo estimators)
     std::uint32_t candidates = 16;               ///< ris, restir: candidates M per reservoir (the GPU pipeline's: 16)
     LightSource source = LightSource::uniform;   ///< ris, restir: source pdf of the candidates (uniform, power, or the light tree at the receiver)
-    double target_stderr = 0.0;                  ///< tree, uniform, power: relative standard error to reach per pixel (0: fixed samples)
+    double target_stderr = 0.0;                  ///< tree, split, uniform, power: relative standard error to reach per pixel (0: fixed samples)
+    std::uint32_t near_lights = 0;               ///< split: lights summed exactly per receiver, its nearest (0: automatic)
     std::uint32_t max_samples = 65536;           ///< cap of the adaptive sampling of target_stderr
     std::uint64_t seed = 0;                      ///< render seed
     std::string output = "out/{scene}.{frame}.exr"; ///< EXR path, {scene} and {frame} patterns
@@ -236,7 +237,8 @@ struct RenderSettings {
         v.field("samples", samples, "light samples per pixel (uniform, power; ris: reservoirs)", Range{1, 1e7});
         v.field("candidates", candidates, "ris, restir: candidates M per reservoir", Range{1, 1e6});
         v.field("source", source, "ris, restir: source pdf of the candidates");
-        v.field("target_stderr", target_stderr, "tree, uniform, power: per-pixel relative standard error to reach, adding `samples` per round (0: off)", Range{0.0, 1.0});
+        v.field("near_lights", near_lights, "split: the k nearest lights of each receiver are summed exactly, the rest sampled from the light tree without them (0: automatic, see docs/MODEL.md section 4)", Range{0, 256});
+        v.field("target_stderr", target_stderr, "tree, split, uniform, power: per-pixel relative standard error to reach, adding `samples` per round (0: off)", Range{0.0, 1.0});
         v.field("max_samples", max_samples, "cap on samples per pixel when target_stderr is set", Range{1, 1e9});
         v.field("seed", seed, "render seed");
         v.field("output", output, "EXR output path; {scene} and {frame} are replaced");

@@ -1,0 +1,36 @@
+#pragma once
+#include <cstdint>
+
+namespace accretion {
+
+/// The near field of one receiver for the `split` estimator (docs/MODEL.md
+/// section 4): its k nearest lights other than its own particle, found on the
+/// light tree (LightTree::nearest), whose terms are summed exactly, and the
+/// receiver's own particle (i = j: no term). The far field is every other
+/// light, sampled from the light tree with these lights' power taken out of
+/// each node above them (LightTree::sampleFar, LightTree::pdfFar), so that
+/// the far pdf is exact and sums to one over the far lights, and no draw
+/// is spent on the receiver's own particle.
+///
+/// The lights are kept in the tree's left-to-right order (`key`: a light's
+/// path from the root, first step most significant), so that the near
+/// lights below any node are one contiguous run, and `power` holds the
+/// prefix sums of their powers: a node's near power is one subtraction.
+struct NearField {
+    static constexpr std::uint32_t kMaxNear = 256;  ///< most nearest lights (render.near_lights)
+    static constexpr std::uint32_t kMaxLights = kMaxNear + 1;
+    std::uint32_t count = 0;             ///< the nearest and the receiver's own particle
+    float radius2 = 0.0f;                ///< squared distance of the farthest: every far light is as far or farther
+    std::uint32_t light[kMaxLights];     ///< light indices, in tree order
+    std::uint64_t key[kMaxLights];       ///< their paths from the root, first step in bit 63
+    double power[kMaxLights + 1];        ///< power[k]: summed luminance(I) of the first k
+
+    /// Whether light i is in the near field (a scan: k is small).
+    bool contains(std::uint32_t i) const {
+        for (std::uint32_t k = 0; k < count; ++k)
+            if (light[k] == i) return true;
+        return false;
+    }
+};
+
+}  // namespace accretion

@@ -1,0 +1,183 @@
+// The light tree's near/far split (lighting/near_field.h): the k nearest
+// lights of a receiver, and the far lights drawn with them taken out.
+#include <algorithm>
+#include <utility>
+
+#include "accretion/core/error.h"
+#include "accretion/lighting/light_tree.h"
+
+namespace accretion {
+
+std::uint64_t LightTree::pathKey(const Trail& t) {
+    std::uint64_t key = 0;
+    for (std::uint32_t k = 0; k < t.depth; ++k) key |= ((t.bits >> k) & 1u) << (63 - k);
+    return key;
+}
+
+float LightTree::farPower(const Node& node, std::uint32_t nearCount, double nearPower) {
+    if (nearCount == 0) return node.power;
+    if (nearCount >= node.count) return 0.0f;
+    // Some light below is far: keep the node reachable even where float
+    // cancellation (a bright near light beside faint far ones) leaves nothing.
+    return std::max(static_cast<float>(double(node.power) - nearPower), node.power * 1e-6f);
+}
+
+void LightTree::nearest(const ShadingPoint& sp, std::uint32_t k, NearField& out) const {
+    constexpr std::uint32_t kNoSeed = 0xffffffffu;
+    out.count = 0;
+    out.power[0] = 0.0;
+    k = std::min(k, NearField::kMaxNear);
+    if (nodes_.empty()) return;
+    // The best so far as a max-heap on squared distance (ties: the larger
+    // index is dropped first).
+    struct Found {
+        float d2;
+        std::uint32_t light;
+        bool operator<(const Found& o) const { return d2 < o.d2 || (d2 == o.d2 && light < o.light); }
+    };
+    Found best[NearField::kMaxLights];
+    std::uint32_t found = 0;
+    // Depth-first, the nearer child first, pruned by the k-th distance.
+    struct Pending {
+        std::uint32_t node;
+        float bound;  ///< squared distance from x to the node's sphere
+    };
+    Pending stack[2 * 64 + 2];
+    std::uint32_t top = 0;
+    const auto sphereBound = [&](const Node& n) {
+        const float d = glm::length(n.center - sp.x) - n.radius;
+        return d > 0.0f ? d * d : 0.0f;
+    };
+    // One pruned depth-first search below `root`, skipping the subtree `skip`.
+    const auto search = [&](std::uint32_t root, std::uint32_t skip) {
+        top = 0;
+        stack[top++] = {root, sphereBound(nodes_[root])};
+        while (top > 0) {
+            const Pending p = stack[--top];
+            if (p.node == skip || (found == k && !(p.bound <= best[0].d2))) continue;
+            const Node& n = nodes_[p.node];
+            if (n.count == 1) {
+                if (n.child == sp.self) continue;
+                const Vec3 delta = n.center - sp.x;
+                const Found f{glm::dot(delta, delta), n.child};
+                if (found < k) {
+                    best[found++] = f;
+                    std::push_heap(best, best + found);
+                } else if (f < best[0]) {
+                    std::pop_heap(best, best + found);
+                    best[found - 1] = f;
+                    std::push_heap(best, best + found);
+                }
+                continue;
+            }
+            const Pending a{n.child, sphereBound(nodes_[n.child])}, b{n.child + 1, sphereBound(nodes_[n.child + 1])};
+            // Pushed far first, so the near one is popped first.
+            ACC_CHECK(top + 2 <= std::size(stack));
+            stack[top++] = a.bound <= b.bound ? b : a;
+            stack[top++] = a.bound <= b.bound ? a : b;
+        }
+    };
+    // First the smallest subtree on the receiver's path that holds k others
+    // (the tree's neighbours are spatial ones), so that the search from the
+    // root starts with a tight k-th distance and skips that subtree.
+    std::uint32_t seed = 0;
+    if (k > 0 && sp.self < trail_.size()) {
+        const Trail t = trail_[sp.self];
+        for (std::uint32_t d = 0; d < t.depth; ++d) {
+            const std::uint32_t next = nodes_[seed].child + ((t.bits >> d) & 1u);
+            if (nodes_[next].count <= k) break;
+            seed = next;
+        }
+    }
+    if (k > 0) {
+        search(seed, kNoSeed);
+        if (seed != 0) search(0, seed);
+    }
+    // The receiver's own particle joins them: it gives no term, and the far
+    // sampler must not spend draws on it.
+    std::uint32_t lights[NearField::kMaxLights];
+    for (std::uint32_t j = 0; j < found; ++j) lights[j] = best[j].light;
+    if (sp.self < trail_.size()) lights[found++] = sp.self;
+    nearField(sp, lights, found, out);
+}
+
+void LightTree::nearField(const ShadingPoint& sp, const std::uint32_t* lights, std::uint32_t count, NearField& out) const {
+    ACC_CHECK(count <= NearField::kMaxLights);
+    // Tree order, with the prefix sums of the powers.
+    std::pair<std::uint64_t, std::uint32_t> order[NearField::kMaxLights];
+    for (std::uint32_t j = 0; j < count; ++j) order[j] = {pathKey(trail_[lights[j]]), lights[j]};
+    std::sort(order, order + count);
+    out.count = count;
+    out.power[0] = 0.0;
+    out.radius2 = 0.0f;
+    for (std::uint32_t j = 0; j < count; ++j) {
+        const Node& leaf = nodes_[trail_[order[j].second].leaf];
+        out.light[j] = order[j].second;
+        out.key[j] = order[j].first;
+        out.power[j + 1] = out.power[j] + double(leaf.power);
+        const Vec3 delta = leaf.center - sp.x;
+        out.radius2 = std::max(out.radius2, glm::dot(delta, delta));
+    }
+}
+
+namespace {
+
+/// The first of the near lights [lo, hi) (one node's, in tree order) that
+/// lies right of the node's split at `depth`.
+std::uint32_t splitNear(const NearField& near, std::uint32_t lo, std::uint32_t hi, std::uint32_t depth) {
+    const std::uint64_t bit = std::uint64_t(1) << (63 - depth);
+    while (lo < hi && !(near.key[lo] & bit)) ++lo;
+    return lo;
+}
+
+}  // namespace
+
+LightSample LightTree::sampleFar(const ShadingPoint& sp, const NearField& near, Rng& rng) const {
+    if (nodes_.empty() || near.count >= nodes_[0].count) return {kNoLightSample, 0.0f};
+    std::uint32_t n = 0, lo = 0, hi = near.count, depth = 0;
+    float pdf = 1.0f;
+    while (nodes_[n].count > 1) {
+        const std::uint32_t c = nodes_[n].child;
+        const std::uint32_t mid = splitNear(near, lo, hi, depth);
+        const float a = importance(nodes_[c], farPower(nodes_[c], mid - lo, near.power[mid] - near.power[lo]), sp, near.radius2);
+        const float b = importance(nodes_[c + 1], farPower(nodes_[c + 1], hi - mid, near.power[hi] - near.power[mid]), sp, near.radius2);
+        const float u = rng.uniform();
+        if (!(a + b > 0.0f)) return {kNoLightSample, 0.0f};
+        const float pa = a / (a + b);
+        if (u < pa) {
+            n = c;
+            hi = mid;
+            pdf *= pa;
+        } else {
+            n = c + 1;
+            lo = mid;
+            pdf *= 1.0f - pa;
+        }
+        ++depth;
+    }
+    if (!(pdf > 0.0f)) return {kNoLightSample, 0.0f};
+    return {nodes_[n].child, pdf};
+}
+
+float LightTree::pdfFar(const ShadingPoint& sp, const NearField& near, std::uint32_t i) const {
+    if (i >= trail_.size() || near.contains(i)) return 0.0f;
+    const Trail t = trail_[i];
+    std::uint32_t n = 0, lo = 0, hi = near.count;
+    float pdf = 1.0f;
+    for (std::uint32_t k = 0; k < t.depth; ++k) {
+        const std::uint32_t c = nodes_[n].child;
+        const std::uint32_t mid = splitNear(near, lo, hi, k);
+        const float a = importance(nodes_[c], farPower(nodes_[c], mid - lo, near.power[mid] - near.power[lo]), sp, near.radius2);
+        const float b = importance(nodes_[c + 1], farPower(nodes_[c + 1], hi - mid, near.power[hi] - near.power[mid]), sp, near.radius2);
+        if (!(a + b > 0.0f)) return 0.0f;
+        const bool right = (t.bits >> k) & 1u;
+        const float pa = a / (a + b);
+        pdf *= right ? 1.0f - pa : pa;
+        n = right ? c + 1 : c;
+        if (right) lo = mid;
+        else hi = mid;
+    }
+    return pdf;
+}
+
+}  // namespace accretion
