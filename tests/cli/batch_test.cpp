@@ -8,15 +8,15 @@
 
 #include <nlohmann/json.hpp>
 
+#include "support/cli.h"
 #include "support/test_scenes.h"
 
 namespace fs = std::filesystem;
 using Catch::Matchers::Contains;
+using accretion::test::kBin;
 using accretion::test::runCommand;
 
 namespace {
-
-const std::string kBin = ACCRETION_BINARY;
 
 nlohmann::json readJson(const fs::path& file) { return nlohmann::json::parse(accretion::test::readFile(file)); }
 
