@@ -600,8 +600,8 @@ void Suite::benchSplitReference() {
         const ParticleSource src(base);
         Settings ref = base;
         ref.render.estimator = EstimatorKind::split;
-        ref.render.near_lights = 64;
-        ref.render.samples = quick ? 256 : 2048;
+        ref.render.near_lights = 256;
+        ref.render.samples = quick ? 128 : 1024;
         ref.render.seed = 1000;
         FrameRenderer refRenderer(ref, src, RenderOptions{true});
         FrameStats refStats;
@@ -609,6 +609,7 @@ void Suite::benchSplitReference() {
         Settings tree = base, split = base;
         tree.render.estimator = EstimatorKind::tree;
         split.render.estimator = EstimatorKind::split;
+        split.render.near_lights = 256;  // the automatic k at 32 spp, fixed so that the cost is a + b S
         const auto c = measureErrorCosts({tree, split}, src, 8, 32, reference, quick ? 1 : 3);
         const ErrorCost& t = c[0];
         const ErrorCost& sp = c[1];
@@ -616,7 +617,7 @@ void Suite::benchSplitReference() {
             {"reference", {{"estimator", "split"}, {"near_lights", ref.render.near_lights}, {"samples", ref.render.samples},
                            {"seconds", refStats.seconds},
                            {"relMSE_floor", computeErrors(reference.lighting.Lr, reference.lighting.Lr, &reference.lighting.Lr_stderr).relMSEFloor}}},
-            {"near_lights", nearLightCount(split.render)},
+            {"near_lights", split.render.near_lights},
             {"tree", t.json(kTarget)},
             {"split", sp.json(kTarget)},
             {"tree_s_to_1e-2", t.secondsTo(1e-2)},
@@ -635,6 +636,7 @@ void Suite::benchSplitReference() {
         const auto ex = renderInterleaved({exact}, src, quick ? 1 : 3);
         Settings split = base;
         split.render.estimator = EstimatorKind::split;
+        split.render.near_lights = 256;
         const ErrorCost sp = measureErrorCosts({split}, src, 8, 32, ex[0].first, quick ? 1 : 3)[0];
         figures["split_vs_exact_10k_320x180"] = {{"exact_s", ex[0].second}, {"split", sp.json(kTarget)},
                                                  {"split_s_to_1e-4", sp.secondsTo(1e-4)}};

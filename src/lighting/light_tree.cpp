@@ -99,14 +99,35 @@ float LightTree::importance(const Node& node, float power, const ShadingPoint& s
     return power * cosBound / std::max(std::max(d2, r2), minDist2);
 }
 
+float LightTree::descentImportance(std::uint32_t n, float power, const ShadingPoint& sp, float minDist2,
+                                   const std::uint32_t* excluded, std::uint32_t excludedCount) const {
+    const Node& node = nodes_[n];
+    if (node.count == 1 || node.count > kExactBelow) return importance(node, power, sp, minDist2);
+    if (!(power > 0.0f)) return 0.0f;
+    float sum = 0.0f;
+    std::uint32_t stack[2 * kExactBelow], top = 0;
+    stack[top++] = n;
+    while (top > 0) {
+        const Node& m = nodes_[stack[--top]];
+        if (m.count > 1) {
+            stack[top++] = m.child;
+            stack[top++] = m.child + 1;
+            continue;
+        }
+        if (std::find(excluded, excluded + excludedCount, m.child) != excluded + excludedCount) continue;
+        sum += importance(m, m.power, sp);
+    }
+    return sum;
+}
+
 LightSample LightTree::sample(const ShadingPoint& sp, Rng& rng) const {
     if (nodes_.empty()) return {kNoLightSample, 0.0f};
     std::uint32_t n = 0;
     float pdf = 1.0f;
     while (nodes_[n].count > 1) {
         const std::uint32_t c = nodes_[n].child;
-        const float a = importance(nodes_[c], sp);
-        const float b = importance(nodes_[c + 1], sp);
+        const float a = descentImportance(c, nodes_[c].power, sp);
+        const float b = descentImportance(c + 1, nodes_[c + 1].power, sp);
         const float u = rng.uniform();
         if (!(a + b > 0.0f)) return {kNoLightSample, 0.0f};
         const float pa = a / (a + b);
@@ -129,8 +150,8 @@ float LightTree::pdf(const ShadingPoint& sp, std::uint32_t i) const {
     float pdf = 1.0f;
     for (std::uint32_t k = 0; k < t.depth; ++k) {
         const std::uint32_t c = nodes_[n].child;
-        const float a = importance(nodes_[c], sp);
-        const float b = importance(nodes_[c + 1], sp);
+        const float a = descentImportance(c, nodes_[c].power, sp);
+        const float b = descentImportance(c + 1, nodes_[c + 1].power, sp);
         if (!(a + b > 0.0f)) return 0.0f;
         const bool right = (t.bits >> k) & 1u;
         const float pa = a / (a + b);

@@ -139,8 +139,10 @@ LightSample LightTree::sampleFar(const ShadingPoint& sp, const NearField& near, 
     while (nodes_[n].count > 1) {
         const std::uint32_t c = nodes_[n].child;
         const std::uint32_t mid = splitNear(near, lo, hi, depth);
-        const float a = importance(nodes_[c], farPower(nodes_[c], mid - lo, near.power[mid] - near.power[lo]), sp, near.radius2);
-        const float b = importance(nodes_[c + 1], farPower(nodes_[c + 1], hi - mid, near.power[hi] - near.power[mid]), sp, near.radius2);
+        const float a = descentImportance(c, farPower(nodes_[c], mid - lo, near.power[mid] - near.power[lo]), sp, near.radius2,
+                                          near.light + lo, mid - lo);
+        const float b = descentImportance(c + 1, farPower(nodes_[c + 1], hi - mid, near.power[hi] - near.power[mid]), sp,
+                                          near.radius2, near.light + mid, hi - mid);
         const float u = rng.uniform();
         if (!(a + b > 0.0f)) return {kNoLightSample, 0.0f};
         const float pa = a / (a + b);
@@ -167,8 +169,10 @@ float LightTree::pdfFar(const ShadingPoint& sp, const NearField& near, std::uint
     for (std::uint32_t k = 0; k < t.depth; ++k) {
         const std::uint32_t c = nodes_[n].child;
         const std::uint32_t mid = splitNear(near, lo, hi, k);
-        const float a = importance(nodes_[c], farPower(nodes_[c], mid - lo, near.power[mid] - near.power[lo]), sp, near.radius2);
-        const float b = importance(nodes_[c + 1], farPower(nodes_[c + 1], hi - mid, near.power[hi] - near.power[mid]), sp, near.radius2);
+        const float a = descentImportance(c, farPower(nodes_[c], mid - lo, near.power[mid] - near.power[lo]), sp, near.radius2,
+                                          near.light + lo, mid - lo);
+        const float b = descentImportance(c + 1, farPower(nodes_[c + 1], hi - mid, near.power[hi] - near.power[mid]), sp,
+                                          near.radius2, near.light + mid, hi - mid);
         if (!(a + b > 0.0f)) return 0.0f;
         const bool right = (t.bits >> k) & 1u;
         const float pa = a / (a + b);

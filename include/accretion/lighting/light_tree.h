@@ -70,7 +70,13 @@ private:
     /// own, every light below being at least sqrt(minDist2) away (split: the
     /// far lights lie beyond the near field's farthest).
     float importance(const Node& node, float power, const ShadingPoint& sp, float minDist2 = 0.0f) const;
-    float importance(const Node& node, const ShadingPoint& sp) const { return importance(node, node.power, sp); }
+    /// The importance a descent gives node n: importance() for a large node;
+    /// for a node of at most kExactBelow lights, the sum of its leaves' own
+    /// (the lights in `excluded` left out), so that a descent never ends
+    /// below it on lights that all have no term.
+    float descentImportance(std::uint32_t n, float power, const ShadingPoint& sp, float minDist2 = 0.0f,
+                            const std::uint32_t* excluded = nullptr, std::uint32_t excludedCount = 0) const;
+    static constexpr std::uint32_t kExactBelow = 8;
     /// The power of a node's far lights (`nearCount` of its lights are near, with `nearPower`).
     static float farPower(const Node& node, std::uint32_t nearCount, double nearPower);
     /// A light's path from the root as a tree-order key (the first step in bit 63).
