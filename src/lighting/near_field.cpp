@@ -132,6 +132,14 @@ std::uint32_t splitNear(const NearField& near, std::uint32_t lo, std::uint32_t h
 
 }  // namespace
 
+std::pair<float, float> LightTree::farChildren(std::uint32_t c, const NearField& near, std::uint32_t lo, std::uint32_t mid,
+                                               std::uint32_t hi, const ShadingPoint& sp) const {
+    return {descentImportance(c, farPower(nodes_[c], mid - lo, near.power[mid] - near.power[lo]), sp, near.radius2,
+                              near.light + lo, mid - lo),
+            descentImportance(c + 1, farPower(nodes_[c + 1], hi - mid, near.power[hi] - near.power[mid]), sp, near.radius2,
+                              near.light + mid, hi - mid)};
+}
+
 LightSample LightTree::sampleFar(const ShadingPoint& sp, const NearField& near, Rng& rng) const {
     if (nodes_.empty() || near.count >= nodes_[0].count) return {kNoLightSample, 0.0f};
     std::uint32_t n = 0, lo = 0, hi = near.count, depth = 0;
@@ -139,10 +147,7 @@ LightSample LightTree::sampleFar(const ShadingPoint& sp, const NearField& near, 
     while (nodes_[n].count > 1) {
         const std::uint32_t c = nodes_[n].child;
         const std::uint32_t mid = splitNear(near, lo, hi, depth);
-        const float a = descentImportance(c, farPower(nodes_[c], mid - lo, near.power[mid] - near.power[lo]), sp, near.radius2,
-                                          near.light + lo, mid - lo);
-        const float b = descentImportance(c + 1, farPower(nodes_[c + 1], hi - mid, near.power[hi] - near.power[mid]), sp,
-                                          near.radius2, near.light + mid, hi - mid);
+        const auto [a, b] = farChildren(c, near, lo, mid, hi, sp);
         const float u = rng.uniform();
         if (!(a + b > 0.0f)) return {kNoLightSample, 0.0f};
         const float pa = a / (a + b);
@@ -169,10 +174,7 @@ float LightTree::pdfFar(const ShadingPoint& sp, const NearField& near, std::uint
     for (std::uint32_t k = 0; k < t.depth; ++k) {
         const std::uint32_t c = nodes_[n].child;
         const std::uint32_t mid = splitNear(near, lo, hi, k);
-        const float a = descentImportance(c, farPower(nodes_[c], mid - lo, near.power[mid] - near.power[lo]), sp, near.radius2,
-                                          near.light + lo, mid - lo);
-        const float b = descentImportance(c + 1, farPower(nodes_[c + 1], hi - mid, near.power[hi] - near.power[mid]), sp,
-                                          near.radius2, near.light + mid, hi - mid);
+        const auto [a, b] = farChildren(c, near, lo, mid, hi, sp);
         if (!(a + b > 0.0f)) return 0.0f;
         const bool right = (t.bits >> k) & 1u;
         const float pa = a / (a + b);

@@ -1,5 +1,6 @@
 #pragma once
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "accretion/core/math.h"
@@ -77,6 +78,10 @@ private:
     float descentImportance(std::uint32_t n, float power, const ShadingPoint& sp, float minDist2 = 0.0f,
                             const std::uint32_t* excluded = nullptr, std::uint32_t excludedCount = 0) const;
     static constexpr std::uint32_t kExactBelow = 8;
+    /// The far importances of children c and c + 1, whose near lights are
+    /// near.light[lo, mid) and [mid, hi): one step of sampleFar / pdfFar.
+    std::pair<float, float> farChildren(std::uint32_t c, const NearField& near, std::uint32_t lo, std::uint32_t mid,
+                                        std::uint32_t hi, const ShadingPoint& sp) const;
     /// The power of a node's far lights (`nearCount` of its lights are near, with `nearPower`).
     static float farPower(const Node& node, std::uint32_t nearCount, double nearPower);
     /// A light's path from the root as a tree-order key (the first step in bit 63).
