@@ -39,7 +39,7 @@ std::vector<EstimatorSpec> parseEstimatorSpecs(const std::string& list, const st
             } else if (parseEnum(o, src)) {
                 spec.settings.push_back({"render.source", flag, [src](Settings& s) { s.render.source = src; }});
             } else {
-                fail(fmt::format("unknown option '{}' (none, basic, basic+vis, pairwise, uniform, power, tree or key=value)", o));
+                fail(fmt::format("unknown option '{}' (none, basic, basic+vis, pairwise, uniform, power, tree, tiles, regir or key=value)", o));
             }
         }
         specs.push_back(std::move(spec));

@@ -1,6 +1,7 @@
 #include "accretion/gpu/gpu_report.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include <fmt/format.h>
 
@@ -98,11 +99,16 @@ GpuReport makeGpuReport(const FrameCounters& counters, const Settings& settings,
     for (std::uint32_t n : accel.blasPrimitives) primitives += n;
     const std::uint64_t lights = settings.geometry.primitive == Primitive::billboard ? primitives / 2 : primitives;
     const LightSource source = settings.render.source;
-    const double lightBytes = double(lights) * (gpu_layout::kParticleRecord + (source == LightSource::power ? gpu_layout::kAliasEntry : 0u) +
-                                                (source == LightSource::tree ? 2u * gpu_layout::kLightTreeNode : 0u));
+    const RestirSettings& rs = settings.restir;
+    const bool presampled = source == LightSource::tiles || source == LightSource::regir;
+    const double lightBytes = double(lights) * (gpu_layout::kParticleRecord + (source == LightSource::power || presampled ? gpu_layout::kAliasEntry : 0u) +
+                                                (source == LightSource::tree ? 2u * gpu_layout::kLightTreeNode : 0u)) +
+                              // the tiles, and the grid's slots
+                              (presampled ? double(rs.tile_count) * rs.tile_size * gpu_layout::kRisEntry : 0.0) +
+                              (source == LightSource::regir ? std::pow(double(rs.regir_cells), 3.0) * rs.regir_lights_per_cell * gpu_layout::kRisEntry : 0.0);
     for (PassReport& p : r.passes) {
         if (p.rays > 0) p.workingSetBytes = double(r.blas.gpuBytes);
-        else if (p.pass == pass::generateCandidates || p.pass == pass::temporalResampling || passFamily(p.pass) == pass::spatialResampling)
+        else if (p.pass == pass::generateCandidates || p.pass == pass::presampleLightTiles || p.pass == pass::presampleRegirGrid || p.pass == pass::temporalResampling || passFamily(p.pass) == pass::spatialResampling)
             p.workingSetBytes = lightBytes;
     }
 

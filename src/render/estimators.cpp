@@ -230,6 +230,8 @@ void runChunk(const LightingInputs& in, const LightArrays& L, const VisibilityOp
             case LightSource::uniform: chunk.template operator()<LightSource::uniform>(p, rng, rc); break;
             case LightSource::power: chunk.template operator()<LightSource::power>(p, rng, rc); break;
             case LightSource::tree: chunk.template operator()<LightSource::tree>(p, rng, rc); break;
+            case LightSource::tiles:
+            case LightSource::regir: break;  // restir sources (refused for ris by the scene's validation)
             }
         }
     } else {
@@ -489,6 +491,7 @@ LightingCounters accumulateLighting(const LightingInputs& in, const LightingPlan
     ACC_CHECK(in.render.estimator != EstimatorKind::ris || (in.render.source == LightSource::power) == (in.powerTable != nullptr));
     ACC_CHECK((in.render.estimator != EstimatorKind::tree && in.render.estimator != EstimatorKind::split) || in.lightTree);
     ACC_CHECK(in.render.estimator != EstimatorKind::ris || in.render.source != LightSource::tree || in.lightTree);
+    ACC_CHECK(in.render.estimator != EstimatorKind::ris || (in.render.source != LightSource::tiles && in.render.source != LightSource::regir));
     ACC_CHECK(in.render.estimator != EstimatorKind::restir);
     const LightArrays L(in.particles, in.shading);
     switch (in.shading.model) {
@@ -546,6 +549,7 @@ LightingCounters estimateLighting(const LightingInputs& in, LightingImage& out, 
     ACC_CHECK(in.render.estimator != EstimatorKind::ris || (in.render.source == LightSource::power) == (in.powerTable != nullptr));
     ACC_CHECK((in.render.estimator != EstimatorKind::tree && in.render.estimator != EstimatorKind::split) || in.lightTree);
     ACC_CHECK(in.render.estimator != EstimatorKind::ris || in.render.source != LightSource::tree || in.lightTree);
+    ACC_CHECK(in.render.estimator != EstimatorKind::ris || (in.render.source != LightSource::tiles && in.render.source != LightSource::regir));
     ACC_CHECK(in.render.estimator != EstimatorKind::restir);
     allocate(out, pixels);
     const LightingPlan plan = planLighting(in.render, in.gbuffer.height);

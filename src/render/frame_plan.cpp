@@ -31,9 +31,12 @@ void planPasses(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
     plan.shadowRays = plan.lighting && s.shading.visibility;
     if (plan.lighting && (est == EstimatorKind::tree || est == EstimatorKind::split || (resampling && s.render.source == LightSource::tree)))
         plan.sampler = LightSamplerKind::tree;
-    if (plan.lighting && (est == EstimatorKind::power || (resampling && s.render.source == LightSource::power)))
-        plan.sampler = LightSamplerKind::power;
+    const bool presampled = s.render.source == LightSource::tiles || s.render.source == LightSource::regir;
+    if (plan.lighting && (est == EstimatorKind::power || (resampling && (s.render.source == LightSource::power || presampled))))
+        plan.sampler = LightSamplerKind::power;  // the tiles are drawn from the power table
     plan.restir = plan.lighting && est == EstimatorKind::restir;
+    plan.presampleTiles = plan.restir && presampled;
+    plan.presampleRegir = plan.restir && s.render.source == LightSource::regir;
     plan.temporal = plan.restir && plan.keepHistory && facts.historyAvailable;
     plan.spatialIterations = plan.restir && s.restir.spatial_neighbours > 0 ? s.restir.spatial_iterations : 0;
     plan.upsample = plan.restir && float(s.restir.resolution_scale) < 1.0f;
@@ -72,7 +75,16 @@ void describe(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
     step(pass::estimateLighting, plan.lighting,
          dark ? noLight : restir ? "the restir passes below" : std::string(enumName(est)));
     if (restir) {
-        step(pass::generateCandidates, plan.restir, dark ? noLight : fmt::format("{} candidates", s.render.candidates), true, true);
+        const RestirSettings& r = s.restir;
+        step(pass::presampleLightTiles, plan.presampleTiles,
+             plan.presampleTiles ? fmt::format("{} tiles x {} lights by power", r.tile_count, r.tile_size)
+             : dark ? noLight : fmt::format("source {}: no light tiles", enumName(s.render.source)), true, true);
+        step(pass::presampleRegirGrid, plan.presampleRegir,
+             plan.presampleRegir ? fmt::format("{}^3 cells x {} reservoirs of {} tile candidates", r.regir_cells,
+                                               r.regir_lights_per_cell, r.regir_build_samples)
+             : dark ? noLight : fmt::format("source {}: no ReGIR grid", enumName(s.render.source)), true, true);
+        step(pass::generateCandidates, plan.restir,
+             dark ? noLight : fmt::format("{} candidates from {}", s.render.candidates, enumName(s.render.source)), true, true);
         step(pass::temporalResampling, plan.temporal,
              plan.temporal ? "reprojection through particle motion"
              : dark ? noLight : !s.restir.temporal ? "temporal off: no history buffers or motion"

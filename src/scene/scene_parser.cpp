@@ -318,6 +318,16 @@ void validate(const Settings& s, const std::map<std::string, std::string>& loc, 
                  fmt::format("{} particles at {}x{} need about {:.0f} MB, more than this machine's {:.0f} MB of physical "
                              "memory", particles, s.camera.width, s.camera.height, mb, physicalMb));
     }
+    if (s.render.estimator == EstimatorKind::ris && (s.render.source == LightSource::tiles || s.render.source == LightSource::regir))
+        fail("render.source", fmt::format("\"{}\" is a restir source: its presampled lights are drawn once per frame, and ris "
+                                          "averages many samples of one frame, which would converge to that frame's draw, not "
+                                          "to Lr (use uniform, power or tree)", enumName(s.render.source)));
+    if (static_cast<std::uint64_t>(s.restir.regir_cells) * s.restir.regir_cells * s.restir.regir_cells * s.restir.regir_lights_per_cell >
+        (std::uint64_t(1) << 28))
+        fail("restir.regir_lights_per_cell", fmt::format("{}^3 cells x {} lights is more than 2^28 slots", s.restir.regir_cells,
+                                                         s.restir.regir_lights_per_cell));
+    if (std::uint64_t(s.restir.tile_count) * s.restir.tile_size > (std::uint64_t(1) << 28))
+        fail("restir.tile_size", fmt::format("{} tiles x {} lights is more than 2^28 entries", s.restir.tile_count, s.restir.tile_size));
     if (s.gpu.omm != OmmMode::off && s.geometry.alpha != AlphaMode::disc)
         fail("gpu.omm", "opacity micromaps apply to disc-alpha billboards (geometry.alpha = \"disc\")");
     if (s.geometry.primitive == Primitive::sphere && s.geometry.alpha == AlphaMode::disc)

@@ -72,6 +72,8 @@ void requireSupported(const Settings& s, bool lighting) {
     if (lighting && e == EstimatorKind::restir) {
         const RestirSettings& r = s.restir;
         if (s.render.source == LightSource::tree) refuse("render.source = \"tree\"");
+        if (s.render.source == LightSource::tiles) refuse("render.source = \"tiles\"");
+        if (s.render.source == LightSource::regir) refuse("render.source = \"regir\"");
         if (r.layout != ReservoirLayout::full) refuse("restir.layout = \"packed\"");
         if (r.basic_visibility) refuse("restir.basic_visibility");
         if (r.candidate_visibility) refuse("restir.candidate_visibility");

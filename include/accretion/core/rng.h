@@ -14,6 +14,9 @@ enum class RngPass : std::uint32_t {
     restirCandidates = 3,  ///< restir: initial candidates
     restirTemporal = 4,    ///< restir: temporal resampling
     restirSpatial = 5,     ///< restir: spatial neighbours and resampling (item mixes the iteration)
+    presampleTiles = 6,    ///< light tiles: one entry's power draw
+    presampleRegir = 7,    ///< ReGIR grid: one slot's RIS (and a slot group's tile)
+    tileSelection = 8,     ///< light tiles: the tile of a pixel block
 };
 
 /// 64-bit finaliser (SplitMix64), a bijection with good avalanche.

@@ -14,6 +14,9 @@ inline constexpr std::uint32_t kRadiance = 8;
 inline constexpr std::uint32_t kAliasEntry = 8;
 /// A light-tree node (centre, radius, power, clamp, child, count, box): read twice per level of a tree traversal.
 inline constexpr std::uint32_t kLightTreeNode = 56;
+/// A presampled light (RTXDI's RIS buffer entry: light index, pdf or W):
+/// a light tile's entry, a ReGIR slot.
+inline constexpr std::uint32_t kRisEntry = 8;
 /// Ray payloads of the pipeline (TraceRay) form: primary hit (t, instance,
 /// primitive, barycentrics) and shadow visibility.
 inline constexpr std::uint32_t kPrimaryPayload = 16;

@@ -14,7 +14,11 @@ namespace accretion {
 /// - uniform: sampleSource<false>, sourcePdf<false> (1 / N);
 /// - power: sampleSource<true>, sourcePdf<true> (an alias table over luminance(I_i));
 /// - tree: LightTree::sample, LightTree::pdf (receiver-dependent, light_tree.h);
-/// - ris / restir candidates by render.source: sampleCandidate, candidatePdf.
+/// - ris / restir candidates by render.source: sampleCandidate, candidatePdf;
+/// - split's far field: LightTree::sampleFar, pdfFar (near_field.cpp);
+/// - restir's presampled sources: LightTiles::sample with the power pmf as
+///   its marginal pdf (light_tiles.h), RegirGrid::sample whose pdf is 1 / W,
+///   W an unbiased estimate of 1 / p_src (regir_grid.h).
 /// tests/lighting/light_sampler_test.cpp runs one chi-square harness over all of them.
 
 /// The light selection pmf of the `power` estimator (and of ris / restir with

@@ -47,6 +47,8 @@ struct FramePlan {
     LightSamplerKind sampler = LightSamplerKind::none;  ///< buildLightSampler
     bool shadowRays = true;       ///< visibility by shadow rays (off: V = 1)
     bool restir = false;          ///< the restir passes instead of estimateLighting's accumulation
+    bool presampleTiles = false;  ///< presampleLightTiles (render.source tiles or regir)
+    bool presampleRegir = false;  ///< presampleRegirGrid (render.source regir)
     bool temporal = false;        ///< temporalResampling
     std::uint32_t spatialIterations = 0;  ///< spatialResampling runs
     bool upsample = false;        ///< upsampleLighting (restir at reduced resolution)

@@ -42,7 +42,7 @@ enum class ShadingModel { lambert, sphere, isotropic };
 enum class EstimatorKind { exact, uniform, power, ris, restir, tree, split };
 enum class BiasCorrection { none, basic, pairwise };
 enum class ReservoirLayout { full, packed };
-enum class LightSource { uniform, power, tree };
+enum class LightSource { uniform, power, tree, tiles, regir };
 enum class OmmMode { off, two_state, four_state };
 enum class NonFinitePolicy { zero_sample, discard };
 enum class VisibilityRule { exact, offset };
@@ -60,7 +60,7 @@ ACC_ENUM_NAMES(ShadingModel, "lambert", "sphere", "isotropic");
 ACC_ENUM_NAMES(EstimatorKind, "exact", "uniform", "power", "ris", "restir", "tree", "split");
 ACC_ENUM_NAMES(BiasCorrection, "none", "basic", "pairwise");
 ACC_ENUM_NAMES(ReservoirLayout, "full", "packed");
-ACC_ENUM_NAMES(LightSource, "uniform", "power", "tree");
+ACC_ENUM_NAMES(LightSource, "uniform", "power", "tree", "tiles", "regir");
 ACC_ENUM_NAMES(OmmMode, "off", "2state", "4state");
 ACC_ENUM_NAMES(NonFinitePolicy, "zero_sample", "discard");
 ACC_ENUM_NAMES(VisibilityRule, "exact", "offset");
@@ -212,7 +212,7 @@ struct RenderSettings {
     EstimatorKind estimator = EstimatorKind::exact; ///< estimator of Lr
     std::uint32_t samples = 16;                  ///< light samples per pixel (Monte Carlo estimators)
     std::uint32_t candidates = 16;               ///< ris, restir: candidates M per reservoir (the GPU pipeline's: 16)
-    LightSource source = LightSource::uniform;   ///< ris, restir: source pdf of the candidates (uniform, power, or the light tree at the receiver)
+    LightSource source = LightSource::uniform;   ///< ris, restir: source of the candidates (uniform, power, the light tree at the receiver; restir also RTXDI's light tiles and ReGIR grid)
     double target_stderr = 0.0;                  ///< tree, split, uniform, power: relative standard error to reach per pixel (0: fixed samples)
     std::uint32_t near_lights = 0;               ///< split: lights summed exactly per receiver, its nearest (0: automatic)
     std::uint32_t max_samples = 65536;           ///< cap of the adaptive sampling of target_stderr
@@ -236,7 +236,7 @@ struct RenderSettings {
         v.field("estimator", estimator, "estimator of the reflected light Lr");
         v.field("samples", samples, "light samples per pixel (uniform, power; ris: reservoirs)", Range{1, 1e7});
         v.field("candidates", candidates, "ris, restir: candidates M per reservoir", Range{1, 1e6});
-        v.field("source", source, "ris, restir: source pdf of the candidates");
+        v.field("source", source, "ris, restir: source of the candidates: uniform, power, tree (the light tree at the receiver); restir only: tiles (RTXDI's presampled light tiles, [restir] tile_*) or regir (a world-space grid of light reservoirs, [restir] regir_*)");
         v.field("near_lights", near_lights, "split: the k nearest lights of each receiver are summed exactly, the rest sampled from the light tree without them (0: automatic, see docs/MODEL.md section 4)", Range{0, 256});
         v.field("target_stderr", target_stderr, "tree, split, uniform, power: per-pixel relative standard error to reach, adding `samples` per round (0: off)", Range{0.0, 1.0});
         v.field("max_samples", max_samples, "cap on samples per pixel when target_stderr is set", Range{1, 1e9});
@@ -274,6 +274,15 @@ struct RestirSettings {
     ReservoirLayout layout = ReservoirLayout::full; ///< stored reservoir: full (16 B) or packed
     std::uint32_t light_bits = 20;           ///< packed: bits of the light index (the rest of 32 hold M)
     bool half_weights = true;                ///< packed: W and p_hat as half floats (8 B) rather than floats (12 B)
+    // Candidate sources tiles and regir, with RTXDI's defaults (its
+    // RISBufferSegmentParameters and ReGIR grid parameters).
+    std::uint32_t tile_count = 128;          ///< tiles: presampled tiles per frame (RTXDI tileCount)
+    std::uint32_t tile_size = 1024;          ///< tiles: lights per tile (RTXDI tileSize)
+    std::uint32_t regir_cells = 16;          ///< regir: cells per axis (RTXDI GridSize 16 x 16 x 16)
+    double regir_cell_size = 0.0;            ///< regir: cell edge in scene units (0: the grid fits the particles; RTXDI regirCellSize, 1)
+    std::uint32_t regir_lights_per_cell = 512; ///< regir: reservoirs per cell (RTXDI LightsPerCell)
+    std::uint32_t regir_build_samples = 8;   ///< regir: candidates per cell reservoir (RTXDI regirNumBuildSamples)
+    double regir_jitter = 1.0;               ///< regir: receiver jitter in cells (RTXDI regirSamplingJitter)
 
     template <class V> void visit(V& v) {
         v.field("temporal", temporal, "temporal reuse through particle motion and the previous camera");
@@ -291,6 +300,13 @@ struct RestirSettings {
         v.field("layout", layout, "stored reservoir layout: full (16 B) or packed (light index + M in 32 bits, weights)");
         v.field("light_bits", light_bits, "packed: light index bits (M gets 32 - light_bits)", Range{1, 31});
         v.field("half_weights", half_weights, "packed: W and p_hat as half floats (8 B) instead of floats (12 B)");
+        v.field("tile_count", tile_count, "render.source = tiles or regir: light tiles presampled per frame (RTXDI tileCount)", Range{1, 65536});
+        v.field("tile_size", tile_size, "render.source = tiles or regir: lights per tile, drawn by power (RTXDI tileSize)", Range{1, 1 << 20});
+        v.field("regir_cells", regir_cells, "render.source = regir: grid cells per axis (RTXDI GridSize)", Range{1, 128});
+        v.field("regir_cell_size", regir_cell_size, "render.source = regir: cell edge in scene units, the grid centred on the particles (0: fitted to the particles' bounds)", kNonNegative);
+        v.field("regir_lights_per_cell", regir_lights_per_cell, "render.source = regir: light reservoirs per cell (RTXDI LightsPerCell)", Range{1, 65536});
+        v.field("regir_build_samples", regir_build_samples, "render.source = regir: tile candidates per cell reservoir, resampled by the cell's target (RTXDI regirNumBuildSamples)", Range{1, 1024});
+        v.field("regir_jitter", regir_jitter, "render.source = regir: receiver position jitter in cells before the cell lookup (RTXDI regirSamplingJitter)", Range{0.0, 8.0});
     }
 };
 

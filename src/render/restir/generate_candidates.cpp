@@ -10,7 +10,9 @@ LightingCounters generateCandidatesKernel(const FrameContext& f, std::vector<Sto
     const std::uint32_t Mc = f.in.settings.render.candidates;
     PassCounters* pc = passCounters<Count>(f, pass::generateCandidates);
     const std::uint32_t R = f.codec.bytes();
-    return forEachPixel(f.lg.width, f.lg.height, [&](std::size_t px, std::uint32_t, std::uint32_t, LightingCounters& c) {
+    const std::uint64_t seed = f.in.settings.render.seed;
+    const float jitter = float(f.rs.regir_jitter);
+    return forEachPixel(f.lg.width, f.lg.height, [&](std::size_t px, std::uint32_t tx, std::uint32_t ty, LightingCounters& c) {
         const GBufferTexel& g = f.lg.texels[px];
         auto rec = recorder<Count>(pc, px);
         recordHit(rec, f, g);
@@ -19,17 +21,31 @@ LightingCounters generateCandidatesKernel(const FrameContext& f, std::vector<Sto
         rec.trip(Mc);
         // Per candidate its light's record, and the source's reads: an alias
         // entry, or both children at every level of the tree.
+        // an entry of a tile or a ReGIR slot.
+        constexpr bool presampled = S == LightSource::tiles || S == LightSource::regir;
         rec.read(Mc * (gpu_layout::kParticleRecord + (S == LightSource::power ? gpu_layout::kAliasEntry : 0u) +
-                       (S == LightSource::tree ? 2u * gpu_layout::kLightTreeNode * f.in.lightTree->depth() : 0u)));
+                       (S == LightSource::tree ? 2u * gpu_layout::kLightTreeNode * f.in.lightTree->depth() : 0u) +
+                       (presampled ? gpu_layout::kRisEntry : 0u)));
         rec.write(R);
         const ShadingPoint sp = shadingPoint(g, f.in.particles);
-        Rng rng(px, f.in.frame, RngPass::restirCandidates, f.in.settings.render.seed);
+        Rng rng(px, f.in.frame, RngPass::restirCandidates, seed);
+        // tiles: the pixel block's tile; regir: the receiver's jittered
+        // cell, or outside the grid the tile (RTXDI's fallback).
+        std::uint32_t tile = 0;
+        std::int64_t cell = -1;
+        if constexpr (presampled) tile = f.tiles->tileOf(tx, ty, f.lg.width, f.in.frame, seed);
+        if constexpr (S == LightSource::regir) cell = f.regir->jitteredCell(sp.x, jitter, rng);
         Reservoir r;
         bool discard = false;
         for (std::uint32_t m = 0; m < Mc; ++m) {
-            const LightSample x = sampleCandidate<S>(f.L, f.in.powerTable, f.in.lightTree, sp, rng);
+            LightSample x;
+            if constexpr (S == LightSource::regir) x = cell >= 0 ? f.regir->sample(std::uint32_t(cell), rng) : f.tiles->sample(tile, rng);
+            else if constexpr (S == LightSource::tiles) x = f.tiles->sample(tile, rng);
+            else x = sampleCandidate<S>(f.L, f.in.powerTable, f.in.lightTree, sp, rng);
             float p_hat = f.L.targetPdf<SM>(sp, x.i);
-            float w = x.pdf > 0.0f ? p_hat / x.pdf : 0.0f;  // the tree drew no light: a zero candidate
+            // The tree drew no light, or an empty ReGIR slot: a zero candidate.
+            // regir: pdf = 1 / W, so w = p_hat W, W the slot's unbiased 1 / p_src.
+            float w = x.pdf > 0.0f ? p_hat / x.pdf : 0.0f;
             ++c.lightTerms;
             if (!std::isfinite(w) || !std::isfinite(p_hat)) {  // render.nonfinite: a zero candidate, or no reservoir
                 discard = f.reject(px, c) || discard;
@@ -63,8 +79,8 @@ LightingCounters generateCandidatesKernel(const FrameContext& f, std::vector<Sto
 
 }  // namespace
 
-/// RIS of render.candidates lights from the source pmf (render.source:
-/// uniform, power or the light tree) with target p_hat (no visibility);
+/// RIS of render.candidates lights from render.source (uniform, power, the
+/// light tree, a light tile, a ReGIR cell) with target p_hat (no visibility);
 /// with candidate_visibility, an occluded winner is dropped before reuse.
 LightingCounters generateCandidates(const FrameContext& f, std::vector<StoredReservoir>& out) {
     const LightSource source = f.in.settings.render.source;
@@ -72,6 +88,8 @@ LightingCounters generateCandidates(const FrameContext& f, std::vector<StoredRes
         switch (source) {
         case LightSource::power: return generateCandidatesKernel<SM, P, LightSource::power, Count>(f, out);
         case LightSource::tree: return generateCandidatesKernel<SM, P, LightSource::tree, Count>(f, out);
+        case LightSource::tiles: return generateCandidatesKernel<SM, P, LightSource::tiles, Count>(f, out);
+        case LightSource::regir: return generateCandidatesKernel<SM, P, LightSource::regir, Count>(f, out);
         case LightSource::uniform: break;
         }
         return generateCandidatesKernel<SM, P, LightSource::uniform, Count>(f, out);

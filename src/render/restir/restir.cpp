@@ -8,10 +8,11 @@
 namespace accretion {
 namespace {
 
-/// The plan's restir passes: generateCandidates, temporalResampling,
+/// The plan's restir passes: presampleLightTiles and presampleRegirGrid
+/// (sources tiles, regir), generateCandidates, temporalResampling,
 /// spatialResampling (plan.spatialIterations times), traceShadowRays.
 /// With a trace (render --pixel), the reservoir of texel `traced` after each pass.
-LightingCounters runPasses(const restir::FrameContext& f, std::vector<StoredReservoir>& a, std::vector<StoredReservoir>& b,
+LightingCounters runPasses(restir::FrameContext& f, std::vector<StoredReservoir>& a, std::vector<StoredReservoir>& b,
                            std::vector<Vec3>& lowLr, PassTimer& timer, PassRejections& rejected, std::size_t traced) {
     const FramePlan& plan = f.in.plan;
     LightingCounters total;
@@ -22,6 +23,18 @@ LightingCounters runPasses(const restir::FrameContext& f, std::vector<StoredRese
     auto snapshot = [&](std::string_view name, const std::vector<StoredReservoir>& r) {
         if (f.in.trace) f.in.trace->passes.push_back({std::string(name), r[traced]});
     };
+    LightTiles tiles;
+    RegirGrid grid;
+    if (plan.presampleTiles) {
+        auto t = timer.scope(pass::presampleLightTiles);
+        tiles = restir::presampleLightTiles(f);
+        f.tiles = &tiles;
+    }
+    if (plan.presampleRegir) {
+        auto t = timer.scope(pass::presampleRegirGrid);
+        grid = restir::presampleRegirGrid(f);
+        f.regir = &grid;
+    }
     {
         auto t = timer.scope(pass::generateCandidates);
         add(pass::generateCandidates, restir::generateCandidates(f, a));

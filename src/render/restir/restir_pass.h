@@ -13,6 +13,8 @@
 #include "accretion/core/rng.h"
 #include "accretion/counters/gpu_layouts.h"
 #include "accretion/lighting/light_arrays.h"
+#include "accretion/lighting/light_tiles.h"
+#include "accretion/lighting/regir_grid.h"
 #include "accretion/lighting/reservoir.h"
 #include "accretion/lighting/shading.h"
 #include "accretion/render/restir.h"
@@ -92,6 +94,8 @@ struct FrameContext {
     bool shadows;               ///< plan.shadowRays: trace shadow rays (off: V = 1)
     FrameCounters* counters;    ///< counting mode: per-pass thread records
     std::uint32_t* rejected;    ///< per lighting texel: non-finite values rejected (render.nonfinite)
+    const LightTiles* tiles = nullptr;  ///< render.source tiles or regir: this frame's presampled tiles
+    const RegirGrid* regir = nullptr;   ///< render.source regir: this frame's grid
 
     /// A reservoir whose weights overflowed or went NaN: counted at px;
     /// zero_sample keeps its M with W = 0, discard empties it.
@@ -150,6 +154,8 @@ LightingCounters dispatchKernel(const FrameContext& f, Fn&& fn) {
 }
 
 // The passes, in the order a frame runs them (one file each).
+LightTiles presampleLightTiles(const FrameContext& f);
+RegirGrid presampleRegirGrid(const FrameContext& f);
 LightingCounters generateCandidates(const FrameContext& f, std::vector<StoredReservoir>& out);
 LightingCounters temporalResampling(const FrameContext& f, const std::vector<StoredReservoir>& cur,
                                     std::vector<StoredReservoir>& out);
