@@ -198,3 +198,56 @@ TEST_CASE("the plan is the frame: every frame's timed passes are exactly the pla
         CHECK(planFrame(s, FrameFacts{false, true, true}).sampler == sampler);
     }
 }
+
+TEST_CASE("restir sources tiles and regir: their presampling passes run, are timed and counted, only when asked for", "[plan][restir][gpu]") {
+    Settings s = small();
+    s.render.estimator = EstimatorKind::restir;
+    s.gpu.counters = true;
+    s.restir.tile_count = 6;
+    s.restir.tile_size = 40;
+    s.restir.regir_cells = 3;
+    s.restir.regir_lights_per_cell = 20;
+    s.restir.regir_build_samples = 5;
+    const auto passesOf = [](const Settings& st) {
+        FrameRenderer r(st, ParticleSource(st), RenderOptions{true});
+        FrameStats fs;
+        FrameImage img = r.render(0, fs);
+        return std::make_pair(std::move(img.counters.passes), fs);
+    };
+    for (const LightSource src : {LightSource::power, LightSource::tiles, LightSource::regir}) {
+        INFO(enumName(src));
+        s.render.source = src;
+        const FramePlan plan = planPasses(s);
+        const bool tiles = src != LightSource::power, regir = src == LightSource::regir;
+        CHECK(step(plan, "presampleLightTiles").runs == tiles);
+        CHECK(step(plan, "presampleRegirGrid").runs == regir);
+        CHECK(plan.sampler == LightSamplerKind::power);  // the tiles are drawn from the power table
+        const auto [passes, stats] = passesOf(s);
+        CHECK((stats.timer.seconds(pass::presampleLightTiles) > 0.0) == tiles);
+        CHECK((stats.timer.seconds(pass::presampleRegirGrid) > 0.0) == regir);
+        std::size_t seen = 0;
+        for (const PassCounters& p : passes) {
+            std::uint64_t active = 0, trips = 0, written = 0;
+            for (const ThreadCounters& t : p.threads) {
+                active += t.active;
+                trips += t.trips;
+                written += t.bytesWritten;
+            }
+            if (p.pass == pass::presampleLightTiles) {  // one thread per entry: one draw, an 8-byte entry
+                ++seen;
+                CHECK((p.width == 40 && p.height == 6));
+                CHECK(active == 240);
+                CHECK(trips == 240);
+                CHECK(written == 240 * 8);
+            }
+            if (p.pass == pass::presampleRegirGrid) {  // one thread per slot: 5 candidates, an 8-byte slot
+                ++seen;
+                CHECK((p.width == 20 && p.height == 27));
+                CHECK(active == 540);
+                CHECK(trips == 540 * 5);
+                CHECK(written == 540 * 8);
+            }
+        }
+        CHECK(seen == std::size_t(tiles) + std::size_t(regir));
+    }
+}
