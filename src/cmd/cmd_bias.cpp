@@ -44,6 +44,8 @@ struct BiasRow {
     double z = 0.0;
     double energyLossPct = 0.0;
     double secondsPerRender = 0.0;
+    double secondsPerFrame = 0.0;  ///< the measured frame alone (restir: without its history frames)
+    double relMse = 0.0;       ///< mean over seeds of one render's relMSE, less the reference's own noise
     bool biased = false;
 };
 
@@ -140,7 +142,7 @@ BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vec
     const std::size_t pixels = ref.image.rgb.size();
     const double n = 3.0 * double(pixels);
     std::vector<DVec3> s1(pixels, DVec3(0.0)), s2(pixels, DVec3(0.0));
-    double e1 = 0.0, e2 = 0.0, seconds = 0.0;
+    double e1 = 0.0, e2 = 0.0, seconds = 0.0, frameSeconds = 0.0, relMse = 0.0;
     for (std::uint32_t k = 0; k < a.seeds; ++k) {
         Settings s = specBase;
         s.render.seed = specBase.render.seed + k;
@@ -148,6 +150,7 @@ BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vec
                                        ? renderForExperiment(s, source, frame, a.history)
                                        : readGpuRender(gpuFramePath(a.gpuFrames, biasMapName(spec), s.render.seed), s, frame, ref);
         seconds += r.totalSeconds;
+        frameSeconds += a.gpuFrames.empty() ? r.frameSeconds : r.totalSeconds;
         double e = 0.0;
         for (std::size_t p = 0; p < pixels; ++p) {
             const DVec3 d = DVec3(r.image.lighting.Lr[p]) - DVec3(ref.image.rgb[p]);
@@ -156,6 +159,8 @@ BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vec
             e += d.x + d.y + d.z;
         }
         e /= n;
+        const ErrorMetrics m = computeErrors(r.image.lighting.Lr, ref.image.rgb, ref.stderr.empty() ? nullptr : &ref.stderr);
+        relMse += m.relMSE - m.relMSEFloor;
         e1 += e;
         e2 += e * e;
         if (!a.quiet) fmt::print(stderr, "\rbias: {} seed {}/{} ({:.2f} s)", spec.label, k + 1, a.seeds, r.totalSeconds);
@@ -171,6 +176,8 @@ BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vec
     row.z = row.stderr > 0.0 ? row.meanError / row.stderr : 0.0;
     row.energyLossPct = ref.mean > 0.0 ? -100.0 * row.meanError / ref.mean : 0.0;
     row.secondsPerRender = seconds / S;
+    row.relMse = relMse / S;
+    row.secondsPerFrame = frameSeconds / S;
     row.biased = std::fabs(row.z) > a.zCritical;
     writeBiasMap(prefix + "." + biasMapName(spec) + ".exr", s1, s2, S, ref,
                  {{"version", std::string(version())}, {"estimator", spec.label}, {"seeds", std::to_string(a.seeds)},
@@ -186,11 +193,12 @@ Table biasTable(const std::vector<BiasRow>& rows, double refMean, double zCritic
              {"stderr", "stderr", 11, "{:.3g}", "{:.8g}"}, {"z", "z", 8, "{:.2f}", "{:.5g}"},
              hidden("energy_loss_pct", "{:.6g}"), hidden("energy_loss_stderr_pct", "{:.6g}"), {"", "energy loss %", 15},
              hidden("biased", "{}"), {"seconds_per_render", "s/render", 9, "{:.3f}", "{:.6g}"},
+             {"seconds_per_frame", "s/frame", 8, "{:.3f}", "{:.6g}"}, {"rel_mse", "relMSE", 10, "{:.4g}", "{:.6g}"},
              {"", fmt::format("verdict (|z| > {:.2f}: 99.9%)", zCritical), 0, "{}", "{}", true, "  "}});
     for (const BiasRow& r : rows) {
         const double lossSe = refMean > 0.0 ? 100.0 * r.stderr / refMean : 0.0;
         t.add({r.label, std::uint64_t(r.seeds), r.meanError, r.stderr, r.z, r.energyLossPct, lossSe,
-               fmt::format("{:>8.3f} +- {:<5.3f}", r.energyLossPct, lossSe), r.biased, r.secondsPerRender,
+               fmt::format("{:>8.3f} +- {:<5.3f}", r.energyLossPct, lossSe), r.biased, r.secondsPerRender, r.secondsPerFrame, r.relMse,
                r.biased ? "BIASED" : fmt::format("no bias detected (|bias| < {:.2g}%)", zCritical * lossSe + std::fabs(r.energyLossPct))});
     }
     return t;
