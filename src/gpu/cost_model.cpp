@@ -14,6 +14,7 @@
 #include "accretion/core/error.h"
 #include "accretion/core/median.h"
 #include "accretion/core/parse.h"
+#include "accretion/core/pass_timer.h"
 
 namespace accretion {
 
@@ -105,8 +106,16 @@ std::string passFamily(const std::string& pass) {
     return bracket == std::string::npos ? pass : pass.substr(0, bracket);
 }
 
+std::string costProxy(const std::string& family) {
+    // RTXDI's presampling passes are generateCandidates' kind of work: one
+    // thread per entry, a RIS loop over random light records, no rays.
+    if (family == pass::presampleLightTiles || family == pass::presampleRegirGrid) return std::string(pass::generateCandidates);
+    return family;
+}
+
 double CostCoefficients::predictMs(const std::string& pass, const CostFeatures& f) const {
-    const auto it = perPass.find(passFamily(pass));
+    auto it = perPass.find(passFamily(pass));
+    if (it == perPass.end()) it = perPass.find(costProxy(passFamily(pass)));
     return dotMs(it == perPass.end() ? ns : it->second, f);
 }
 

@@ -226,3 +226,21 @@ TEST_CASE("calibrate finds the cache of the working-set term that made the timin
     std::ofstream(file) << calibrate(rows, CostModelForm::per_pass).coefficients.toJson().dump();
     CHECK(CostCoefficients::load(file.string()).cacheBytes == cache);
 }
+
+TEST_CASE("a presampling pass without timings is priced with generateCandidates' coefficients", "[gpu][cost]") {
+    CostCoefficients c;
+    c.ns = {};
+    c.ns[0] = 1.0;  // shared: 1 ns per unit of the first feature
+    CostFeatures candidates{};
+    candidates[1] = 2.0;  // generateCandidates: 2 ns per unit of the second
+    c.perPass["generateCandidates"] = candidates;
+    CostFeatures f{};
+    f[0] = 1e6;
+    f[1] = 1e6;
+    // 1e6 units x 2 ns = 2 ms by the proxy; the shared form would give 1 ms.
+    CHECK(c.predictMs("presampleLightTiles", f) == Approx(2.0));
+    CHECK(c.predictMs("presampleRegirGrid", f) == Approx(2.0));
+    CHECK(c.predictMs("traceShadowRays", f) == Approx(1.0));  // no proxy: shared
+    c.perPass["presampleRegirGrid"] = CostFeatures{};  // its own coefficients, once fitted, win
+    CHECK(c.predictMs("presampleRegirGrid", f) == Approx(0.0));
+}

@@ -72,7 +72,8 @@ struct CostCoefficients {
 
     /// With the shared coefficients.
     double predictMs(const CostFeatures& f) const;
-    /// With the pass's own coefficients when there are any, else the shared ones.
+    /// With the pass's own coefficients when there are any, else those of
+    /// its proxy (costProxy), else the shared ones.
     double predictMs(const std::string& pass, const CostFeatures& f) const;
 };
 
@@ -124,6 +125,11 @@ struct Holdout {
 };
 Holdout holdout(const std::vector<CostRow>& rows, CostModelForm form, double fraction, std::uint64_t seed);
 
+/// The pass whose per-pass coefficients price a pass that has none of its
+/// own: presampleLightTiles and presampleRegirGrid -> generateCandidates
+/// (one thread per entry, a RIS loop over random light records, no rays);
+/// any other pass is its own.
+std::string costProxy(const std::string& family);
 /// "spatialResampling[2]" -> "spatialResampling": the pass a run belongs to.
 std::string passFamily(const std::string& pass);
 
