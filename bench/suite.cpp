@@ -22,6 +22,7 @@
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
 
+#include "accretion/analysis/experiment.h"
 #include "accretion/analysis/image_metrics.h"
 #include "accretion/core/rng.h"
 #include "accretion/core/version.h"
@@ -435,6 +436,7 @@ struct Suite {
     void benchRestirFrame();
     void benchTreeReference();
     void benchSplitReference();
+    void benchRestirSources();
     void benchScaling();
     void benchMemory();
     void benchPlanSkips();
@@ -645,6 +647,58 @@ void Suite::benchSplitReference() {
     }
 }
 
+/// restir against uniform Monte Carlo at equal time on disk_100k at 320x180
+/// (issue 17's bar: the best unbiased configuration at least 5x lower
+/// error): frame 1 after one history frame, per seed the restir frame's
+/// relMSE against uniform's at the same time (uniform's relMSE x seconds
+/// is constant in its samples: relMSE_u t_u / t_r), the median over seeds of
+/// their ratio. The configuration is the best unbiased one of the README's
+/// restir table (scripts/restir_table.py); the reference is split at
+/// k = 256, 1024 spp (its noise subtracted).
+void Suite::benchRestirSources() {
+    log("restir (pairwise, light tree candidates, visibility reuse) against uniform at equal time, 100K at 320x180");
+    Settings base = diskScene(scene, 100'000, 320, 180);
+    const ParticleSource src(base);
+    Settings ref = base;
+    ref.render.estimator = EstimatorKind::split;
+    ref.render.near_lights = 256;
+    ref.render.samples = quick ? 128 : 1024;
+    ref.render.seed = 1000;
+    ref.render.frame_start = 1;
+    FrameRenderer refRenderer(ref, src, RenderOptions{true});
+    FrameStats refStats;
+    const FrameImage reference = refRenderer.render(1, refStats);
+    Settings uniform = base, restir = base;
+    uniform.render.estimator = EstimatorKind::uniform;
+    uniform.render.samples = 16;
+    restir.render.estimator = EstimatorKind::restir;
+    restir.render.source = LightSource::tree;
+    restir.restir.bias_correction = BiasCorrection::pairwise;
+    restir.restir.visibility_reuse = true;
+    const std::uint32_t seeds = quick ? 3 : 9;
+    std::vector<double> gains, tr, tu, er, eu;
+    for (std::uint32_t k = 0; k < seeds; ++k) {
+        uniform.render.seed = restir.render.seed = k;
+        const ExperimentRender u = renderForExperiment(uniform, src, 1, 1);
+        const ExperimentRender r = renderForExperiment(restir, src, 1, 1);
+        eu.push_back(correctedRelMse(u.image, reference));
+        er.push_back(correctedRelMse(r.image, reference));
+        tu.push_back(u.frameSeconds);
+        tr.push_back(r.frameSeconds);
+        gains.push_back(eu.back() * tu.back() / tr.back() / er.back());
+    }
+    const double gain = median(gains), t = median(tr);
+    figures["restir_vs_uniform_100k_320x180"] = {
+        {"configuration", "restir:pairwise:tree:restir.visibility_reuse=true"}, {"seeds", seeds},
+        {"reference", {{"estimator", "split"}, {"near_lights", 256}, {"samples", ref.render.samples}, {"frame", 1}}},
+        {"restir_relMSE_median", median(er)}, {"restir_frame_s_median", t},
+        {"uniform_16spp_relMSE_median", median(eu)}, {"uniform_frame_s_median", median(tu)},
+        {"equal_time_gains", gains}, {"equal_time_gain_median", gain}};
+    // Bar: the restir frame's time against the time uniform needs for its
+    // error (the median gain), at most 1/5.
+    bars["restir_vs_uniform_equal_time"] = bar(t, t * gain, 0.2);
+}
+
 /// Scaling curves over particles and resolution (CSV and PNG).
 void Suite::benchScaling() {
     const Settings restir = restirScene();
@@ -792,6 +846,12 @@ int main(int argc, char** argv) {
     app.add_option("--accretion", binary, "The accretion binary (memory runs)");
     app.add_option("--scene", scene, "The disk scene");
     app.add_option("--micro", micro, "The Google Benchmark micro-benchmarks binary (empty: skip)");
+    std::vector<std::string> only;
+    app.add_option("--only", only,
+                   "Run only these sections (bvh, bvh_1m, rays, restir_frame, tree, split, restir_sources, scaling, memory, "
+                   "plan, micro) and merge their bars and figures into the existing results.json, each marked with "
+                   "this commit")
+        ->delimiter(',');
     CLI11_PARSE(app, argc, argv);
     std::filesystem::create_directories(outDir);
     Suite suite(scene);
@@ -803,19 +863,43 @@ int main(int argc, char** argv) {
                               {"machine", {{"cpu", machine()}, {"cores", suite.cores}}},
                               {"scene", scene},
                               {"quick", quick}};
-    suite.benchBvhRebuild();
-    suite.benchBvhRebuild1M();
-    suite.benchRays();
-    suite.benchRestirFrame();
-    if (!quick) suite.benchTreeReference();
-    suite.benchSplitReference();
-    suite.benchScaling();
-    suite.benchMemory();
-    suite.benchPlanSkips();
-    if (!micro.empty()) suite.benchMicro();
+    const std::vector<std::pair<std::string, std::function<void()>>> sections = {
+        {"bvh", [&] { suite.benchBvhRebuild(); }},
+        {"bvh_1m", [&] { suite.benchBvhRebuild1M(); }},
+        {"rays", [&] { suite.benchRays(); }},
+        {"restir_frame", [&] { suite.benchRestirFrame(); }},
+        {"tree", [&] { if (!quick) suite.benchTreeReference(); }},
+        {"split", [&] { suite.benchSplitReference(); }},
+        {"restir_sources", [&] { suite.benchRestirSources(); }},
+        {"scaling", [&] { suite.benchScaling(); }},
+        {"memory", [&] { suite.benchMemory(); }},
+        {"plan", [&] { suite.benchPlanSkips(); }},
+        {"micro", [&] { if (!micro.empty()) suite.benchMicro(); }}};
+    for (const std::string& name : only)
+        if (std::none_of(sections.begin(), sections.end(), [&](const auto& sec) { return sec.first == name; })) {
+            fmt::print(stderr, "accretion_suite: --only {}: no such section\n", name);
+            return 2;
+        }
+    for (const auto& [name, run] : sections)
+        if (only.empty() || std::find(only.begin(), only.end(), name) != only.end()) run();
 
-    results["bars"] = suite.bars;
-    results["figures"] = suite.figures;
+    if (only.empty()) {
+        results["bars"] = suite.bars;
+        results["figures"] = suite.figures;
+    } else {
+        // Merge: the sections run now replace their entries in the last
+        // results, each entry naming the commit and machine it was measured on.
+        const std::filesystem::path last = outDir + "/results.json";
+        if (std::filesystem::exists(last)) results = nlohmann::json::parse(std::ifstream(last));
+        const nlohmann::json at = {{"version", std::string(version())}, {"cpu", machine()}, {"cores", suite.cores}};
+        for (auto& [key, part] : {std::pair<const char*, nlohmann::json*>{"bars", &suite.bars}, {"figures", &suite.figures}})
+            for (auto& [name, value] : part->items()) {
+                results[key][name] = value;
+                if (results[key][name].is_object()) results[key][name]["measured_at"] = at;
+                else results[key][name] = {{"value", value}, {"measured_at", at}};
+            }
+        results["partial_runs"].push_back({{"sections", only}, {"measured_at", at}});
+    }
     std::ofstream(outDir + "/results.json.tmp") << results.dump(2) << "\n";
     std::filesystem::rename(outDir + "/results.json.tmp", outDir + "/results.json");
     printBars(suite.bars);

@@ -111,14 +111,17 @@ TEST_CASE("restir with basic or pairwise correction agrees with the oracle and e
     s.restir.bias_correction = mode.correction;
     s.restir.visibility_reuse = mode.visibilityReuse;
     s.restir.basic_visibility = mode.basicVisibility;
-    const std::uint32_t frames = 4, seeds = 300;
+    // 200 seeds (the largest standard error, basic animated, is 0.8% of the
+    // sum: a 5% bias is still seen, checked below); the biased modes lose
+    // 25-30% of the energy (z of -70 to -110 at 300 seeds), which 50 seeds show.
+    const std::uint32_t frames = 4, seeds = mode.biased ? 50 : 200;
     const double exact = exactSum(s, frames - 1), oracle = oracleSum(s, frames - 1);
     const SeedStats r = restirSums(s, frames, seeds);
     const double z = (r.mean - oracle) / r.stderr;
     INFO("oracle " << oracle << ", exact " << exact << ", restir " << r.mean << " +- " << r.stderr << ", z " << z);
     // exact is the oracle's image to float rounding (tests/render/oracle_test.cpp).
     CHECK(std::fabs(exact - oracle) < 1e-4 * oracle);
-    // Confidence: |z| < 4.4 is p ~ 1e-5 for an unbiased estimator (300 seeds: CLT).
+    // Confidence: |z| < 4.4 is p ~ 1e-5 for an unbiased estimator (CLT over the seeds).
     if (mode.biased) {
         CHECK(std::fabs(z) > 4.4);
     } else {
