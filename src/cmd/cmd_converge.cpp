@@ -27,7 +27,7 @@ namespace accretion::cmd {
 namespace {
 
 struct ConvergeArgs : ExperimentArgs {
-    ConvergeArgs() { estimators = "uniform,power,tree,ris,restir"; }
+    ConvergeArgs() { estimators = "uniform,power,tree,split,ris,restir"; }
     std::string budget = "60s";
     std::uint32_t sequence = 0, minEffort = 1, maxEffort = 1u << 16;
 };

@@ -120,11 +120,32 @@ float LightTree::descentImportance(std::uint32_t n, float power, const ShadingPo
     return sum;
 }
 
+std::uint32_t LightTree::smallNodeLeaves(std::uint32_t n, const ShadingPoint& sp, SmallNode& out) const {
+    std::uint32_t stack[2 * kExactBelow], top = 0, count = 0;
+    stack[top++] = n;
+    out.total = 0.0f;
+    // The order of descentImportance's sum, so that the total is its value.
+    while (top > 0) {
+        const std::uint32_t k = stack[--top];
+        const Node& m = nodes_[k];
+        if (m.count > 1) {
+            stack[top++] = m.child;
+            stack[top++] = m.child + 1;
+            continue;
+        }
+        out.leaf[count] = k;
+        out.importance[count] = importance(m, m.power, sp);
+        out.total += out.importance[count];
+        ++count;
+    }
+    return count;
+}
+
 LightSample LightTree::sample(const ShadingPoint& sp, Rng& rng) const {
     if (nodes_.empty()) return {kNoLightSample, 0.0f};
     std::uint32_t n = 0;
     float pdf = 1.0f;
-    while (nodes_[n].count > 1) {
+    while (nodes_[n].count > kExactBelow) {
         const std::uint32_t c = nodes_[n].child;
         const float a = descentImportance(c, nodes_[c].power, sp);
         const float b = descentImportance(c + 1, nodes_[c + 1].power, sp);
@@ -139,6 +160,21 @@ LightSample LightTree::sample(const ShadingPoint& sp, Rng& rng) const {
             pdf *= 1.0f - pa;
         }
     }
+    if (nodes_[n].count > 1) {
+        // A node of at most kExactBelow lights: one draw among its leaves in
+        // proportion to their importances (the binary descent below it with
+        // exact sums gives each the same probability, at one uniform).
+        SmallNode leaves;
+        const std::uint32_t count = smallNodeLeaves(n, sp, leaves);
+        if (!(leaves.total > 0.0f)) return {kNoLightSample, 0.0f};
+        const float target = rng.uniform() * leaves.total;
+        std::uint32_t k = 0;
+        float run = leaves.importance[0];
+        while (k + 1 < count && (run <= target || leaves.importance[k] == 0.0f)) run += leaves.importance[++k];
+        while (leaves.importance[k] == 0.0f && k > 0) --k;  // rounding at the top end: the last leaf with a term
+        pdf *= leaves.importance[k] / leaves.total;
+        n = leaves.leaf[k];
+    }
     if (!(pdf > 0.0f)) return {kNoLightSample, 0.0f};
     return {nodes_[n].child, pdf};
 }
@@ -148,7 +184,7 @@ float LightTree::pdf(const ShadingPoint& sp, std::uint32_t i) const {
     const Trail t = trail_[i];
     std::uint32_t n = 0;
     float pdf = 1.0f;
-    for (std::uint32_t k = 0; k < t.depth; ++k) {
+    for (std::uint32_t k = 0; k < t.depth && nodes_[n].count > kExactBelow; ++k) {
         const std::uint32_t c = nodes_[n].child;
         const float a = descentImportance(c, nodes_[c].power, sp);
         const float b = descentImportance(c + 1, nodes_[c + 1].power, sp);
@@ -157,6 +193,14 @@ float LightTree::pdf(const ShadingPoint& sp, std::uint32_t i) const {
         const float pa = a / (a + b);
         pdf *= right ? 1.0f - pa : pa;
         n = right ? c + 1 : c;
+    }
+    if (nodes_[n].count > 1) {
+        SmallNode leaves;
+        const std::uint32_t count = smallNodeLeaves(n, sp, leaves);
+        if (!(leaves.total > 0.0f)) return 0.0f;
+        for (std::uint32_t k = 0; k < count; ++k)
+            if (leaves.leaf[k] == t.leaf) return pdf * (leaves.importance[k] / leaves.total);
+        return 0.0f;
     }
     return pdf;
 }

@@ -26,7 +26,8 @@ public:
     /// Build over the particles' positions and luminance(emission).
     LightTree(const Particles& particles, const ShadingSettings& shading);
 
-    /// Draw a light for the receiver (one uniform per level).
+    /// Draw a light for the receiver: one uniform per level down to a node of
+    /// at most kExactBelow lights, then one among its leaves.
     LightSample sample(const ShadingPoint& sp, Rng& rng) const;
     /// Probability that sample() returns light i at this receiver.
     float pdf(const ShadingPoint& sp, std::uint32_t i) const;
@@ -78,6 +79,13 @@ private:
     float descentImportance(std::uint32_t n, float power, const ShadingPoint& sp, float minDist2 = 0.0f,
                             const std::uint32_t* excluded = nullptr, std::uint32_t excludedCount = 0) const;
     static constexpr std::uint32_t kExactBelow = 8;
+    /// The leaves of a node of at most kExactBelow lights, with their importances.
+    struct SmallNode {
+        std::uint32_t leaf[kExactBelow];
+        float importance[kExactBelow];
+        float total;
+    };
+    std::uint32_t smallNodeLeaves(std::uint32_t n, const ShadingPoint& sp, SmallNode& out) const;
     /// The far importances of children c and c + 1, whose near lights are
     /// near.light[lo, mid) and [mid, hi): one step of sampleFar / pdfFar.
     std::pair<float, float> farChildren(std::uint32_t c, const NearField& near, std::uint32_t lo, std::uint32_t mid,
