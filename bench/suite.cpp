@@ -674,7 +674,7 @@ void Suite::benchRestirSources() {
     restir.render.estimator = EstimatorKind::restir;
     restir.render.source = LightSource::tree;
     restir.restir.bias_correction = BiasCorrection::pairwise;  // unbiased; with visibility reuse it loses ~4% (README)
-    const std::uint32_t seeds = quick ? 3 : 9;
+    const std::uint32_t seeds = quick ? 3 : 25;
     std::vector<double> gains, tr, tu, er, eu;
     for (std::uint32_t k = 0; k < seeds; ++k) {
         uniform.render.seed = restir.render.seed = k;

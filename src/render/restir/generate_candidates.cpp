@@ -20,8 +20,8 @@ LightingCounters generateCandidatesKernel(const FrameContext& f, std::vector<Sto
         if (!g.hit()) return;
         rec.trip(Mc);
         // Per candidate its light's record, and the source's reads: an alias
-        // entry, or both children at every level of the tree.
-        // an entry of a tile or a ReGIR slot.
+        // entry, both children at every level of the tree, or an entry of a
+        // tile or a ReGIR slot.
         constexpr bool presampled = S == LightSource::tiles || S == LightSource::regir;
         rec.read(Mc * (gpu_layout::kParticleRecord + (S == LightSource::power ? gpu_layout::kAliasEntry : 0u) +
                        (S == LightSource::tree ? 2u * gpu_layout::kLightTreeNode * f.in.lightTree->depth() : 0u) +
