@@ -602,7 +602,7 @@ void Suite::benchSplitReference() {
         const ParticleSource src(base);
         Settings ref = base;
         ref.render.estimator = EstimatorKind::split;
-        ref.render.near_lights = 256;
+        ref.render.near_lights = 1024;
         ref.render.samples = quick ? 128 : 1024;
         ref.render.seed = 1000;
         FrameRenderer refRenderer(ref, src, RenderOptions{true});
@@ -611,7 +611,7 @@ void Suite::benchSplitReference() {
         Settings tree = base, split = base;
         tree.render.estimator = EstimatorKind::tree;
         split.render.estimator = EstimatorKind::split;
-        split.render.near_lights = 256;  // the automatic k at 32 spp, fixed so that the cost is a + b S
+        split.render.near_lights = 1024;  // the automatic k of a long render, fixed so that the cost is a + b S
         const auto c = measureErrorCosts({tree, split}, src, 8, 32, reference, quick ? 1 : 3);
         const ErrorCost& t = c[0];
         const ErrorCost& sp = c[1];
@@ -638,7 +638,7 @@ void Suite::benchSplitReference() {
         const auto ex = renderInterleaved({exact}, src, quick ? 1 : 3);
         Settings split = base;
         split.render.estimator = EstimatorKind::split;
-        split.render.near_lights = 256;
+        split.render.near_lights = 1024;
         const ErrorCost sp = measureErrorCosts({split}, src, 8, 32, ex[0].first, quick ? 1 : 3)[0];
         figures["split_vs_exact_10k_320x180"] = {{"exact_s", ex[0].second}, {"split", sp.json(kTarget)},
                                                  {"split_s_to_1e-4", sp.secondsTo(1e-4)}};
@@ -654,14 +654,14 @@ void Suite::benchSplitReference() {
 /// is constant in its samples: relMSE_u t_u / t_r), the median over seeds of
 /// their ratio. The configuration is the best unbiased one of the README's
 /// restir table (scripts/restir_table.py); the reference is split at
-/// k = 256, 1024 spp (its noise subtracted).
+/// k = 1024, 1024 spp (its noise subtracted).
 void Suite::benchRestirSources() {
     log("restir (pairwise, light tree candidates) against uniform at equal time, 100K at 320x180");
     Settings base = diskScene(scene, 100'000, 320, 180);
     const ParticleSource src(base);
     Settings ref = base;
     ref.render.estimator = EstimatorKind::split;
-    ref.render.near_lights = 256;
+    ref.render.near_lights = 1024;
     ref.render.samples = quick ? 128 : 1024;
     ref.render.seed = 1000;
     ref.render.frame_start = 1;
@@ -689,7 +689,7 @@ void Suite::benchRestirSources() {
     const double gain = median(gains), t = median(tr);
     figures["restir_vs_uniform_100k_320x180"] = {
         {"configuration", "restir:pairwise:tree"}, {"seeds", seeds},
-        {"reference", {{"estimator", "split"}, {"near_lights", 256}, {"samples", ref.render.samples}, {"frame", 1}}},
+        {"reference", {{"estimator", "split"}, {"near_lights", ref.render.near_lights}, {"samples", ref.render.samples}, {"frame", 1}}},
         {"restir_relMSE_median", median(er)}, {"restir_frame_s_median", t},
         {"uniform_16spp_relMSE_median", median(eu)}, {"uniform_frame_s_median", median(tu)},
         {"equal_time_gains", gains}, {"equal_time_gain_median", gain}};

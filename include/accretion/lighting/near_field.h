@@ -17,7 +17,7 @@ namespace accretion {
 /// lights below any node are one contiguous run, and `power` holds the
 /// prefix sums of their powers: a node's near power is one subtraction.
 struct NearField {
-    static constexpr std::uint32_t kMaxNear = 256;  ///< most nearest lights (render.near_lights)
+    static constexpr std::uint32_t kMaxNear = 1024;  ///< most nearest lights (render.near_lights)
     static constexpr std::uint32_t kMaxLights = kMaxNear + 1;
     std::uint32_t count = 0;             ///< the nearest and the receiver's own particle
     float radius2 = 0.0f;                ///< squared distance of the farthest: every far light is as far or farther

@@ -237,7 +237,7 @@ struct RenderSettings {
         v.field("samples", samples, "light samples per pixel (uniform, power; ris: reservoirs)", Range{1, 1e7});
         v.field("candidates", candidates, "ris, restir: candidates M per reservoir", Range{1, 1e6});
         v.field("source", source, "ris, restir: source of the candidates: uniform, power, tree (the light tree at the receiver); restir only: tiles (RTXDI's presampled light tiles, [restir] tile_*) or regir (a world-space grid of light reservoirs, [restir] regir_*)");
-        v.field("near_lights", near_lights, "split: the k nearest lights of each receiver are summed exactly, the rest sampled from the light tree without them (0: automatic, see docs/MODEL.md section 4)", Range{0, 256});
+        v.field("near_lights", near_lights, "split: the k nearest lights of each receiver are summed exactly, the rest sampled from the light tree without them (0: automatic, see docs/MODEL.md section 4)", Range{0, 1024});
         v.field("target_stderr", target_stderr, "tree, split, uniform, power: per-pixel relative standard error to reach, adding `samples` per round (0: off)", Range{0.0, 1.0});
         v.field("max_samples", max_samples, "cap on samples per pixel when target_stderr is set", Range{1, 1e9});
         v.field("seed", seed, "render seed");
