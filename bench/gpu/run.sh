@@ -176,6 +176,75 @@ step_frame() {
     rm -f "$t"/*.gpuframe
 }
 
+# Every layout's exact frame (quickstart, 320x180), for the per-pixel
+# comparison with the CPU: the layout changes the traversal, not the image.
+step_layout_images() {
+    local q=scenes/quickstart.toml small="-D camera.width=320 -D camera.height=180 -D render.estimator=exact"
+    local t="$W/layout_images"
+    mkdir -p "$t"
+    one() { local name=$1; shift; $BIN $q $small --frames 0:1 --repeat 1 -q -o "$t/$name.{frame}.exr" "$@" || echo "layout_images: $name failed"; }
+    one clusters_all -D geometry.cluster_size=10000000
+    one instances -D geometry.layout=instances
+    one aabbs -D geometry.layout=aabbs
+    one aabbs_all -D geometry.layout=aabbs -D geometry.cluster_size=10000000
+    one instances_disc -D geometry.layout=instances -D geometry.alpha=disc
+    one aabbs_disc -D geometry.layout=aabbs -D geometry.alpha=disc
+    one instances_omm4 -D geometry.layout=instances -D geometry.alpha=disc -D gpu.omm=4state -D gpu.omm_level=4
+    one spheres -D geometry.primitive=sphere
+    one spheres_all -D geometry.primitive=sphere -D geometry.cluster_size=10000000
+    one clusters_graph --build-graph
+    one clusters_threads4 --build-threads 4
+}
+
+# Seed 004's decision matrix: every layout at 10K, 100K and 1M particles,
+# 720p and 1080p, restir (frame 1 after a history frame), per-pass GPU ms
+# (`accretion-optix --timings`) and the acceleration structure's memory
+# (the stats JSON). Build-only variants (refit, several host threads, one
+# CUDA graph) at 1080p. LAYOUT_PARTS=i/n runs the i-th of n parts.
+layout_rows() {
+    local all="-D geometry.cluster_size=10000000"
+    for p in 10000 100000 1000000; do
+        for res in 1280x720 1920x1080; do
+            local pre="p${p}_${res}"
+            echo "${pre}_k25 -D geometry.cluster_size=25"
+            echo "${pre}_k100 -D geometry.cluster_size=100"
+            echo "${pre}_k1000 -D geometry.cluster_size=1000"
+            echo "${pre}_k10000 -D geometry.cluster_size=10000"
+            echo "${pre}_one $all"
+            echo "${pre}_instances -D geometry.layout=instances"
+            echo "${pre}_aabbs_k1000 -D geometry.layout=aabbs -D geometry.cluster_size=1000"
+            echo "${pre}_aabbs_one -D geometry.layout=aabbs $all"
+            echo "${pre}_spheres_k1000 -D geometry.primitive=sphere -D geometry.cluster_size=1000"
+            echo "${pre}_spheres_one -D geometry.primitive=sphere $all"
+            [ "$res" = 1920x1080 ] || continue
+            echo "${pre}_k100_refit -D geometry.cluster_size=100 -D geometry.build=refit"
+            echo "${pre}_one_refit $all -D geometry.build=refit"
+            echo "${pre}_instances_refit -D geometry.layout=instances -D geometry.build=refit"
+            echo "${pre}_k100_threads4 -D geometry.cluster_size=100 --build-threads 4"
+            echo "${pre}_k100_graph -D geometry.cluster_size=100 --build-graph"
+            echo "${pre}_k25_graph -D geometry.cluster_size=25 --build-graph"
+            echo "${pre}_k1000_threads4 -D geometry.cluster_size=1000 --build-threads 4"
+        done
+    done
+}
+
+step_layouts() {
+    local t="$W/layouts" part=${LAYOUT_PARTS:-1/1} k=0
+    mkdir -p "$t"
+    layout_rows | while read -r name args; do
+        k=$((k + 1))
+        [ $(((k - 1) % ${part#*/})) -eq $((${part%/*} - 1)) ] || continue
+        local p=${name#p}; p=${p%%_*}
+        local res=${name#*_}; res=${res%%_*}
+        # shellcheck disable=SC2086  # the overrides are words
+        timeout 120 $BIN scenes/disk_100k.toml -D render.estimator=restir -D particles.count=$p \
+            -D camera.width=${res%x*} -D camera.height=${res#*x} $args --frames 0:2 --repeat 3 -q \
+            -o "$t/$name.{frame}.exr" --timings "$t/$name.timings.csv" --config "$name" < /dev/null \
+            || echo "layouts: $name failed"
+        rm -f "$t"/*.gpuframe
+    done
+}
+
 # Nsight Compute: average active threads per executed instruction of the
 # lighting kernels of a restir frame (quickstart, 320x180, frames 0-1; the
 # BLAS builds, measured before, are left out: their replay is slow and

@@ -104,8 +104,12 @@ struct LaunchParams {
     const float* dmin2 = nullptr;        ///< max(r_i, dmin)^2
     const BillboardFrame* frames = nullptr;
 
-    // Clusters: BLAS c (TLAS instance id c) holds particles
-    // clusterParticle[clusterOffset[c] ..], two triangles each.
+    // The layout (geometry.layout). clusters and aabbs: BLAS c (TLAS
+    // instance id c) holds particles clusterParticle[clusterOffset[c] ..],
+    // two triangles, one sphere or one box each; instances: instance id i is
+    // particle i, its BLAS the unit billboard's two triangles.
+    AccelLayout layout = AccelLayout::clusters;
+    bool spheres = false;                ///< built-in spheres (geometry.primitive = sphere)
     const std::uint32_t* clusterParticle = nullptr;
     const std::uint32_t* clusterOffset = nullptr;
 
@@ -120,9 +124,11 @@ struct LaunchParams {
     LaunchCounters* counters = nullptr;  ///< null: not counted (timed launches: the atomics would be timed too)
 };
 
-/// The particle of a hit: instance (cluster) and primitive (2 per particle).
+/// The particle of a hit: its instance and primitive, by the layout.
 ACC_HD inline std::uint32_t hitParticle(const LaunchParams& p, unsigned instance, unsigned primitive) {
-    return p.clusterParticle[p.clusterOffset[instance] + (primitive >> 1)];
+    if (p.layout == AccelLayout::instances) return instance;
+    const unsigned slot = p.layout == AccelLayout::clusters && !p.spheres ? primitive >> 1 : primitive;
+    return p.clusterParticle[p.clusterOffset[instance] + slot];
 }
 
 }  // namespace accretion::twin

@@ -30,7 +30,8 @@ void logCallback(unsigned level, const char* tag, const char* message, void*) {
 
 }  // namespace
 
-TwinPipeline::TwinPipeline(const std::filesystem::path& programs, bool validation, bool opacityMicromaps) {
+TwinPipeline::TwinPipeline(const std::filesystem::path& programs, bool validation, bool opacityMicromaps, AccelLayout layout,
+                           bool spheres, unsigned sphereBuildFlags) {
     CUDA_CHECK(cudaFree(nullptr));  // the primary context
     OPTIX_CHECK(optixInit());
     OptixDeviceContextOptions options{};
@@ -49,12 +50,20 @@ TwinPipeline::TwinPipeline(const std::filesystem::path& programs, bool validatio
     pipelineOptions.numAttributeValues = 2;
     pipelineOptions.exceptionFlags = OPTIX_EXCEPTION_FLAG_NONE;
     pipelineOptions.pipelineLaunchParamsVariableName = "params";
-    pipelineOptions.usesPrimitiveTypeFlags = OPTIX_PRIMITIVE_TYPE_FLAGS_TRIANGLE;
+    pipelineOptions.usesPrimitiveTypeFlags = spheres                           ? OPTIX_PRIMITIVE_TYPE_FLAGS_SPHERE
+                                             : layout == AccelLayout::aabbs ? OPTIX_PRIMITIVE_TYPE_FLAGS_CUSTOM
+                                                                            : OPTIX_PRIMITIVE_TYPE_FLAGS_TRIANGLE;
     pipelineOptions.allowOpacityMicromaps = opacityMicromaps ? 1 : 0;
     const std::string ir = readBinary(programs);
     char log[4096];
     size_t logSize = sizeof log;
     OPTIX_CHECK(optixModuleCreate(context_, &moduleOptions, &pipelineOptions, ir.data(), ir.size(), log, &logSize, &module_));
+    if (spheres) {
+        OptixBuiltinISOptions builtin{};
+        builtin.builtinISModuleType = OPTIX_PRIMITIVE_TYPE_SPHERE;
+        builtin.buildFlags = sphereBuildFlags;
+        OPTIX_CHECK(optixBuiltinISModuleGet(context_, &moduleOptions, &pipelineOptions, &builtin, &sphereModule_));
+    }
 
     auto group = [&](const OptixProgramGroupDesc& desc) {
         OptixProgramGroupOptions groupOptions{};
@@ -86,6 +95,12 @@ TwinPipeline::TwinPipeline(const std::filesystem::path& programs, bool validatio
         d.hitgroup.entryFunctionNameCH = closestHit;
         d.hitgroup.moduleAH = module_;
         d.hitgroup.entryFunctionNameAH = anyHit;
+        if (spheres) {
+            d.hitgroup.moduleIS = sphereModule_;  // built-in: no entry function
+        } else if (layout == AccelLayout::aabbs) {
+            d.hitgroup.moduleIS = module_;
+            d.hitgroup.entryFunctionNameIS = "__intersection__billboard";
+        }
         return group(d);
     };
     hitPrimary_ = hitGroup("__closesthit__primary", "__anyhit__primary");
@@ -131,6 +146,7 @@ TwinPipeline::~TwinPipeline() {
     for (OptixProgramGroup g : {miss_, hitPrimary_, hitShadow_})
         if (g) optixProgramGroupDestroy(g);
     if (module_) optixModuleDestroy(module_);
+    if (sphereModule_) optixModuleDestroy(sphereModule_);
     if (context_) optixDeviceContextDestroy(context_);
 }
 

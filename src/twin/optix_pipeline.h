@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <string>
 
+#include "accretion/scene/settings.h"
 #include "device_buffer.h"
 
 namespace accretion::twin {
@@ -19,8 +20,11 @@ enum class Raygen { gbuffer, exact, sample, shade, shadeTraverse, count };
 class TwinPipeline {
 public:
     /// programs: the OptiX-IR file built from programs.cu; opacityMicromaps:
-    /// the BLAS may carry opacity micromaps.
-    TwinPipeline(const std::filesystem::path& programs, bool validation, bool opacityMicromaps);
+    /// the BLAS may carry opacity micromaps; layout and spheres pick the hit
+    /// groups' intersection (triangles, the billboard intersection program,
+    /// or OptiX's built-in spheres, whose module takes the BLAS build flags).
+    TwinPipeline(const std::filesystem::path& programs, bool validation, bool opacityMicromaps, AccelLayout layout,
+                 bool spheres, unsigned sphereBuildFlags);
     ~TwinPipeline();
     TwinPipeline(const TwinPipeline&) = delete;
     TwinPipeline& operator=(const TwinPipeline&) = delete;
@@ -32,7 +36,7 @@ public:
 
 private:
     OptixDeviceContext context_ = nullptr;
-    OptixModule module_ = nullptr;
+    OptixModule module_ = nullptr, sphereModule_ = nullptr;
     OptixProgramGroup raygen_[int(Raygen::count)] = {};
     OptixProgramGroup miss_ = nullptr, hitPrimary_ = nullptr, hitShadow_ = nullptr;
     OptixPipeline pipeline_ = nullptr;

@@ -1,6 +1,8 @@
 // The twin's OptiX programs (compiled to OptiX-IR): the G-buffer raygen,
 // the exact estimator's raygen, the uniform / power estimators' raygen,
-// restir's shading raygens, and the hit programs of its two ray types.
+// restir's shading raygens, the hit programs of its two ray types, and the
+// billboard intersection program of the aabbs layout (which runs the disc
+// alpha test itself, so that its hits need no any-hit for it).
 //  - primary rays: closest hit; on disc-alpha billboards an any-hit runs the
 //    alpha test;
 //  - shadow rays (V(x, p_i), docs/MODEL.md section 3): an any-hit excludes the
@@ -26,10 +28,19 @@ namespace {
 // Shadow payload: 0 receiver, 1 light, 2 occluded, 3 any-hit count.
 // Primary payload: 0 instance, 1 primitive, 2-3 barycentrics, 4 t (0xffffffff instance: miss).
 
+/// The quad uv of the current billboard hit: from the triangle's
+/// barycentrics, or the intersection program's attributes (aabbs).
 __device__ Vec2 hitUv() {
-    const float2 b = optixGetTriangleBarycentrics();
-    return quadUv(optixGetPrimitiveIndex() & 1u, b.x, b.y);
+    if (optixIsTriangleHit()) {
+        const float2 b = optixGetTriangleBarycentrics();
+        return quadUv(optixGetPrimitiveIndex() & 1u, b.x, b.y);
+    }
+    return Vec2(__uint_as_float(optixGetAttribute_0()), __uint_as_float(optixGetAttribute_1()));
 }
+
+/// The alpha test runs in the any-hit for triangles; the intersection
+/// program has run it for boxes.
+__device__ bool anyHitAlpha() { return params.discAlpha && params.layout != AccelLayout::aabbs; }
 
 /// V(x, p_i) by render.visibility_rule (the CPU's shadowQuery): true when
 /// no blocker is found (counted into the thread's counters). Trace:
@@ -47,8 +58,11 @@ __device__ Vec2 hitUv() {
 template <bool Trace>
 __device__ bool visible(const ShadingPoint& sp, std::uint32_t light, const LightTerm& t, LaunchCounters& c,
                         bool reorder = false, unsigned hint = 0, unsigned bits = 0) {
-    const ShadowQuery q = shadowQuery<Primitive::billboard>(params.visibility, sp, light, params.position[light],
-                                                            params.radius[light], t);
+    const ShadowQuery q = params.spheres
+                              ? shadowQuery<Primitive::sphere>(params.visibility, sp, light, params.position[light],
+                                                               params.radius[light], t)
+                              : shadowQuery<Primitive::billboard>(params.visibility, sp, light, params.position[light],
+                                                                  params.radius[light], t);
     if (!(q.tfar > q.tnear)) return true;  // an empty interval sees the light (as on the CPU)
     float tnear = q.tnear, tfar = q.tfar;
     const float3 o = make_float3(q.o.x, q.o.y, q.o.z), d = make_float3(q.d.x, q.d.y, q.d.z);
@@ -200,13 +214,17 @@ extern "C" __global__ void __raygen__gbuffer() {
     unsigned inst = 0xffffffffu, prim = 0, b0 = 0, b1 = 0, tb = 0;
     optixTrace(params.tlas, make_float3(cam.position.x, cam.position.y, cam.position.z), make_float3(dir.x, dir.y, dir.z),
                0.0f, __int_as_float(0x7f800000), 0.0f, OptixVisibilityMask(255),
-               params.discAlpha ? OPTIX_RAY_FLAG_NONE : OPTIX_RAY_FLAG_DISABLE_ANYHIT, kPrimaryRay, kRayTypes, kPrimaryRay,
+               anyHitAlpha() ? OPTIX_RAY_FLAG_NONE : OPTIX_RAY_FLAG_DISABLE_ANYHIT, kPrimaryRay, kRayTypes, kPrimaryRay,
                inst, prim, b0, b1, tb);
     GBufferTexel g;
     if (inst != 0xffffffffu) {
         const std::uint32_t j = hitParticle(params, inst, prim);
-        const Vec2 uv = quadUv(prim & 1u, __uint_as_float(b0), __uint_as_float(b1));
-        g = billboardTexel(cam, x, y, dir, j, params.position[j], params.radius[j], params.frames[j], uv, params.model);
+        if (params.spheres) {
+            g = sphereTexel(cam, x, y, dir, j, params.position[j], params.radius[j], __uint_as_float(tb));
+        } else {
+            const Vec2 uv(__uint_as_float(b0), __uint_as_float(b1));
+            g = billboardTexel(cam, x, y, dir, j, params.position[j], params.radius[j], params.frames[j], uv, params.model);
+        }
     }
     params.gbuffer[std::size_t(y) * cam.width + x] = g;
 }
@@ -249,17 +267,41 @@ extern "C" __global__ void __raygen__sample() {
     addCounters(c);
 }
 
+/// The primary hit: instance, primitive, the billboard's quad uv (none for
+/// spheres) and t.
 extern "C" __global__ void __closesthit__primary() {
-    const float2 b = optixGetTriangleBarycentrics();
+    const Vec2 uv = params.spheres ? Vec2(0.0f) : hitUv();
     optixSetPayload_0(optixGetInstanceId());
     optixSetPayload_1(optixGetPrimitiveIndex());
-    optixSetPayload_2(__float_as_uint(b.x));
-    optixSetPayload_3(__float_as_uint(b.y));
+    optixSetPayload_2(__float_as_uint(uv.x));
+    optixSetPayload_3(__float_as_uint(uv.y));
     optixSetPayload_4(__float_as_uint(optixGetRayTmax()));
 }
 
 extern "C" __global__ void __anyhit__primary() {
     if (!insideDisc(hitUv())) optixIgnoreIntersection();
+}
+
+/// The aabbs layout's billboard: the ray meets the plane of particle j's
+/// quad (p_j, r_j right, r_j up) inside the quad (and inside the disc under
+/// disc alpha); the hit reports its quad uv as two attributes. The frame is
+/// the world's (the cluster instances have identity transforms).
+extern "C" __global__ void __intersection__billboard() {
+    const std::uint32_t j = hitParticle(params, optixGetInstanceId(), optixGetPrimitiveIndex());
+    const float3 o3 = optixGetWorldRayOrigin(), d3 = optixGetWorldRayDirection();
+    const Vec3 o(o3.x, o3.y, o3.z), d(d3.x, d3.y, d3.z);
+    const BillboardFrame f = params.frames[j];
+    const Vec3 n = f.normal(), p = params.position[j];
+    const float denom = glm::dot(n, d);
+    if (denom == 0.0f) return;
+    const float t = glm::dot(n, p - o) / denom;
+    if (!(t >= optixGetRayTmin() && t <= optixGetRayTmax())) return;
+    const Vec3 h = o + t * d - p;
+    const float inv = 0.5f / params.radius[j];
+    const Vec2 uv(0.5f + glm::dot(h, f.right) * inv, 0.5f + glm::dot(h, f.up) * inv);
+    if (uv.x < 0.0f || uv.x > 1.0f || uv.y < 0.0f || uv.y > 1.0f) return;
+    if (params.discAlpha && !insideDisc(uv)) return;
+    optixReportIntersection(t, 0, __float_as_uint(uv.x), __float_as_uint(uv.y));
 }
 
 /// A shadow ray's first accepted hit (opacity micromaps only: otherwise
@@ -274,7 +316,7 @@ extern "C" __global__ void __anyhit__shadow() {
     optixSetPayload_3(optixGetPayload_3() + 1);
     const std::uint32_t j = hitParticle(params, optixGetInstanceId(), optixGetPrimitiveIndex());
     if (j == optixGetPayload_0() || j == optixGetPayload_1()) optixIgnoreIntersection();
-    if (params.discAlpha && !insideDisc(hitUv())) optixIgnoreIntersection();
+    if (anyHitAlpha() && !insideDisc(hitUv())) optixIgnoreIntersection();
     optixSetPayload_2(1);
     optixTerminateRay();
 }

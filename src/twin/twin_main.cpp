@@ -29,9 +29,9 @@
 #include "accretion/render/compose_pixel.h"
 #include "accretion/render/upsample_pixel.h"
 #include "accretion/scene/scene_parser.h"
-#include "cluster_accel.h"
 #include "launch_params.h"
 #include "optix_pipeline.h"
+#include "particle_accel.h"
 #include "restir_kernels.h"
 
 #ifndef ACCRETION_TWIN_PROGRAMS
@@ -46,15 +46,17 @@ struct Args {
     std::vector<std::string> defines;
     std::string frames, output, timings, config, programs = ACCRETION_TWIN_PROGRAMS;
     std::string shadowRays = "trace";
-    unsigned repeat = 5, buildStreams = 1, seeds = 1;
-    bool perBlas = false, compact = false, quiet = false, validation = false, skipLighting = false, lrOnly = false;
+    unsigned repeat = 5, buildStreams = 1, buildThreads = 1, seeds = 1;
+    bool buildGraph = false, perBlas = false, compact = false, quiet = false, validation = false, skipLighting = false, lrOnly = false;
 };
 
 /// The pass of `accretion cost` a timed pass belongs to (calibrate joins on
 /// it): the acceleration-structure work of the frame is buildClusters, the
 /// lighting grid's reduction belongs to upsampleLighting.
 std::string costPassOf(const std::string& pass) {
-    if (pass == "expandBillboards" || pass == "buildBlas" || pass == "compactBlas" || pass == "buildTlas") return "buildClusters";
+    if (pass == "expandPrimitives" || pass == "writeInstances" || pass == "buildBlas" || pass == "compactBlas" ||
+        pass == "buildTlas")
+        return "buildClusters";
     if (pass == "reduceGBuffer") return "upsampleLighting";
     return pass;
 }
@@ -64,7 +66,15 @@ void requireSupported(const Settings& s, bool lighting) {
     auto refuse = [](const std::string& what) {
         throw InputError(fmt::format("accretion-optix does not run {} yet (the CPU renderer does)", what));
     };
-    if (s.geometry.primitive != Primitive::billboard) refuse("geometry.primitive = \"sphere\"");
+    const GeometrySettings& g = s.geometry;
+    if (g.primitive == Primitive::sphere && g.layout != AccelLayout::clusters)
+        refuse(fmt::format("geometry.primitive = \"sphere\" with geometry.layout = \"{}\" (spheres: clusters)", enumName(g.layout)));
+    if (g.primitive == Primitive::sphere && g.alpha != AlphaMode::opaque) refuse("geometry.alpha on spheres");
+    if (g.layout == AccelLayout::aabbs && s.gpu.omm != OmmMode::off && g.alpha == AlphaMode::disc)
+        refuse("gpu.omm with geometry.layout = \"aabbs\" (micromaps are for triangles)");
+    if (g.layout == AccelLayout::instances && g.build != BuildPolicy::rebuild && g.build != BuildPolicy::refit)
+        refuse(fmt::format("geometry.build = \"{}\" with geometry.layout = \"instances\" (rebuild or refit the TLAS)",
+                           enumName(g.build)));
     const EstimatorKind e = s.render.estimator;
     if (lighting && e != EstimatorKind::exact && e != EstimatorKind::uniform && e != EstimatorKind::power &&
         e != EstimatorKind::restir)
@@ -168,12 +178,24 @@ int run(const Args& a) {
     CUDA_CHECK(cudaGetDeviceProperties(&prop, 0));
     const std::string device = prop.name;
     const bool omm = settings.geometry.alpha == AlphaMode::disc && settings.gpu.omm != OmmMode::off;
-    TwinPipeline pipeline(a.programs, a.validation, omm);
+    const GeometrySettings& geometry = settings.geometry;
+    AccelOptions accelOptions;
+    accelOptions.layout = geometry.layout;
+    accelOptions.spheres = geometry.primitive == Primitive::sphere;
+    accelOptions.build = geometry.build;
+    accelOptions.rebuildFraction = geometry.rebuild_fraction;
+    accelOptions.pooled = !a.perBlas;
+    accelOptions.compact = a.compact;
+    accelOptions.streams = a.buildStreams;
+    accelOptions.hostThreads = a.buildThreads;
+    accelOptions.graph = a.buildGraph;
+    accelOptions.omm = omm ? settings.gpu.omm : OmmMode::off;
+    accelOptions.ommLevel = settings.gpu.omm_level;
+    TwinPipeline pipeline(a.programs, a.validation, omm, geometry.layout, accelOptions.spheres, blasBuildFlags(accelOptions));
     cudaStream_t stream;
     CUDA_CHECK(cudaStreamCreate(&stream));
     GpuTimer timer(stream);
-    ClusterAccel accel(pipeline.context(), {settings.geometry.build, settings.geometry.rebuild_fraction, !a.perBlas, a.compact,
-                                            a.buildStreams, omm ? settings.gpu.omm : OmmMode::off, settings.gpu.omm_level});
+    ParticleAccel accel(pipeline.context(), accelOptions);
     FrameBuffers buf;
     buf.gbuffer.resize(pixels * sizeof(GBufferTexel));
     buf.Lr.resize(pixels * sizeof(Vec3));
@@ -223,7 +245,9 @@ int run(const Args& a) {
     std::string timingsCsv = "config,pass,ms\n";
     nlohmann::json stats = {{"version", std::string(version())}, {"renderer", "accretion-optix"}, {"device", device},
                             {"scene", settings.scenePath}, {"repeat", a.repeat}, {"allocation", a.perBlas ? "per_blas" : "pooled"},
-                            {"compact", a.compact}, {"build_streams", a.buildStreams}, {"seeds", a.seeds}, {"frames", nlohmann::json::array()}};
+                            {"compact", a.compact}, {"build_streams", a.buildStreams}, {"build_threads", a.buildThreads},
+                            {"build_graph", a.buildGraph}, {"layout", std::string(enumName(settings.geometry.layout))},
+                            {"primitive", std::string(enumName(settings.geometry.primitive))}, {"seeds", a.seeds}, {"frames", nlohmann::json::array()}};
     const std::uint32_t first = settings.render.frame_start, frameCount = settings.render.frames;
     // With --seeds every seed runs the same frames: their particles are loaded once.
     std::map<std::uint32_t, Particles> loaded;
@@ -263,11 +287,14 @@ int run(const Args& a) {
         buf.radius.upload(particles.radius);
         buf.dmin2.upload(dmin2);
         buf.frames.upload(frames);
-        const bool recluster = !built || !persistent;
-        const Clusters clusters = recluster ? clusterParticles(particles.position, settings.geometry.cluster_size) : Clusters{};
+        const bool instances = geometry.layout == AccelLayout::instances;
+        const bool recluster = !instances && (!built || !persistent);
+        const Clusters clusters = recluster ? clusterParticles(particles.position, geometry.cluster_size) : Clusters{};
         if (recluster) current = clusters;
-        if (restir && (recluster || frame == first)) {  // the SER hint: each particle's BLAS
+        if (restir && (recluster || frame == first)) {  // the SER hint: each particle's BLAS (instances: its own)
             std::vector<std::uint32_t> of(n, 0);
+            if (instances)
+                for (std::size_t i = 0; i < n; ++i) of[i] = static_cast<std::uint32_t>(i);
             for (std::size_t c = 0; c < current.count(); ++c)
                 for (std::uint32_t i : current.members(c)) of[i] = static_cast<std::uint32_t>(c);
             buf.particleCluster.upload(of);
@@ -280,6 +307,8 @@ int run(const Args& a) {
         lp.shadows = settings.shading.visibility;
         lp.visibility = VisibilityOptions::from(settings.render);
         lp.omm = omm;
+        lp.layout = geometry.layout;
+        lp.spheres = accelOptions.spheres;
         lp.particleCount = static_cast<std::uint32_t>(n);
         lp.position = buf.position.as<Vec3>();
         lp.emission = buf.emission.as<Vec3>();
@@ -350,11 +379,11 @@ int run(const Args& a) {
         std::map<std::string, std::vector<double>> ms, counted;
         LaunchCounters counters{};
         StoredReservoir* finalReservoirs = nullptr;
-        const DeviceParticles dp{lp.position, lp.radius, lp.frames};
+        const DeviceParticles dp{lp.particleCount, lp.position, lp.radius, lp.frames};
         const unsigned runs = a.repeat > 1 ? a.repeat + 1 : 1;
         for (unsigned r = 0; r < runs; ++r) {
             lp.counters = r == 0 ? buf.counters.as<LaunchCounters>() : nullptr;
-            if (r == 0 || statelessBuild) accel.build(recluster ? &clusters : nullptr, dp, stream, timer);
+            if (r == 0 || statelessBuild) accel.build(recluster || instances ? &clusters : nullptr, dp, stream, timer);
             lp.tlas = accel.tlas();
             lp.clusterParticle = accel.clusterParticle();
             lp.clusterOffset = accel.clusterOffset();
@@ -468,10 +497,13 @@ int run(const Args& a) {
         writeGpuFrame(file, out);
         const AccelStats& as = accel.stats();
         stats["frames"].push_back({{"frame", frame}, {"output", file.string()}, {"particles", n}, {"hit_pixels", hits},
-                                   {"clusters", as.clusters}, {"triangles", as.triangles},
-                                   {"rebuilt_clusters", as.rebuiltClusters}, {"refitted", as.refitted}, {"partial", as.partial},
+                                   {"blases", as.blases}, {"instances", as.instances}, {"primitives", as.primitives},
+                                   {"largest_blas_primitives", as.largestBlas},
+                                   {"rebuilt_blases", as.rebuiltBlases}, {"refitted", as.refitted}, {"partial", as.partial},
+                                   {"graph_replayed", as.graphReplayed},
                                    {"blas_bytes", as.blasBytes}, {"blas_memory_bytes", as.poolBytes},
                                    {"scratch_bytes", as.tempBytes}, {"blas_enqueue_ms", as.blasEnqueueMs}, {"tlas_bytes", as.tlasBytes},
+                                   {"input_bytes", as.inputBytes}, {"accel_total_bytes", as.totalBytes()},
                                    {"primary_rays", pixels}, {"shadow_rays", counters.rays}, {"any_hits", counters.anyHits},
                                    {"compose_nonfinite", nonFinite},
                                    {"shadow_occluded", counters.occluded}, {"light_terms", counters.lightTerms},
@@ -480,7 +512,7 @@ int run(const Args& a) {
         if (!a.quiet) {
             std::string line;
             for (const auto& [pass, v] : ms) line += fmt::format(" {} {:.3f}", pass, median(v));
-            fmt::print(stderr, "frame {}: {} ({} clusters; ms:{})\n", frame, file.string(), as.clusters, line);
+            fmt::print(stderr, "frame {}: {} ({} BLAS, {} instances; ms:{})\n", frame, file.string(), as.blases, as.instances, line);
         }
     }
     const std::filesystem::path first_ = expandPattern(settings.render.output, settings.sceneName, first);
@@ -516,6 +548,11 @@ int main(int argc, char** argv) {
                    "inline-like) or reorder (traverse after optixReorder by the SER key: gpu.ser_hint_bits of the light's BLAS)");
     app.add_option("--build-streams", a.buildStreams, "CUDA streams the BLAS builds are spread over (round robin)")
         ->check(CLI::Range(1, 64));
+    app.add_option("--build-threads", a.buildThreads,
+                   "Host threads issuing the BLAS builds, each on its own stream with its own scratch")
+        ->check(CLI::Range(1, 64));
+    app.add_flag("--build-graph", a.buildGraph,
+                 "Capture the BLAS builds once as a CUDA graph and replay it while the clusters stay the same");
     app.add_flag("--per-blas", a.perBlas, "One cudaMalloc per BLAS instead of one 256-B-aligned pool");
     app.add_flag("--compact", a.compact, "Compact every BLAS after its build");
     app.add_flag("--lr-only", a.lrOnly, "Frames hold Lr alone (for `accretion bias --gpu-frames`; import-gpu refuses them)");

@@ -38,6 +38,7 @@ enum class Primitive { billboard, sphere };
 enum class Orientation { view_plane, view_point, velocity };
 enum class AlphaMode { opaque, disc };
 enum class BuildPolicy { rebuild, refit, fast_trace, partial };
+enum class AccelLayout { clusters, instances, aabbs };
 enum class ShadingModel { lambert, sphere, isotropic };
 enum class EstimatorKind { exact, uniform, power, ris, restir, tree, split };
 enum class BiasCorrection { none, basic, pairwise };
@@ -56,6 +57,7 @@ ACC_ENUM_NAMES(Primitive, "billboard", "sphere");
 ACC_ENUM_NAMES(Orientation, "view_plane", "view_point", "velocity");
 ACC_ENUM_NAMES(AlphaMode, "opaque", "disc");
 ACC_ENUM_NAMES(BuildPolicy, "rebuild", "refit", "fast_trace", "partial");
+ACC_ENUM_NAMES(AccelLayout, "clusters", "instances", "aabbs");
 ACC_ENUM_NAMES(ShadingModel, "lambert", "sphere", "isotropic");
 ACC_ENUM_NAMES(EstimatorKind, "exact", "uniform", "power", "ris", "restir", "tree", "split");
 ACC_ENUM_NAMES(BiasCorrection, "none", "basic", "pairwise");
@@ -170,6 +172,7 @@ struct GeometrySettings {
     Primitive primitive = Primitive::billboard;      ///< billboard quads or procedural spheres
     Orientation orientation = Orientation::view_plane; ///< billboard facing
     AlphaMode alpha = AlphaMode::opaque;             ///< billboard alpha test
+    AccelLayout layout = AccelLayout::clusters;      ///< how the particles become BLASes and TLAS instances
     std::uint32_t cluster_size = 100;                ///< target particles per cluster (one BLAS each)
     BuildPolicy build = BuildPolicy::rebuild;        ///< per-frame BLAS policy
     double rebuild_fraction = 0.7;                   ///< partial: fraction of clusters rebuilt per frame (the GPU pipeline's: 70%)
@@ -179,6 +182,10 @@ struct GeometrySettings {
         v.field("primitive", primitive, "particle geometry");
         v.field("orientation", orientation, "billboard orientation");
         v.field("alpha", alpha, "billboard alpha: opaque quad or alpha-tested disc");
+        v.field("layout", layout,
+                "acceleration layout: clusters (a BLAS of triangles or spheres per cluster; cluster_size >= the "
+                "particle count gives one BLAS), instances (one BLAS of one unit billboard, one TLAS instance per "
+                "particle), aabbs (a BLAS of procedural boxes per cluster, one per particle, with an intersection program)");
         v.field("cluster_size", cluster_size, "target particles per cluster (one BLAS each)", Range{1, 1e7});
         v.field("build", build, "per-frame BLAS policy (partial: rebuild_fraction of the clusters, the rest stale)");
         v.field("rebuild_fraction", rebuild_fraction, "partial: fraction of clusters rebuilt per frame, round robin", Range{0.0, 1.0, true});
