@@ -55,6 +55,20 @@ compare "exact omm2 L4 (GPU) vs any-hit (CPU)" 0 "$T/quickstart_omm2state_l4.000
 compare "offset rule (GPU) vs exact rule (CPU)" 0 "$T/quickstart_offset.0000.exr" "$T/cpu_quickstart.0000.exr"
 compare "offset rule with disc alpha (GPU) vs exact rule (CPU)" 0 "$T/quickstart_disc_offset.0000.exr" "$T/cpu_quickstart_disc.0000.exr"
 
+# Every GPU layout against the CPU's exact frame (the CPU's image does not
+# depend on the layout): layout_images' stems, then the CPU's overrides.
+declare -A layouts=(
+    [clusters_all]="" [instances]="" [aabbs]="" [aabbs_all]="" [clusters_threads4]=""
+    [instances_disc]="${disc[*]}" [aabbs_disc]="${disc[*]}"
+    [instances_omm4]="${disc[*]} -D gpu.omm=4state -D gpu.omm_level=4"
+    [spheres]="-D geometry.primitive=sphere" [spheres_all]="-D geometry.primitive=sphere")
+for name in clusters_all clusters_threads4 instances aabbs aabbs_all instances_disc aabbs_disc instances_omm4 spheres spheres_all; do
+    [ -f "$T/$name.0000.exr" ] || continue
+    # shellcheck disable=SC2086  # the overrides are words
+    cpu "layout_$name" 0:1 -D render.estimator=exact ${layouts[$name]}
+    compare "exact, layout $name" 0 "$T/$name.0000.exr" "$T/cpu_layout_$name.0000.exr"
+done
+
 # restir, frames 0-2: GPU stem, CPU stem, CPU overrides.
 restir_case() {
     local gpu=$1 cpuStem=$2

@@ -192,7 +192,6 @@ step_layout_images() {
     one instances_omm4 -D geometry.layout=instances -D geometry.alpha=disc -D gpu.omm=4state -D gpu.omm_level=4
     one spheres -D geometry.primitive=sphere
     one spheres_all -D geometry.primitive=sphere -D geometry.cluster_size=10000000
-    one clusters_graph --build-graph
     one clusters_threads4 --build-threads 4
 }
 
@@ -221,8 +220,6 @@ layout_rows() {
             echo "${pre}_one_refit $all -D geometry.build=refit"
             echo "${pre}_instances_refit -D geometry.layout=instances -D geometry.build=refit"
             echo "${pre}_k100_threads4 -D geometry.cluster_size=100 --build-threads 4"
-            echo "${pre}_k100_graph -D geometry.cluster_size=100 --build-graph"
-            echo "${pre}_k25_graph -D geometry.cluster_size=25 --build-graph"
             echo "${pre}_k1000_threads4 -D geometry.cluster_size=1000 --build-threads 4"
         done
     done
