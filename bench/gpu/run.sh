@@ -1,6 +1,7 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine (issue 16), from the repository root:
 #   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
+#                                      layout_images layouts streams
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -195,50 +196,43 @@ step_layout_images() {
     one clusters_threads4 --build-threads 4
 }
 
-# Seed 004's decision matrix: every layout at 10K, 100K and 1M particles,
-# 720p and 1080p, restir (frame 1 after a history frame), per-pass GPU ms
-# (`accretion-optix --timings`) and the acceleration structure's memory
-# (the stats JSON). Build-only variants (refit, several host threads, one
-# CUDA graph) at 1080p. LAYOUT_PARTS=i/n runs the i-th of n parts.
-layout_rows() {
-    local all="-D geometry.cluster_size=10000000"
-    for p in 10000 100000 1000000; do
-        for res in 1280x720 1920x1080; do
-            local pre="p${p}_${res}"
-            echo "${pre}_k25 -D geometry.cluster_size=25"
-            echo "${pre}_k100 -D geometry.cluster_size=100"
-            echo "${pre}_k1000 -D geometry.cluster_size=1000"
-            echo "${pre}_k10000 -D geometry.cluster_size=10000"
-            echo "${pre}_one $all"
-            echo "${pre}_instances -D geometry.layout=instances"
-            echo "${pre}_aabbs_k1000 -D geometry.layout=aabbs -D geometry.cluster_size=1000"
-            echo "${pre}_aabbs_one -D geometry.layout=aabbs $all"
-            echo "${pre}_spheres_k1000 -D geometry.primitive=sphere -D geometry.cluster_size=1000"
-            echo "${pre}_spheres_one -D geometry.primitive=sphere $all"
-            [ "$res" = 1920x1080 ] || continue
-            echo "${pre}_k100_refit -D geometry.cluster_size=100 -D geometry.build=refit"
-            echo "${pre}_one_refit $all -D geometry.build=refit"
-            echo "${pre}_instances_refit -D geometry.layout=instances -D geometry.build=refit"
-            echo "${pre}_k100_threads4 -D geometry.cluster_size=100 --build-threads 4"
-            echo "${pre}_k1000_threads4 -D geometry.cluster_size=1000 --build-threads 4"
-        done
-    done
-}
-
+# Seed 004's decision matrix (bench/gpu/layouts.txt): every layout at 10K,
+# 100K and 1M particles, 720p and 1080p, restir (frame 1 after a history
+# frame), per-pass GPU ms (`accretion-optix --timings`) and the acceleration
+# structure's memory (the stats JSON). LAYOUT_PARTS=i/n runs the i-th of n parts.
 step_layouts() {
     local t="$W/layouts" part=${LAYOUT_PARTS:-1/1} k=0
     mkdir -p "$t"
-    layout_rows | while read -r name args; do
+    grep -v '^#' bench/gpu/layouts.txt | while read -r name args; do
+        [ -z "$name" ] && continue
         k=$((k + 1))
         [ $(((k - 1) % ${part#*/})) -eq $((${part%/*} - 1)) ] || continue
-        local p=${name#p}; p=${p%%_*}
-        local res=${name#*_}; res=${res%%_*}
         # shellcheck disable=SC2086  # the overrides are words
-        timeout 120 $BIN scenes/disk_100k.toml -D render.estimator=restir -D particles.count=$p \
-            -D camera.width=${res%x*} -D camera.height=${res#*x} $args --frames 0:2 --repeat 3 -q \
+        timeout 120 $BIN scenes/disk_100k.toml -D render.estimator=restir $args --frames 0:2 --repeat 3 -q \
             -o "$t/$name.{frame}.exr" --timings "$t/$name.timings.csv" --config "$name" < /dev/null \
             || echo "layouts: $name failed"
         rm -f "$t"/*.gpuframe
+    done
+}
+
+# The per-launch costs of many small builds: clusters of 25, 100 and 1000 at
+# 100K and 1M particles, 1080p, with the builds spread over 4 and 16 streams
+# from one host thread, or issued from 4 host threads (each its own stream).
+step_streams() {
+    local t="$W/streams"
+    mkdir -p "$t"
+    for p in 100000 1000000; do
+        for k in 25 100 1000; do
+            for v in streams4:"--build-streams 4" streams16:"--build-streams 16" threads4:"--build-threads 4"; do
+                local n=p${p}_1920x1080_k${k}_${v%%:*}
+                # shellcheck disable=SC2086  # the flags are words
+                timeout 120 $BIN scenes/disk_100k.toml -D render.estimator=restir -D particles.count=$p \
+                    -D camera.width=1920 -D camera.height=1080 -D geometry.cluster_size=$k ${v#*:} --frames 0:2 \
+                    --repeat 3 -q -o "$t/$n.{frame}.exr" --timings "$t/$n.timings.csv" --config "$n" < /dev/null \
+                    || echo "streams: $n failed"
+                rm -f "$t"/*.gpuframe
+            done
+        done
     done
 }
 

@@ -1,14 +1,21 @@
 #!/bin/bash
-# The counters of the cost-model sweep (bench/gpu/sweep.txt), here on the CPU:
-# `accretion cost` of each configuration's frame 1 (one history frame, as the
-# twin's timed frame), one counters CSV for `accretion calibrate`.
-#   bash bench/gpu/sweep_cost.sh OUT_DIR      -> OUT_DIR/counters.csv
+# The counters of the cost-model sweep (bench/gpu/sweep.txt, and the layout
+# rows of bench/gpu/layouts.txt), here on the CPU: `accretion cost` of each
+# configuration's frame 1 (one history frame, as the twin's timed frame), one
+# counters CSV for `accretion calibrate`.
+#   bash bench/gpu/sweep_cost.sh OUT_DIR [LIST...]   -> OUT_DIR/counters.csv
+# (LIST: configuration files, by default bench/gpu/sweep.txt bench/gpu/layouts.txt;
+# a configuration whose .cost.csv is there already is not counted again.)
 set -euo pipefail
-OUT=${1:?usage: sweep_cost.sh OUT_DIR}
+OUT=${1:?usage: sweep_cost.sh OUT_DIR [LIST...]}
+shift
+LISTS=("$@")
+[ ${#LISTS[@]} -gt 0 ] || LISTS=(bench/gpu/sweep.txt bench/gpu/layouts.txt)
 BIN=${ACCRETION:-build/accretion}
 mkdir -p "$OUT"
-grep -v '^#' bench/gpu/sweep.txt | while read -r name args; do
+cat "${LISTS[@]}" | grep -v '^#' | while read -r name args; do
     [ -z "$name" ] && continue
+    [ -f "$OUT/$name.cost.csv" ] && continue
     # shellcheck disable=SC2086  # the overrides are words
     "$BIN" cost scenes/disk_100k.toml -D render.estimator=restir $args --frames 1 --history 1 --overhead 0 \
         --cluster-sizes "" --omm-levels "" --ser-keys hit --config "$name" -q -o "$OUT/$name.cost.json" > /dev/null < /dev/null

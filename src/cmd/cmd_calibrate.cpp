@@ -22,6 +22,7 @@ struct CalibrateArgs {
     CostModelForm form = CostModelForm::shared;
     std::optional<double> holdout;   ///< fraction of the configurations fitted; the rest predicted
     std::uint64_t splitSeed = 1;
+    std::string gpu, measuredAt;     ///< recorded in the coefficients: what measured the timings
 };
 
 /// Held-out errors of every form side by side, per pass.
@@ -84,6 +85,8 @@ void runCalibrate(const CalibrateArgs& args) {
     doc["counters"] = a.counters;
     doc["timings"] = a.timings;
     doc["form"] = costModelFormName(args.form);
+    if (!args.gpu.empty()) doc["gpu"] = args.gpu;
+    if (!args.measuredAt.empty()) doc["measured_at"] = args.measuredAt;
     if (args.holdout) doc["holdout"] = reportHoldout(rows, *args.holdout, args.splitSeed);
     writeJson(a.output, doc);
     fmt::print("coefficients: {} (use with -D gpu.coefficients=\"{}\")\n", a.output, a.output);
@@ -112,6 +115,8 @@ void addCalibrateCommand(CLI::App& app) {
                     "error of predicting the others, per pass")
         ->check(CLI::Range(0.05, 0.95));
     cmd->add_option("--split-seed", args->splitSeed, "Seed of --holdout's split");
+    cmd->add_option("--gpu", args->gpu, "The GPU that measured the timings (recorded; `cost` names it)");
+    cmd->add_option("--measured-at", args->measuredAt, "The commit(s) the timings and counters were measured at (recorded)");
     cmd->callback([args] { runCalibrate(*args); });
 }
 

@@ -36,6 +36,7 @@ struct CostArgs : SceneArgs {
     std::string clusterSizes = "10,100,1000";
     std::string ommLevels = "2,4,6";
     std::vector<std::string> serKeys = {"hit", "hit,type", "hit,type,cluster", "hit,cluster", "hit,type,hint"};
+    bool uncalibrated = false;
 };
 
 std::vector<std::uint32_t> parseList(const std::string& text, const char* option, std::uint32_t lo, std::uint32_t hi) {
@@ -88,6 +89,7 @@ struct CostRun {
 /// Per-pass counters, SIMT, SER and predicted time: the console table and
 /// the CSV calibrate reads (config, pass, features, predicted_ms).
 Table passTable(const GpuReport& r, const CostCoefficients& coef, const std::string& config, double& totalMs) {
+    const char* msTitle = coef.calibrated ? "pred. ms" : "uncal. ms";
     std::vector<Column> columns{{"config", "", 0, "{}", "{}", false}, {"pass", "pass", -20}, {"", "threads", 9},
                                 {"", "trips", 11}, {"", "rays", 10}, {"", "BLAS/ray", 8, "{:.2f}"}, {"", "AH/ray", 8, "{:.2f}"},
                                 {"", "proc/ray", 8, "{:.2f}"}, {"", "MB read", 9, "{:.1f}"}, {"", "MB write", 9, "{:.1f}"},
@@ -95,7 +97,7 @@ Table passTable(const GpuReport& r, const CostCoefficients& coef, const std::str
                                 {"", "model", 9}};
     for (std::string_view f : kCostFeatures) columns.push_back({std::string(f), "", 0, "{}", "{}", false});
     columns.push_back({"working_set_bytes", "", 0, "{}", "{}", false});
-    columns.push_back({"predicted_ms", "pred. ms", 9, "{:.3f}", "{:.6g}"});
+    columns.push_back({coef.calibrated ? "predicted_ms" : "uncalibrated_ms", msTitle, 9, "{:.3f}", "{:.6g}"});
     Table t(columns);
     totalMs = 0.0;
     for (const PassReport& p : r.passes) {
@@ -312,13 +314,12 @@ void runCost(const CostArgs& a) {
     requireWholeImage(settings, "cost");
     std::vector<SerKey> serKeys;
     for (const std::string& k : a.serKeys) serKeys.push_back(SerKey::parse(k, std::max(settings.gpu.ser_hint_bits, 4u), "--ser-keys " + k));
-    const CostCoefficients coef = settings.gpu.coefficients.empty() ? CostCoefficients::defaults()
-                                                                    : CostCoefficients::load(settings.gpu.coefficients);
+    const CostCoefficients coef = CostCoefficients::forSetting(a.uncalibrated ? "uncalibrated" : settings.gpu.coefficients);
     const auto threads = limitThreads(a.threads);
     const std::string prefix = a.output.empty() ? "out/" + settings.sceneName + ".cost" : std::filesystem::path(a.output).replace_extension().string();
     const std::string config = a.config.empty() ? settings.sceneName : a.config;
     OutputGuard guard = sceneInputs(settings);
-    if (!settings.gpu.coefficients.empty()) guard.addInput(settings.gpu.coefficients);
+    if (!settings.gpu.coefficients.empty() && settings.gpu.coefficients != "uncalibrated") guard.addInput(settings.gpu.coefficients);
     checkOutputs(guard, prefix, {".json", ".csv", ".heatmaps.exr"}, "-o");
     const ParticleSource source(settings);
     const CostRun run{a, settings, source, settings.render.frame_start, parseList(a.clusterSizes, "--cluster-sizes", 1, 10000000),
@@ -336,7 +337,10 @@ void runCost(const CostArgs& a) {
     double totalMs = 0.0;
     const Table passes = passTable(r, coef, config, totalMs);
     fmt::print("{}", passes.console());
-    fmt::print("{:<20} predicted {:.3f} ms per frame\n", "total", totalMs);
+    if (coef.calibrated)
+        fmt::print("{:<20} predicted {:.3f} ms per frame ({})\n", "total", totalMs, coef.source);
+    else
+        fmt::print("{:<20} {:.3f} UNCALIBRATED ms per frame (an order-of-magnitude guess, not a measurement)\n", "total", totalMs);
     for (const PassReport& p : r.passes)
         if (p.rays > 0) fmt::print("  {}: {} ({})\n", p.pass, p.rayModel, p.reason);
 
@@ -376,6 +380,9 @@ void addCostCommand(CLI::App& app) {
     cmd->add_option("--cluster-sizes", args->clusterSizes, "BLAS memory table at these cluster sizes (empty: skip)");
     cmd->add_option("--omm-levels", args->ommLevels, "Disc alpha: OMM levels compared with alpha testing (empty: skip)");
     cmd->add_option("--ser-keys", args->serKeys, "SER sort keys compared (each comma-separated hit,type,cluster,hint)");
+    cmd->add_flag("--uncalibrated", args->uncalibrated,
+                  "Price with the uncalibrated order-of-magnitude defaults instead of the committed H100 calibration "
+                  "(labelled as such; = -D gpu.coefficients=uncalibrated)");
     cmd->callback([args] { runCost(*args); });
 }
 

@@ -269,8 +269,8 @@ void printFrame(const Settings& settings, std::uint32_t frame, const nlohmann::j
     for (const auto& [name, count] : fs.nonFinite)
         fmt::print("  {}: {} non-finite values rejected ({})\n", name, count, enumName(settings.render.nonfinite));
     const double lighting = fs.timer.seconds(pass::estimateLighting);
-    fmt::print("frame {}: {} ({:.2f} s, {} particles, {} clusters, build {:.1f} ms, {:.2f} M shadow rays/s)\n", frame,
-               fj["outputs"]["exr"].get<std::string>(), fs.seconds, fs.particles, fs.bvh.clusters,
+    fmt::print("frame {}: {} ({:.2f} s, {} particles, CPU traces {}, build {:.1f} ms, {:.2f} M shadow rays/s)\n", frame,
+               fj["outputs"]["exr"].get<std::string>(), fs.seconds, fs.particles, fs.bvh.layout,
                1e3 * (fs.bvh.clusterSeconds + fs.bvh.blasSeconds + fs.bvh.tlasSeconds),
                lighting > 0 ? 1e-6 * double(fs.lighting.shadowRays) / lighting : 0.0);
     const std::string base = std::filesystem::path(fj["outputs"]["exr"].get<std::string>()).replace_extension().string();

@@ -40,9 +40,7 @@ QueryContext queryContext(RayCounters* counters, std::uint64_t receiver = kNoKey
 /// The disc alpha test of candidate hit i (an any-hit): false rejects it.
 /// With an opacity micromap, opaque and transparent micro-triangles are
 /// decided without the any-hit (nor its count).
-inline bool passesAlpha(const AlphaTest& alpha, const RTCFilterFunctionNArguments* args, unsigned i, RayCounters* counters) {
-    // Embree's quad parametrisation is the billboard's uv.
-    const Vec2 uv(RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i));
+inline bool passesAlpha(const AlphaTest& alpha, Vec2 uv, RayCounters* counters) {
     if (alpha.omm) {
         if (counters) ++counters->ommLookups;
         Vec2 bary;
@@ -58,12 +56,17 @@ inline bool passesAlpha(const AlphaTest& alpha, const RTCFilterFunctionNArgument
     return insideDisc(uv);
 }
 
+/// Embree's quad parametrisation is the billboard's uv.
+inline Vec2 hitUv(const RTCFilterFunctionNArguments* args, unsigned i) {
+    return Vec2(RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i));
+}
+
 /// Closest-hit queries on disc-alpha billboards: the alpha test.
 void discAlphaFilter(const RTCFilterFunctionNArguments* args) {
     const auto* alpha = static_cast<const AlphaTest*>(args->geometryUserPtr);
     RayCounters* counters = reinterpret_cast<const QueryContext*>(args->context)->counters;
     for (unsigned i = 0; i < args->N; ++i)
-        if (args->valid[i] == -1 && !passesAlpha(*alpha, args, i, counters)) args->valid[i] = 0;
+        if (args->valid[i] == -1 && !passesAlpha(*alpha, hitUv(args, i), counters)) args->valid[i] = 0;
 }
 
 /// Occlusion queries: the receiver and the light are excluded by identity
@@ -80,7 +83,8 @@ void occlusionFilter(const RTCFilterFunctionNArguments* args) {
                                   RTCHitN_primID(args->hit, args->N, i);
         if (key == context->exclude[0] || key == context->exclude[1]) args->valid[i] = 0;
         else if constexpr (Alpha) {
-            if (!passesAlpha(*static_cast<const AlphaTest*>(args->geometryUserPtr), args, i, context->counters)) args->valid[i] = 0;
+            if (!passesAlpha(*static_cast<const AlphaTest*>(args->geometryUserPtr), hitUv(args, i), context->counters))
+                args->valid[i] = 0;
         }
     }
 }
@@ -114,13 +118,99 @@ bool overlapsBounds(const RTCBounds& b, const float org[3], const float dir[3], 
     return true;
 }
 
+/// A box primitive's bounds: the billboard's quad or the sphere.
+void boxBounds(const RTCBoundsFunctionArguments* args) {
+    const auto* blas = static_cast<const BoxBlas*>(args->geometryUserPtr);
+    const BoxPrimitive& b = blas->prims[args->primID];
+    const Vec3 e = blas->sphere ? Vec3(b.r) : billboardExtent(b.r, blas->frames[blas->members[args->primID]]);
+    *args->bounds_o = {b.p.x - e.x, b.p.y - e.y, b.p.z - e.z, 0.0f, b.p.x + e.x, b.p.y + e.y, b.p.z + e.z, 0.0f};
+}
+
+/// A ray entering box `prim` of `blas` (as GPU traversal tests each box
+/// before it calls the primitive's program; Embree may call a leaf's
+/// primitives without): counted as an intersection-program invocation, or
+/// for the instances layout as a BLAS (instance) entry of one level; then
+/// the billboard's or sphere's own test and, for instances, the alpha test
+/// of the any-hit (the aabbs layout's program tests alpha itself). True
+/// with t and uv of a hit in [tnear, tfar].
+bool hitBox(const BoxBlas& blas, unsigned prim, const float org[3], const float dir[3], float tnear, float tfar,
+            RayCounters* counters, float& t, Vec2& uv) {
+    const BoxPrimitive& b = blas.prims[prim];
+    const std::uint32_t i = blas.members[prim];
+    const BillboardFrame& f = blas.frames[i];
+    const Vec3 e = blas.sphere ? Vec3(b.r) : billboardExtent(b.r, f);
+    const RTCBounds box{b.p.x - e.x, b.p.y - e.y, b.p.z - e.z, 0.0f, b.p.x + e.x, b.p.y + e.y, b.p.z + e.z, 0.0f};
+    if (!overlapsBounds(box, org, dir, tnear, tfar)) return false;
+    if (counters) {
+        if (blas.instances) {
+            ++counters->blasEntries;
+            ++counters->blasLevels;  // two triangles: one level
+        } else {
+            ++counters->intersections;
+        }
+    }
+    const Vec3 o(org[0], org[1], org[2]), d(dir[0], dir[1], dir[2]);
+    if (blas.sphere) {
+        const Vec3 oc = o - b.p;
+        const float a = glm::dot(d, d), h = glm::dot(d, oc), c = glm::dot(oc, oc) - b.r * b.r;
+        const float disc = h * h - a * c;
+        if (!(disc >= 0.0f)) return false;
+        const float s = std::sqrt(disc), t0 = (-h - s) / a, t1 = (-h + s) / a;
+        t = t0 >= tnear && t0 <= tfar ? t0 : t1;
+        uv = Vec2(0.0f);
+        return t >= tnear && t <= tfar;
+    }
+    const bool alphaInProgram = blas.disc && !blas.instances;
+    if (!intersectBillboard(o, d, tnear, tfar, b.p, b.r, f, alphaInProgram, t, uv)) return false;
+    return !(blas.disc && blas.instances) || passesAlpha(*blas.alpha, uv, counters);
+}
+
+void boxIntersect(const RTCIntersectFunctionNArguments* args) {
+    ACC_CHECK(args->N == 1);  // rtcIntersect1 only (intersect8 traces these one ray at a time)
+    if (args->valid[0] != -1) return;
+    const auto* blas = static_cast<const BoxBlas*>(args->geometryUserPtr);
+    auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
+    const float org[3] = {rh->ray.org_x, rh->ray.org_y, rh->ray.org_z}, dir[3] = {rh->ray.dir_x, rh->ray.dir_y, rh->ray.dir_z};
+    float t;
+    Vec2 uv;
+    if (!hitBox(*blas, args->primID, org, dir, rh->ray.tnear, rh->ray.tfar,
+                reinterpret_cast<const QueryContext*>(args->context)->counters, t, uv))
+        return;
+    rh->ray.tfar = t;
+    rh->hit.u = uv.x;
+    rh->hit.v = uv.y;
+    rh->hit.Ng_x = rh->hit.Ng_y = 0.0f;
+    rh->hit.Ng_z = 1.0f;
+    rh->hit.primID = args->primID;
+    rh->hit.geomID = args->geomID;
+    rh->hit.instID[0] = args->context->instID[0];
+}
+
+void boxOccluded(const RTCOccludedFunctionNArguments* args) {
+    ACC_CHECK(args->N == 1);
+    if (args->valid[0] != -1) return;
+    const auto* blas = static_cast<const BoxBlas*>(args->geometryUserPtr);
+    const auto* context = reinterpret_cast<const QueryContext*>(args->context);
+    auto* ray = reinterpret_cast<RTCRay*>(args->ray);
+    const float org[3] = {ray->org_x, ray->org_y, ray->org_z}, dir[3] = {ray->dir_x, ray->dir_y, ray->dir_z};
+    float t;
+    Vec2 uv;
+    if (!hitBox(*blas, args->primID, org, dir, ray->tnear, ray->tfar, context->counters, t, uv)) return;
+    // The identity exclusion (the any-hit's test): the receiver's and the
+    // light's own primitives are not blockers.
+    const std::uint64_t key = std::uint64_t(args->context->instID[0]) << 32 | args->primID;
+    if (key == context->exclude[0] || key == context->exclude[1]) return;
+    ray->tfar = -std::numeric_limits<float>::infinity();
+}
+
 void instanceIntersect(const RTCIntersectFunctionNArguments* args) {
     if (args->N != 1 || args->valid[0] != -1) return;
     const auto* bvh = static_cast<const ParticleBvh*>(args->geometryUserPtr);
     auto* ray = reinterpret_cast<RTCRayHit*>(args->rayhit);
     const float org[3] = {ray->ray.org_x, ray->ray.org_y, ray->ray.org_z}, dir[3] = {ray->ray.dir_x, ray->ray.dir_y, ray->ray.dir_z};
     if (!overlapsBounds(bvh->blasBounds(args->primID), org, dir, ray->ray.tnear, ray->ray.tfar)) return;
-    if (RayCounters* c = reinterpret_cast<QueryContext*>(args->context)->counters) {
+    if (RayCounters* c = reinterpret_cast<QueryContext*>(args->context)->counters;
+        c && bvh->settings().layout != AccelLayout::instances) {  // instances: each box counts its own entry
         ++c->blasEntries;
         c->blasLevels += bvh->blasLevels(args->primID);
     }
@@ -140,7 +230,8 @@ void instanceOccluded(const RTCOccludedFunctionNArguments* args) {
     const auto* ray = reinterpret_cast<const RTCRay*>(args->ray);
     const float org[3] = {ray->org_x, ray->org_y, ray->org_z}, dir[3] = {ray->dir_x, ray->dir_y, ray->dir_z};
     if (!overlapsBounds(bvh->blasBounds(args->primID), org, dir, ray->tnear, ray->tfar)) return;
-    if (RayCounters* c = reinterpret_cast<QueryContext*>(args->context)->counters) {
+    if (RayCounters* c = reinterpret_cast<QueryContext*>(args->context)->counters;
+        c && bvh->settings().layout != AccelLayout::instances) {  // instances: each box counts its own entry
         ++c->blasEntries;
         c->blasLevels += bvh->blasLevels(args->primID);
     }
@@ -192,9 +283,22 @@ void ParticleBvh::buildBlas(std::size_t c, const Particles& particles, bool crea
                                     (settings_.build == BuildPolicy::refit ? RTC_SCENE_FLAG_DYNAMIC : RTC_SCENE_FLAG_NONE));
         // Billboards are Embree quads (one primitive, builds ~1.5x faster than
         // two triangles); the GPU's two triangles are recovered from uv.
-        geom = rtcNewGeometry(device_.get(), billboards ? RTC_GEOMETRY_TYPE_QUAD : RTC_GEOMETRY_TYPE_SPHERE_POINT);
+        const bool boxes = boxPrimitives();
+        geom = rtcNewGeometry(device_.get(), boxes        ? RTC_GEOMETRY_TYPE_USER
+                                             : billboards ? RTC_GEOMETRY_TYPE_QUAD
+                                                          : RTC_GEOMETRY_TYPE_SPHERE_POINT);
         if (settings_.build == BuildPolicy::refit) rtcSetGeometryBuildQuality(geom, RTC_BUILD_QUALITY_REFIT);
-        if (billboards) {
+        if (boxes) {
+            BoxBlas& b = boxBlas_[c];
+            b = {boxes_.data() + clusters_.offset[c], clusters_.particle.data() + clusters_.offset[c], frames_.data(), &alpha_,
+                 static_cast<std::uint32_t>(c), billboards && settings_.alpha == AlphaMode::disc, !billboards,
+                 settings_.layout == AccelLayout::instances};
+            rtcSetGeometryUserPrimitiveCount(geom, static_cast<unsigned>(n));
+            rtcSetGeometryUserData(geom, &b);
+            rtcSetGeometryBoundsFunction(geom, &boxBounds, &b);
+            rtcSetGeometryIntersectFunction(geom, &boxIntersect);
+            rtcSetGeometryOccludedFunction(geom, &boxOccluded);
+        } else if (billboards) {
             rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, sizeof(float) * 3, 4 * n);
             auto* idx = static_cast<std::uint32_t*>(
                 rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT4, sizeof(std::uint32_t) * 4, n));
@@ -202,20 +306,24 @@ void ParticleBvh::buildBlas(std::size_t c, const Particles& particles, bool crea
         } else {
             rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, sizeof(float) * 4, n);
         }
-        // Every occlusion query excludes its receiver and light by identity.
+        // Every occlusion query excludes its receiver and light by identity
+        // (box primitives: in their own occlusion function).
         const bool alpha = billboards && settings_.alpha == AlphaMode::disc;
-        if (alpha) {
+        if (boxes) {
+        } else if (alpha) {
             rtcSetGeometryUserData(geom, const_cast<AlphaTest*>(&alpha_));
             rtcSetGeometryIntersectFilterFunction(geom, &discAlphaFilter);
         }
-        rtcSetGeometryOccludedFilterFunction(geom, alpha ? &occlusionFilter<true> : &occlusionFilter<false>);
+        if (!boxes) rtcSetGeometryOccludedFilterFunction(geom, alpha ? &occlusionFilter<true> : &occlusionFilter<false>);
         rtcAttachGeometryByID(scene, geom, 0);
         rtcReleaseGeometry(geom);  // the scene keeps it
         blas_[c] = scene;
         geometry_[c] = geom;
     }
     geom = geometry_[c];
-    auto* vtx = static_cast<float*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, 0));
+    const bool boxes = boxPrimitives();
+    auto* vtx = boxes ? nullptr : static_cast<float*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, 0));
+    BoxPrimitive* box = boxes ? boxes_.data() + clusters_.offset[c] : nullptr;
     for (std::size_t k = 0; k < n; ++k) {
         const std::uint32_t i = members[k];
         if (k + 8 < n) {  // members are scattered over the particle arrays
@@ -228,7 +336,9 @@ void ParticleBvh::buildBlas(std::size_t c, const Particles& particles, bool crea
         if (create) where_[i] = std::uint64_t(c) << 32 | k;
         const Vec3 p = particles.position[i];
         const float r = particles.radius[i];
-        if (billboards) {
+        if (boxes) {
+            box[k] = {p, r};
+        } else if (billboards) {
             const BillboardFrame& f = frames_[i];
             const Vec3 a = r * f.right, b = r * f.up;
             const Vec3 corners[4] = {p - a - b, p + a - b, p + a + b, p - a + b};
@@ -241,7 +351,7 @@ void ParticleBvh::buildBlas(std::size_t c, const Particles& particles, bool crea
             vtx[4 * k + 3] = r;
         }
     }
-    if (!create) rtcUpdateGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0);
+    if (!create && !boxes) rtcUpdateGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0);
     rtcCommitGeometry(geom);
     rtcCommitScene(blas_[c]);
 }
@@ -291,7 +401,10 @@ void ParticleBvh::build(const Particles& particles, const Camera& camera) {
 
     auto t0 = std::chrono::steady_clock::now();
     if (!keep) {
-        clusters_ = clusterParticles(particles.position, settings_.cluster_size);
+        // The instances layout: one BLAS of boxes, each box one instance.
+        const std::uint32_t target = settings_.layout == AccelLayout::instances ? std::numeric_limits<std::uint32_t>::max()
+                                                                                : settings_.cluster_size;
+        clusters_ = clusterParticles(particles.position, target);
         stats_.reclustered = true;
     }
     stats_.clusterSeconds = secondsSince(t0);
@@ -311,6 +424,8 @@ void ParticleBvh::build(const Particles& particles, const Camera& camera) {
         blas_.assign(clusters_.count(), nullptr);
         geometry_.assign(clusters_.count(), nullptr);
         where_.resize(n);
+        boxes_.assign(boxPrimitives() ? n : 0, BoxPrimitive{});
+        boxBlas_.assign(boxPrimitives() ? clusters_.count() : 0, BoxBlas{});
     }
     // partial: a window of rebuild_fraction of the clusters, advancing round
     // robin frame by frame; the others keep last frame's (stale) geometry.
@@ -337,9 +452,11 @@ void ParticleBvh::build(const Particles& particles, const Camera& camera) {
     stats_.refitted = refit;
     stats_.partial = keep && settings_.build == BuildPolicy::partial;
     stats_.clusters = clusters_.count();
-    stats_.primitives = settings_.primitive == Primitive::billboard ? 2 * n : n;
-    stats_.triangles = settings_.primitive == Primitive::billboard ? stats_.primitives : 0;
+    const bool triangles = settings_.primitive == Primitive::billboard && settings_.layout == AccelLayout::clusters;
+    stats_.primitives = triangles ? 2 * n : n;
+    stats_.triangles = triangles ? stats_.primitives : 0;
     stats_.embreeBytes = device_.bytesInUse();
+    stats_.layout = describeLayout(settings_);
 }
 
 bool ParticleBvh::intersect(const Vec3& o, const Vec3& d, float tfar, SurfaceHit& hit, RayCounters* counters) const {
@@ -371,6 +488,10 @@ bool ParticleBvh::intersect(const Vec3& o, const Vec3& d, float tfar, SurfaceHit
 }
 
 void ParticleBvh::intersect8(const Vec3& o, const Vec3* d, int n, SurfaceHit* hit, bool* found) const {
+    if (boxPrimitives()) {  // their functions take one ray at a time
+        for (int k = 0; k < n; ++k) found[k] = intersect(o, d[k], std::numeric_limits<float>::infinity(), hit[k]);
+        return;
+    }
     QueryContext context = queryContext(nullptr);
     alignas(32) int valid[8];
     alignas(32) RTCRayHit8 rh;
@@ -425,9 +546,25 @@ bool ParticleBvh::occluded(const Vec3& o, const Vec3& d, float tnear, float tfar
     return ray.tfar < 0.0f;
 }
 
+GeometrySettings cpuGeometry(const GeometrySettings& g, bool counting) {
+    if (counting || g.cpu_layout == CpuLayout::gpu || g.build == BuildPolicy::partial) return g;
+    GeometrySettings one = g;
+    one.layout = AccelLayout::clusters;
+    one.cluster_size = std::numeric_limits<std::uint32_t>::max();
+    return one;
+}
+
+std::string describeLayout(const GeometrySettings& g) {
+    const std::string what = g.primitive == Primitive::sphere ? "spheres" : "billboards";
+    if (g.layout == AccelLayout::instances) return "one TLAS instance per particle (instances layout)";
+    const std::string of = g.layout == AccelLayout::aabbs ? "procedural boxes of " + what : what;
+    if (g.cluster_size == std::numeric_limits<std::uint32_t>::max()) return "one BVH of every particle (" + of + ")";
+    return "BLAS per cluster of " + std::to_string(g.cluster_size) + " (" + of + ")";
+}
+
 AccelCounters ParticleBvh::accelCounters() const {
     AccelCounters a;
-    const bool billboards = settings().primitive == Primitive::billboard;
+    const bool billboards = settings().primitive == Primitive::billboard && settings().layout == AccelLayout::clusters;
     a.blasPrimitives.resize(clusters_.count());
     for (std::size_t c = 0; c < clusters_.count(); ++c)
         a.blasPrimitives[c] = static_cast<std::uint32_t>(clusters_.members(c).size()) * (billboards ? 2u : 1u);

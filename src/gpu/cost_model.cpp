@@ -28,13 +28,16 @@ CostFeatures costFeatures(const PassReport& p, double cacheBytes) {
     return {double(p.threads),     double(p.warpSteps()), double(p.rays),
             double(p.blasEntries), double(p.anyHits),     bytes,
             double(p.blasLevels),  double(p.ommLookups),  double(p.dispatches),
-            double(p.blasBuilds),  double(p.blasRefits),  coldWork(double(p.rays), bytes, p.workingSetBytes, cacheBytes)};
+            double(p.blasBuilds),  double(p.blasRefits),  coldWork(double(p.rays), bytes, p.workingSetBytes, cacheBytes),
+            double(p.build.primitives), double(p.build.primitivesSmall), double(p.build.primitivesMid),
+            double(p.build.customBuilds), double(p.build.tlasInstances), double(p.intersections)};
 }
 
 CostCoefficients CostCoefficients::defaults() {
     CostCoefficients c;
-    c.ns = {0.02, 0.5, 0.5, 0.2, 1.0, 0.002, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};  // the later counters: not in the uncalibrated guess
-    c.source = "defaults (uncalibrated)";
+    c.ns = {0.02, 0.5, 0.5, 0.2, 1.0, 0.002};  // the later counters: not in the uncalibrated guess
+    c.source = "defaults (uncalibrated: an order-of-magnitude guess, not a measurement)";
+    c.calibrated = false;
     return c;
 }
 
@@ -47,10 +50,30 @@ CostCoefficients CostCoefficients::load(const std::string& path) {
     } catch (const nlohmann::json::exception& e) {
         throw InputError(fmt::format("{}: not JSON: {}", path, e.what()));
     }
+    CostCoefficients out = fromJson(j, path);
+    out.source = out.gpu.empty() ? path : fmt::format("{} ({}, measured at {})", path, out.gpu, out.measuredAt);
+    return out;
+}
+
+CostCoefficients CostCoefficients::committed() {
+    CostCoefficients out = fromJson(nlohmann::json::parse(defaultCoefficientsJson()), kDefaultCoefficientsFile);
+    out.source = fmt::format("{} calibration of {}, measured at {}", out.gpu, kDefaultCoefficientsFile, out.measuredAt);
+    return out;
+}
+
+CostCoefficients CostCoefficients::forSetting(const std::string& setting) {
+    if (setting.empty()) return committed();
+    if (setting == "uncalibrated") return defaults();
+    return load(setting);
+}
+
+CostCoefficients CostCoefficients::fromJson(const nlohmann::json& j, const std::string& path) {
     const nlohmann::json* c = j.contains("coefficients_ns") ? &j["coefficients_ns"] : nullptr;
     if (!c || !c->is_object()) throw InputError(fmt::format("{}: no \"coefficients_ns\" object", path));
     CostCoefficients out;
     out.source = path;
+    if (j.contains("gpu") && j["gpu"].is_string()) out.gpu = j["gpu"].get<std::string>();
+    if (j.contains("measured_at") && j["measured_at"].is_string()) out.measuredAt = j["measured_at"].get<std::string>();
     // The counters after the first six are optional (files of the first form lack them).
     auto read = [&](const nlohmann::json& obj, const std::string& where, CostFeatures& into) {
         for (std::size_t k = 0; k < kCostFeatures.size(); ++k) {
@@ -82,7 +105,9 @@ CostCoefficients CostCoefficients::load(const std::string& path) {
 nlohmann::json CostCoefficients::toJson() const {
     nlohmann::json c;
     for (std::size_t k = 0; k < kCostFeatures.size(); ++k) c[std::string(kCostFeatures[k])] = ns[k];
-    nlohmann::json j = {{"coefficients_ns", c}, {"cache_bytes", cacheBytes}, {"source", source}};
+    nlohmann::json j = {{"coefficients_ns", c}, {"cache_bytes", cacheBytes}, {"source", source}, {"calibrated", calibrated}};
+    if (!gpu.empty()) j["gpu"] = gpu;
+    if (!measuredAt.empty()) j["measured_at"] = measuredAt;
     for (const auto& [pass, f] : perPass)
         for (std::size_t k = 0; k < kCostFeatures.size(); ++k) j["per_pass_ns"][pass][std::string(kCostFeatures[k])] = f[k];
     return j;

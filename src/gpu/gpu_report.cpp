@@ -52,6 +52,7 @@ PassReport summarise(const PassCounters& pc, const GpuSettings& gpu, const SerKe
     p.dispatches = pc.dispatches;
     p.blasBuilds = pc.blasBuilds;
     p.blasRefits = pc.blasRefits;
+    p.build = pc.build;
     for (const ThreadCounters& t : pc.threads) {
         p.threads += t.active;
         p.hitThreads += t.hit;
@@ -63,6 +64,7 @@ PassReport summarise(const PassCounters& pc, const GpuSettings& gpu, const SerKe
         p.anyHits += t.anyHits;
         p.blasLevels += t.blasLevels;
         p.ommLookups += t.ommLookups;
+        p.intersections += t.intersections;
         p.bytesRead += t.bytesRead;
         p.bytesWritten += t.bytesWritten;
     }
@@ -148,6 +150,10 @@ nlohmann::json toJson(const PassReport& p) {
             {"dispatches", p.dispatches},
             {"blas_builds", p.blasBuilds},
             {"blas_refits", p.blasRefits},
+            {"build_primitives", p.build.primitives},
+            {"custom_builds", p.build.customBuilds},
+            {"tlas_instances", p.build.tlasInstances},
+            {"intersections", p.intersections},
             {"working_set_bytes", p.workingSetBytes},
             {"trips", p.trips},
             {"max_trips", p.maxTrips},

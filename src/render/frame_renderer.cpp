@@ -13,23 +13,45 @@ namespace accretion {
 namespace {
 
 /// buildClusters as a dispatch of one thread per cluster (counting mode):
-/// its primitives as loop trips, particle records read, BLAS bytes written.
+/// its primitives as loop trips, particle records read, BLAS bytes written;
+/// the builds as the cost model prices them (BuildCounters). The instances
+/// layout is one thread per particle writing its instance record; its BLAS
+/// (the unit billboard) is built once, so only the TLAS is built per frame.
 void recordClusterBuild(const ParticleBvh& bvh, const Particles& particles, FrameCounters& counters) {
     const Clusters& clusters = bvh.clusters();
-    PassCounters& pc = counters.add(pass::buildClusters, static_cast<std::uint32_t>(clusters.count()), 1);
-    // The GPU's launches: one build (or refit) per BLAS updated, the billboard expansion and the TLAS.
     const BvhStats& s = bvh.stats();
+    const GeometrySettings& g = bvh.settings();
+    if (g.layout == AccelLayout::instances) {
+        const auto n = static_cast<std::uint32_t>(particles.size());
+        PassCounters& pc = counters.add(pass::buildClusters, n, 1);
+        pc.dispatches = 2;  // the instance records, the TLAS
+        pc.build.tlasInstances = n;
+        for (ThreadCounters& t : pc.threads) {
+            t.active = 1;
+            t.trips = 1;
+            t.bytesRead = gpu_layout::kParticleRecord;
+            t.bytesWritten = 64;  // OptixInstance
+        }
+        return;
+    }
+    PassCounters& pc = counters.add(pass::buildClusters, static_cast<std::uint32_t>(clusters.count()), 1);
+    // The GPU's launches: one build (or refit) per BLAS updated, the primitive expansion and the TLAS.
     pc.dispatches = 2;
     (s.refitted ? pc.blasRefits : pc.blasBuilds) = s.rebuiltClusters;
-    const bool billboards = bvh.settings().primitive == Primitive::billboard;
+    pc.build.tlasInstances = clusters.count();
+    const bool triangles = g.primitive == Primitive::billboard && g.layout == AccelLayout::clusters;
+    const bool custom = !triangles;  // boxes or spheres
     for (std::size_t c = 0; c < clusters.count(); ++c) {
         ThreadCounters& t = pc.threads[c];
         const auto n = static_cast<std::uint32_t>(clusters.members(c).size());
         t.active = 1;
         t.cluster = static_cast<std::uint32_t>(c);
-        t.trips = billboards ? 2 * n : n;
+        t.trips = triangles ? 2 * n : n;
         t.bytesRead = n * gpu_layout::kParticleRecord;
-        t.bytesWritten = billboards ? n * (4 * 12 + 2 * 12) : n * 16;  // vertex + index buffers, or sphere points
+        // vertex + index buffers, sphere points, or boxes (OptixAabb)
+        t.bytesWritten = triangles ? n * (4 * 12 + 2 * 12) : g.layout == AccelLayout::aabbs ? n * 24 : n * 16;
+        // The partial policy rebuilds a window of the clusters: their sizes are alike, so the first ones stand in.
+        if (c < s.rebuiltClusters) pc.build.addBlas(t.trips, custom);
     }
 }
 
@@ -89,7 +111,7 @@ void composeImage(const GBuffer& gbuffer, const Particles& particles, const Shad
 FrameRenderer::FrameRenderer(const Settings& settings, ParticleSource source, RenderOptions options)
     : settings_(settings), cameras_(settings.camera), plan_(planFrame(settings, FrameFacts{})), source_(std::move(source)), options_(options),
       device_(std::make_unique<EmbreeDevice>()),
-      bvh_(std::make_unique<ParticleBvh>(*device_, settings.geometry, settings.gpu)) {
+      bvh_(std::make_unique<ParticleBvh>(*device_, cpuGeometry(settings.geometry, settings.gpu.counters), settings.gpu)) {
     if (settings_.render.estimator == EstimatorKind::restir) restir_ = std::make_unique<Restir>(settings_, plan_.keepHistory);
 }
 
@@ -116,7 +138,8 @@ const Particles& FrameRenderer::prepareGeometry(std::uint32_t frame, const Camer
         auto t = stats.timer.scope(pass::buildClusters);
         if (plan_.previousBvh) {  // double buffer: last frame's BVH stays valid
             std::swap(bvh_, previousBvh_);
-            if (!bvh_) bvh_ = std::make_unique<ParticleBvh>(*device_, settings_.geometry, settings_.gpu);
+            if (!bvh_)
+                bvh_ = std::make_unique<ParticleBvh>(*device_, cpuGeometry(settings_.geometry, settings_.gpu.counters), settings_.gpu);
         }
         bvh_->build(particles, camera);
         built_ = true;

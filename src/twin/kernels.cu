@@ -41,7 +41,7 @@ __global__ void expandBillboardBoxesKernel(const std::uint32_t* clusterParticle,
     const Vec3 p = position[i];
     const float r = radius[i];
     const BillboardFrame f = frames[i];
-    const Vec3 e = r * (glm::abs(f.right) + glm::abs(f.up));
+    const Vec3 e = billboardExtent(r, f);
     const Vec3 lo = p - e, hi = p + e;
     boxes[slot] = {nextafterf(lo.x, -INFINITY), nextafterf(lo.y, -INFINITY), nextafterf(lo.z, -INFINITY),
                    nextafterf(hi.x, INFINITY),  nextafterf(hi.y, INFINITY),  nextafterf(hi.z, INFINITY)};

@@ -288,20 +288,12 @@ extern "C" __global__ void __anyhit__primary() {
 /// the world's (the cluster instances have identity transforms).
 extern "C" __global__ void __intersection__billboard() {
     const std::uint32_t j = hitParticle(params, optixGetInstanceId(), optixGetPrimitiveIndex());
-    const float3 o3 = optixGetWorldRayOrigin(), d3 = optixGetWorldRayDirection();
-    const Vec3 o(o3.x, o3.y, o3.z), d(d3.x, d3.y, d3.z);
-    const BillboardFrame f = params.frames[j];
-    const Vec3 n = f.normal(), p = params.position[j];
-    const float denom = glm::dot(n, d);
-    if (denom == 0.0f) return;
-    const float t = glm::dot(n, p - o) / denom;
-    if (!(t >= optixGetRayTmin() && t <= optixGetRayTmax())) return;
-    const Vec3 h = o + t * d - p;
-    const float inv = 0.5f / params.radius[j];
-    const Vec2 uv(0.5f + glm::dot(h, f.right) * inv, 0.5f + glm::dot(h, f.up) * inv);
-    if (uv.x < 0.0f || uv.x > 1.0f || uv.y < 0.0f || uv.y > 1.0f) return;
-    if (params.discAlpha && !insideDisc(uv)) return;
-    optixReportIntersection(t, 0, __float_as_uint(uv.x), __float_as_uint(uv.y));
+    const float3 o = optixGetWorldRayOrigin(), d = optixGetWorldRayDirection();
+    float t;
+    Vec2 uv;
+    if (intersectBillboard(Vec3(o.x, o.y, o.z), Vec3(d.x, d.y, d.z), optixGetRayTmin(), optixGetRayTmax(),
+                           params.position[j], params.radius[j], params.frames[j], params.discAlpha, t, uv))
+        optixReportIntersection(t, 0, __float_as_uint(uv.x), __float_as_uint(uv.y));
 }
 
 /// A shadow ray's first accepted hit (opacity micromaps only: otherwise

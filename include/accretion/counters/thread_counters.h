@@ -13,6 +13,7 @@ struct RayCounters {
     std::uint32_t candidates = 0;   ///< non-opaque candidates seen (RayQuery Proceed() returning true)
     std::uint32_t blasLevels = 0;   ///< per BLAS entered, its depth: ceil(log2(primitives)) (traversal inside it)
     std::uint32_t ommLookups = 0;   ///< candidate hits on micromapped triangles (the micromap looked up)
+    std::uint32_t intersections = 0;///< intersection-program invocations: boxes (aabbs layout) or spheres whose bounds the ray entered
 };
 
 /// The work of one pixel's thread in one pass (docs/MODEL.md section 6). The
@@ -31,6 +32,7 @@ struct ThreadCounters {
     std::uint32_t anyHits = 0;      ///< any-hit invocations
     std::uint32_t blasLevels = 0;   ///< BLAS depths entered, summed over the thread's rays
     std::uint32_t ommLookups = 0;   ///< micromap lookups, summed over the thread's rays
+    std::uint32_t intersections = 0;///< intersection-program invocations, summed over the thread's rays
     std::uint32_t bytesRead = 0;    ///< G-buffer, reservoirs, particle records read
     std::uint32_t bytesWritten = 0; ///< G-buffer, reservoirs, radiance written
 
@@ -43,8 +45,29 @@ struct ThreadCounters {
         anyHits += r.anyHits;
         blasLevels += r.blasLevels;
         ommLookups += r.ommLookups;
+        intersections += r.intersections;
     }
     void addRay(const RayCounters& r) { addRays(r, 1); }
+};
+
+/// buildClusters' acceleration-structure work as the cost model prices it:
+/// a build's time is a launch plus a cost per primitive that falls as the
+/// build grows (a small build leaves the GPU idle, a big one fills it), so
+/// its primitives are counted whole and clamped at two knots (Sigma n,
+/// Sigma min(n, 1024), Sigma min(n, 32768) over the BLAS built or refitted);
+/// the BLAS of boxes or spheres built, and the TLAS's instances.
+struct BuildCounters {
+    std::uint64_t primitives = 0, primitivesSmall = 0, primitivesMid = 0;
+    std::uint64_t customBuilds = 0;   ///< BLAS builds or refits of procedural boxes or spheres
+    std::uint64_t tlasInstances = 0;
+    static constexpr std::uint64_t kSmallKnot = 1024, kMidKnot = 32768;
+    /// One BLAS of n primitives built or refitted.
+    void addBlas(std::uint64_t n, bool custom) {
+        primitives += n;
+        primitivesSmall += n < kSmallKnot ? n : kSmallKnot;
+        primitivesMid += n < kMidKnot ? n : kMidKnot;
+        customBuilds += custom;
+    }
 };
 
 /// One pass's dispatch: a width x height grid of threads (pixels; for
@@ -57,6 +80,7 @@ struct PassCounters {
     // Launches beside the threads (cost model features): kernel dispatches,
     // and for buildClusters the BLAS built and refitted (one launch each).
     std::uint64_t dispatches = 1, blasBuilds = 0, blasRefits = 0;
+    BuildCounters build;  ///< buildClusters only
 
     PassCounters() = default;
     PassCounters(std::string_view name, std::uint32_t w, std::uint32_t h)

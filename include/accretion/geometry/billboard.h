@@ -42,6 +42,27 @@ ACC_HD inline bool insideDisc(Vec2 uv) {
     return glm::dot(c, c) <= 0.25f;
 }
 
+/// The billboard as a procedural primitive (the aabbs layout's intersection
+/// program on the GPU, the CPU's box primitives): where o + t d, t in
+/// [tmin, tmax], meets the plane of the quad p -+ r right -+ r up inside the
+/// quad (and inside the disc when `disc`); t and the quad uv.
+ACC_HD inline bool intersectBillboard(const Vec3& o, const Vec3& d, float tmin, float tmax, const Vec3& p, float r,
+                                      const BillboardFrame& f, bool disc, float& t, Vec2& uv) {
+    const Vec3 n = f.normal();
+    const float denom = glm::dot(n, d);
+    if (denom == 0.0f) return false;
+    t = glm::dot(n, p - o) / denom;
+    if (!(t >= tmin && t <= tmax)) return false;
+    const Vec3 h = o + t * d - p;
+    const float inv = 0.5f / r;
+    uv = Vec2(0.5f + glm::dot(h, f.right) * inv, 0.5f + glm::dot(h, f.up) * inv);
+    if (uv.x < 0.0f || uv.x > 1.0f || uv.y < 0.0f || uv.y > 1.0f) return false;
+    return !disc || insideDisc(uv);
+}
+
+/// The bounds of a billboard's quad: p -+ r (|right| + |up|) per axis.
+ACC_HD inline Vec3 billboardExtent(float r, const BillboardFrame& f) { return r * (glm::abs(f.right) + glm::abs(f.up)); }
+
 /// Normal of the sphere impostor at quad uv: (x, y, sqrt(1-x^2-y^2)) in the
 /// billboard frame, x, y = 2 uv - 1, clamped to the rim (z = 0) outside the
 /// disc. In double: near the rim z moves fast with uv.

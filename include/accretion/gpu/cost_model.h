@@ -19,13 +19,24 @@ namespace accretion {
 /// the launches (kernel dispatches, BLAS builds and refits: a constant
 /// cost each; the number of builds, not their triangles, set the build
 /// time), and cold_work (coldWork: random reads of a working set larger
-/// than a cache). Counter CSVs without them read as 0.
-inline constexpr std::array<std::string_view, 12> kCostFeatures = {
-    "threads",     "warp_steps",  "rays",       "blas_entries", "any_hits",   "bytes",
-    "blas_levels", "omm_lookups", "dispatches", "blas_builds",  "blas_refits", "cold_work"};
+/// than a cache). The layouts (one BLAS to one per particle, boxes,
+/// spheres, instances) added the build's primitives whole and clamped per
+/// BLAS at 1024 and 32768 (BuildCounters: a build's cost per primitive
+/// falls as it fills the GPU), the builds of boxes or spheres, the TLAS's
+/// instances and the intersection-program invocations. Counter CSVs
+/// without them read as 0.
+inline constexpr std::array<std::string_view, 18> kCostFeatures = {
+    "threads",          "warp_steps",          "rays",        "blas_entries",   "any_hits",    "bytes",
+    "blas_levels",      "omm_lookups",         "dispatches",  "blas_builds",    "blas_refits", "cold_work",
+    "build_primitives", "build_primitives_1k", "build_primitives_32k", "custom_builds", "tlas_instances", "intersections"};
 inline constexpr std::size_t kBaseCostFeatures = 6;
 inline constexpr std::size_t kColdWork = 11;
 using CostFeatures = std::array<double, kCostFeatures.size()>;
+
+/// The committed calibration (compiled in from this file of the source tree).
+inline constexpr const char* kDefaultCoefficientsFile = "bench/gpu/results/fit/coefficients_h100.json";
+/// Its text (generated/default_coefficients.cpp).
+const char* defaultCoefficientsJson();
 
 /// The cache the working-set term assumes before calibration (calibrate
 /// chooses its own by cross-validation).
@@ -60,14 +71,26 @@ struct CostCoefficients {
     CostFeatures ns{};
     std::map<std::string, CostFeatures> perPass;  ///< per_pass form: by pass name (spatialResampling[2] uses spatialResampling's)
     double cacheBytes = kDefaultCacheBytes;       ///< the cache of cold_work
-    std::string source;  ///< "defaults (uncalibrated)" or the file read
+    std::string source;      ///< where they came from, in words
+    bool calibrated = true;  ///< false: defaults(), an order-of-magnitude guess
+    std::string gpu;         ///< the GPU the timings were measured on (calibrate --gpu)
+    std::string measuredAt;  ///< the commit(s) that measured them (calibrate --measured-at)
 
     /// Order-of-magnitude defaults for a current desktop RTX GPU, for use
     /// before calibration: 50 G threads/s, 2 G warp steps/s, 2 G rays/s,
-    /// 5 G BLAS entries/s, 1 G any-hits/s, 500 GB/s.
+    /// 5 G BLAS entries/s, 1 G any-hits/s, 500 GB/s. Uncalibrated: only on request.
     static CostCoefficients defaults();
     /// Reads a file written by save() / `accretion calibrate`; throws InputError naming it.
     static CostCoefficients load(const std::string& path);
+    /// The calibration committed with the project (bench/gpu/results/fit/
+    /// coefficients_h100.json, compiled in): what `accretion cost` prices with
+    /// by default.
+    static CostCoefficients committed();
+    /// By gpu.coefficients: "" the committed calibration, "uncalibrated" the
+    /// defaults, else the file.
+    static CostCoefficients forSetting(const std::string& setting);
+    /// The parsed JSON of a coefficients file; `name` names it in errors.
+    static CostCoefficients fromJson(const nlohmann::json& j, const std::string& name);
     nlohmann::json toJson() const;
 
     /// With the shared coefficients.

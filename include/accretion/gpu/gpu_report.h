@@ -21,7 +21,9 @@ struct PassReport {
     std::uint64_t trips = 0, rays = 0, proceeds = 0, blasEntries = 0, anyHits = 0;
     std::uint64_t bytesRead = 0, bytesWritten = 0;
     std::uint64_t blasLevels = 0, ommLookups = 0;                 ///< BLAS depths entered, micromap lookups
+    std::uint64_t intersections = 0;                             ///< intersection-program invocations (boxes, spheres)
     std::uint64_t dispatches = 1, blasBuilds = 0, blasRefits = 0;  ///< launches beside the threads (PassCounters)
+    BuildCounters build;                                          ///< buildClusters: primitives built, TLAS instances
     /// Bytes of what the pass reads at random: the acceleration structures
     /// (traced passes), the light records (restir's resampling passes), else
     /// 0. With more of it than a cache holds, its reads miss (the cost model's

@@ -39,6 +39,7 @@ enum class Orientation { view_plane, view_point, velocity };
 enum class AlphaMode { opaque, disc };
 enum class BuildPolicy { rebuild, refit, fast_trace, partial };
 enum class AccelLayout { clusters, instances, aabbs };
+enum class CpuLayout { fastest, gpu };
 enum class ShadingModel { lambert, sphere, isotropic };
 enum class EstimatorKind { exact, uniform, power, ris, restir, tree, split };
 enum class BiasCorrection { none, basic, pairwise };
@@ -58,6 +59,7 @@ ACC_ENUM_NAMES(Orientation, "view_plane", "view_point", "velocity");
 ACC_ENUM_NAMES(AlphaMode, "opaque", "disc");
 ACC_ENUM_NAMES(BuildPolicy, "rebuild", "refit", "fast_trace", "partial");
 ACC_ENUM_NAMES(AccelLayout, "clusters", "instances", "aabbs");
+ACC_ENUM_NAMES(CpuLayout, "fastest", "gpu");
 ACC_ENUM_NAMES(ShadingModel, "lambert", "sphere", "isotropic");
 ACC_ENUM_NAMES(EstimatorKind, "exact", "uniform", "power", "ris", "restir", "tree", "split");
 ACC_ENUM_NAMES(BiasCorrection, "none", "basic", "pairwise");
@@ -174,6 +176,7 @@ struct GeometrySettings {
     AlphaMode alpha = AlphaMode::opaque;             ///< billboard alpha test
     AccelLayout layout = AccelLayout::clusters;      ///< how the particles become BLASes and TLAS instances
     std::uint32_t cluster_size = 100;                ///< target particles per cluster (one BLAS each)
+    CpuLayout cpu_layout = CpuLayout::fastest;       ///< what the CPU renderer traces (images do not depend on it)
     BuildPolicy build = BuildPolicy::rebuild;        ///< per-frame BLAS policy
     double rebuild_fraction = 0.7;                   ///< partial: fraction of clusters rebuilt per frame (the GPU pipeline's: 70%)
     bool watertight = false;                         ///< Embree robust mode: watertight quads (slower)
@@ -186,6 +189,10 @@ struct GeometrySettings {
                 "acceleration layout: clusters (a BLAS of triangles or spheres per cluster; cluster_size >= the "
                 "particle count gives one BLAS), instances (one BLAS of one unit billboard, one TLAS instance per "
                 "particle), aabbs (a BLAS of procedural boxes per cluster, one per particle, with an intersection program)");
+        v.field("cpu_layout", cpu_layout,
+                "what the CPU renderer traces: fastest (one Embree BVH of every particle; the image does not depend on "
+                "the layout) or gpu (geometry.layout and cluster_size). Counting (cost, gpu.counters) and the partial "
+                "build policy, whose stale clusters change the image, always trace the GPU's layout");
         v.field("cluster_size", cluster_size, "target particles per cluster (one BLAS each)", Range{1, 1e7});
         v.field("build", build, "per-frame BLAS policy (partial: rebuild_fraction of the clusters, the rest stale)");
         v.field("rebuild_fraction", rebuild_fraction, "partial: fraction of clusters rebuilt per frame, round robin", Range{0.0, 1.0, true});
