@@ -32,6 +32,7 @@
 #include "accretion/core/atomic_file.h"
 #include "accretion/scene/toml_limits.h"
 #include "accretion/io/stats_writer.h"
+#include "child_process.h"
 #include "commands.h"
 #include "jobs_file.h"
 
@@ -114,40 +115,6 @@ struct Running {
     pid_t pid;
     std::chrono::steady_clock::time_point start;
 };
-
-pid_t spawn(const std::vector<std::string>& argv, const std::filesystem::path& log) {
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-    std::vector<char*> args;
-    for (const std::string& s : argv) args.push_back(const_cast<char*>(s.c_str()));
-    args.push_back(nullptr);
-    // Its own process group: a terminal's Ctrl-C reaches the batch only,
-    // which forwards it once (a second signal would stop a render at once).
-    posix_spawnattr_t attr;
-    posix_spawnattr_init(&attr);
-    posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP);
-    posix_spawnattr_setpgroup(&attr, 0);
-    pid_t pid = 0;
-    const int rc = posix_spawn(&pid, "/proc/self/exe", &actions, &attr, args.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    posix_spawnattr_destroy(&attr);
-    if (rc != 0) throw InternalError(fmt::format("cannot start a render process: {}", std::strerror(rc)));
-    return pid;
-}
-
-/// The last non-empty line of a log (the error of a failed job).
-std::string lastLine(const std::filesystem::path& log) {
-    std::ifstream in(log);
-    std::string line, last;
-    while (std::getline(in, line)) {
-        const auto cr = line.rfind('\r');  // progress lines
-        if (cr != std::string::npos) line = line.substr(cr + 1);
-        if (!line.empty()) last = line;
-    }
-    return last;
-}
 
 /// The files a finished job wrote, as its render listed them (--outputs-file).
 nlohmann::json jobOutputs(const std::filesystem::path& manifest) {
@@ -269,7 +236,7 @@ void runBatch(BatchArgs args) {
             const std::vector<std::string> argv = renderArgv(j, args);
             results[next] = {{"name", j.name}, {"outcome", "running"}, {"log", log.string()},
                              {"command", fmt::format("accretion {}", fmt::join(argv.begin() + 1, argv.end(), " "))}};
-            running.push_back({next, spawn(argv, log), std::chrono::steady_clock::now()});
+            running.push_back({next, spawnSelf(argv, log), std::chrono::steady_clock::now()});
             if (!args.quiet) fmt::print(stderr, "accretion batch: [{}/{}] {} started\n", next + 1, jobs.size(), j.name);
             ++next;
         }

@@ -77,5 +77,6 @@ void addMergeCommand(CLI::App& app);
 void addBatchCommand(CLI::App& app);
 void addCamerasCommand(CLI::App& app);
 void addImportGpuCommand(CLI::App& app);
+void addTuneCommand(CLI::App& app);
 
 }  // namespace accretion::cmd

@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
     accretion::cmd::addBatchCommand(app);
     accretion::cmd::addCamerasCommand(app);
     accretion::cmd::addImportGpuCommand(app);
+    accretion::cmd::addTuneCommand(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

@@ -565,9 +565,16 @@ std::string describeLayout(const GeometrySettings& g) {
 AccelCounters ParticleBvh::accelCounters() const {
     AccelCounters a;
     const bool billboards = settings().primitive == Primitive::billboard && settings().layout == AccelLayout::clusters;
-    a.blasPrimitives.resize(clusters_.count());
-    for (std::size_t c = 0; c < clusters_.count(); ++c)
-        a.blasPrimitives[c] = static_cast<std::uint32_t>(clusters_.members(c).size()) * (billboards ? 2u : 1u);
+    a.particles = clusters_.particle.size();
+    if (settings().layout == AccelLayout::instances) {  // one BLAS of the unit billboard, an instance per particle
+        a.blasPrimitives = {2};
+        a.tlasInstances = a.particles;
+    } else {
+        a.blasPrimitives.resize(clusters_.count());
+        for (std::size_t c = 0; c < clusters_.count(); ++c)
+            a.blasPrimitives[c] = static_cast<std::uint32_t>(clusters_.members(c).size()) * (billboards ? 2u : 1u);
+        a.tlasInstances = clusters_.count();
+    }
     a.embreeBytes = stats_.embreeBytes;
     if (omm_) {
         const OmmMemory m = ommMemory(*omm_, stats_.primitives / 2);

@@ -30,7 +30,7 @@ CostFeatures costFeatures(const PassReport& p, double cacheBytes) {
             double(p.blasLevels),  double(p.ommLookups),  double(p.dispatches),
             double(p.blasBuilds),  double(p.blasRefits),  coldWork(double(p.rays), bytes, p.workingSetBytes, cacheBytes),
             double(p.build.primitives), double(p.build.primitivesSmall), double(p.build.primitivesMid),
-            double(p.build.customBuilds), double(p.build.tlasInstances), double(p.intersections)};
+            double(p.build.customBuilds), double(p.build.tlasInstances), double(p.intersections), double(p.tlasLevels)};
 }
 
 CostCoefficients CostCoefficients::defaults() {

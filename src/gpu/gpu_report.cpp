@@ -1,5 +1,6 @@
 #include "accretion/gpu/gpu_report.h"
 
+#include <bit>
 #include <algorithm>
 #include <cmath>
 
@@ -97,9 +98,7 @@ GpuReport makeGpuReport(const FrameCounters& counters, const Settings& settings,
     r.blas = blasMemory(accel.blasPrimitives, gpu, accel.embreeBytes);
     // Working sets: the BLAS bytes for traced passes; the light records (and
     // alias entries with power candidates) for the resampling passes.
-    std::uint64_t primitives = 0;
-    for (std::uint32_t n : accel.blasPrimitives) primitives += n;
-    const std::uint64_t lights = settings.geometry.primitive == Primitive::billboard ? primitives / 2 : primitives;
+    const std::uint64_t lights = accel.particles;
     const LightSource source = settings.render.source;
     const RestirSettings& rs = settings.restir;
     const bool presampled = source == LightSource::tiles || source == LightSource::regir;
@@ -108,7 +107,10 @@ GpuReport makeGpuReport(const FrameCounters& counters, const Settings& settings,
                               // the tiles, and the grid's slots
                               (presampled ? double(rs.tile_count) * rs.tile_size * gpu_layout::kRisEntry : 0.0) +
                               (source == LightSource::regir ? std::pow(double(rs.regir_cells), 3.0) * rs.regir_lights_per_cell * gpu_layout::kRisEntry : 0.0);
+    // A ray descends the TLAS before it enters any BLAS: its depth over the instances.
+    const std::uint32_t tlasDepth = accel.tlasInstances > 1 ? std::uint32_t(std::bit_width(accel.tlasInstances - 1)) : 0u;
     for (PassReport& p : r.passes) {
+        p.tlasLevels = p.rays * tlasDepth;
         if (p.rays > 0) p.workingSetBytes = double(r.blas.gpuBytes);
         else if (p.pass == pass::generateCandidates || p.pass == pass::presampleLightTiles || p.pass == pass::presampleRegirGrid || p.pass == pass::temporalResampling || passFamily(p.pass) == pass::spatialResampling)
             p.workingSetBytes = lightBytes;
@@ -154,6 +156,7 @@ nlohmann::json toJson(const PassReport& p) {
             {"custom_builds", p.build.customBuilds},
             {"tlas_instances", p.build.tlasInstances},
             {"intersections", p.intersections},
+            {"tlas_levels", p.tlasLevels},
             {"working_set_bytes", p.workingSetBytes},
             {"trips", p.trips},
             {"max_trips", p.maxTrips},

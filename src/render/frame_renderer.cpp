@@ -25,7 +25,12 @@ void recordClusterBuild(const ParticleBvh& bvh, const Particles& particles, Fram
         const auto n = static_cast<std::uint32_t>(particles.size());
         PassCounters& pc = counters.add(pass::buildClusters, n, 1);
         pc.dispatches = 2;  // the instance records, the TLAS
-        pc.build.tlasInstances = n;
+        if (s.refitted) {   // the TLAS updated: one refit launch over the instances
+            pc.blasRefits = 1;
+            pc.build.addBlas(n, false);
+        } else {
+            pc.build.tlasInstances = n;
+        }
         for (ThreadCounters& t : pc.threads) {
             t.active = 1;
             t.trips = 1;

@@ -101,7 +101,9 @@ struct OmmCounters {
 };
 
 struct AccelCounters {
-    std::vector<std::uint32_t> blasPrimitives;  ///< per cluster: triangles (2 per billboard) or spheres
+    std::vector<std::uint32_t> blasPrimitives;  ///< per GPU BLAS: triangles (2 per billboard), spheres or boxes
+    std::uint64_t tlasInstances = 0;            ///< TLAS instances: one per BLAS, or per particle (instances layout)
+    std::uint64_t particles = 0;
     std::int64_t embreeBytes = 0;
     OmmCounters omm;
 };

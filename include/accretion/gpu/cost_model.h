@@ -23,12 +23,14 @@ namespace accretion {
 /// spheres, instances) added the build's primitives whole and clamped per
 /// BLAS at 1024 and 32768 (BuildCounters: a build's cost per primitive
 /// falls as it fills the GPU), the builds of boxes or spheres, the TLAS's
-/// instances and the intersection-program invocations. Counter CSVs
+/// instances, the intersection-program invocations and the TLAS levels a
+/// ray descends (rays x log2 of the instances). Counter CSVs
 /// without them read as 0.
-inline constexpr std::array<std::string_view, 18> kCostFeatures = {
+inline constexpr std::array<std::string_view, 19> kCostFeatures = {
     "threads",          "warp_steps",          "rays",        "blas_entries",   "any_hits",    "bytes",
     "blas_levels",      "omm_lookups",         "dispatches",  "blas_builds",    "blas_refits", "cold_work",
-    "build_primitives", "build_primitives_1k", "build_primitives_32k", "custom_builds", "tlas_instances", "intersections"};
+    "build_primitives", "build_primitives_1k", "build_primitives_32k", "custom_builds", "tlas_instances", "intersections",
+    "tlas_levels"};
 inline constexpr std::size_t kBaseCostFeatures = 6;
 inline constexpr std::size_t kColdWork = 11;
 using CostFeatures = std::array<double, kCostFeatures.size()>;
