@@ -284,6 +284,8 @@ void runTune(const TuneArgs& a) {
     }
     if (t.errorWidth < 8 || t.errorHeight < 8 || t.errorWidth > 8192 || t.errorHeight > 8192)
         throw InputError(fmt::format("command line --error-size {}: each side 8 to 8192 pixels", a.errorSize));
+    const std::vector<Option> geometry = geometryOptions(scene);
+    const std::vector<Option> lighting = lightingOptions(a.space);
     const std::string prefix = a.out.empty() ? "out/" + scene.sceneName + ".tune" : a.out;
     t.cache = a.cache.empty() ? std::filesystem::path("out") / "tune_cache" / scene.sceneName : std::filesystem::path(a.cache);
     OutputGuard guard = sceneInputs(scene);
@@ -295,8 +297,6 @@ void runTune(const TuneArgs& a) {
     for (const std::string& d : a.defines) t.sceneText += "\n-D " + d;
     t.sceneText += "\n-D render.estimator=restir";  // sceneArgv's
 
-    const std::vector<Option> geometry = geometryOptions(scene);
-    const std::vector<Option> lighting = lightingOptions(a.space);
     t.steps = geometry.size() + 2 * lighting.size();
     t.reference = ensureReference(t, scene);
 

@@ -150,6 +150,17 @@ TwinPipeline::~TwinPipeline() {
     if (context_) optixDeviceContextDestroy(context_);
 }
 
+nlohmann::json TwinPipeline::deviceProperties() const {
+    auto property = [&](OptixDeviceProperty p) {
+        unsigned value = 0;
+        OPTIX_CHECK(optixDeviceContextGetProperty(context_, p, &value, sizeof value));
+        return value;
+    };
+    return {{"rtcore_version", property(OPTIX_DEVICE_PROPERTY_RTCORE_VERSION)},
+            {"shader_execution_reordering", property(OPTIX_DEVICE_PROPERTY_SHADER_EXECUTION_REORDERING)},
+            {"cluster_accel", property(OPTIX_DEVICE_PROPERTY_CLUSTER_ACCEL)}};
+}
+
 void TwinPipeline::launch(Raygen r, CUdeviceptr params, std::size_t paramsBytes, unsigned width, unsigned height,
                            cudaStream_t stream) const {
     OPTIX_CHECK(optixLaunch(pipeline_, stream, params, paramsBytes, &sbt_[int(r)], width, height, 1));

@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "accretion/scene/settings.h"
 #include "device_buffer.h"
 
@@ -30,6 +32,10 @@ public:
     TwinPipeline& operator=(const TwinPipeline&) = delete;
 
     OptixDeviceContext context() const { return context_; }
+    /// What the device reports of its ray-tracing hardware: the RT core
+    /// version (0: none, traversal in software), SER and cluster
+    /// acceleration structure support.
+    nlohmann::json deviceProperties() const;
     /// Launch raygen `r` over width x height with the params at `params` (device).
     void launch(Raygen r, CUdeviceptr params, std::size_t paramsBytes, unsigned width, unsigned height,
                 cudaStream_t stream) const;

@@ -32,8 +32,6 @@ std::size_t primitivesPerParticle(const AccelOptions& o) {
 ParticleAccel::ParticleAccel(OptixDeviceContext context, AccelOptions options) : context_(context), options_(options) {
     if (options_.spheres && options_.layout != AccelLayout::clusters)
         throw InputError("accretion-optix: geometry.primitive = \"sphere\" runs with geometry.layout = \"clusters\" only");
-    if (options_.graph && options_.compact)
-        throw InputError("accretion-optix: --build-graph and --compact together (compaction reads sizes back on the host)");
     lanes_ = std::max({1u, options_.streams, options_.hostThreads});
     temp_.resize(lanes_);
     buildStreams_.resize(lanes_ - 1);
@@ -41,13 +39,9 @@ ParticleAccel::ParticleAccel(OptixDeviceContext context, AccelOptions options) :
     for (cudaStream_t& s : buildStreams_) CUDA_CHECK(cudaStreamCreateWithFlags(&s, cudaStreamNonBlocking));
     for (cudaEvent_t& e : join_) CUDA_CHECK(cudaEventCreateWithFlags(&e, cudaEventDisableTiming));
     CUDA_CHECK(cudaEventCreateWithFlags(&fork_, cudaEventDisableTiming));
-    if (options_.graph) CUDA_CHECK(cudaStreamCreateWithFlags(&captureStream_, cudaStreamNonBlocking));
 }
 
 ParticleAccel::~ParticleAccel() {
-    for (cudaGraphExec_t g : graphs_)
-        if (g) cudaGraphExecDestroy(g);
-    if (captureStream_) cudaStreamDestroy(captureStream_);
     for (cudaStream_t s : buildStreams_) cudaStreamDestroy(s);
     for (cudaEvent_t e : join_) cudaEventDestroy(e);
     if (fork_) cudaEventDestroy(fork_);
@@ -112,14 +106,8 @@ OptixBuildInput ParticleAccel::blasInput(std::size_t c, OptixOpacityMicromapUsag
 }
 
 void ParticleAccel::setClusters(const Clusters& clusters) {
-    // The same clusters as the last build (a repeated frame): nothing to set
-    // up, and a captured graph of their builds stays valid.
+    // The same clusters as the last build (a repeated frame): nothing to set up.
     if (clusters.offset == offset_ && clusters.particle == particle_) return;
-    for (cudaGraphExec_t& g : graphs_)
-        if (g) {
-            CUDA_CHECK(cudaGraphExecDestroy(g));
-            g = nullptr;
-        }
     offset_ = clusters.offset;
     particle_ = clusters.particle;
     clusterParticle_.upload(clusters.particle);
@@ -226,7 +214,8 @@ void ParticleAccel::issueBlasBuilds(std::size_t first, std::size_t count, bool r
     const unsigned L = lanes_;
     // Lanes (streams) forked from and joined to the frame's stream; the
     // builds of one lane run one after another, lanes may overlap.
-    auto issue = [&](cudaStream_t s) {
+    {
+        const cudaStream_t s = stream;
         if (L > 1) {
             CUDA_CHECK(cudaEventRecord(fork_, s));
             for (cudaStream_t bs : buildStreams_) CUDA_CHECK(cudaStreamWaitEvent(bs, fork_, 0));
@@ -248,26 +237,7 @@ void ParticleAccel::issueBlasBuilds(std::size_t first, std::size_t count, bool r
             CUDA_CHECK(cudaEventRecord(join_[l - 1], buildStreams_[l - 1]));
             CUDA_CHECK(cudaStreamWaitEvent(s, join_[l - 1], 0));
         }
-    };
-    stats_.graphReplayed = false;
-    if (!options_.graph || options_.build == BuildPolicy::partial) {
-        issue(stream);
-        return;
     }
-    // One graph per operation, captured the first time and replayed while
-    // the clusters stay the same (setClusters drops it when they change).
-    cudaGraphExec_t& exec = graphs_[refit ? 1 : 0];
-    if (!exec) {
-        cudaGraph_t graph = nullptr;
-        CUDA_CHECK(cudaStreamBeginCapture(captureStream_, cudaStreamCaptureModeRelaxed));
-        issue(captureStream_);
-        CUDA_CHECK(cudaStreamEndCapture(captureStream_, &graph));
-        CUDA_CHECK(cudaGraphInstantiate(&exec, graph, 0));
-        CUDA_CHECK(cudaGraphDestroy(graph));
-    } else {
-        stats_.graphReplayed = true;
-    }
-    CUDA_CHECK(cudaGraphLaunch(exec, stream));
 }
 
 void ParticleAccel::buildUnitBillboard(cudaStream_t stream) {

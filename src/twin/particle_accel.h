@@ -11,8 +11,10 @@
 // The cluster BLASes are built every frame by their policy (rebuild with
 // fast build, refit, fast_trace, partial: a round-robin window of the
 // clusters), in one 256-B-aligned pool or one allocation per BLAS, optionally
-// compacted, and issued from one host thread over one or more streams, from
-// several host threads, or replayed as one CUDA graph. With gpu.omm, every
+// compacted, and issued from one host thread over one or more streams or
+// from several host threads. (Capturing the builds as one CUDA graph was
+// tried: OptiX 9.0 on driver 580 fails optixAccelBuild under stream capture,
+// bench/gpu/README.md.) With gpu.omm, every
 // triangle carries one of two opacity micromaps of the disc (the quad's two
 // uv triangles; the CPU's classification, in OptiX's micro-triangle order).
 #include <cstdint>
@@ -35,7 +37,6 @@ struct AccelOptions {
     bool compact = false;  ///< compact each BLAS after its build (rebuild, fast_trace)
     unsigned streams = 1;  ///< BLAS builds spread round robin over this many streams (each its own scratch)
     unsigned hostThreads = 1;  ///< host threads issuing the BLAS builds (each its own stream and scratch)
-    bool graph = false;    ///< the BLAS builds captured once as a CUDA graph and replayed while the clusters stay
     OmmMode omm = OmmMode::off;  ///< opacity micromaps of the disc alpha (gpu.omm; disc-alpha billboards only)
     std::uint32_t ommLevel = 4;  ///< their subdivision level (gpu.omm_level)
 };
@@ -50,14 +51,14 @@ struct AccelStats {
     std::size_t primitives = 0;       ///< triangles, spheres or boxes in all BLASes
     std::size_t largestBlas = 0;      ///< primitives of the largest BLAS
     std::size_t rebuiltBlases = 0;    ///< BLAS built or refitted this frame
-    bool refitted = false, partial = false, graphReplayed = false;
+    bool refitted = false, partial = false;
     std::size_t blasBytes = 0;        ///< sum of the BLAS outputs (after compaction, if any)
     std::size_t poolBytes = 0;        ///< the BLAS memory held: the pool, or what the per-BLAS allocations took of the device (cudaMemGetInfo)
     std::size_t tempBytes = 0;        ///< the scratch buffers (one per build lane)
     std::size_t tlasBytes = 0;        ///< the TLAS output
     std::size_t inputBytes = 0;       ///< build inputs: vertices, spheres, boxes or instance records
     std::size_t ommBytes = 0;         ///< the opacity micromap array (two micromaps every BLAS shares)
-    double blasEnqueueMs = 0.0;       ///< host time of issuing the BLAS builds (optixAccelBuild calls, or the graph launch)
+    double blasEnqueueMs = 0.0;       ///< host time of issuing the BLAS builds (the optixAccelBuild calls)
     std::size_t totalBytes() const { return poolBytes + tempBytes + tlasBytes + inputBytes + ommBytes; }
 };
 
@@ -94,7 +95,7 @@ private:
     /// Cluster c's build input; `usage` (which it points at) receives its micromap usage.
     OptixBuildInput blasInput(std::size_t c, OptixOpacityMicromapUsageCount& usage) const;
     unsigned buildFlags() const { return blasBuildFlags(options_); }
-    /// The BLAS builds of clusters (first + k) mod C, k < count, by lanes, threads or the graph.
+    /// The BLAS builds of clusters (first + k) mod C, k < count, by lanes and threads.
     void issueBlasBuilds(std::size_t first, std::size_t count, bool refit, bool compact, cudaStream_t stream);
     void issueLane(unsigned lane, unsigned lanes, std::size_t first, std::size_t count, const OptixAccelBuildOptions& opts,
                    bool compact, cudaStream_t stream);
@@ -106,7 +107,7 @@ private:
     AccelOptions options_;
     unsigned lanes_ = 1;                      ///< build streams (the frame's first): max(streams, hostThreads)
     std::vector<std::uint32_t> offset_;       ///< host copy of the cluster offsets
-    std::vector<std::uint32_t> particle_;     ///< host copy of the cluster members (graph reuse)
+    std::vector<std::uint32_t> particle_;     ///< host copy of the cluster members (a repeated frame's are not set up again)
     DeviceBuffer clusterParticle_, clusterOffset_, primitives_, radii_, indices_;
     DeviceBuffer ommArray_, ommIndices_;      ///< the micromap array; per triangle 0 or 1 (its uv triangle)
     OptixOpacityMicromapFormat ommFormat_ = OPTIX_OPACITY_MICROMAP_FORMAT_NONE;
@@ -119,9 +120,6 @@ private:
     std::vector<cudaEvent_t> join_;
     std::vector<DeviceBuffer> perBlas_;
     std::vector<OptixTraversableHandle> handles_;
-    // The captured builds (graph): one executable graph per operation (build, update).
-    cudaStream_t captureStream_ = nullptr;
-    cudaGraphExec_t graphs_[2] = {nullptr, nullptr};
     // instances: the unit billboard's BLAS, built once.
     DeviceBuffer unitVertices_, unitBlas_;
     OptixTraversableHandle unitHandle_ = 0;

@@ -47,7 +47,7 @@ struct Args {
     std::string frames, output, timings, config, programs = ACCRETION_TWIN_PROGRAMS;
     std::string shadowRays = "trace";
     unsigned repeat = 5, buildStreams = 1, buildThreads = 1, seeds = 1;
-    bool buildGraph = false, perBlas = false, compact = false, quiet = false, validation = false, skipLighting = false, lrOnly = false;
+    bool perBlas = false, compact = false, quiet = false, validation = false, skipLighting = false, lrOnly = false;
 };
 
 /// The pass of `accretion cost` a timed pass belongs to (calibrate joins on
@@ -188,7 +188,6 @@ int run(const Args& a) {
     accelOptions.compact = a.compact;
     accelOptions.streams = a.buildStreams;
     accelOptions.hostThreads = a.buildThreads;
-    accelOptions.graph = a.buildGraph;
     accelOptions.omm = omm ? settings.gpu.omm : OmmMode::off;
     accelOptions.ommLevel = settings.gpu.omm_level;
     TwinPipeline pipeline(a.programs, a.validation, omm, geometry.layout, accelOptions.spheres, blasBuildFlags(accelOptions));
@@ -244,9 +243,9 @@ int run(const Args& a) {
     bool built = false;
     std::string timingsCsv = "config,pass,ms\n";
     nlohmann::json stats = {{"version", std::string(version())}, {"renderer", "accretion-optix"}, {"device", device},
-                            {"scene", settings.scenePath}, {"repeat", a.repeat}, {"allocation", a.perBlas ? "per_blas" : "pooled"},
+                            {"optix_device", pipeline.deviceProperties()}, {"scene", settings.scenePath}, {"repeat", a.repeat}, {"allocation", a.perBlas ? "per_blas" : "pooled"},
                             {"compact", a.compact}, {"build_streams", a.buildStreams}, {"build_threads", a.buildThreads},
-                            {"build_graph", a.buildGraph}, {"layout", std::string(enumName(settings.geometry.layout))},
+                            {"layout", std::string(enumName(settings.geometry.layout))},
                             {"primitive", std::string(enumName(settings.geometry.primitive))}, {"seeds", a.seeds}, {"frames", nlohmann::json::array()}};
     const std::uint32_t first = settings.render.frame_start, frameCount = settings.render.frames;
     // With --seeds every seed runs the same frames: their particles are loaded once.
@@ -500,7 +499,6 @@ int run(const Args& a) {
                                    {"blases", as.blases}, {"instances", as.instances}, {"primitives", as.primitives},
                                    {"largest_blas_primitives", as.largestBlas},
                                    {"rebuilt_blases", as.rebuiltBlases}, {"refitted", as.refitted}, {"partial", as.partial},
-                                   {"graph_replayed", as.graphReplayed},
                                    {"blas_bytes", as.blasBytes}, {"blas_memory_bytes", as.poolBytes},
                                    {"scratch_bytes", as.tempBytes}, {"blas_enqueue_ms", as.blasEnqueueMs}, {"tlas_bytes", as.tlasBytes},
                                    {"input_bytes", as.inputBytes}, {"accel_total_bytes", as.totalBytes()},
@@ -551,8 +549,6 @@ int main(int argc, char** argv) {
     app.add_option("--build-threads", a.buildThreads,
                    "Host threads issuing the BLAS builds, each on its own stream with its own scratch")
         ->check(CLI::Range(1, 64));
-    app.add_flag("--build-graph", a.buildGraph,
-                 "Capture the BLAS builds once as a CUDA graph and replay it while the clusters stay the same");
     app.add_flag("--per-blas", a.perBlas, "One cudaMalloc per BLAS instead of one 256-B-aligned pool");
     app.add_flag("--compact", a.compact, "Compact every BLAS after its build");
     app.add_flag("--lr-only", a.lrOnly, "Frames hold Lr alone (for `accretion bias --gpu-frames`; import-gpu refuses them)");

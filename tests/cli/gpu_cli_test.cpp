@@ -213,3 +213,62 @@ TEST_CASE("cost counts the launches of the builds: one per BLAS rebuilt, refitte
     CHECK(build["partial"]["blas_refits"] == 0);
     for (const auto& [policy, columns] : build) CHECK(columns.at("dispatches") == 2);
 }
+
+TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbiased one under the budget, cached",
+          "[cli][gpu][tune]") {
+    const auto dir = accretion::test::scratchDir("tune");
+    const std::string cmd = kBin + " tune " + tinyScene() + " --error-size 48x32 --seeds 3 --cache " + (dir / "cache").string() +
+                            " -o " + (dir / "t").string() + " --budget-ms 50";
+    std::string out;
+    REQUIRE(runCommand(cmd, out) == 0);
+    INFO(out);
+    const nlohmann::json j = nlohmann::json::parse(slurp(dir / "t.json"));
+    // Every measured point: the front is exactly the set no other point beats on both axes.
+    const nlohmann::json& rows = j.at("lighting");
+    REQUIRE(rows.size() == 34);
+    for (const auto& p : rows) {
+        bool dominated = false;
+        for (const auto& q : rows)
+            dominated |= q["gpu_ms"].get<double>() <= p["gpu_ms"].get<double>() && q["rel_mse"].get<double>() < p["rel_mse"].get<double>() &&
+                         (q["gpu_ms"].get<double>() < p["gpu_ms"].get<double>() || q["rel_mse"].get<double>() < p["rel_mse"].get<double>());
+        CHECK(p["front"].get<bool>() == !dominated);
+    }
+    // The recommendation: under the budget, unbiased, the lowest error of those.
+    const nlohmann::json& r = j.at("recommended");
+    REQUIRE(r.is_object());
+    CHECK(r["gpu_ms"].get<double>() <= 50.0);
+    CHECK_FALSE(r["biased"].get<bool>());
+    for (const auto& p : rows)
+        if (!p["biased"].get<bool>() && p["gpu_ms"].get<double>() <= 50.0) CHECK(p["rel_mse"].get<double>() >= r["rel_mse"].get<double>());
+    // The geometry: the fastest predicted of its options (none changes the image).
+    double fastest = 1e300;
+    for (const auto& g : j.at("geometry")) fastest = std::min(fastest, g["frame_ms"].get<double>());
+    for (const auto& g : j.at("geometry"))
+        if (g["geometry"] == j["chosen_geometry"]) CHECK(g["frame_ms"].get<double>() == fastest);
+    CHECK(std::filesystem::exists(dir / "t.csv"));
+
+    // A second run reads every measurement back and gives the same table.
+    const std::string first = slurp(dir / "t.csv");
+    std::filesystem::remove(dir / "t.csv");
+    std::filesystem::remove(dir / "t.json");
+    std::filesystem::remove(dir / "t.png");
+    REQUIRE(runCommand(cmd, out) == 0);
+    std::istringstream lines(out);
+    std::size_t measurements = 0;
+    for (std::string line; std::getline(lines, line);)
+        if (line.rfind("tune: [", 0) == 0) {
+            ++measurements;
+            CHECK_THAT(line, Contains("(cached)"));
+        }
+    CHECK(measurements == 1 + 8 + 2 * 34);  // the reference, the geometry options, then cost and bias per lighting option
+    CHECK(slurp(dir / "t.csv") == first);
+
+    // Bad input: one clear error each, exit 1, nothing written.
+    CHECK(runCommand(kBin + " tune " + tinyScene() + " --budget-ms 0 -o " + (dir / "bad").string(), out) == 1);
+    CHECK_THAT(out, Contains("--budget-ms"));
+    CHECK(runCommand(kBin + " tune " + tinyScene() + " --budget-ms 5 --error-size 48 -o " + (dir / "bad").string(), out) == 1);
+    CHECK_THAT(out, Contains("--error-size 48: expected WIDTHxHEIGHT"));
+    CHECK(runCommand(kBin + " tune " + tinyScene() + " --budget-ms 5 --space huge -o " + (dir / "bad").string(), out) == 1);
+    CHECK_THAT(out, Contains("--space huge"));
+    CHECK_FALSE(std::filesystem::exists(dir / "bad.json"));
+}

@@ -53,8 +53,12 @@ TEST_CASE("Embree hits match brute force for every geometry and build policy", "
     g.alpha = g.primitive == Primitive::sphere ? AlphaMode::opaque : GENERATE(AlphaMode::opaque, AlphaMode::disc);
     g.orientation = GENERATE(Orientation::view_plane, Orientation::view_point, Orientation::velocity);
     g.build = GENERATE(BuildPolicy::rebuild, BuildPolicy::refit, BuildPolicy::fast_trace);
+    // Every GPU layout (the aabbs and instances layouts are box primitives running the billboard intersection).
+    g.layout = g.primitive == Primitive::sphere ? AccelLayout::clusters
+                                                : GENERATE(AccelLayout::clusters, AccelLayout::instances, AccelLayout::aabbs);
     g.cluster_size = 16;
-    INFO(enumName(g.primitive) << " " << enumName(g.alpha) << " " << enumName(g.orientation) << " " << enumName(g.build));
+    INFO(enumName(g.primitive) << " " << enumName(g.alpha) << " " << enumName(g.orientation) << " " << enumName(g.build) << " "
+                               << enumName(g.layout));
 
     auto [ps, cs] = accretion::test::smallView(400, 3.0, 0.1, Vec3(0.0f, 3.0f, 6.0f), 40, 30);
     ps.time_step = 0.2;
@@ -202,4 +206,61 @@ TEST_CASE("counting queries: same answers, BLAS entries bounded by the overlappe
         REQUIRE(entries >= hits);
         if (g.alpha == AlphaMode::disc) REQUIRE(anyHits >= hits);
     }
+}
+
+TEST_CASE("box primitives: an instance entered per box is an intersection program per box", "[geometry][bvh][gpu]") {
+    // The instances layout counts a BLAS entry per box a ray enters; the aabbs
+    // layout of one BLAS runs its intersection program per box entered. Over
+    // the same boxes and rays the two counts are equal, ray by ray, and the
+    // intersections are at least the hits (a hit is inside its box).
+    GeometrySettings g;
+    g.alpha = GENERATE(AlphaMode::opaque, AlphaMode::disc);
+    g.cluster_size = 1u << 30;
+    const auto [ps, cs] = accretion::test::smallView(400, 3.0, 0.1, Vec3(0.0f, 3.0f, 6.0f), 40, 30);
+    GpuSettings gpu;
+    gpu.counters = true;
+    EmbreeDevice device;
+    g.layout = AccelLayout::instances;
+    ParticleBvh instances(device, g, gpu);
+    g.layout = AccelLayout::aabbs;
+    ParticleBvh boxes(device, g, gpu);
+    const Particles p = generateDisk(ps, 0);
+    const Camera cam = Camera::atFrame(cs, 0);
+    instances.build(p, cam);
+    boxes.build(p, cam);
+    std::uint64_t hits = 0, entries = 0, programs = 0;
+    for (std::uint32_t y = 0; y < cam.height; ++y)
+        for (std::uint32_t x = 0; x < cam.width; ++x) {
+            const Vec3 d = cam.pixelDirection(x, y);
+            SurfaceHit a, b;
+            RayCounters ra, rb;
+            const bool ha = instances.intersect(cam.position, d, 1e30f, a, &ra);
+            const bool hb = boxes.intersect(cam.position, d, 1e30f, b, &rb);
+            REQUIRE(ha == hb);
+            if (ha) REQUIRE(a.particle == b.particle);
+            REQUIRE(ra.intersections == 0);
+            REQUIRE(rb.blasEntries == 1);  // the one BLAS of boxes
+            hits += ha;
+            entries += ra.blasEntries;
+            programs += rb.intersections;
+        }
+    REQUIRE(hits > 50);
+    REQUIRE(entries == programs);
+    REQUIRE(programs >= hits);
+}
+
+TEST_CASE("the CPU traces one BVH unless counting, asked for the GPU's layout, or partial", "[geometry][bvh]") {
+    GeometrySettings g;
+    g.layout = AccelLayout::aabbs;
+    g.cluster_size = 100;
+    const GeometrySettings fastest = cpuGeometry(g, false);
+    REQUIRE(fastest.layout == AccelLayout::clusters);
+    REQUIRE(fastest.cluster_size == std::numeric_limits<std::uint32_t>::max());
+    REQUIRE(describeLayout(fastest).find("one BVH of every particle") == 0);
+    REQUIRE(cpuGeometry(g, true).layout == AccelLayout::aabbs);  // counting: the GPU's
+    g.cpu_layout = CpuLayout::gpu;
+    REQUIRE(cpuGeometry(g, false).cluster_size == 100);
+    g.cpu_layout = CpuLayout::fastest;
+    g.build = BuildPolicy::partial;  // stale clusters are part of the image
+    REQUIRE(cpuGeometry(g, false).layout == AccelLayout::aabbs);
 }

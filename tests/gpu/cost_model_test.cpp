@@ -244,3 +244,31 @@ TEST_CASE("a presampling pass without timings is priced with generateCandidates'
     c.perPass["presampleRegirGrid"] = CostFeatures{};  // its own coefficients, once fitted, win
     CHECK(c.predictMs("presampleRegirGrid", f) == Approx(0.0));
 }
+
+TEST_CASE("a build's primitives are counted whole and clamped at the knots", "[gpu][cost]") {
+    BuildCounters b;
+    b.addBlas(50, false);        // below both knots
+    b.addBlas(2000, true);       // between them
+    b.addBlas(2000000, false);   // above both
+    REQUIRE(b.primitives == 50u + 2000u + 2000000u);
+    REQUIRE(b.primitivesSmall == 50u + 1024u + 1024u);
+    REQUIRE(b.primitivesMid == 50u + 2000u + 32768u);
+    REQUIRE(b.customBuilds == 1u);
+}
+
+TEST_CASE("cost prices with the committed calibration; the uncalibrated guess only on request", "[gpu][cost]") {
+    const CostCoefficients committed = CostCoefficients::forSetting("");
+    REQUIRE(committed.calibrated);
+    REQUIRE_FALSE(committed.gpu.empty());
+    REQUIRE_FALSE(committed.measuredAt.empty());
+    REQUIRE_THAT(committed.source, Catch::Matchers::Contains(kDefaultCoefficientsFile));
+    // The per-pass coefficients of the passes the GPU timed, the BLAS builds' launch cost among them.
+    for (const char* pass : {"buildClusters", "traceGBuffer", "traceShadowRays", "generateCandidates"})
+        REQUIRE(committed.perPass.count(pass) == 1);
+    // The file of the source tree, read as a file, is the same calibration.
+    const CostCoefficients file = CostCoefficients::load(std::string(ACCRETION_SOURCE_DIR) + "/" + kDefaultCoefficientsFile);
+    REQUIRE(file.perPass.at("buildClusters") == committed.perPass.at("buildClusters"));
+    const CostCoefficients guess = CostCoefficients::forSetting("uncalibrated");
+    REQUIRE_FALSE(guess.calibrated);
+    REQUIRE_THAT(guess.source, Catch::Matchers::Contains("uncalibrated"));
+}
