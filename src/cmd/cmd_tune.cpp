@@ -12,7 +12,9 @@
 // configurations are then measured for error and priced on that geometry.
 // Every measurement is a child process whose result is cached by a hash of
 // everything it depends on (the accretion version included), so a second
-// run reads them back.
+// run reads them back. The GPU time is priced here from the cached
+// counters, with gpu.coefficients' calibration (the committed one by
+// default), so that a new calibration re-prices without measuring again.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -30,6 +32,7 @@
 #include "accretion/core/error.h"
 #include "accretion/core/read_file.h"
 #include "accretion/core/version.h"
+#include "accretion/gpu/cost_model.h"
 #include "accretion/io/plot.h"
 #include "accretion/io/report_table.h"
 #include "accretion/io/stats_writer.h"
@@ -152,6 +155,7 @@ struct TuneContext {
     std::string sceneText;  ///< version + scene file + overrides: every cache key starts with it
     std::uint32_t errorWidth = 0, errorHeight = 0;
     std::string reference;
+    CostCoefficients coefficients;  ///< what prices the counters
     std::size_t step = 0, steps = 0;
 };
 
@@ -178,20 +182,21 @@ std::vector<std::string> sceneArgv(const TuneContext& t, const std::string& comm
     return a;
 }
 
-/// Predicted GPU ms per pass of one configuration at the scene's resolution (cost, calibrated).
+/// Predicted GPU ms per pass of one configuration at the scene's
+/// resolution: its counters (`accretion cost`, cached) priced with the calibration.
 std::map<std::string, double> predictMs(TuneContext& t, const std::vector<std::string>& defines, const std::string& what) {
     std::string key = t.sceneText + "\ncost frame " + std::to_string(t.args.frame);
     for (const std::string& d : defines) key += "\n" + d;
-    const std::filesystem::path file = t.cache / (cacheKey(key) + ".cost.json");
+    const std::filesystem::path prefix = t.cache / (cacheKey(key) + ".cost");
     std::vector<std::string> argv = sceneArgv(t, "cost", defines);
     argv.insert(argv.end(), {"--frames", fmt::format("{}:{}", t.args.frame, t.args.frame + 1), "--history", "1", "--overhead", "0",
-                             "--cluster-sizes", "", "--omm-levels", "", "--ser-keys", "hit", "-q", "-o", file.string()});
-    measure(t, argv, file, "GPU time of " + what);
-    const nlohmann::json j = nlohmann::json::parse(readWholeFile(file, "tune"));
-    if (!j.value("coefficients", nlohmann::json::object()).value("calibrated", true))
-        throw InputError("tune: the cost model is uncalibrated (gpu.coefficients = \"uncalibrated\"): tune prices with a calibration");
+                             "--cluster-sizes", "", "--omm-levels", "", "--ser-keys", "hit", "-q", "-o", prefix.string() + ".json"});
+    measure(t, argv, prefix.string() + ".csv", "GPU time of " + what);
     std::map<std::string, double> ms;
-    for (const nlohmann::json& p : j.at("passes")) ms[p.at("pass").get<std::string>()] += p.at("predicted_ms").get<double>();
+    for (CostRow& r : readCounterCsv(prefix.string() + ".csv")) {
+        r.features[kColdWork] = coldWork(r.features[2], r.features[5], r.workingSetBytes, t.coefficients.cacheBytes);
+        ms[r.pass] += t.coefficients.predictMs(r.pass, r.features);
+    }
     return ms;
 }
 
@@ -293,8 +298,14 @@ void runTune(const TuneArgs& a) {
     checkOutputs(guard, prefix, {".csv", ".json", ".png"}, "-o");
     std::filesystem::create_directories(t.cache);
     if (auto dir = std::filesystem::path(prefix).parent_path(); !dir.empty()) std::filesystem::create_directories(dir);
+    t.coefficients = CostCoefficients::forSetting(scene.gpu.coefficients);
+    if (!t.coefficients.calibrated)
+        throw InputError("tune: gpu.coefficients = \"uncalibrated\": tune prices with a calibration (the committed one by default)");
+    // The cache key: this build, the scene and its overrides (but the
+    // calibration, which prices the cached counters here, not in them).
     t.sceneText = std::string(version()) + "\n" + readWholeFile(a.scene, "tune");
-    for (const std::string& d : a.defines) t.sceneText += "\n-D " + d;
+    for (const std::string& d : a.defines)
+        if (d.rfind("gpu.coefficients", 0) != 0) t.sceneText += "\n-D " + d;
     t.sceneText += "\n-D render.estimator=restir";  // sceneArgv's
 
     t.steps = geometry.size() + 2 * lighting.size();
@@ -345,8 +356,8 @@ void runTune(const TuneArgs& a) {
                 p.front,
                 std::string(p.front ? "front" : "") + (p.error.biased ? " BIASED" : "") + (&p == best ? " <- recommended" : "")});
     fmt::print("{}\n{}", gt.console(), lt.console());
-    fmt::print("geometry: {} ({:.3f} ms predicted at {}x{}, the scene's lighting)\n", chosen.label, total(fastest->second),
-               scene.camera.width, scene.camera.height);
+    fmt::print("geometry: {} ({:.3f} ms predicted at {}x{}, the scene's lighting)\nGPU time: {}\n", chosen.label,
+               total(fastest->second), scene.camera.width, scene.camera.height, t.coefficients.source);
     if (best)
         fmt::print("recommended under {:g} ms{}: {} + {}: {:.3f} GPU ms predicted, relMSE {:.4g} at {} ({} seeds){}\n", a.budgetMs,
                    a.maxError ? fmt::format(" and relMSE {:g}", *a.maxError) : "", chosen.label, best->lighting.label, best->ms,
@@ -368,7 +379,7 @@ void runTune(const TuneArgs& a) {
                                  {"defines", a.defines}, {"settings", settingsToToml(scene)}, {"seed", scene.render.seed},
                                  {"budget_ms", a.budgetMs}, {"max_error", a.maxError ? nlohmann::json(*a.maxError) : nlohmann::json()},
                                  {"seeds", a.seeds}, {"frame", a.frame}, {"error_size", a.errorSize}, {"reference", t.reference},
-                                 {"space", a.space}, {"geometry", gt.json()}, {"chosen_geometry", chosen.label},
+                                 {"space", a.space}, {"coefficients", t.coefficients.source}, {"geometry", gt.json()}, {"chosen_geometry", chosen.label},
                                  {"lighting", lt.json()}, {"recommended", recommended}});
     const std::string csv = gnuplotQuote(prefix + ".csv");
     const std::string script = fmt::format(

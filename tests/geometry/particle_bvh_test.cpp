@@ -239,7 +239,7 @@ TEST_CASE("box primitives: an instance entered per box is an intersection progra
             REQUIRE(ha == hb);
             if (ha) REQUIRE(a.particle == b.particle);
             REQUIRE(ra.intersections == 0);
-            REQUIRE(rb.blasEntries == 1);  // the one BLAS of boxes
+            REQUIRE(rb.blasEntries <= 1);  // the one BLAS of boxes, when its bounds are entered
             hits += ha;
             entries += ra.blasEntries;
             programs += rb.intersections;
