@@ -1,7 +1,7 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine (issue 16), from the repository root:
 #   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
-#                                      layout_images layouts streams
+#                                      layout_images layouts streams front
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -233,6 +233,21 @@ step_streams() {
                 rm -f "$t"/*.gpuframe
             done
         done
+    done
+}
+
+# The configurations on tune's Pareto fronts (bench/gpu/front.txt, written
+# by bench/gpu/front_configs.py), timed as the layouts are.
+step_front() {
+    local t="$W/front"
+    mkdir -p "$t"
+    grep -v '^#' bench/gpu/front.txt | sed 's/ *#.*//' | while read -r name args; do
+        [ -z "$name" ] && continue
+        # shellcheck disable=SC2086  # the overrides are words
+        timeout 120 $BIN scenes/disk_100k.toml -D render.estimator=restir $args --frames 0:2 --repeat 5 -q \
+            -o "$t/$name.{frame}.exr" --timings "$t/$name.timings.csv" --config "$name" < /dev/null \
+            || echo "front: $name failed"
+        rm -f "$t"/*.gpuframe
     done
 }
 
