@@ -386,12 +386,13 @@ void runTune(const TuneArgs& a) {
         "set datafile separator ','\nset logscale y\nset grid\nset key top right\n"
         "set title {0}\nset xlabel 'predicted GPU ms per frame ({1}; calibrated cost model)'\nset ylabel 'relMSE at {2} ({3} seeds)'\n"
         "set arrow from {4},graph 0 to {4},graph 1 nohead dt 2 lc rgb 'gray40'\n"
+        "set label 'budget' at {4},graph 0.95 right offset -0.5,0 tc rgb 'gray40'\n{6}"
         "plot {5} skip 1 using 2:($7 == 0 ? $3 : NaN) with points pt 7 lc rgb 'gray60' title 'configurations', "
         "{5} skip 1 using 2:($7 != 0 ? $3 : NaN) with points pt 2 ps 1.5 lc rgb 'red' title 'biased (|z| > 3.29)', "
-        "{5} skip 1 using 2:($8 != 0 ? $3 : NaN) with linespoints pt 6 ps 1.5 lc rgb 'blue' title 'Pareto front'{6}\n",
+        "{5} skip 1 using 2:($8 != 0 ? $3 : NaN) with points pt 6 ps 2 lc rgb 'blue' title 'Pareto front'\n",
         gnuplotQuote(fmt::format("{} at {}x{}: budget {:g} ms", scene.sceneName, scene.camera.width, scene.camera.height, a.budgetMs)),
-        gnuplotQuote(chosen.label).substr(1, gnuplotQuote(chosen.label).size() - 2), a.errorSize, a.seeds, a.budgetMs, csv,
-        best ? fmt::format(", '-' using 1:2 with points pt 3 ps 3 lc rgb 'dark-green' title 'recommended'\n{} {}\ne", best->ms,
+        chosen.label, a.errorSize, a.seeds, a.budgetMs, csv,
+        best ? fmt::format("set label 'recommended' at {},{} point pt 3 ps 3 lc rgb 'dark-green' offset 1,1 tc rgb 'dark-green'\n", best->ms,
                            best->error.relMse)
              : std::string());
     plotPng(prefix + ".png", script);
