@@ -256,7 +256,7 @@ TEST_CASE("a build's primitives are counted whole and clamped at the knots", "[g
     REQUIRE(b.customBuilds == 1u);
 }
 
-TEST_CASE("cost prices with the committed calibration; the uncalibrated guess only on request", "[gpu][cost]") {
+TEST_CASE("cost prices with the committed calibration, the uncalibrated guess only on request", "[gpu][cost]") {
     const CostCoefficients committed = CostCoefficients::forSetting("");
     REQUIRE(committed.calibrated);
     REQUIRE_FALSE(committed.gpu.empty());
