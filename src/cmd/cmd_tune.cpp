@@ -34,6 +34,7 @@
 #include "accretion/core/version.h"
 #include "accretion/gpu/cost_model.h"
 #include "accretion/io/plot.h"
+#include "accretion/particles/particle_source.h"
 #include "accretion/io/report_table.h"
 #include "accretion/io/stats_writer.h"
 #include "child_process.h"
@@ -233,9 +234,9 @@ ErrorRow measureError(TuneContext& t, const Option& o) {
 
 /// The reference of the error measurements: given, or rendered once (exact
 /// up to 20K particles, else split at --reference-spp) and cached.
-std::string ensureReference(TuneContext& t, const Settings& scene) {
+std::string ensureReference(TuneContext& t, std::size_t particles) {
     if (!t.args.reference.empty()) return t.args.reference;
-    const bool exact = scene.particles.count <= 20000;
+    const bool exact = particles <= 20000;
     const std::string how = exact ? "exact" : fmt::format("split {} spp", t.args.referenceSpp);
     const std::filesystem::path file = t.cache / (cacheKey(t.sceneText + fmt::format("\nreference {} frame {} {}x{}", how, t.args.frame,
                                                                                       t.errorWidth, t.errorHeight)) + ".ref.exr");
@@ -309,7 +310,8 @@ void runTune(const TuneArgs& a) {
     t.sceneText += "\n-D render.estimator=restir";  // sceneArgv's
 
     t.steps = geometry.size() + 2 * lighting.size();
-    t.reference = ensureReference(t, scene);
+    const std::size_t particles = ParticleSource(scene).frame(a.frame).size();
+    t.reference = ensureReference(t, particles);
 
     // Geometry: the same image whatever it is; the fastest predicted frame.
     Option base{"the scene's lighting", {}};
@@ -390,7 +392,8 @@ void runTune(const TuneArgs& a) {
         "plot {5} skip 1 using 2:($7 == 0 ? $3 : NaN) with points pt 7 lc rgb 'gray60' title 'configurations', "
         "{5} skip 1 using 2:($7 != 0 ? $3 : NaN) with points pt 2 ps 1.5 lc rgb 'red' title 'biased (|z| > 3.29)', "
         "{5} skip 1 using 2:($8 != 0 ? $3 : NaN) with points pt 6 ps 2 lc rgb 'blue' title 'Pareto front'\n",
-        gnuplotQuote(fmt::format("{} at {}x{}: budget {:g} ms", scene.sceneName, scene.camera.width, scene.camera.height, a.budgetMs)),
+        gnuplotQuote(fmt::format("{} ({} particles) at {}x{}: budget {:g} ms", scene.sceneName, particles,
+                                 scene.camera.width, scene.camera.height, a.budgetMs)),
         chosen.label, a.errorSize, a.seeds, a.budgetMs, csv,
         best ? fmt::format("set label 'recommended' at {},{} point pt 3 ps 3 lc rgb 'dark-green' offset 1,1 tc rgb 'dark-green'\n", best->ms,
                            best->error.relMse)
