@@ -360,6 +360,16 @@ void runTune(const TuneArgs& a) {
     fmt::print("{}\n{}", gt.console(), lt.console());
     fmt::print("geometry: {} ({:.3f} ms predicted at {}x{}, the scene's lighting)\nGPU time: {}\n", chosen.label,
                total(fastest->second), scene.camera.width, scene.camera.height, t.coefficients.source);
+    // Procedural boxes beat triangles only where traversal is software: on
+    // RT cores every box entered calls the intersection program on the SM
+    // (docs/layouts.md). Name the fastest triangle layout beside them.
+    const auto triangles = std::min_element(geometryMs.begin(), geometryMs.end(), [](const auto& p, const auto& q) {
+        const bool pb = p.first.defines[0] == "geometry.layout=aabbs", qb = q.first.defines[0] == "geometry.layout=aabbs";
+        return pb != qb ? qb : total(p.second) < total(q.second);
+    });
+    if (chosen.defines[0] == "geometry.layout=aabbs" && triangles->first.defines[0] != "geometry.layout=aabbs")
+        fmt::print("on a GPU with RT cores prefer {} ({:+.3f} ms here): boxes win only where traversal runs in software\n",
+                   triangles->first.label, total(triangles->second) - total(fastest->second));
     if (best)
         fmt::print("recommended under {:g} ms{}: {} + {}: {:.3f} GPU ms predicted, relMSE {:.4g} at {} ({} seeds){}\n", a.budgetMs,
                    a.maxError ? fmt::format(" and relMSE {:g}", *a.maxError) : "", chosen.label, best->lighting.label, best->ms,
@@ -381,7 +391,8 @@ void runTune(const TuneArgs& a) {
                                  {"defines", a.defines}, {"settings", settingsToToml(scene)}, {"seed", scene.render.seed},
                                  {"budget_ms", a.budgetMs}, {"max_error", a.maxError ? nlohmann::json(*a.maxError) : nlohmann::json()},
                                  {"seeds", a.seeds}, {"frame", a.frame}, {"error_size", a.errorSize}, {"reference", t.reference},
-                                 {"space", a.space}, {"coefficients", t.coefficients.source}, {"geometry", gt.json()}, {"chosen_geometry", chosen.label},
+                                 {"space", a.space}, {"coefficients", t.coefficients.source}, {"geometry", gt.json()},
+                                 {"fastest_triangle_geometry", triangles->first.label}, {"chosen_geometry", chosen.label},
                                  {"lighting", lt.json()}, {"recommended", recommended}});
     const std::string csv = gnuplotQuote(prefix + ".csv");
     const std::string script = fmt::format(
