@@ -126,22 +126,22 @@ void boxBounds(const RTCBoundsFunctionArguments* args) {
     *args->bounds_o = {b.p.x - e.x, b.p.y - e.y, b.p.z - e.z, 0.0f, b.p.x + e.x, b.p.y + e.y, b.p.z + e.z, 0.0f};
 }
 
-/// A ray entering box `prim` of `blas` (as GPU traversal tests each box
-/// before it calls the primitive's program; Embree may call a leaf's
-/// primitives without): counted as an intersection-program invocation, or
-/// for the instances layout as a BLAS (instance) entry of one level; then
-/// the billboard's or sphere's own test and, for instances, the alpha test
-/// of the any-hit (the aabbs layout's program tests alpha itself). True
-/// with t and uv of a hit in [tnear, tfar].
+/// A ray reaching box `prim` of `blas`. Counting, the box is tested first,
+/// as GPU traversal tests each box before it calls the primitive's program
+/// (Embree may call a leaf's primitives without), and an entered box counts
+/// as an intersection-program invocation, or for the instances layout as a
+/// BLAS (instance) entry of one level; the test decides the count only, so
+/// renders skip it. Then the billboard's or sphere's own test and, for
+/// instances, the alpha test of the any-hit (the aabbs layout's program
+/// tests alpha itself). True with t and uv of a hit in [tnear, tfar].
 bool hitBox(const BoxBlas& blas, unsigned prim, const float org[3], const float dir[3], float tnear, float tfar,
             RayCounters* counters, float& t, Vec2& uv) {
     const BoxPrimitive& b = blas.prims[prim];
-    const std::uint32_t i = blas.members[prim];
-    const BillboardFrame& f = blas.frames[i];
-    const Vec3 e = blas.sphere ? Vec3(b.r) : billboardExtent(b.r, f);
-    const RTCBounds box{b.p.x - e.x, b.p.y - e.y, b.p.z - e.z, 0.0f, b.p.x + e.x, b.p.y + e.y, b.p.z + e.z, 0.0f};
-    if (!overlapsBounds(box, org, dir, tnear, tfar)) return false;
+    const BillboardFrame& f = blas.frames[blas.members[prim]];
     if (counters) {
+        const Vec3 e = blas.sphere ? Vec3(b.r) : billboardExtent(b.r, f);
+        const RTCBounds box{b.p.x - e.x, b.p.y - e.y, b.p.z - e.z, 0.0f, b.p.x + e.x, b.p.y + e.y, b.p.z + e.z, 0.0f};
+        if (!overlapsBounds(box, org, dir, tnear, tfar)) return false;
         if (blas.instances) {
             ++counters->blasEntries;
             ++counters->blasLevels;  // two triangles: one level
@@ -291,8 +291,7 @@ void ParticleBvh::buildBlas(std::size_t c, const Particles& particles, bool crea
         if (boxes) {
             BoxBlas& b = boxBlas_[c];
             b = {boxes_.data() + clusters_.offset[c], clusters_.particle.data() + clusters_.offset[c], frames_.data(), &alpha_,
-                 static_cast<std::uint32_t>(c), billboards && settings_.alpha == AlphaMode::disc, !billboards,
-                 settings_.layout == AccelLayout::instances};
+                 billboards && settings_.alpha == AlphaMode::disc, !billboards, settings_.layout == AccelLayout::instances};
             rtcSetGeometryUserPrimitiveCount(geom, static_cast<unsigned>(n));
             rtcSetGeometryUserData(geom, &b);
             rtcSetGeometryBoundsFunction(geom, &boxBounds, &b);

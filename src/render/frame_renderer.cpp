@@ -60,6 +60,11 @@ void recordClusterBuild(const ParticleBvh& bvh, const Particles& particles, Fram
     }
 }
 
+/// The structure the CPU traces for these settings (cpuGeometry).
+std::unique_ptr<ParticleBvh> newBvh(const EmbreeDevice& device, const Settings& s) {
+    return std::make_unique<ParticleBvh>(device, cpuGeometry(s.geometry, s.gpu.counters), s.gpu);
+}
+
 /// composeImage (the final shading, Le + Lr) per pixel (counting mode).
 void recordCompose(const GBuffer& gbuffer, const Particles& particles, const ParticleBvh& bvh, PassCounters& pc) {
     for (std::size_t px = 0; px < gbuffer.texels.size(); ++px) {
@@ -116,7 +121,7 @@ void composeImage(const GBuffer& gbuffer, const Particles& particles, const Shad
 FrameRenderer::FrameRenderer(const Settings& settings, ParticleSource source, RenderOptions options)
     : settings_(settings), cameras_(settings.camera), plan_(planFrame(settings, FrameFacts{})), source_(std::move(source)), options_(options),
       device_(std::make_unique<EmbreeDevice>()),
-      bvh_(std::make_unique<ParticleBvh>(*device_, cpuGeometry(settings.geometry, settings.gpu.counters), settings.gpu)) {
+      bvh_(newBvh(*device_, settings)) {
     if (settings_.render.estimator == EstimatorKind::restir) restir_ = std::make_unique<Restir>(settings_, plan_.keepHistory);
 }
 
@@ -143,8 +148,7 @@ const Particles& FrameRenderer::prepareGeometry(std::uint32_t frame, const Camer
         auto t = stats.timer.scope(pass::buildClusters);
         if (plan_.previousBvh) {  // double buffer: last frame's BVH stays valid
             std::swap(bvh_, previousBvh_);
-            if (!bvh_)
-                bvh_ = std::make_unique<ParticleBvh>(*device_, cpuGeometry(settings_.geometry, settings_.gpu.counters), settings_.gpu);
+            if (!bvh_) bvh_ = newBvh(*device_, settings_);
         }
         bvh_->build(particles, camera);
         built_ = true;

@@ -60,10 +60,15 @@ TEST_CASE("Embree hits match brute force for every geometry and build policy", "
     INFO(enumName(g.primitive) << " " << enumName(g.alpha) << " " << enumName(g.orientation) << " " << enumName(g.build) << " "
                                << enumName(g.layout));
 
+    // Counting, spheres are box primitives running their own sphere test: brute force checks both.
+    GpuSettings gpu;
+    gpu.counters = g.primitive == Primitive::sphere && GENERATE(false, true);
+    INFO("counting " << gpu.counters);
+
     auto [ps, cs] = accretion::test::smallView(400, 3.0, 0.1, Vec3(0.0f, 3.0f, 6.0f), 40, 30);
     ps.time_step = 0.2;
     EmbreeDevice device;
-    ParticleBvh bvh(device, g);
+    ParticleBvh bvh(device, g, gpu);
 
     for (std::uint32_t frame = 0; frame < 3; ++frame) {  // refit reuses frame 0's clusters
         const Particles p = generateDisk(ps, frame);
@@ -211,8 +216,10 @@ TEST_CASE("counting queries: same answers, BLAS entries bounded by the overlappe
 TEST_CASE("box primitives: an instance entered per box is an intersection program per box", "[geometry][bvh][gpu]") {
     // The instances layout counts a BLAS entry per box a ray enters; the aabbs
     // layout of one BLAS runs its intersection program per box entered. Over
-    // the same boxes and rays the two counts are equal, ray by ray, and the
-    // intersections are at least the hits (a hit is inside its box).
+    // the same boxes and rays the two counts are equal, ray by ray; and,
+    // against boxes formed and slab-tested here from the particles alone,
+    // a ray enters at most the boxes it overlaps and at least those it
+    // overlaps before its closest hit (traversal may skip boxes behind it).
     GeometrySettings g;
     g.alpha = GENERATE(AlphaMode::opaque, AlphaMode::disc);
     g.cluster_size = 1u << 30;
@@ -228,6 +235,25 @@ TEST_CASE("box primitives: an instance entered per box is an intersection progra
     const Camera cam = Camera::atFrame(cs, 0);
     instances.build(p, cam);
     boxes.build(p, cam);
+    // The boxes a ray o + t d, t in [0, tfar), overlaps: a slab test per
+    // particle of its quad's bounds, p -+ r (|right| + |up|), widened (slack
+    // > 0) or narrowed (< 0) by a relative margin.
+    auto overlapped = [&](const Vec3& o, const Vec3& d, float tfar, float slack) {
+        std::uint32_t n = 0;
+        for (std::uint32_t i = 0; i < p.size(); ++i) {
+            const BillboardFrame& f = boxes.frame(i);
+            const Vec3 e = p.radius[i] * (glm::abs(f.right) + glm::abs(f.up)) * (1.0f + slack);
+            float t0 = 0.0f, t1 = tfar;
+            for (int k = 0; k < 3; ++k) {
+                float lo = (p.position[i][k] - e[k] - o[k]) / d[k], hi = (p.position[i][k] + e[k] - o[k]) / d[k];
+                if (lo > hi) std::swap(lo, hi);
+                t0 = std::max(t0, lo);
+                t1 = std::min(t1, hi);
+            }
+            n += t0 <= t1;
+        }
+        return n;
+    };
     std::uint64_t hits = 0, entries = 0, programs = 0;
     for (std::uint32_t y = 0; y < cam.height; ++y)
         for (std::uint32_t x = 0; x < cam.width; ++x) {
@@ -240,6 +266,9 @@ TEST_CASE("box primitives: an instance entered per box is an intersection progra
             if (ha) REQUIRE(a.particle == b.particle);
             REQUIRE(ra.intersections == 0);
             REQUIRE(rb.blasEntries <= 1);  // the one BLAS of boxes, when its bounds are entered
+            REQUIRE(ra.blasEntries == rb.intersections);
+            REQUIRE(rb.intersections <= overlapped(cam.position, d, 1e30f, 1e-4f));
+            REQUIRE(rb.intersections >= overlapped(cam.position, d, hb ? b.t * (1.0f - 1e-4f) : 1e30f, -1e-4f));
             hits += ha;
             entries += ra.blasEntries;
             programs += rb.intersections;

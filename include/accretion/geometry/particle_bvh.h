@@ -63,7 +63,6 @@ struct BoxBlas {
     const std::uint32_t* members = nullptr;  ///< the cluster's particles
     const BillboardFrame* frames = nullptr;  ///< every particle's frame
     const AlphaTest* alpha = nullptr;
-    std::uint32_t cluster = 0;
     bool disc = false;       ///< disc alpha
     bool sphere = false;     ///< spheres (else billboards)
     bool instances = false;  ///< a box is a TLAS instance (instances layout), else an intersection program (aabbs, spheres)
