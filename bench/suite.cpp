@@ -648,11 +648,11 @@ void Suite::benchSplitReference() {
 }
 
 /// restir against uniform Monte Carlo at equal time on disk_100k at 320x180
-/// (issue 17's bar: the best unbiased configuration at least 5x lower
+/// (the bar: the best unbiased configuration at least 5x lower
 /// error): frame 1 after one history frame, per seed the restir frame's
 /// relMSE against uniform's at the same time (uniform's relMSE x seconds
 /// is constant in its samples: relMSE_u t_u / t_r), the median over seeds of
-/// their ratio. The configuration is the best unbiased one of the README's
+/// their ratio. The configuration is the best unbiased one of docs/experiments.md's
 /// restir table (scripts/restir_table.py); the reference is split at
 /// k = 1024, 1024 spp (its noise subtracted).
 void Suite::benchRestirSources() {
@@ -673,7 +673,7 @@ void Suite::benchRestirSources() {
     uniform.render.samples = 16;
     restir.render.estimator = EstimatorKind::restir;
     restir.render.source = LightSource::tree;
-    restir.restir.bias_correction = BiasCorrection::pairwise;  // unbiased; with visibility reuse it loses ~4% (README)
+    restir.restir.bias_correction = BiasCorrection::pairwise;  // unbiased; with visibility reuse it loses ~4% (docs/experiments.md)
     const std::uint32_t seeds = quick ? 3 : 25;
     std::vector<double> gains, tr, tu, er, eu;
     for (std::uint32_t k = 0; k < seeds; ++k) {

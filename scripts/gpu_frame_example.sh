@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# The README's worked example, end to end: an engine's camera file (an orbit
+# docs/gpu-frame-loop.md's worked example, end to end: an engine's camera file (an orbit
 # with TAA jitter, as a CSV), the exact reference of its frames, "GPU"
 # frames (restir at the GPU pipeline's settings stands in for the engine's
 # output), compare with error maps, a sequence with flicker, one pixel
-# explained. Writes the pictures the README shows into docs/gpu_frame_loop/.
+# explained. Writes the pictures docs/gpu-frame-loop.md shows into docs/gpu_frame_loop/.
 # Usage: bash scripts/gpu_frame_example.sh [BUILD_DIR]   (from the repository root)
 set -euo pipefail
 cd "$(dirname "$0")/.."

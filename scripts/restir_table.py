@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The restir configuration table for the GPU team (issue 17, part 4).
+"""The restir configuration table for the GPU team.
 
 For each scene: every candidate source (uniform, power, tree, tiles, regir)
 x bias correction (none, basic, pairwise) x visibility reuse (off, on), and
@@ -20,8 +20,8 @@ uniform Monte Carlo as the baseline, measured by `accretion bias` over
   generateCandidates' coefficients (cost_model.h, costProxy).
 
 References: quickstart, exact; disk_100k, split with k = 256 at 1024 spp.
-Writes out/restir_table/<scene>.{md,json} and, with --update-readme, the
-table between the README's restir-table markers. Run from anywhere; needs
+Writes out/restir_table/<scene>.{md,json} and, with --update-docs, the
+table between the restir-table markers of docs/experiments.md. Run from anywhere; needs
 build/accretion (Release).
 """
 import argparse
@@ -130,7 +130,7 @@ def main():
     ap.add_argument("--scenes", default="quickstart,disk_100k")
     ap.add_argument("--seeds", type=int, default=64)
     ap.add_argument("--out", default=str(ROOT / "out" / "restir_table"))
-    ap.add_argument("--update-readme", action="store_true")
+    ap.add_argument("--update-docs", action="store_true")
     a = ap.parse_args()
     out = pathlib.Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -145,8 +145,8 @@ def main():
         (out / f"{scene}.md").write_text(md)
         print(md)
         parts.append(md)
-    if a.update_readme:
-        readme = ROOT / "README.md"
+    if a.update_docs:
+        readme = ROOT / "docs" / "experiments.md"
         text = readme.read_text()
         if BEGIN not in text or END not in text:
             sys.exit(f"{readme}: no {BEGIN} ... {END} markers")

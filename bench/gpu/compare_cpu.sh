@@ -1,5 +1,5 @@
 #!/bin/bash
-# The image agreement of the OptiX twin with the CPU renderer (issue 16), on
+# The image agreement of the OptiX twin with the CPU renderer, on
 # this (CPU) machine: import the GPU frames that bench/gpu/run.sh's images,
 # restir and sampling steps brought back, render the same frames with
 # `accretion render`, and compare Lr per pixel (relMSE, identical pixels,

@@ -1,5 +1,5 @@
 #!/bin/bash
-# The OptiX twin's runs on a GPU machine (issue 16), from the repository root:
+# The OptiX twin's runs on a GPU machine, from the repository root:
 #   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
 #                                      layout_images layouts streams front
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12

@@ -96,7 +96,7 @@ same_pixels() {
 
 SCENE_ARGS=(-D particles.count=3000 -D camera.width=96 -D camera.height=54)
 export ACCRETION=$BIN SCENE=$ROOT/scenes/quickstart.toml ESTIMATOR=tree SPP=256 FRAME=0 SHARDS=4 OUT=$WORK/out/array
-# The README's job array, scaled down: 4 tasks of one CPU each; the scene
+# docs/batches.md's job array, scaled down: 4 tasks of one CPU each; the scene
 # is shrunk through the same render flags for every task.
 sed "s|render \"\$SCENE\"|render \"\$SCENE\" ${SCENE_ARGS[*]}|" scripts/slurm/reference.sbatch > "$WORK/reference.sbatch"
 cd "$WORK"

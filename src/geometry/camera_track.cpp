@@ -439,7 +439,7 @@ std::vector<std::uint32_t> CameraTrack::missing(std::uint32_t first, std::uint32
 void writeCameraFile(const std::filesystem::path& file, const CameraTrack& track, const CameraSettings& settings,
                      std::uint32_t first, std::uint32_t end, const CameraConvention& conv, bool matrices) {
     nlohmann::json doc;
-    doc["comment"] = "accretion camera file: one camera per frame (see README, Cameras from the engine)";
+    doc["comment"] = "accretion camera file: one camera per frame (see docs/gpu-frame-loop.md, Cameras from the engine)";
     doc["convention"] = {{"storage", conv.storage == CameraConvention::Storage::row_major ? "row_major" : "column_major"},
                          {"vectors", conv.vectors == CameraConvention::Vectors::row ? "row" : "column"},
                          {"handedness", conv.handedness == CameraConvention::Handedness::left ? "left" : "right"},

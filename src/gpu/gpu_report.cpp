@@ -15,7 +15,7 @@ namespace {
 
 WarpLayout warpLayout(const GpuSettings& gpu) { return {gpu.group_width, gpu.group_height, gpu.warp_size}; }
 
-/// Seed 003's rule: pipeline TraceRay pays off with many any-hits per ray
+/// Pipeline TraceRay pays off with many any-hits per ray
 /// (they run as a compact separate shader) or divergence SER can regroup;
 /// inline RayQuery wins for simple occlusion queries with no any-hit, a
 /// trivial miss and a small payload.

@@ -1,4 +1,4 @@
-// accretion-optix: the OptiX twin of the GPU pipeline (issue 16). It reads
+// accretion-optix: the OptiX twin of the GPU pipeline. It reads
 // the scene files, particle buffers and settings `accretion render` reads,
 // runs the pipeline on the GPU (per-frame cluster BLAS builds, TLAS,
 // G-buffer raygen, lighting) and writes per frame a .gpuframe (the layers

@@ -13,8 +13,8 @@
 namespace accretion {
 
 /// The counters a pass's predicted time is linear in (docs/MODEL.md section
-/// 6). The first six are the model's first form; the others came with the
-/// GPU measurements of issue 16: the traversal inside the BLAS entered
+/// 6). The first six are the model's first form; the others came with
+/// measurements on a GPU (bench/gpu): the traversal inside the BLAS entered
 /// (their depths), micromap lookups (software on a GPU without RT cores),
 /// the launches (kernel dispatches, BLAS builds and refits: a constant
 /// cost each; the number of builds, not their triangles, set the build

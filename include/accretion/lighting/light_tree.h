@@ -32,9 +32,12 @@ public:
     /// Probability that sample() returns light i at this receiver.
     float pdf(const ShadingPoint& sp, std::uint32_t i) const;
 
-    /// The `split` estimator's near field: the min(k, N - 1) lights nearest
-    /// to the receiver other than its own particle (best-first on the
-    /// nodes' spheres), in tree order with their powers.
+    // The `split` estimator's near and far fields: nearest, sampleFar and
+    // pdfFar are defined beside the near field, in src/lighting/near_field.cpp.
+
+    /// The min(k, N - 1) lights nearest to the receiver other than its own
+    /// particle (depth-first, the nearer child first, pruned by the k-th
+    /// distance on the nodes' spheres), in tree order with their powers.
     void nearest(const ShadingPoint& sp, std::uint32_t k, NearField& out) const;
     /// The near field of these lights (nearest()'s out.light, in any order:
     /// what a cache keeps of it).
