@@ -1,7 +1,7 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine, from the repository root:
 #   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
-#                                      layout_images layouts streams front
+#                                      layout_images layouts streams front identity
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -266,6 +266,45 @@ step_ncu() {
         --metrics smsp__thread_inst_executed_per_inst_executed.ratio,gpu__time_duration.sum > "$t/ncu.csv" 2>&1
     rm -f "$t"/*.gpuframe
     head -5 "$t/ncu.csv"
+}
+
+# A change that must not move a GPU frame: the twin of the source tree in
+# .twin-deps/old (staged by `bash bench/gpu/stage_deps.sh SDK OLD_COMMIT`)
+# built beside this one, both run on every restir option the twin has, and
+# each pair of .gpuframe files compared byte for byte (`cmp`).
+step_identity() {
+    local t="$W/identity" old=$D/old
+    [ -d "$old" ] || { echo "identity: no $old (stage_deps.sh with an old commit)"; return 1; }
+    mkdir -p "$t"
+    (cd "$old" && cmake -S . -B build-gpu -G Ninja -DCMAKE_BUILD_TYPE=Release -DACCRETION_CPU=OFF -DACCRETION_OPTIX=ON \
+        -DOptiX_INCLUDE="$D/optix/include" -DACCRETION_COMMIT="$(cat "$D/old.commit")" -DCMAKE_CUDA_ARCHITECTURES=90 \
+        -DTBB_DIR=$L/cmake/TBB -Dfmt_DIR=$L/cmake/fmt -Dtomlplusplus_DIR=$L/cmake/tomlplusplus \
+        -Dglm_DIR=$S/share/cmake/glm -Dnlohmann_json_DIR=$S/share/cmake/nlohmann_json -DCLI11_DIR=$S/share/cmake/CLI11 \
+        > "$t/build_old.log" 2>&1 && cmake --build build-gpu -j 16 >> "$t/build_old.log" 2>&1) || { tail -20 "$t/build_old.log"; return 1; }
+    local q="scenes/quickstart.toml -D camera.width=320 -D camera.height=180 -D render.estimator=\"restir\" --frames 0:3 --repeat 1"
+    local k=0 differ=0
+    while read -r opts; do
+        k=$((k + 1))
+        # shellcheck disable=SC2086  # the overrides are words
+        $BIN $q $opts -o "$t/new$k.{frame}.exr" > /dev/null 2>&1 || { echo "identity: new twin failed on: $opts"; differ=1; continue; }
+        # shellcheck disable=SC2086
+        (cd "$old" && build-gpu/accretion-optix $q $opts -o "$t/old$k.{frame}.exr" > /dev/null 2>&1) ||
+            { echo "identity: old twin failed on: $opts"; differ=1; continue; }
+        for f in "$t"/new$k.*.gpuframe; do
+            cmp -s "$f" "${f/new$k/old$k}" && echo "same    $k $(basename "$f") $opts" || { echo "DIFFERS $k $(basename "$f") $opts"; differ=1; }
+        done
+    done <<'CONFIGS'
+-D restir.bias_correction="pairwise"
+-D restir.bias_correction="basic"
+-D restir.bias_correction="none"
+-D restir.bias_correction="basic" -D restir.visibility_reuse=true
+-D render.source="power" -D restir.spatial_iterations=2 -D restir.spatial_neighbours=10
+-D render.source="power" -D restir.resolution_scale=0.5
+-D restir.layout="packed" -D geometry.alpha="disc"
+-D geometry.layout="aabbs" -D restir.m_cap=5
+CONFIGS
+    rm -f "$t"/*.gpuframe
+    return $differ
 }
 
 for s in "$@"; do

@@ -4,7 +4,9 @@
 # (TBB, fmt, glm, toml++, nlohmann-json, CLI11, pcg) from the installed
 # packages, the OptiX SDK headers (never committed: .twin-deps is ignored),
 # and the commit the results belong to.
-#   bash bench/gpu/stage_deps.sh <OptiX SDK include folder's parent>
+#   bash bench/gpu/stage_deps.sh <OptiX SDK include folder's parent> [OLD_COMMIT]
+# With OLD_COMMIT, also that commit's source tree in .twin-deps/old (run.sh's
+# identity step compares its GPU frames with this tree's).
 set -euo pipefail
 optix=${1:?usage: stage_deps.sh OPTIX_SDK_DIR (the folder holding include/optix.h)}
 D=.twin-deps
@@ -15,4 +17,8 @@ for p in libtbb-dev libtbb12 libtbbmalloc2 libtbbbind-2-5 libfmt-dev libfmt9 lib
 done | grep -v '/usr/share/doc\|/usr/share/lintian\|/usr/share/man' | tar cf - -T - 2>/dev/null | tar xf - -C "$D/sysroot"
 mkdir -p "$D/optix" && cp -r "$optix/include" "$D/optix/"
 git rev-parse --short=10 HEAD > "$D/commit"
+if [ -n "${2:-}" ]; then
+    mkdir -p "$D/old" && git archive "$2" CMakeLists.txt cmake include src scenes | tar xf - -C "$D/old"
+    git rev-parse --short=10 "$2" > "$D/old.commit"
+fi
 du -sh "$D"

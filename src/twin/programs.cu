@@ -181,12 +181,14 @@ __device__ void shadePixel() {
                 seen = visible<true>(sp, r.y, t, c);
             }
         }
-        if (!seen) {
-            if (rp.visibilityReuse) rp.out[px] = StoredReservoir{kNoLight, 0.0f, r.M, 0.0f};
-        } else {
-            const Vec3 value = t.value * r.W;
-            if (isfinite(value.x) && isfinite(value.y) && isfinite(value.z)) rp.Lr[px] = value;
-            else if (rejectAt(rp, px)) rp.out[px] = StoredReservoir{};
+        switch (restir::shadeSample(t, r.W, seen, rp.Lr[px])) {
+        case restir::Shade::lit: break;
+        case restir::Shade::occluded:
+            if (rp.visibilityReuse) rp.out[px] = restir::occludedReservoir(r);
+            break;
+        case restir::Shade::overflow:
+            if (rejectAt(rp, px)) rp.out[px] = StoredReservoir{};
+            break;
         }
     }
     addCounters(c);

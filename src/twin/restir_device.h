@@ -1,21 +1,20 @@
 #pragma once
-// The per-pixel steps of the twin's restir passes (restir_kernels.cu and the
-// shading raygens of programs.cu): the CPU passes of src/render/restir/ written
-// again for one GPU thread, on the functions both share (evalLight, Reservoir,
-// the resampling weights, PortableRng), so that a GPU frame draws the CPU
-// frame's candidates and keeps its samples.
+// What the twin's restir kernels (restir_kernels.cu) and shading raygens
+// (programs.cu) read of a frame: the adapters through which they run the
+// per-pixel steps they share with the CPU (accretion/render/restir_steps.h),
+// so that a GPU frame draws the CPU frame's candidates and keeps its samples.
 #include <cmath>
 
 #include "accretion/core/rng.h"
 #include "accretion/lighting/reservoir.h"
 #include "accretion/lighting/resampling.h"
 #include "accretion/lighting/shading.h"
+#include "accretion/render/restir_steps.h"
 #include "launch_params.h"
 
 namespace accretion::twin {
 
-/// Offers of one resampling step: the canonical reservoir and up to 64 neighbours.
-inline constexpr std::uint32_t kMaxOffers = 65;
+using restir::kMaxOffers;
 
 __device__ inline ShadingPoint shadingPointOf(const GBufferTexel& g, const LightView& L) {
     const Vec3 centre = L.position[g.particle];
@@ -57,68 +56,24 @@ struct Offer {
     const LightView* lights;
 };
 
-/// combineReservoirs (src/render/restir/combine_reservoirs.h) without
-/// basic_visibility: the same weights, in the same order, from the same stream.
+/// The offers of a kernel as restir_steps.h's Domains (combineReservoirs):
+/// each domain's p_hat from its own lights; nothing counted; basic's support
+/// is p_hat > 0 (the twin has no basic_visibility).
 template <ShadingModel SM>
-__device__ StoredReservoir combineReservoirs(const Offer* offers, std::uint32_t n, const LightView& L, BiasCorrection bias,
-                                             PortableRng& rng) {
-    const Offer& can = offers[0];
-    const ShadingPoint& sp = can.sp;
-    if (n == 1) return can.r;
-    double Mtotal = 0.0;
-    for (std::uint32_t i = 0; i < n; ++i) Mtotal += offers[i].r.M;
-    float pc[kMaxOffers];
-    pc[0] = can.r.W > 0.0f ? can.r.p_hat : 0.0f;
-    for (std::uint32_t i = 1; i < n; ++i) pc[i] = offers[i].r.W > 0.0f ? targetPdf<SM>(L, sp, offers[i].r.y) : 0.0f;
+struct DeviceDomains {
+    const Offer* offers;
+    std::uint32_t n;
 
-    Reservoir out;
-    StoredReservoir res;
-    res.M = static_cast<std::uint32_t>(Mtotal < 4294967295.0 ? Mtotal : 4294967295.0);
-    if (bias == BiasCorrection::pairwise) {
-        const double k = n - 1;
-        const double Mc = can.r.M;
-        for (std::uint32_t i = 0; i < n; ++i) {
-            const StoredReservoir& r = offers[i].r;
-            double m = 0.0;
-            if (r.W > 0.0f && pc[i] > 0.0f) {
-                if (i == 0) {
-                    for (std::uint32_t j = 1; j < n; ++j) {
-                        const double pj = targetPdf<SM>(*offers[j].lights, offers[j].sp, r.y);
-                        m += resampling::pairwiseCanonicalTerm(offers[j].r.M, pj, Mc, k, pc[0], Mtotal);
-                    }
-                } else {
-                    m = resampling::pairwiseNeighbourWeight(r.M, r.p_hat, Mc, k, pc[i], Mtotal);
-                }
-            }
-            const float w = static_cast<float>(m * double(pc[i]) * double(r.W));
-            out.merge(r.y, w, pc[i], r.M, rng.uniform());
-        }
-        if (out.y == kNoLight || !(out.p_hat > 0.0f)) return res;
-        res.y = out.y;
-        res.p_hat = out.p_hat;
-        res.W = out.w_sum / out.p_hat;
-        return res;
+    __device__ std::uint32_t count() const { return n; }
+    __device__ const StoredReservoir& reservoir(std::uint32_t i) const { return offers[i].r; }
+    __device__ float targetPdf(std::uint32_t i, std::uint32_t y) const {
+        return twin::targetPdf<SM>(*offers[i].lights, offers[i].sp, y);
     }
-    std::uint32_t chosen = 0;
-    for (std::uint32_t i = 0; i < n; ++i) {
-        const StoredReservoir& r = offers[i].r;
-        const float w = pc[i] * r.W * float(r.M);
-        if (out.merge(r.y, w, pc[i], r.M, rng.uniform())) chosen = i;
+    __device__ void countTerm() const {}
+    __device__ bool supports(std::uint32_t i, std::uint32_t y) const {
+        LightTerm t;
+        return lightTerm<SM>(*offers[i].lights, offers[i].sp, y, t) && luminance(t.value) > 0.0f;
     }
-    if (out.y == kNoLight || !(out.p_hat > 0.0f)) return res;
-    double Z = Mtotal;
-    if (bias == BiasCorrection::basic) {  // resampling::basicNormalization, in domain order
-        Z = offers[chosen].r.M;
-        for (std::uint32_t i = 0; i < n; ++i) {
-            if (i == chosen) continue;
-            LightTerm t;
-            if (lightTerm<SM>(*offers[i].lights, offers[i].sp, out.y, t) && luminance(t.value) > 0.0f) Z += offers[i].r.M;
-        }
-    }
-    res.y = out.y;
-    res.p_hat = out.p_hat;
-    res.W = static_cast<float>(double(out.w_sum) / (Z * double(out.p_hat)));
-    return res;
-}
+};
 
 }  // namespace accretion::twin

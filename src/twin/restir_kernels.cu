@@ -26,24 +26,10 @@ __global__ void generateCandidatesKernel(LaunchParams p) {
     if (!g.hit()) return;
     const ShadingPoint sp = shadingPointOf(g, p.lights);
     PortableRng rng(px, rp.frame, RngPass::restirCandidates, rp.seed);
+    const auto draw = [&](PortableRng& g) { return p.source.sample(g); };
+    const auto target = [&](std::uint32_t i) { return targetPdf<SM>(p.lights, sp, i); };
     Reservoir r;
-    bool discard = false;
-    for (std::uint32_t m = 0; m < rp.candidates; ++m) {
-        const LightSample x = p.source.sample(rng);
-        float p_hat = targetPdf<SM>(p.lights, sp, x.i);
-        float w = p_hat / x.pdf;
-        if (!finiteF(w) || !finiteF(p_hat)) {
-            discard = rejectAt(rp, px) || discard;
-            w = p_hat = 0.0f;
-        }
-        r.update(x.i, w, p_hat, rng.uniform());
-    }
-    r.finalize();
-    if (!finiteF(r.w_sum) || !finiteF(r.W)) {
-        discard = rejectAt(rp, px) || discard;
-        r.W = 0.0f;
-    }
-    if (discard) return;
+    if (!restir::resampleCandidates(rp.candidates, rng, draw, target, [&] { return rejectAt(rp, px); }, r)) return;
     rp.out[px] = StoredReservoir::of(r);
 }
 
@@ -61,14 +47,10 @@ __global__ void temporalResamplingKernel(LaunchParams p) {
     const std::uint32_t j = g.particle;
     if (j >= rp.prevLights.count) return;
     const Vec3 xPrev = rp.prevLights.position[j] + g.local;
-    float fx, fy, depth;
-    bool ok = rp.prevCamera.project(xPrev, fx, fy, depth);
-    const float lx = fx * rp.scale, ly = fy * rp.scale;
-    const std::uint32_t W = rp.width, H = rp.height;
-    ok = ok && lx >= 0.0f && ly >= 0.0f && lx < float(W) && ly < float(H);
+    float depth;
     std::size_t q = 0;
+    bool ok = restir::reprojectPoint(rp.prevCamera, xPrev, rp.scale, rp.width, rp.height, q, depth);
     if (ok) {
-        q = std::size_t(ly) * W + std::size_t(lx);
         const GBufferTexel gp = rp.prevGbuffer[q];
         ok = gp.particle == j &&
              resampling::similarSurface(g.normal, depth, gp.normal, gp.depth, rp.normalThreshold, rp.depthThreshold);
@@ -77,12 +59,10 @@ __global__ void temporalResamplingKernel(LaunchParams p) {
     Offer offers[2];
     offers[0] = {cur, shadingPointOf(g, p.lights), &p.lights};
     StoredReservoir prev = rp.prevReservoirs[q];
-    const double cap = rp.mCap * double(cur.M > 1u ? cur.M : 1u);
-    const double capped = floor(cap);
-    prev.M = static_cast<std::uint32_t>(double(prev.M) < capped ? double(prev.M) : capped);
+    prev.M = restir::capHistoryM(prev.M, cur.M, rp.mCap);
     offers[1] = {prev, shadingPointOf(rp.prevGbuffer[q], rp.prevLights), &rp.prevLights};
     PortableRng rng(px, rp.frame, RngPass::restirTemporal, rp.seed);
-    rp.out[px] = sanitize(rp, combineReservoirs<SM>(offers, 2, p.lights, rp.bias, rng), px);
+    rp.out[px] = sanitize(rp, restir::combineReservoirs(DeviceDomains<SM>{offers, 2}, rp.bias, rng), px);
 }
 
 /// spatialResampling: k neighbours uniform in a disc of the radius.
@@ -101,19 +81,15 @@ __global__ void spatialResamplingKernel(LaunchParams p, std::uint32_t iteration)
     std::uint32_t n = 0;
     offers[n++] = {rp.in[px], shadingPointOf(g, p.lights), &p.lights};
     for (std::uint32_t s = 0; s < rp.neighbours; ++s) {
-        const float r = rp.radius * sqrtf(rng.uniform());
-        const float phi = 6.28318530718f * rng.uniform();
-        const long nx = lroundf(float(x) + r * cosf(phi));
-        const long ny = lroundf(float(y) + r * sinf(phi));
-        if (nx < 0 || ny < 0 || nx >= long(W) || ny >= long(H) || (nx == long(x) && ny == long(y))) continue;
-        const std::size_t q = std::size_t(ny) * W + std::size_t(nx);
+        std::size_t q;
+        if (!restir::drawNeighbour(rng, rp.radius, x, y, W, H, q)) continue;
         const GBufferTexel gn = rp.gbuffer[q];
         if (!gn.hit() ||
             !resampling::similarSurface(g.normal, g.depth, gn.normal, gn.depth, rp.normalThreshold, rp.depthThreshold))
             continue;
         offers[n++] = {rp.in[q], shadingPointOf(gn, p.lights), &p.lights};
     }
-    rp.out[px] = sanitize(rp, combineReservoirs<SM>(offers, n, p.lights, rp.bias, rng), px);
+    rp.out[px] = sanitize(rp, restir::combineReservoirs(DeviceDomains<SM>{offers, n}, rp.bias, rng), px);
 }
 
 dim3 blocks(const LaunchParams& p) { return dim3((p.restir.width + 7) / 8, (p.restir.height + 7) / 8); }

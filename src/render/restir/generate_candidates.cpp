@@ -1,6 +1,7 @@
 // generateCandidates: the initial reservoir of each lighting texel.
 #include "restir_pass.h"
 #include "accretion/lighting/light_sampler.h"
+#include "accretion/render/restir_steps.h"
 
 namespace accretion::restir {
 namespace {
@@ -35,30 +36,18 @@ LightingCounters generateCandidatesKernel(const FrameContext& f, std::vector<Sto
         std::int64_t cell = -1;
         if constexpr (presampled) tile = f.tiles->tileOf(tx, ty, f.lg.width, f.in.frame, seed);
         if constexpr (S == LightSource::regir) cell = f.regir->jitteredCell(sp.x, jitter, rng);
-        Reservoir r;
-        bool discard = false;
-        for (std::uint32_t m = 0; m < Mc; ++m) {
-            LightSample x;
-            if constexpr (S == LightSource::regir) x = cell >= 0 ? f.regir->sample(std::uint32_t(cell), rng) : f.tiles->sample(tile, rng);
-            else if constexpr (S == LightSource::tiles) x = f.tiles->sample(tile, rng);
-            else x = sampleCandidate<S>(f.L, f.in.powerTable, f.in.lightTree, sp, rng);
-            float p_hat = f.L.targetPdf<SM>(sp, x.i);
-            // The tree drew no light, or an empty ReGIR slot: a zero candidate.
-            // regir: pdf = 1 / W, so w = p_hat W, W the slot's unbiased 1 / p_src.
-            float w = x.pdf > 0.0f ? p_hat / x.pdf : 0.0f;
+        const auto draw = [&](Rng& g) {
+            if constexpr (S == LightSource::regir) return cell >= 0 ? f.regir->sample(std::uint32_t(cell), g) : f.tiles->sample(tile, g);
+            else if constexpr (S == LightSource::tiles) return f.tiles->sample(tile, g);
+            else return sampleCandidate<S>(f.L, f.in.powerTable, f.in.lightTree, sp, g);
+        };
+        // regir: pdf = 1 / W, so w = p_hat W, W the slot's unbiased 1 / p_src.
+        const auto target = [&](std::uint32_t i) {
             ++c.lightTerms;
-            if (!std::isfinite(w) || !std::isfinite(p_hat)) {  // render.nonfinite: a zero candidate, or no reservoir
-                discard = f.reject(px, c) || discard;
-                w = p_hat = 0.0f;
-            }
-            r.update(x.i, w, p_hat, rng.uniform());
-        }
-        r.finalize();
-        if (!std::isfinite(r.w_sum) || !std::isfinite(r.W)) {  // finite weights whose sum overflowed
-            discard = f.reject(px, c) || discard;
-            r.W = 0.0f;
-        }
-        if (discard) return;  // out[px] stays empty
+            return f.L.targetPdf<SM>(sp, i);
+        };
+        Reservoir r;
+        if (!resampleCandidates(Mc, rng, draw, target, [&] { return f.reject(px, c); }, r)) return;  // out[px] stays empty
         if (f.rs.candidate_visibility && f.shadows && r.W > 0.0f) {
             // Bitterli et al. 2020, Alg. 5: drop an occluded candidate before reuse.
             LightTerm t;

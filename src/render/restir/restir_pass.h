@@ -52,9 +52,6 @@ struct Offer {
 /// Per-thread buffers of a resampling pass, sized by the neighbours asked for.
 struct Scratch {
     std::vector<Offer> offers;
-    std::vector<float> pc;              ///< p_hat at the current pixel of each offered sample
-    std::vector<std::uint32_t> M;
-    std::vector<std::uint8_t> counts;   ///< basic: the domain counts in Z
 };
 
 /// Runs body(px, x, y, counters) or body(px, x, y, counters, scratch) over

@@ -33,16 +33,11 @@ LightingCounters spatialResamplingKernel(const FrameContext& f, std::uint32_t it
         const bool tested = f.rs.candidate_visibility;
         offers.push_back({cur[px], {sp, &f.L, tested, &f.in.bvh}});
         for (std::uint32_t s = 0; s < k; ++s) {
-            // Uniform in the disc of the radius (polar, sqrt for area).
-            const float r = radius * std::sqrt(rng.uniform());
-            const float phi = 6.28318530718f * rng.uniform();
-            const long nx = std::lround(float(x) + r * std::cos(phi));
-            const long ny = std::lround(float(y) + r * std::sin(phi));
-            if (nx < 0 || ny < 0 || nx >= long(W) || ny >= long(H) || (nx == long(x) && ny == long(y))) {
+            std::size_t q;
+            if (!drawNeighbour(rng, radius, x, y, W, H, q)) {
                 ++c.reuseRejected;
                 continue;
             }
-            const std::size_t q = std::size_t(ny) * W + std::size_t(nx);
             const GBufferTexel& gn = f.lg.texels[q];
             rec.read(gpu_layout::kGBufferTexel);
             if (!gn.hit() || !resampling::similarSurface(g.normal, g.depth, gn.normal, gn.depth,
@@ -54,7 +49,7 @@ LightingCounters spatialResamplingKernel(const FrameContext& f, std::uint32_t it
             rec.read(R + gpu_layout::kParticleRecord);
             offers.push_back({cur[q], {shadingPoint(gn, f.in.particles), &f.L, tested, &f.in.bvh}});
         }
-        out[px] = f.codec.roundTrip(f.sanitize(combineReservoirs<SM, P, Count>(scratch, f.L, f.rs, f.vis, f.shadows, rng, c, rec), px, c));
+        out[px] = f.codec.roundTrip(f.sanitize(combineOffers<SM, P, Count>(scratch, f, rng, c, rec), px, c));
     });
 }
 

@@ -29,14 +29,11 @@ LightingCounters temporalResamplingKernel(const FrameContext& f, const std::vect
             return;
         }
         const Vec3 xPrev = h.particles.position[j] + g.local;  // frame-independent: relative to the particle
-        float fx, fy, depth;
-        bool ok = h.camera.project(xPrev, fx, fy, depth);
-        const float lx = fx * f.scale, ly = fy * f.scale;
-        ok = ok && lx >= 0.0f && ly >= 0.0f && lx < float(h.gbuffer.width) && ly < float(h.gbuffer.height);
+        float depth;
         std::size_t q = 0;
+        bool ok = reprojectPoint(h.camera, xPrev, f.scale, h.gbuffer.width, h.gbuffer.height, q, depth);
         if (ok) {
             rec.read(gpu_layout::kGBufferTexel);
-            q = std::size_t(ly) * h.gbuffer.width + std::size_t(lx);
             const GBufferTexel& gp = h.gbuffer.texels[q];
             ok = gp.particle == j && resampling::similarSurface(g.normal, depth, gp.normal, gp.depth,
                                                                 float(f.rs.normal_threshold), float(f.rs.depth_threshold));
@@ -52,15 +49,14 @@ LightingCounters temporalResamplingKernel(const FrameContext& f, const std::vect
         offers.clear();
         offers.push_back({cur[px], {sp, &f.L, f.rs.candidate_visibility, &f.in.bvh}});
         StoredReservoir prev = h.reservoirs[q];
-        const double cap = f.rs.m_cap * double(std::max<std::uint32_t>(cur[px].M, 1));
-        prev.M = static_cast<std::uint32_t>(std::min(double(prev.M), std::floor(cap)));
+        prev.M = capHistoryM(prev.M, cur[px].M, f.rs.m_cap);
         // The previous frame's visibility needs the previous frame's BVH
         // (kept by the frame renderer when basic_visibility asks for it).
         offers.push_back({prev, {shadingPoint(h.gbuffer.texels[q], h.particles), &h.lights,
                                  f.rs.candidate_visibility || f.rs.visibility_reuse,
                                  f.in.previousBvh ? f.in.previousBvh : &f.in.bvh}});
         Rng rng(px, f.in.frame, RngPass::restirTemporal, f.in.settings.render.seed);
-        out[px] = f.codec.roundTrip(f.sanitize(combineReservoirs<SM, P, Count>(scratch, f.L, f.rs, f.vis, f.shadows, rng, c, rec), px, c));
+        out[px] = f.codec.roundTrip(f.sanitize(combineOffers<SM, P, Count>(scratch, f, rng, c, rec), px, c));
     });
 }
 

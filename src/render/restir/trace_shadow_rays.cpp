@@ -1,5 +1,6 @@
 // traceShadowRays: one shadow ray for the kept sample, and Lr.
 #include "restir_pass.h"
+#include "accretion/render/restir_steps.h"
 
 namespace accretion::restir {
 namespace {
@@ -32,18 +33,18 @@ LightingCounters traceShadowRaysKernel(const FrameContext& f, std::vector<Stored
             seen = visible<P>(f.in.bvh, f.vis, sp, r.y, f.L.packed[r.y].position, f.L.packed[r.y].radius, t, rec.rayCounters(rc));
             rec.ray(rc);
         }
-        if (!seen) {
+        switch (shadeSample(t, r.W, seen, Lr[px])) {
+        case Shade::lit: break;
+        case Shade::occluded:
             ++c.shadowOccluded;
             if (f.rs.visibility_reuse) {
-                r = f.codec.roundTrip(StoredReservoir{kNoLight, 0.0f, r.M, 0.0f});
+                r = f.codec.roundTrip(occludedReservoir(r));
                 rec.write(R);
             }
-            return;
-        }
-        const Vec3 value = t.value * r.W;
-        if (std::isfinite(value.x) && std::isfinite(value.y) && std::isfinite(value.z)) Lr[px] = value;
-        else {  // overflow in f I G W: a zero sample (discard: and no reservoir for reuse)
+            break;
+        case Shade::overflow:  // a zero sample (discard: and no reservoir for reuse)
             if (f.reject(px, c)) r = f.codec.roundTrip(StoredReservoir{});
+            break;
         }
     });
 }

@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# Compiles the OptiX twin (src/twin) without a GPU, as CI does: the OptiX
+# programs to OptiX-IR, the CUDA kernels and the host code to objects, and
+# links accretion-optix against the Release build's accretion_base. Then the
+# ReSTIR steps the CPU and the twin share (restir_steps.h) are compiled both
+# ways, with g++ and with nvcc, and the two programs must print the same bits
+# (tests/twin/restir_steps_check.cpp). GPU runs stay on a GPU machine
+# (bench/gpu/run.sh).
+#   scripts/compile_twin.sh [BUILD_DIR]      (default build: the Release build)
+# nvcc: $NVCC, else nvcc on PATH, else /usr/local/cuda, else CUDA 13's
+# compiler wheels from the Python package index in .cache/cuda (Debian has
+# no nvcc). OptiX headers: $OPTIX_INCLUDE, else ../shared/optix-9.0/include.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build=${1:-build}
+out=build-twin
+mkdir -p "$out"
+
+nvcc=${NVCC:-$(command -v nvcc || true)}
+[ -n "$nvcc" ] || [ ! -x /usr/local/cuda/bin/nvcc ] || nvcc=/usr/local/cuda/bin/nvcc
+if [ -z "$nvcc" ]; then
+    venv=.cache/cuda
+    if [ ! -x "$venv/bin/python" ]; then
+        echo "compile_twin: installing CUDA 13's nvcc, runtime headers and cudart from PyPI into $venv" >&2
+        python3 -m venv "$venv"
+        "$venv/bin/pip" install -q "cuda-toolkit[nvcc,cudart,crt,nvvm]==13.0.*"
+    fi
+    nvcc=$(find "$venv" -path '*/nvidia/cu13/bin/nvcc' | head -1)
+    [ -x "$nvcc" ] || { echo "compile_twin: no nvcc in $venv" >&2; exit 1; }
+fi
+cuda=$(cd "$(dirname "$nvcc")/.." && pwd)
+optix=${OPTIX_INCLUDE:-../shared/optix-9.0/include}
+[ -f "$optix/optix.h" ] || { echo "compile_twin: no optix.h in '$optix' (set OPTIX_INCLUDE)" >&2; exit 1; }
+[ -f "$build/libaccretion_base.a" ] || { echo "compile_twin: no $build/libaccretion_base.a (build the project first)" >&2; exit 1; }
+echo "compile_twin: $("$nvcc" --version | tail -2 | head -1), OptiX headers $optix" >&2
+
+# The flags of src/twin/CMakeLists.txt: no FMA contraction, so that the
+# shared ACC_HD functions round as the CPU's do.
+cuflags=(-std=c++20 -O3 -fmad=false --expt-relaxed-constexpr -diag-suppress=20012,20011,20014,20044 -arch=sm_90
+         -Iinclude -Isrc/twin -I"$optix" -I"$build/generated")
+cxxflags=(-std=c++20 -O2 -Wall -Wextra -Wno-unused-parameter -Iinclude -Isrc/twin -I"$optix" -I"$cuda/include")
+
+pids=()
+"$nvcc" "${cuflags[@]}" -optix-ir -c src/twin/programs.cu -o "$out/programs.optixir" & pids+=($!)
+for f in kernels restir_kernels; do
+    "$nvcc" "${cuflags[@]}" -c src/twin/$f.cu -o "$out/$f.o" & pids+=($!)
+done
+for f in twin_main optix_pipeline particle_accel; do
+    g++ "${cxxflags[@]}" -DACCRETION_TWIN_PROGRAMS="\"$out/programs.optixir\"" -c src/twin/$f.cpp -o "$out/$f.o" & pids+=($!)
+done
+for p in "${pids[@]}"; do wait "$p"; done
+cudart=$(find "$cuda" -name 'libcudart.so*' -o -name 'libcudart_static.a' | head -1)
+"$nvcc" -arch=sm_90 "$out"/{twin_main,optix_pipeline,particle_accel,kernels,restir_kernels}.o \
+    "$build/libaccretion_base.a" -L"$(dirname "$cudart")" -ltomlplusplus -ltbb -lfmt -ldl -lpthread -o "$out/accretion-optix"
+echo "compile_twin: $out/accretion-optix and $out/programs.optixir" >&2
+
+# The shared steps, both ways: the same bits or a failure.
+g++ -std=c++20 -O2 -ffp-contract=off -Iinclude tests/twin/restir_steps_check.cpp "$build/libaccretion_base.a" -ltomlplusplus -ltbb -lfmt \
+    -o "$out/restir_steps_gcc"
+"$nvcc" "${cuflags[@]}" -x cu -c tests/twin/restir_steps_check.cpp -o "$out/restir_steps_check.o"
+"$nvcc" -arch=sm_90 "$out/restir_steps_check.o" "$build/libaccretion_base.a" -L"$(dirname "$cudart")" -ltomlplusplus -ltbb -lfmt \
+    -o "$out/restir_steps_nvcc"
+"$out/restir_steps_gcc" > "$out/restir_steps_gcc.txt"
+"$out/restir_steps_nvcc" > "$out/restir_steps_nvcc.txt"
+if ! cmp -s "$out/restir_steps_gcc.txt" "$out/restir_steps_nvcc.txt"; then
+    echo "compile_twin: the shared restir steps differ between g++ and nvcc:" >&2
+    diff "$out/restir_steps_gcc.txt" "$out/restir_steps_nvcc.txt" | head -20 >&2
+    exit 1
+fi
+echo "compile_twin: restir_steps.h gives the same $(wc -l < "$out/restir_steps_gcc.txt") results compiled by g++ and by nvcc" >&2
