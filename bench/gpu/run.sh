@@ -271,7 +271,8 @@ step_ncu() {
 # A change that must not move a GPU frame: the twin of the source tree in
 # .twin-deps/old (staged by `bash bench/gpu/stage_deps.sh SDK OLD_COMMIT`)
 # built beside this one, both run on every restir option the twin has, and
-# each pair of .gpuframe files compared byte for byte (`cmp`).
+# each pair of .gpuframe files compared plane by plane, byte for byte
+# (bench/gpu/gpuframe_equal.py: the metadata records the run and differs).
 step_identity() {
     local t="$W/identity" old=$D/old
     [ -d "$old" ] || { echo "identity: no $old (stage_deps.sh with an old commit)"; return 1; }
@@ -286,12 +287,12 @@ step_identity() {
     while read -r opts; do
         k=$((k + 1))
         # shellcheck disable=SC2086  # the overrides are words
-        $BIN $q $opts -o "$t/new$k.{frame}.exr" > /dev/null 2>&1 || { echo "identity: new twin failed on: $opts"; differ=1; continue; }
+        $BIN $q $opts -o "$t/new$k.{frame}.exr" > "$t/new$k.log" 2>&1 || { echo "identity: new twin failed on: $opts"; tail -3 "$t/new$k.log"; differ=1; continue; }
         # shellcheck disable=SC2086
         (cd "$old" && build-gpu/accretion-optix $q $opts -o "$t/old$k.{frame}.exr" > /dev/null 2>&1) ||
             { echo "identity: old twin failed on: $opts"; differ=1; continue; }
         for f in "$t"/new$k.*.gpuframe; do
-            cmp -s "$f" "${f/new$k/old$k}" && echo "same    $k $(basename "$f") $opts" || { echo "DIFFERS $k $(basename "$f") $opts"; differ=1; }
+            python3 bench/gpu/gpuframe_equal.py "$f" "${f/new$k/old$k}" && echo "same    $k $(basename "$f") $opts" || { echo "DIFFERS $k $(basename "$f") $opts"; differ=1; }
         done
     done <<'CONFIGS'
 -D restir.bias_correction="pairwise"
@@ -300,7 +301,7 @@ step_identity() {
 -D restir.bias_correction="basic" -D restir.visibility_reuse=true
 -D render.source="power" -D restir.spatial_iterations=2 -D restir.spatial_neighbours=10
 -D render.source="power" -D restir.resolution_scale=0.5
--D restir.layout="packed" -D geometry.alpha="disc"
+-D geometry.alpha="disc" -D restir.spatial_neighbours=64
 -D geometry.layout="aabbs" -D restir.m_cap=5
 CONFIGS
     rm -f "$t"/*.gpuframe
