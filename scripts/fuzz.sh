@@ -11,9 +11,22 @@ CXX=clang++ CC=clang cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWit
   -DACCRETION_BUILD_TESTS=OFF -DACCRETION_BUILD_BENCH=OFF >/dev/null
 targets="scene particles ply_header accumulation jobs"
 cmake --build build-fuzz --target $(for t in $targets; do printf "fuzz_%s " $t; done)
+# Two targets at a time (one per core), each for its full time.
+jobs=${FUZZ_JOBS:-2}
+pids=() names=()
 for target in $targets; do
   mkdir -p build-fuzz/corpus_$target
   cp -n tests/fuzz/corpus_$target/* build-fuzz/corpus_$target/ 2>/dev/null || true
   (cd build-fuzz && ./fuzz_$target -max_total_time="$seconds" -timeout=10 -rss_limit_mb=4096 \
-      -print_final_stats=1 corpus_$target)
+      -print_final_stats=1 corpus_$target > fuzz_$target.log 2>&1) &
+  pids+=($!) names+=($target)
+  if ((${#pids[@]} >= jobs)); then
+    wait "${pids[0]}" || { tail -30 build-fuzz/fuzz_${names[0]}.log; exit 1; }
+    tail -3 build-fuzz/fuzz_${names[0]}.log
+    pids=("${pids[@]:1}") names=("${names[@]:1}")
+  fi
+done
+for i in "${!pids[@]}"; do
+  wait "${pids[$i]}" || { tail -30 build-fuzz/fuzz_${names[$i]}.log; exit 1; }
+  tail -3 build-fuzz/fuzz_${names[$i]}.log
 done
