@@ -303,8 +303,14 @@ std::size_t bareIntersect(RTCScene scene, const Camera& cam, bool packets) {
 
 struct FrameTiming {
     double frameSeconds = 0.0;
-    std::map<std::string, double> passes;
+    std::map<std::string, double, std::less<>> passes;
     std::uint64_t shadowRays = 0, hitPixels = 0;
+    /// A pass's seconds; the pass must have run.
+    double seconds(std::string_view pass) const {
+        const auto it = passes.find(pass);
+        if (it == passes.end()) throw std::runtime_error(fmt::format("bench: no pass {} in the frame", pass));
+        return it->second;
+    }
 };
 
 /// Median frame time (and its passes) of `measured` frames after `history` frames.
@@ -563,14 +569,14 @@ void Suite::benchRestirFrame() {
         double lighting = 0.0;
         nlohmann::json passes;
         for (const auto& [name, sec] : t.passes) passes[name] = sec;
-        for (const char* name : {"generateCandidates", "temporalResampling", "spatialResampling"})
-            lighting += t.passes.count(name) ? t.passes.at(name) : 0.0;
+        for (const std::string_view name : {pass::generateCandidates, pass::temporalResampling, pass::spatialResampling})
+            if (const auto it = t.passes.find(name); it != t.passes.end()) lighting += it->second;
         const double candidates = double(t.hitPixels) * restir.render.candidates;
         figures["restir_frame_100k_720p"] = {
             {"seconds", t.frameSeconds},
             {"passes_s", passes},
             {"resampling_share", lighting / t.frameSeconds},
-            {"candidates_per_s_per_core", candidates / t.passes.at("generateCandidates") / cores},
+            {"candidates_per_s_per_core", candidates / t.seconds(pass::generateCandidates) / cores},
             {"shadow_rays", t.shadowRays}};
     }
 }
@@ -710,8 +716,8 @@ void Suite::benchScaling() {
         s.particles.count = n;
         const ParticleSource src(s);
         const FrameTiming t = timeFrames(s, src, 2, 2, 1);
-        csvP += fmt::format("{},{:.6f},{:.6f},{:.6f},{}\n", n, t.passes.at("buildClusters"), t.frameSeconds,
-                            t.passes.at("traceShadowRays"), t.shadowRays);
+        csvP += fmt::format("{},{:.6f},{:.6f},{:.6f},{}\n", n, t.seconds(pass::buildClusters), t.frameSeconds,
+                            t.seconds(pass::traceShadowRays), t.shadowRays);
     }
     writeFileAtomic(outDir + "/scaling_particles.csv", csvP);
     std::string csvR = "width,height,pixels,restir_frame_s,trace_gbuffer_s\n";
@@ -721,7 +727,7 @@ void Suite::benchScaling() {
         s.camera.width = w;
         s.camera.height = h;
         const FrameTiming t = timeFrames(s, diskSource, 2, 2, 1);
-        csvR += fmt::format("{},{},{},{:.6f},{:.6f}\n", w, h, std::uint64_t(w) * h, t.frameSeconds, t.passes.at("traceGBuffer"));
+        csvR += fmt::format("{},{},{},{:.6f},{:.6f}\n", w, h, std::uint64_t(w) * h, t.frameSeconds, t.seconds(pass::traceGBuffer));
     }
     writeFileAtomic(outDir + "/scaling_resolution.csv", csvR);
     try {
@@ -778,7 +784,7 @@ void Suite::benchPlanSkips() {
         };
         auto primaryPass = [&](const Settings& s) {
             const ParticleSource src(s);
-            return timeFrames(s, src, 2, 1, 3).passes.at("traceGBuffer");
+            return timeFrames(s, src, 2, 1, 3).seconds(pass::traceGBuffer);
         };
         auto pair = [&](const std::string& name, double with, double without) {
             skips[name] = {{"with_work_s", with}, {"skipped_s", without}, {"saved_s", with - without}};

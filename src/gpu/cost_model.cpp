@@ -10,6 +10,7 @@
 
 #include <Eigen/Dense>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "accretion/core/error.h"
 #include "accretion/core/median.h"
@@ -17,6 +18,12 @@
 #include "accretion/core/pass_timer.h"
 
 namespace accretion {
+
+namespace {
+/// The pass names, for errors that name an unknown one.
+std::string knownPasses() { return fmt::format("passes: {}", fmt::join(kPassNames, ", ")); }
+}  // namespace
+
 
 double coldWork(double rays, double bytes, double workingSetBytes, double cacheBytes) {
     if (!(workingSetBytes > cacheBytes) || !(cacheBytes > 0.0)) return 0.0;
@@ -96,6 +103,8 @@ CostCoefficients CostCoefficients::fromJson(const nlohmann::json& j, const std::
         if (!j["per_pass_ns"].is_object()) throw InputError(fmt::format("{}: per_pass_ns is not an object", path));
         for (const auto& [pass, obj] : j["per_pass_ns"].items()) {
             if (!obj.is_object()) throw InputError(fmt::format("{}: per_pass_ns.{} is not an object", path, pass));
+            if (!parsePass(pass) || pass.find('[') != std::string::npos)
+                throw InputError(fmt::format("{}: per_pass_ns.{}: not a pass ({})", path, pass, knownPasses()));
             read(obj, "per_pass_ns." + pass, out.perPass[pass]);
         }
     }
@@ -249,6 +258,8 @@ std::vector<CostRow> readCounterCsv(const std::string& path) {
     std::vector<CostRow> rows;
     for (auto& [lineNo, r] : readCsv(path, required)) {
         CostRow row{r["config"], r["pass"], {}, 0.0};
+        if (!parsePass(row.pass))
+            throw InputError(fmt::format("{}:{}: pass '{}' is not a pass ({})", path, lineNo, row.pass, knownPasses()));
         for (std::size_t k = 0; k < kCostFeatures.size(); ++k) {
             const auto cell = r.find(std::string(kCostFeatures[k]));
             if (cell == r.end()) continue;  // a later counter, absent from a CSV of the first form: 0
@@ -266,6 +277,8 @@ void joinTimings(const std::string& path, std::vector<CostRow>& rows) {
     std::map<std::pair<std::string, std::string>, double> ms;
     for (auto& [lineNo, r] : readCsv(path, {"config", "pass", "ms"})) {
         const auto key = std::make_pair(r["config"], r["pass"]);
+        if (!parsePass(key.second))
+            throw InputError(fmt::format("{}:{}: pass '{}' is not a pass ({})", path, lineNo, key.second, knownPasses()));
         if (ms.count(key))
             throw InputError(fmt::format("{}:{}: a second timing for config '{}' pass '{}'", path, lineNo, key.first, key.second));
         ms[key] = parseNumber(r["ms"], fmt::format("{}:{}: ms", path, lineNo));

@@ -1,11 +1,16 @@
 #pragma once
-// GPU time per pass name from CUDA events around each pass on one stream
-// (read after the stream is synchronised), in order of first use.
+// GPU time per step from CUDA events around each step on one stream (read
+// after the stream is synchronised), in order of first use. A step is a
+// pass, or a named part of one (buildBlas of buildClusters): each scope
+// says which pass it times, so the timings join the CPU's cost rows.
 #include <algorithm>
+#include <map>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
+#include "accretion/core/pass_timer.h"
 #include "cuda_check.h"
 
 namespace accretion::twin {
@@ -17,19 +22,24 @@ public:
     GpuTimer(const GpuTimer&) = delete;
     GpuTimer& operator=(const GpuTimer&) = delete;
 
-    void begin(const std::string& pass) {
+    /// Opens `step` of `pass` (the pass itself when step is empty).
+    void begin(Pass pass, std::string_view step = {}) {
+        const std::string name(step.empty() ? passName(pass) : step);
+        passOf_.emplace(name, pass);
         cudaEvent_t a, b;
         CUDA_CHECK(cudaEventCreate(&a));
         CUDA_CHECK(cudaEventCreate(&b));
         CUDA_CHECK(cudaEventRecord(a, stream_));
-        open_.push_back({pass, a, b});
+        open_.push_back({name, a, b});
     }
     void end() {
         CUDA_CHECK(cudaEventRecord(open_.back().stop, stream_));
         done_.push_back(open_.back());
         open_.pop_back();
     }
-    /// Milliseconds per pass (summed over its spans); synchronises the stream.
+    /// The pass a step belongs to (a step this timer has opened).
+    Pass passOf(const std::string& step) const { return passOf_.at(step); }
+    /// Milliseconds per step (summed over its spans); synchronises the stream.
     std::vector<std::pair<std::string, double>> read() {
         CUDA_CHECK(cudaStreamSynchronize(stream_));
         std::vector<std::pair<std::string, double>> out;
@@ -58,12 +68,13 @@ private:
     }
     cudaStream_t stream_;
     std::vector<Span> open_, done_;
+    std::map<std::string, Pass> passOf_;
 };
 
-/// begin .. end of a pass for a scope.
+/// begin .. end of a pass, or of a step of one, for a scope.
 class GpuScope {
 public:
-    GpuScope(GpuTimer& t, const std::string& pass) : t_(t) { t_.begin(pass); }
+    GpuScope(GpuTimer& t, Pass pass, std::string_view step = {}) : t_(t) { t_.begin(pass, step); }
     ~GpuScope() { t_.end(); }
     GpuScope(const GpuScope&) = delete;
     GpuScope& operator=(const GpuScope&) = delete;

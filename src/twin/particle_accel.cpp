@@ -274,7 +274,7 @@ void ParticleAccel::build(const Clusters* clusters, const DeviceParticles& parti
         // (refit: the TLAS updated after its first build).
         if (!unitHandle_) buildUnitBillboard(stream);
         {
-            GpuScope s(timer, "writeInstances");
+            GpuScope s(timer, Pass::buildClusters, "writeInstances");
             instances_.reserve(std::size_t(particles.count) * sizeof(OptixInstance));
             writeInstances(particles.count, particles.position, particles.radius, particles.frames, unitHandle_,
                            instances_.as<OptixInstance>(), stream);
@@ -286,7 +286,7 @@ void ParticleAccel::build(const Clusters* clusters, const DeviceParticles& parti
         stats_.rebuiltBlases = 0;
         stats_.inputBytes = std::size_t(particles.count) * sizeof(OptixInstance);
         {
-            GpuScope s(timer, "buildTlas");
+            GpuScope s(timer, Pass::buildClusters, "buildTlas");
             buildTlas(particles, stream, timer);
         }
         return;
@@ -304,7 +304,7 @@ void ParticleAccel::build(const Clusters* clusters, const DeviceParticles& parti
     }
     // The slots of clusters [first, first + count) mod C: one or two ranges.
     {
-        GpuScope s(timer, "expandPrimitives");
+        GpuScope s(timer, Pass::buildClusters, "expandPrimitives");
         auto expand = [&](std::size_t c0, std::size_t c1) {
             const std::uint32_t b = offset_[c0], e = offset_[c1];
             if (options_.layout == AccelLayout::aabbs)
@@ -327,7 +327,7 @@ void ParticleAccel::build(const Clusters* clusters, const DeviceParticles& parti
     const bool compact = options_.compact && !refit && policy != BuildPolicy::partial;
     if (compact) compactSizes_.reserve(C * sizeof(std::uint64_t));
     {
-        GpuScope s(timer, "buildBlas");
+        GpuScope s(timer, Pass::buildClusters, "buildBlas");
         const auto host0 = std::chrono::steady_clock::now();
         issueBlasBuilds(first, count, refit, compact, stream);
         stats_.blasEnqueueMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - host0).count();
@@ -335,7 +335,7 @@ void ParticleAccel::build(const Clusters* clusters, const DeviceParticles& parti
     stats_.blasBytes = 0;
     for (std::size_t c = 0; c < C; ++c) stats_.blasBytes += outputBytes_[c];
     if (compact) {
-        GpuScope s(timer, "compactBlas");
+        GpuScope s(timer, Pass::buildClusters, "compactBlas");
         std::vector<std::uint64_t> sizes = compactSizes_.download<std::uint64_t>(C);  // synchronises
         std::vector<std::size_t> at(C);
         std::size_t pool = 0;
@@ -352,7 +352,7 @@ void ParticleAccel::build(const Clusters* clusters, const DeviceParticles& parti
         stats_.poolBytes = compactPool_.bytes();
     }
     {
-        GpuScope s(timer, "buildTlas");
+        GpuScope s(timer, Pass::buildClusters, "buildTlas");
         buildTlas(particles, stream, timer);
     }
     stats_.rebuiltBlases = count;

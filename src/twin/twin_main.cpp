@@ -50,17 +50,6 @@ struct Args {
     bool perBlas = false, compact = false, quiet = false, validation = false, skipLighting = false, lrOnly = false;
 };
 
-/// The pass of `accretion cost` a timed pass belongs to (calibrate joins on
-/// it): the acceleration-structure work of the frame is buildClusters, the
-/// lighting grid's reduction belongs to upsampleLighting.
-std::string costPassOf(const std::string& pass) {
-    if (pass == "expandPrimitives" || pass == "writeInstances" || pass == "buildBlas" || pass == "compactBlas" ||
-        pass == "buildTlas")
-        return "buildClusters";
-    if (pass == "reduceGBuffer") return "upsampleLighting";
-    return pass;
-}
-
 /// The settings the twin runs; anything else is refused by name.
 void requireSupported(const Settings& s, bool lighting) {
     auto refuse = [](const std::string& what) {
@@ -118,20 +107,20 @@ StoredReservoir* runRestir(LaunchParams& lp, FrameBuffers& buf, const Settings& 
     const std::size_t pixels = std::size_t(rp.width) * rp.height;
     const bool upsample = rp.width != s.camera.width || rp.height != s.camera.height;
     if (upsample) {
-        GpuScope t(timer, "reduceGBuffer");
+        GpuScope t(timer, Pass::upsampleLighting, "reduceGBuffer");
         reduceGBuffer(lp, buf.gridGbuffer.as<GBufferTexel>(), stream);
     }
     StoredReservoir* a = buf.resA.as<StoredReservoir>();
     StoredReservoir* b = buf.resB.as<StoredReservoir>();
     CUDA_CHECK(cudaMemsetAsync(buf.rejected.as<void>(), 0, pixels * sizeof(std::uint32_t), stream));
     {
-        GpuScope t(timer, "generateCandidates");
+        GpuScope t(timer, Pass::generateCandidates);
         rp.in = nullptr;
         rp.out = a;
         generateCandidates(lp, stream);
     }
     if (rp.temporal) {
-        GpuScope t(timer, "temporalResampling");
+        GpuScope t(timer, Pass::temporalResampling);
         rp.in = a;
         rp.out = b;
         temporalResampling(lp, stream);
@@ -139,7 +128,7 @@ StoredReservoir* runRestir(LaunchParams& lp, FrameBuffers& buf, const Settings& 
     }
     const std::uint32_t iterations = s.restir.spatial_neighbours > 0 ? s.restir.spatial_iterations : 0;
     if (iterations > 0) {
-        GpuScope t(timer, "spatialResampling");
+        GpuScope t(timer, Pass::spatialResampling);
         for (std::uint32_t it = 0; it < iterations; ++it) {
             rp.in = a;
             rp.out = b;
@@ -148,14 +137,14 @@ StoredReservoir* runRestir(LaunchParams& lp, FrameBuffers& buf, const Settings& 
         }
     }
     {
-        GpuScope t(timer, "traceShadowRays");
+        GpuScope t(timer, Pass::traceShadowRays);
         rp.in = nullptr;
         rp.out = a;
         CUDA_CHECK(cudaMemcpyAsync(buf.params.as<void>(), &lp, sizeof lp, cudaMemcpyHostToDevice, stream));
         pipeline.launch(shade, buf.params.address(), sizeof lp, rp.width, rp.height, stream);
     }
     if (upsample) {
-        GpuScope t(timer, "upsampleLighting");
+        GpuScope t(timer, Pass::upsampleLighting);
         upsampleLighting(lp, stream);
     }
     CUDA_CHECK(cudaGetLastError());
@@ -389,13 +378,13 @@ int run(const Args& a) {
             CUDA_CHECK(cudaMemcpyAsync(buf.params.as<void>(), &lp, sizeof lp, cudaMemcpyHostToDevice, stream));
             CUDA_CHECK(cudaMemsetAsync(buf.counters.as<void>(), 0, sizeof(LaunchCounters), stream));
             {
-                GpuScope s(timer, "traceGBuffer");
+                GpuScope s(timer, Pass::traceGBuffer);
                 pipeline.launch(Raygen::gbuffer, buf.params.address(), sizeof lp, W, H, stream);
             }
             if (restir) {
                 finalReservoirs = runRestir(lp, buf, settings, shade, pipeline, stream, timer);
             } else if (!a.skipLighting) {
-                GpuScope s(timer, "estimateLighting");
+                GpuScope s(timer, Pass::estimateLighting);
                 pipeline.launch(sampling ? Raygen::sample : Raygen::exact, buf.params.address(), sizeof lp, W, H, stream);
             } else {
                 CUDA_CHECK(cudaMemsetAsync(buf.Lr.as<void>(), 0, pixels * sizeof(Vec3), stream));
@@ -466,7 +455,7 @@ int run(const Args& a) {
         std::map<std::string, double> calibrated;  // by the pass names of `accretion cost`
         for (const auto& [pass, v] : ms) {
             timing[pass] = {{"median_ms", median(v)}, {"ms", v}};
-            calibrated[costPassOf(pass)] += median(v);
+            calibrated[std::string(passName(timer.passOf(pass)))] += median(v);
         }
         timingsCsv = "config,pass,ms\n";  // the last frame's
         if (!a.config.empty())

@@ -169,10 +169,14 @@ TEST_CASE("calibrate recovers the coefficients that made the timings of real cos
                            (dir / "coef.json").string() + "\\\" -o " + (dir / "again.json").string(), out) == 0);
     CHECK(nlohmann::json::parse(slurp(dir / "again.json"))["coefficients"]["source"] == (dir / "coef.json").string());
 
-    // Bad input: a timing row without counters, a malformed number.
-    std::ofstream(dir / "bad1.csv") << "config,pass,ms\npower,noSuchPass,1.0\n";
+    // Bad input: a name that is no pass (a pass renamed on one side), a
+    // timing row without counters, a malformed number.
+    std::ofstream(dir / "bad0.csv") << "config,pass,ms\npower,traceShadowRay,1.0\n";
+    CHECK(runCommand(kBin + " calibrate " + csvs[0] + " " + (dir / "bad0.csv").string() + " -o " + (dir / "x.json").string(), out) == 1);
+    CHECK_THAT(out, Contains("bad0.csv:2: pass 'traceShadowRay' is not a pass (passes: loadParticles,"));
+    std::ofstream(dir / "bad1.csv") << "config,pass,ms\npower,presampleRegirGrid,1.0\n";
     CHECK(runCommand(kBin + " calibrate " + csvs[0] + " " + (dir / "bad1.csv").string() + " -o " + (dir / "x.json").string(), out) == 1);
-    CHECK_THAT(out, Contains("no counters for config 'power' pass 'noSuchPass'"));
+    CHECK_THAT(out, Contains("no counters for config 'power' pass 'presampleRegirGrid'"));
     std::ofstream(dir / "bad2.csv") << "config,pass,ms\nrestir_disc,traceGBuffer,fast\n";
     CHECK(runCommand(kBin + " calibrate " + csvs[0] + " " + (dir / "bad2.csv").string() + " -o " + (dir / "x.json").string(), out) == 1);
     CHECK_THAT(out, Contains("bad2.csv:2: ms: 'fast' is not a finite non-negative number"));
