@@ -483,10 +483,10 @@ std::uint32_t nearLightCount(const RenderSettings& render) {
     return std::clamp<std::uint32_t>(16u * std::min(render.samples, NearField::kMaxNear / 16u), 16u, NearField::kMaxNear);
 }
 
-LightingCounters accumulateLighting(const LightingInputs& in, const LightingPlan& plan, Accumulation& acc,
-                                    const ChunkHook& afterChunk, Progress* progress) {
-    ACC_CHECK(acc.width == in.gbuffer.width && acc.height == in.gbuffer.height);
-    if (in.particles.empty() || acc.nextChunk >= plan.end) return {};
+namespace {
+/// The light samplers an estimator needs were built for it (the plan's
+/// work): a missing one is a defect of the caller, not of the input.
+void checkSamplerInputs(const LightingInputs& in) {
     ACC_CHECK(in.render.estimator != EstimatorKind::power || in.powerTable);
     // ris draws its candidates in proportion to power exactly when given the table: it must be the configured source.
     ACC_CHECK(in.render.estimator != EstimatorKind::ris || (in.render.source == LightSource::power) == (in.powerTable != nullptr));
@@ -494,6 +494,14 @@ LightingCounters accumulateLighting(const LightingInputs& in, const LightingPlan
     ACC_CHECK(in.render.estimator != EstimatorKind::ris || in.render.source != LightSource::tree || in.lightTree);
     ACC_CHECK(in.render.estimator != EstimatorKind::ris || (in.render.source != LightSource::tiles && in.render.source != LightSource::regir));
     ACC_CHECK(in.render.estimator != EstimatorKind::restir);
+}
+}  // namespace
+
+LightingCounters accumulateLighting(const LightingInputs& in, const LightingPlan& plan, Accumulation& acc,
+                                    const ChunkHook& afterChunk, Progress* progress) {
+    ACC_CHECK(acc.width == in.gbuffer.width && acc.height == in.gbuffer.height);
+    if (in.particles.empty() || acc.nextChunk >= plan.end) return {};
+    checkSamplerInputs(in);
     const LightArrays L(in.particles, in.shading);
     switch (in.shading.model) {
     case ShadingModel::lambert: return dispatchPrimitive<ShadingModel::lambert>(in, L, plan, acc, afterChunk, progress);
@@ -545,13 +553,7 @@ LightingCounters estimateLighting(const LightingInputs& in, LightingImage& out, 
         out.rejected.assign(pixels, 0.0f);
         return {};
     }
-    ACC_CHECK(in.render.estimator != EstimatorKind::power || in.powerTable);
-    // ris draws its candidates in proportion to power exactly when given the table: it must be the configured source.
-    ACC_CHECK(in.render.estimator != EstimatorKind::ris || (in.render.source == LightSource::power) == (in.powerTable != nullptr));
-    ACC_CHECK((in.render.estimator != EstimatorKind::tree && in.render.estimator != EstimatorKind::split) || in.lightTree);
-    ACC_CHECK(in.render.estimator != EstimatorKind::ris || in.render.source != LightSource::tree || in.lightTree);
-    ACC_CHECK(in.render.estimator != EstimatorKind::ris || (in.render.source != LightSource::tiles && in.render.source != LightSource::regir));
-    ACC_CHECK(in.render.estimator != EstimatorKind::restir);
+    checkSamplerInputs(in);
     allocate(out, pixels);
     const LightingPlan plan = planLighting(in.render, in.gbuffer.height);
     const LightArrays L(in.particles, in.shading);

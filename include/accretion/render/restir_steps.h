@@ -5,6 +5,7 @@
 // the estimator reaches both or neither. Inputs are fixed-size; the frame is
 // reached through small adapters (the Domains of combineReservoirs), which on
 // the CPU also count what a GPU thread would do and on the GPU do nothing.
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 
@@ -23,45 +24,6 @@ namespace accretion::restir {
 /// neighbours (restir.spatial_neighbours is at most 64).
 inline constexpr std::uint32_t kMaxOffers = 65;
 
-namespace detail {
-// The C library's float functions on the host, CUDA's on the device (both
-// correctly rounded for sqrt; the twin's agreement tests bound the rest).
-ACC_HD inline float sqrtF(float v) {
-#if defined(__CUDA_ARCH__)
-    return sqrtf(v);
-#else
-    return std::sqrt(v);
-#endif
-}
-ACC_HD inline float cosF(float v) {
-#if defined(__CUDA_ARCH__)
-    return cosf(v);
-#else
-    return std::cos(v);
-#endif
-}
-ACC_HD inline float sinF(float v) {
-#if defined(__CUDA_ARCH__)
-    return sinf(v);
-#else
-    return std::sin(v);
-#endif
-}
-ACC_HD inline long roundF(float v) {
-#if defined(__CUDA_ARCH__)
-    return lroundf(v);
-#else
-    return std::lround(v);
-#endif
-}
-ACC_HD inline double floorD(double v) {
-#if defined(__CUDA_ARCH__)
-    return floor(v);
-#else
-    return std::floor(v);
-#endif
-}
-}  // namespace detail
 
 /// generateCandidates's RIS: `count` candidates, each drawn by draw(rng)
 /// (a LightSample; pdf 0: no light, a zero candidate) and weighted p_hat /
@@ -98,10 +60,10 @@ ACC_HD bool resampleCandidates(std::uint32_t count, RngT& rng, Draw&& draw, Targ
 template <class RngT>
 ACC_HD bool drawNeighbour(RngT& rng, float radius, std::uint32_t x, std::uint32_t y, std::uint32_t W, std::uint32_t H,
                           std::size_t& q) {
-    const float r = radius * detail::sqrtF(rng.uniform());
+    const float r = radius * std::sqrt(rng.uniform());
     const float phi = 6.28318530718f * rng.uniform();
-    const long nx = detail::roundF(float(x) + r * detail::cosF(phi));
-    const long ny = detail::roundF(float(y) + r * detail::sinF(phi));
+    const long nx = std::lround(float(x) + r * std::cos(phi));
+    const long ny = std::lround(float(y) + r * std::sin(phi));
     if (nx < 0 || ny < 0 || nx >= long(W) || ny >= long(H) || (nx == long(x) && ny == long(y))) return false;
     q = std::size_t(ny) * W + std::size_t(nx);
     return true;
@@ -125,7 +87,7 @@ ACC_HD inline bool reprojectPoint(const Camera& prevCamera, const Vec3& xPrev, f
 /// The history's M, capped at m_cap x the current M (at least 1), so an old
 /// sample cannot outweigh the new ones without bound.
 ACC_HD inline std::uint32_t capHistoryM(std::uint32_t historyM, std::uint32_t currentM, double mCap) {
-    const double capped = detail::floorD(mCap * double(currentM > 1u ? currentM : 1u));
+    const double capped = std::floor(mCap * double(currentM > 1u ? currentM : 1u));
     return static_cast<std::uint32_t>(double(historyM) < capped ? double(historyM) : capped);
 }
 
