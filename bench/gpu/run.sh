@@ -22,12 +22,18 @@ step_env() {
     cat "$OUT/env.txt"
 }
 
-step_build() {
-    cmake -S . -B build-gpu -G Ninja -DCMAKE_BUILD_TYPE=Release -DACCRETION_CPU=OFF -DACCRETION_OPTIX=ON \
-        -DOptiX_INCLUDE="$D/optix/include" -DACCRETION_COMMIT="$(cat "$D/commit")" -DCMAKE_CUDA_ARCHITECTURES=90 \
+# Configures and builds the twin of the source tree in $1 (build-gpu there),
+# recording commit $2; the log goes to $3.
+build_twin() {
+    (cd "$1" && cmake -S . -B build-gpu -G Ninja -DCMAKE_BUILD_TYPE=Release -DACCRETION_CPU=OFF -DACCRETION_OPTIX=ON \
+        -DOptiX_INCLUDE="$D/optix/include" -DACCRETION_COMMIT="$2" -DCMAKE_CUDA_ARCHITECTURES=90 \
         -DTBB_DIR=$L/cmake/TBB -Dfmt_DIR=$L/cmake/fmt -Dtomlplusplus_DIR=$L/cmake/tomlplusplus \
         -Dglm_DIR=$S/share/cmake/glm -Dnlohmann_json_DIR=$S/share/cmake/nlohmann_json -DCLI11_DIR=$S/share/cmake/CLI11 \
-        > "$W/build.log" 2>&1 && cmake --build build-gpu -j 16 >> "$W/build.log" 2>&1
+        > "$3" 2>&1 && cmake --build build-gpu -j 16 >> "$3" 2>&1)
+}
+
+step_build() {
+    build_twin . "$(cat "$D/commit")" "$W/build.log"
     local rc=$?
     tail -30 "$W/build.log"
     return $rc
@@ -277,11 +283,7 @@ step_identity() {
     local t="$W/identity" old=$D/old
     [ -d "$old" ] || { echo "identity: no $old (stage_deps.sh with an old commit)"; return 1; }
     mkdir -p "$t"
-    (cd "$old" && cmake -S . -B build-gpu -G Ninja -DCMAKE_BUILD_TYPE=Release -DACCRETION_CPU=OFF -DACCRETION_OPTIX=ON \
-        -DOptiX_INCLUDE="$D/optix/include" -DACCRETION_COMMIT="$(cat "$D/old.commit")" -DCMAKE_CUDA_ARCHITECTURES=90 \
-        -DTBB_DIR=$L/cmake/TBB -Dfmt_DIR=$L/cmake/fmt -Dtomlplusplus_DIR=$L/cmake/tomlplusplus \
-        -Dglm_DIR=$S/share/cmake/glm -Dnlohmann_json_DIR=$S/share/cmake/nlohmann_json -DCLI11_DIR=$S/share/cmake/CLI11 \
-        > "$t/build_old.log" 2>&1 && cmake --build build-gpu -j 16 >> "$t/build_old.log" 2>&1) || { tail -20 "$t/build_old.log"; return 1; }
+    build_twin "$old" "$(cat "$D/old.commit")" "$t/build_old.log" || { tail -20 "$t/build_old.log"; return 1; }
     local q="scenes/quickstart.toml -D camera.width=320 -D camera.height=180 -D render.estimator=\"restir\" --frames 0:3 --repeat 1"
     local k=0 differ=0
     while read -r opts; do

@@ -43,6 +43,13 @@ ACC_HD inline bool isFiniteNumber(double x) {
     return std::isfinite(x);
 #endif
 }
+ACC_HD inline bool isFiniteNumber(float x) {
+#if defined(__CUDA_ARCH__)
+    return isfinite(x);
+#else
+    return std::isfinite(x);
+#endif
+}
 
 /// Orthonormal basis around a unit vector n (Duff et al. 2017, branchless).
 inline void orthonormalBasis(const Vec3& n, Vec3& t, Vec3& b) {

@@ -47,6 +47,8 @@ inline constexpr std::array<std::string_view, 14> kPassNames = {
     "writeOutputs",
 };
 
+static_assert(kPassNames.size() == static_cast<std::size_t>(Pass::writeOutputs) + 1, "a name for every pass");
+
 constexpr std::string_view passName(Pass p) { return kPassNames[static_cast<std::size_t>(p)]; }
 
 /// The pass a name denotes; a repeated run's name (spatialResampling[2])

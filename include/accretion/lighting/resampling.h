@@ -44,12 +44,16 @@ ACC_HD inline double pairwiseNeighbourWeight(double Mi, double pi, double Mc, do
 /// that produced y, plus the M of every other domain that counts (its
 /// p_hat of y is non-zero and, with basic_visibility, it sees y), summed
 /// in domain order. W = w_sum / (Z p_hat(y)).
-inline double basicNormalization(std::span<const std::uint32_t> M, std::span<const std::uint8_t> counts,
-                                 std::size_t chosen) {
+ACC_HD inline double basicNormalization(const std::uint32_t* M, const std::uint8_t* counts, std::size_t n,
+                                        std::size_t chosen) {
     double Z = M[chosen];
-    for (std::size_t i = 0; i < M.size(); ++i)
+    for (std::size_t i = 0; i < n; ++i)
         if (i != chosen && counts[i]) Z += M[i];
     return Z;
+}
+inline double basicNormalization(std::span<const std::uint32_t> M, std::span<const std::uint8_t> counts,
+                                 std::size_t chosen) {
+    return basicNormalization(M.data(), counts.data(), M.size(), chosen);
 }
 
 /// The MIS weight m_i(y) of every domain for one sample y, given each

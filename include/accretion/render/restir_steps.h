@@ -24,7 +24,6 @@ namespace accretion::restir {
 /// neighbours (restir.spatial_neighbours is at most 64).
 inline constexpr std::uint32_t kMaxOffers = 65;
 
-
 /// generateCandidates's RIS: `count` candidates, each drawn by draw(rng)
 /// (a LightSample; pdf 0: no light, a zero candidate) and weighted p_hat /
 /// pdf with p_hat = target(light). A non-finite weight makes a zero
@@ -160,13 +159,17 @@ ACC_HD StoredReservoir combineReservoirs(const Domains& d, BiasCorrection bias, 
     }
     if (out.y == kNoLight || !(out.p_hat > 0.0f)) return res;
     double Z = Mtotal;
-    if (bias == BiasCorrection::basic) {  // resampling::basicNormalization, in domain order
-        Z = d.reservoir(chosen).M;
+    if (bias == BiasCorrection::basic) {
+        std::uint32_t M[kMaxOffers];
+        std::uint8_t counts[kMaxOffers];
         for (std::uint32_t i = 0; i < n; ++i) {
+            M[i] = d.reservoir(i).M;
+            counts[i] = 0;
             if (i == chosen) continue;
             d.countTerm();
-            if (d.supports(i, out.y)) Z += d.reservoir(i).M;
+            counts[i] = d.supports(i, out.y) ? 1 : 0;
         }
+        Z = resampling::basicNormalization(M, counts, n, chosen);
     }
     res.y = out.y;
     res.p_hat = out.p_hat;

@@ -41,7 +41,8 @@ LightingCounters generateCandidatesKernel(const FrameContext& f, std::vector<Sto
             else if constexpr (S == LightSource::tiles) return f.tiles->sample(tile, g);
             else return sampleCandidate<S>(f.L, f.in.powerTable, f.in.lightTree, sp, g);
         };
-        // regir: pdf = 1 / W, so w = p_hat W, W the slot's unbiased 1 / p_src.
+        // A ReGIR slot's pdf is 1 / W (W its unbiased 1 / p_src), so its
+        // weight p_hat / pdf is p_hat W.
         const auto target = [&](std::uint32_t i) {
             ++c.lightTerms;
             return f.L.targetPdf<SM>(sp, i);
