@@ -15,7 +15,7 @@ using accretion::test::renderParticles;
 
 namespace {
 
-struct Agreement {
+struct EstimatorAgreement {
     double worstPixelP = 1.0;  ///< smallest per-pixel two-sided p-value
     double globalZ = 0.0;      ///< z of the image sum against the exact sum
     std::size_t pixels = 0;    ///< pixels tested
@@ -42,8 +42,8 @@ Reference reference(const FrameImage& img) {
 /// Per pixel z = (estimate - reference) / stderr (stderr from the estimate's
 /// own samples), and the z of the sum over pixels (independent pixel
 /// streams), over the pixels where both see the same particle.
-Agreement compare(const FrameImage& mc, const Reference& ref, float scale = 1.0f) {
-    Agreement a;
+EstimatorAgreement compare(const FrameImage& mc, const Reference& ref, float scale = 1.0f) {
+    EstimatorAgreement a;
     double diff = 0.0, var = 0.0;
     for (std::size_t px = 0; px < ref.particle.size(); ++px) {
         if (ref.particle[px] == kNoParticle || mc.particle[px] != ref.particle[px]) continue;
@@ -123,7 +123,7 @@ TEST_CASE("uniform, power, tree, split and ris (every source) agree with the ora
     // global z has a standard deviation of 1.49 (mean -0.10).
     constexpr double kZ = 4.4 * 1.5;
     for (const Reference* ref : {&oracle, &exact}) {
-        const Agreement ok = compare(mc, *ref);
+        const EstimatorAgreement ok = compare(mc, *ref);
         INFO((ref == &oracle ? "oracle" : "exact") << ": pixels " << ok.pixels << ", worst pixel p " << ok.worstPixelP
                                                      << ", global z " << ok.globalZ);
         REQUIRE(ok.pixels > 200);
@@ -133,7 +133,7 @@ TEST_CASE("uniform, power, tree, split and ris (every source) agree with the ora
 
     // Meta-test: the same harness rejects the estimate scaled by 1.03 (a 1%
     // bias shifts z by ~6.4, too close to kZ to be caught every time).
-    const Agreement biased = compare(mc, oracle, 1.03f);
+    const EstimatorAgreement biased = compare(mc, oracle, 1.03f);
     INFO("biased global z " << biased.globalZ);
     CHECK(std::fabs(biased.globalZ) > kZ);
 }
