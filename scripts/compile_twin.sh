@@ -16,29 +16,45 @@ build=${1:-build}
 out=build-twin
 mkdir -p "$out"
 
+# The directory holding cuda_runtime.h, as this nvcc itself would search it
+# (its INCLUDES, from a dry run), or nothing: an nvcc installed alone, or
+# reached through a link on PATH, may come without the runtime headers.
+cuda_include() {
+    local dir
+    for dir in $("$1" --dryrun -x cu -c /dev/null -o /dev/null 2>&1 | sed -n 's/^#\$ INCLUDES=//p' | tr -d '"' | sed 's/-I/ /g'); do
+        [ -f "$dir/cuda_runtime.h" ] && { (cd "$dir" && pwd); return; }
+    done
+    return 0
+}
 nvcc=${NVCC:-$(command -v nvcc || true)}
 [ -n "$nvcc" ] || [ ! -x /usr/local/cuda/bin/nvcc ] || nvcc=/usr/local/cuda/bin/nvcc
-if [ -z "$nvcc" ]; then
+[ -z "$nvcc" ] || nvcc=$(readlink -f "$nvcc")
+cuda_inc=
+[ -z "$nvcc" ] || cuda_inc=$(cuda_include "$nvcc")
+if [ -z "$cuda_inc" ]; then
+    [ -z "$nvcc" ] || echo "compile_twin: $nvcc has no cuda_runtime.h on its include path; using the PyPI wheels" >&2
     venv=.cache/cuda
-    if [ ! -x "$venv/bin/python" ]; then
+    if [ ! -x "$venv/bin/python" ] || [ -z "$(find "$venv" -path '*/nvidia/cu13/bin/nvcc' | head -1)" ]; then
         echo "compile_twin: installing CUDA 13's nvcc, runtime headers and cudart from PyPI into $venv" >&2
         python3 -m venv "$venv"
-        "$venv/bin/pip" install -q "cuda-toolkit[nvcc,cudart,crt,nvvm]==13.0.*"
+        "$venv/bin/pip" install -q "cuda-toolkit[nvcc,cudart,crt,nvvm,cccl]==13.0.*"
     fi
     nvcc=$(find "$venv" -path '*/nvidia/cu13/bin/nvcc' | head -1)
     [ -x "$nvcc" ] || { echo "compile_twin: no nvcc in $venv" >&2; exit 1; }
+    cuda_inc=$(cuda_include "$nvcc")
+    [ -n "$cuda_inc" ] || { echo "compile_twin: no cuda_runtime.h for $nvcc" >&2; exit 1; }
 fi
 cuda=$(cd "$(dirname "$nvcc")/.." && pwd)
 optix=${OPTIX_INCLUDE:-../shared/optix-9.0/include}
 [ -f "$optix/optix.h" ] || { echo "compile_twin: no optix.h in '$optix' (set OPTIX_INCLUDE)" >&2; exit 1; }
 [ -f "$build/libaccretion_base.a" ] || { echo "compile_twin: no $build/libaccretion_base.a (build the project first)" >&2; exit 1; }
-echo "compile_twin: $("$nvcc" --version | tail -2 | head -1), OptiX headers $optix" >&2
+echo "compile_twin: $nvcc ($("$nvcc" --version | tail -2 | head -1)), CUDA headers $cuda_inc, OptiX headers $optix" >&2
 
 # The flags of src/twin/CMakeLists.txt: no FMA contraction, so that the
 # shared ACC_HD functions round as the CPU's do.
 cuflags=(-std=c++20 -O3 -fmad=false --expt-relaxed-constexpr -diag-suppress=20012,20011,20014,20044 -arch=sm_90
          -Iinclude -Isrc/twin -I"$optix" -I"$build/generated")
-cxxflags=(-std=c++20 -O2 -Wall -Wextra -Wno-unused-parameter -Iinclude -Isrc/twin -I"$optix" -I"$cuda/include")
+cxxflags=(-std=c++20 -O2 -Wall -Wextra -Wno-unused-parameter -Iinclude -Isrc/twin -I"$optix" -I"$cuda_inc")
 
 pids=()
 "$nvcc" "${cuflags[@]}" -optix-ir -c src/twin/programs.cu -o "$out/programs.optixir" & pids+=($!)
