@@ -30,14 +30,16 @@ import pathlib
 import subprocess
 import sys
 
+from pass_names import PASS
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 BIN = ROOT / "build" / "accretion"
 SOURCES = ["uniform", "power", "tree", "tiles", "regir"]
 CORRECTIONS = ["none", "basic", "pairwise"]
 SMALL = ["-D", "camera.width=320", "-D", "camera.height=180"]
 COEFFICIENTS = ROOT / "bench" / "gpu" / "results" / "fit" / "coefficients_selected.json"
-LIGHTING = ("presampleLightTiles", "presampleRegirGrid", "generateCandidates", "temporalResampling", "spatialResampling",
-            "traceShadowRays")
+LIGHTING = (PASS.presampleLightTiles, PASS.presampleRegirGrid, PASS.generateCandidates, PASS.temporalResampling,
+            PASS.spatialResampling, PASS.traceShadowRays)
 BEGIN, END = "<!-- restir-table:begin -->", "<!-- restir-table:end -->"
 
 

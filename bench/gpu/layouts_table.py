@@ -7,8 +7,12 @@ import csv
 import glob
 import json
 import os
+import pathlib
 import re
 import sys
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "scripts"))
+from pass_names import PASS  # noqa: E402
 
 NAME = re.compile(r"p(\d+)_(\d+)x(\d+)_(.+)")
 
@@ -50,7 +54,7 @@ def main():
             ms = {k: v["median_ms"] for k, v in f["gpu_ms"].items()}
             layout, primitive, cluster, build, threads, streams = variant(m.group(4))
             expand = ms.get("expandPrimitives", 0.0) + ms.get("writeInstances", 0.0)
-            restir = sum(ms.get(p, 0.0) for p in ("generateCandidates", "temporalResampling", "spatialResampling"))
+            restir = sum(ms.get(p, 0.0) for p in (PASS.generateCandidates, PASS.temporalResampling, PASS.spatialResampling))
             rows.append({
                 "config": name, "commit": j["version"].split("+")[-1], "gpu": j["device"],
                 "particles": int(m.group(1)), "width": int(m.group(2)), "height": int(m.group(3)),
@@ -61,8 +65,8 @@ def main():
                 "expand_ms": round(expand, 4), "blas_ms": round(ms.get("buildBlas", 0.0), 4),
                 "tlas_ms": round(ms.get("buildTlas", 0.0), 4),
                 "build_ms": round(expand + ms.get("buildBlas", 0.0) + ms.get("buildTlas", 0.0), 4),
-                "gbuffer_ms": round(ms.get("traceGBuffer", 0.0), 4), "restir_ms": round(restir, 4),
-                "shadow_ms": round(ms.get("traceShadowRays", 0.0), 4),
+                "gbuffer_ms": round(ms.get(PASS.traceGBuffer, 0.0), 4), "restir_ms": round(restir, 4),
+                "shadow_ms": round(ms.get(PASS.traceShadowRays, 0.0), 4),
                 "frame_ms": round(sum(ms.values()), 4),
                 "blas_enqueue_ms": round(f["blas_enqueue_ms"], 3),
                 "blas_bytes": f["blas_bytes"], "tlas_bytes": f["tlas_bytes"], "scratch_bytes": f["scratch_bytes"],

@@ -9,6 +9,9 @@ The twin's OptiX launches alternate traceGBuffer and traceShadowRays (one of
 each per frame, in that order); FRAME_INDEX (default: the last frame
 profiled) picks the frame whose launches are reported."""
 import csv, json, sys
+import pathlib
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "scripts"))
+from pass_names import PASS  # noqa: E402
 
 cost_json, ncu_csv, out = sys.argv[1:4]
 model = {}
@@ -21,8 +24,8 @@ for p in json.load(open(cost_json))["passes"]:
 rows = list(csv.reader(open(ncu_csv)))
 h = rows[0]
 name, ratio, time = h.index("Kernel Name"), h.index("smsp__thread_inst_executed_per_inst_executed.ratio"), h.index("gpu__time_duration.sum")
-kernels = {"expandBillboards": "buildClusters", "generateCandidates": "generateCandidates",
-           "temporalResampling": "temporalResampling", "spatialResampling": "spatialResampling"}
+kernels = {"expandBillboards": PASS.buildClusters, "generateCandidates": PASS.generateCandidates,
+           "temporalResampling": PASS.temporalResampling, "spatialResampling": PASS.spatialResampling}
 frames, launches = [], 0
 for r in rows[2:]:
     k = r[name]
@@ -31,7 +34,7 @@ for r in rows[2:]:
     if not frames:
         continue
     if k == "optixLaunch":
-        p = "traceGBuffer" if launches % 2 == 0 else "traceShadowRays"
+        p = PASS.traceGBuffer if launches % 2 == 0 else PASS.traceShadowRays
         launches += 1
     else:
         p = next((v for key, v in kernels.items() if key in k), None)
@@ -44,7 +47,7 @@ with open(out, "w", newline="") as fh:
     w = csv.writer(fh)
     w.writerow(["kernel", "model_pass", "model_branch", "model_loop", "model_combined", "ncu_simt", "ncu_us"])
     for label, (simt, us) in frame.items():
-        p = "buildClusters" if label == "expandBillboards" else label
+        p = PASS.buildClusters if label == "expandBillboards" else label
         m = model.get(p, (0.0, 0.0, 0.0))
         w.writerow([label, p] + [f"{x:.3f}" for x in m] + [f"{simt:.3f}", f"{us:.1f}"])
 print(open(out).read())

@@ -6,6 +6,7 @@
 
 #include "accretion/core/error.h"
 #include "accretion/core/parse.h"
+#include "accretion/render/estimator_table.h"
 #include "accretion/scene/scene_parser.h"
 
 namespace accretion {
@@ -34,7 +35,7 @@ std::vector<EstimatorSpec> parseEstimatorSpecs(const std::string& list, const st
                 spec.settings.push_back({"restir.bias_correction", flag, [](Settings& s) { s.restir.bias_correction = BiasCorrection::basic; }});
                 spec.settings.push_back({"restir.basic_visibility", flag, [](Settings& s) { s.restir.basic_visibility = true; }});
             } else if (parseEnum(o, bc)) {
-                if (spec.kind != EstimatorKind::restir) fail("a bias correction applies to restir only");
+                if (!estimatorInfo(spec.kind).reuse) fail("a bias correction applies to restir only");
                 spec.settings.push_back({"restir.bias_correction", flag, [bc](Settings& s) { s.restir.bias_correction = bc; }});
             } else if (parseEnum(o, src)) {
                 spec.settings.push_back({"render.source", flag, [src](Settings& s) { s.render.source = src; }});
@@ -60,7 +61,7 @@ ExperimentRender renderForExperiment(const Settings& settings, const ParticleSou
                                      std::uint32_t history) {
     ExperimentRender r;
     const std::uint32_t first =
-        settings.render.estimator == EstimatorKind::restir ? frame - std::min(frame, history) : frame;
+        estimatorInfo(settings.render.estimator).reuse ? frame - std::min(frame, history) : frame;
     Settings run = settings;  // the frames rendered, so that the pass plan keeps restir's history
     run.render.frame_start = first;
     run.render.frames = frame - first + 1;

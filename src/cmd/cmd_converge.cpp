@@ -20,6 +20,7 @@
 #include "accretion/io/plot.h"
 #include "accretion/io/report_table.h"
 #include "accretion/io/stats_writer.h"
+#include "accretion/render/estimator_table.h"
 #include "accretion/scene/scene_parser.h"
 #include "commands.h"
 
@@ -229,8 +230,7 @@ Table summaryTable(const std::vector<Point>& points, const std::vector<Estimator
     std::vector<Point> baseline;
     std::string baselineLabel;
     for (const EstimatorSpec& spec : specs)
-        if (spec.kind == EstimatorKind::uniform || spec.kind == EstimatorKind::power || spec.kind == EstimatorKind::tree ||
-            spec.kind == EstimatorKind::split) {
+        if (!estimatorInfo(spec.kind).sums && !estimatorInfo(spec.kind).resampling) {
             baselineLabel = spec.label;
             for (const Point& p : points)
                 if (p.label == spec.label) baseline.push_back(p);

@@ -21,6 +21,7 @@
 #include "accretion/io/exr_output.h"
 #include "accretion/io/report_table.h"
 #include "accretion/io/stats_writer.h"
+#include "accretion/render/estimator_table.h"
 #include "accretion/render/frame_renderer.h"
 #include "accretion/scene/scene_parser.h"
 #include "commands.h"
@@ -59,7 +60,7 @@ struct CountedFrame {
 };
 
 CountedFrame renderCounted(const Settings& s, const ParticleSource& source, std::uint32_t frame, std::uint32_t history) {
-    const std::uint32_t first = s.render.estimator == EstimatorKind::restir ? frame - std::min(frame, history) : frame;
+    const std::uint32_t first = estimatorInfo(s.render.estimator).reuse ? frame - std::min(frame, history) : frame;
     Settings run = s;  // the frames rendered, so that the pass plan keeps restir's history
     run.render.frame_start = first;
     run.render.frames = frame - first + 1;
@@ -246,16 +247,9 @@ nlohmann::json reportBlasMemory(const CostRun& run) {
             fmt::print("  {:>8} {:>8} {:>12} {:>14} {:>6.1f}% {:>12} {:>6.1f}% {:>12} {:>12}\n", size, m.clusters, m.gpuBytes,
                        m.perBlasAllocBytes, 100.0 * m.perBlasWaste(), m.pooledBytes, 100.0 * m.pooledWaste(),
                        m.compactedPooledBytes, m.embreeBytes);
-            memory.push_back({{"cluster_size", size},
-                              {"clusters", m.clusters},
-                              {"triangles", m.triangles},
-                              {"gpu_bytes", m.gpuBytes},
-                              {"per_blas_allocation_bytes", m.perBlasAllocBytes},
-                              {"per_blas_allocation_waste", m.perBlasWaste()},
-                              {"pooled_bytes", m.pooledBytes},
-                              {"pooled_waste", m.pooledWaste()},
-                              {"compacted_pooled_bytes", m.compactedPooledBytes},
-                              {"embree_bytes", m.embreeBytes}});
+            nlohmann::json row = toJson(m);
+            row["cluster_size"] = size;
+            memory.push_back(std::move(row));
         }
     }
     return memory;
@@ -327,7 +321,7 @@ void runCost(const CostArgs& a) {
     const std::uint32_t frame = run.frame;
 
     run.log(fmt::format("frame {} of {} with counters ({} history frames)", frame, settings.scenePath,
-                        settings.render.estimator == EstimatorKind::restir ? std::min(frame, a.history) : 0));
+                        estimatorInfo(settings.render.estimator).reuse ? std::min(frame, a.history) : 0));
     const CountedFrame main = renderCounted(settings, source, frame, a.history);
     const GpuReport& r = main.report;
     fmt::print("{}: frame {}, {}x{}, {} particles, {} clusters, estimator {}; warps {}x{} groups of {} lanes; cost: {}\n",

@@ -13,6 +13,7 @@
 #include "accretion/io/exr_output.h"
 #include "accretion/io/preview.h"
 #include "accretion/render/estimators.h"
+#include "accretion/scene/scene_parser.h"
 #include "commands.h"
 
 namespace accretion::cmd {
@@ -141,9 +142,9 @@ void runMerge(const MergeArgs& args) {
     exr.attributes["accretion:shard"] = fmt::format("merged {} shards", count);
     exr.attributes["accretion:merge_version"] = std::string(version());
     exr.attributes.erase("accretion:render_time_s");
-    ToneMap curve = ToneMap::filmic;
-    parseEnum(first.value("tonemap", std::string("filmic")), curve);
-    const PreviewTone tone = previewTone(preview, curve, first.value("auto_exposure", true), first.value("exposure", 0.0));
+    // The preview's tone from the settings the shards were rendered with (every shard's are the same).
+    const RenderSettings render = parseScene(first.at("settings").get<std::string>(), in.front().exr + " (its settings)").render;
+    const PreviewTone tone = previewTone(preview, render.tonemap, render.auto_exposure, render.exposure);
     exr.attributes["accretion:preview"] = tone.describe();
     writeRawExr(output, exr);
     const std::filesystem::path base = std::filesystem::path(output).replace_extension();

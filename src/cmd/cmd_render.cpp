@@ -23,6 +23,7 @@
 #include "accretion/io/preview.h"
 #include "accretion/io/stats_writer.h"
 #include "accretion/particles/particle_source.h"
+#include "accretion/render/estimator_table.h"
 #include "accretion/render/frame_renderer.h"
 #include "accretion/scene/scene_parser.h"
 #include "commands.h"
@@ -144,7 +145,7 @@ Sharding planSharding(const Settings& settings, const RenderArgs& args) {
     if (!s.shard.whole() && !settings.render.crop.empty())
         throw InputError(fmt::format("command line --shard {}: render.crop renders a window; render it whole (shards split whole images)",
                                      args.shard));
-    s.accumulating = settings.render.estimator != EstimatorKind::restir;
+    s.accumulating = !estimatorInfo(settings.render.estimator).reuse;
     s.bySamples = !s.shard.whole() && s.accumulating && !(settings.render.target_stderr > 0.0);
     s.first = settings.render.frame_start;
     s.end = s.first + settings.render.frames;
@@ -220,18 +221,12 @@ nlohmann::json writeFrameOutputs(const RenderRun& run, std::uint32_t frame, cons
     const RenderSettings& rs = settings.render;
     const PreviewTone tone = previewTone(L, rs.tonemap, rs.auto_exposure, rs.exposure);
     const PreviewTone lrTone = previewTone(Lr, rs.tonemap, rs.auto_exposure, rs.exposure);
-    const OutputMetadata meta = {
-        {"version", std::string(version())},   {"scene", settings.scenePath},
-        {"preview", tone.describe()},
-        {"frame", std::to_string(frame)},      {"estimator", std::string(enumName(settings.render.estimator))},
-        {"samples", std::to_string(settings.render.samples)}, {"seed", std::to_string(settings.render.seed)},
-        {"shard", run.shardLabel},             {"render_time_s", fmt::format("{:.6f}", fs.seconds)},
-        {"settings", run.settingsToml},
-    };
+    OutputMetadata meta = frameMetadata(settings, run.settingsToml, frame, settings.render.seed, run.shardLabel, fs.seconds);
+    meta["preview"] = tone.describe();
     nlohmann::json outputs;
     {
         auto t = fs.timer.scope(pass::writeOutputs);
-        writeFrameExr(exr, image, settings.render.estimator != EstimatorKind::exact, meta);
+        writeFrameExr(exr, image, !estimatorInfo(settings.render.estimator).sums, meta);
         writePreviewPng(base + ".png", L, w.width(), w.height(), tone);
         writePreviewPng(base + ".Lr.png", Lr, w.width(), w.height(), lrTone);
         outputs = {{"exr", exr}, {"png", base + ".png"}, {"lr_png", base + ".Lr.png"}, {"preview_tone", tone.describe()}};
@@ -240,9 +235,6 @@ nlohmann::json writeFrameOutputs(const RenderRun& run, std::uint32_t frame, cons
             AccumulationFile f{accumulationHeader("shard", run.settingsToml, run.shardLabel, frame), sums};
             f.header["chunks"] = {plan.begin, plan.end};
             f.header["exact"] = plan.exact;
-            f.header["auto_exposure"] = settings.render.auto_exposure;
-            f.header["exposure"] = settings.render.exposure;
-            f.header["tonemap"] = std::string(enumName(settings.render.tonemap));
             writeAccumulationFile(base + ".acc", f);
             outputs["accumulation"] = base + ".acc";
         }
@@ -292,19 +284,11 @@ void writeRunOutputs(const std::string& stem, const std::string& settingsToml, c
 
 /// The run's stats.json before its frames: what made it.
 nlohmann::json runStats(const RenderRun& run, int threads) {
-    const Settings& settings = run.settings;
-    return {
-        {"version", std::string(version())},
-        {"scene", settings.scenePath},
-        {"estimator", std::string(enumName(settings.render.estimator))},
-        {"seed", settings.render.seed},
-        {"samples", settings.render.samples},
-        {"threads", threads},
-        {"shard", run.shardLabel},
-        {"shard_by", run.sharding.shard.whole() ? "none" : run.sharding.bySamples ? "samples" : "frames"},
-        {"settings", run.settingsToml},
-        {"frames", nlohmann::json::array()},
-    };
+    nlohmann::json stats = statsHeader(run.settings, run.settingsToml);
+    stats["threads"] = threads;
+    stats["shard"] = run.shardLabel;
+    stats["shard_by"] = run.sharding.shard.whole() ? "none" : run.sharding.bySamples ? "samples" : "frames";
+    return stats;
 }
 
 void runRender(const RenderArgs& args) {
@@ -408,7 +392,8 @@ void addRenderCommand(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("render", "Render frames of a scene to EXR (+ PNG preview, stats.json)");
     addSceneOptions(cmd, *args, "Frames A:B, half-open (= render.frame_start, render.frames)");
     cmd->add_option("-o,--output", args->output, "EXR output path ({scene}, {frame} patterns) = render.output");
-    cmd->add_option("--estimator", args->estimator, "exact | uniform | power | tree | split | ris | restir  (= render.estimator)");
+    cmd->add_option("--estimator", args->estimator,
+                    fmt::format("{}  (= render.estimator; `accretion estimators` says what each needs)", enumChoices<EstimatorKind>()));
     cmd->add_option("--target-stderr", args->targetStderr,
                     "Sample each pixel until its relative standard error is below this (e.g. 0.5%; = render.target_stderr)");
     cmd->add_option("--spp", args->spp, "Light samples per pixel (= render.samples)");

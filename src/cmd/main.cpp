@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
     accretion::cmd::addCostCommand(app);
     accretion::cmd::addCalibrateCommand(app);
     accretion::cmd::addPlanCommand(app);
+    accretion::cmd::addEstimatorsCommand(app);
     accretion::cmd::addMergeCommand(app);
     accretion::cmd::addBatchCommand(app);
     accretion::cmd::addCamerasCommand(app);

@@ -34,4 +34,17 @@ BlasMemory blasMemory(std::span<const std::uint32_t> trianglesPerCluster, const 
     return m;
 }
 
+nlohmann::json toJson(const BlasMemory& m) {
+    return {{"clusters", m.clusters},
+            {"triangles", m.triangles},
+            {"gpu_bytes", m.gpuBytes},
+            {"per_blas_allocation_bytes", m.perBlasAllocBytes},
+            {"per_blas_allocation_waste", m.perBlasWaste()},
+            {"pooled_bytes", m.pooledBytes},
+            {"pooled_waste", m.pooledWaste()},
+            {"compacted_pooled_bytes", m.compactedPooledBytes},
+            {"embree_bytes", m.embreeBytes},
+            {"embree_bytes_per_cluster", m.clusters ? double(m.embreeBytes) / double(m.clusters) : 0.0}};
+}
+
 }  // namespace accretion

@@ -184,23 +184,12 @@ nlohmann::json toJson(const PassReport& p) {
 nlohmann::json toJson(const GpuReport& r) {
     nlohmann::json passes = nlohmann::json::array();
     for (const PassReport& p : r.passes) passes.push_back(toJson(p));
-    const BlasMemory& b = r.blas;
     return {{"warp_layout", {{"group_width", r.layout.groupWidth}, {"group_height", r.layout.groupHeight},
                              {"warp_size", r.layout.warpSize}}},
             {"ser_key", r.serKey},
             {"ser_window", r.serWindow},
             {"passes", passes},
-            {"blas_bytes",
-             {{"clusters", b.clusters},
-              {"triangles", b.triangles},
-              {"gpu_estimate", b.gpuBytes},
-              {"per_blas_allocation", b.perBlasAllocBytes},
-              {"per_blas_allocation_waste", b.perBlasWaste()},
-              {"pooled", b.pooledBytes},
-              {"pooled_waste", b.pooledWaste()},
-              {"compacted_pooled", b.compactedPooledBytes},
-              {"embree", b.embreeBytes},
-              {"embree_per_cluster", b.clusters ? double(b.embreeBytes) / double(b.clusters) : 0.0}}},
+            {"blas_memory", toJson(r.blas)},
             {"layouts",
              {{"reservoir_bytes", r.layouts.reservoirBytes},
               {"gbuffer_texel_bytes", r.layouts.gbufferTexelBytes},

@@ -1,7 +1,5 @@
 #include "accretion/io/stats_writer.h"
 
-#include "accretion/core/atomic_file.h"
-
 namespace accretion {
 
 nlohmann::json frameStatsJson(const FrameStats& s) {
@@ -45,10 +43,6 @@ nlohmann::json frameStatsJson(const FrameStats& s) {
           {"tlas_seconds", s.bvh.tlasSeconds},
           {"embree_bytes", s.bvh.embreeBytes}}},
     };
-}
-
-void writeJson(const std::filesystem::path& file, const nlohmann::json& doc) {
-    writeFileAtomic(file, doc.dump(2) + "\n");
 }
 
 }  // namespace accretion

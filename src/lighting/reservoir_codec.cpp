@@ -26,15 +26,6 @@ float fromHalfBits(std::uint32_t b) {
 
 }  // namespace
 
-ReservoirCodec::ReservoirCodec(const RestirSettings& s)
-    : layout_(s.layout), lightBits_(s.light_bits), half_(s.half_weights),
-      maxM_(s.layout == ReservoirLayout::full ? 0xffffffffu : (1u << (32 - s.light_bits)) - 1u) {}
-
-std::size_t ReservoirCodec::bytes() const {
-    if (layout_ == ReservoirLayout::full) return 16;
-    return half_ ? 8 : 12;
-}
-
 std::uint32_t ReservoirCodec::bitsFor(std::size_t n) { return indexBits(n); }
 
 void ReservoirCodec::checkCapacity(std::size_t lights, std::string_view where) const {

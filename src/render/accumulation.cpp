@@ -5,13 +5,15 @@
 #include <fmt/format.h>
 
 #include "accretion/core/error.h"
+#include "accretion/render/estimator_table.h"
 
 namespace accretion {
 
 LightingPlan planLighting(const RenderSettings& render, std::uint32_t height, Shard shard) {
     LightingPlan plan;
-    plan.exact = render.estimator == EstimatorKind::exact;
-    plan.adaptive = !plan.exact && render.target_stderr > 0.0;
+    const EstimatorInfo& e = estimatorInfo(render.estimator);
+    plan.exact = e.sums;
+    plan.adaptive = e.adaptive && render.target_stderr > 0.0;
     plan.samples = render.samples;
     plan.chunksPerRound = plan.exact ? (height + LightingPlan::kChunkRows - 1) / LightingPlan::kChunkRows
                                      : (render.samples + LightingPlan::kChunkSamples - 1) / LightingPlan::kChunkSamples;

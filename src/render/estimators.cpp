@@ -19,6 +19,7 @@
 #include "accretion/lighting/near_field.h"
 #include "accretion/lighting/reservoir.h"
 #include "accretion/lighting/shading.h"
+#include "accretion/render/estimator_table.h"
 #include "accretion/render/sample_sums.h"
 #include "accretion/render/visibility.h"
 
@@ -487,13 +488,14 @@ namespace {
 /// The light samplers an estimator needs were built for it (the plan's
 /// work): a missing one is a defect of the caller, not of the input.
 void checkSamplerInputs(const LightingInputs& in) {
-    ACC_CHECK(in.render.estimator != EstimatorKind::power || in.powerTable);
+    const EstimatorInfo& e = estimatorInfo(in.render.estimator);
+    const LightSamplerKind need = samplerFor(in.render);
+    ACC_CHECK(!e.reuse);  // restir runs its own passes
+    ACC_CHECK(need != LightSamplerKind::tree || in.lightTree);
     // ris draws its candidates in proportion to power exactly when given the table: it must be the configured source.
-    ACC_CHECK(in.render.estimator != EstimatorKind::ris || (in.render.source == LightSource::power) == (in.powerTable != nullptr));
-    ACC_CHECK((in.render.estimator != EstimatorKind::tree && in.render.estimator != EstimatorKind::split) || in.lightTree);
-    ACC_CHECK(in.render.estimator != EstimatorKind::ris || in.render.source != LightSource::tree || in.lightTree);
-    ACC_CHECK(in.render.estimator != EstimatorKind::ris || (in.render.source != LightSource::tiles && in.render.source != LightSource::regir));
-    ACC_CHECK(in.render.estimator != EstimatorKind::restir);
+    ACC_CHECK((need == LightSamplerKind::power) == (in.powerTable != nullptr) || !e.resampling);
+    ACC_CHECK(need != LightSamplerKind::power || in.powerTable);
+    ACC_CHECK(!e.resampling || (in.render.source != LightSource::tiles && in.render.source != LightSource::regir));
 }
 }  // namespace
 

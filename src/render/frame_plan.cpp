@@ -13,7 +13,7 @@ namespace {
 void planRun(const Settings& s, FramePlan& plan) {
     const bool staticCamera = s.camera.path == CameraPath::static_pose ||
                               (s.camera.path == CameraPath::orbit && s.camera.orbit_speed == 0.0);
-    const bool restir = s.render.estimator == EstimatorKind::restir;
+    const bool restir = estimatorInfo(s.render.estimator).reuse;
     plan.staticGeometry = staticParticles(s.particles) && staticCamera;
     plan.alphaFilter = s.geometry.primitive == Primitive::billboard && s.geometry.alpha == AlphaMode::disc;
     plan.keepHistory = restir && s.restir.temporal && s.render.frames > 1;
@@ -24,17 +24,13 @@ void planRun(const Settings& s, FramePlan& plan) {
 
 /// This frame's passes.
 void planPasses(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
-    const EstimatorKind est = s.render.estimator;
-    const bool resampling = est == EstimatorKind::ris || est == EstimatorKind::restir;
+    const EstimatorInfo& est = estimatorInfo(s.render.estimator);
     plan.loadParticles = plan.buildClusters = !(plan.staticGeometry && facts.geometryBuilt);
-    plan.lighting = facts.emissive && glm::length(s.shading.albedo) > 0.0f;
+    plan.lighting = !facts.lightingSkipped && facts.emissive && glm::length(s.shading.albedo) > 0.0f;
     plan.shadowRays = plan.lighting && s.shading.visibility;
-    if (plan.lighting && (est == EstimatorKind::tree || est == EstimatorKind::split || (resampling && s.render.source == LightSource::tree)))
-        plan.sampler = LightSamplerKind::tree;
+    if (plan.lighting) plan.sampler = samplerFor(s.render);  // tiles and the ReGIR grid are drawn from the power table
     const bool presampled = s.render.source == LightSource::tiles || s.render.source == LightSource::regir;
-    if (plan.lighting && (est == EstimatorKind::power || (resampling && (s.render.source == LightSource::power || presampled))))
-        plan.sampler = LightSamplerKind::power;  // the tiles are drawn from the power table
-    plan.restir = plan.lighting && est == EstimatorKind::restir;
+    plan.restir = plan.lighting && est.reuse;
     plan.presampleTiles = plan.restir && presampled;
     plan.presampleRegir = plan.restir && s.render.source == LightSource::regir;
     plan.temporal = plan.restir && plan.keepHistory && facts.historyAvailable;
@@ -45,7 +41,7 @@ void planPasses(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
 /// The plan as lines, with what each step does or why it is skipped.
 void describe(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
     const EstimatorKind est = s.render.estimator;
-    const bool restir = est == EstimatorKind::restir;
+    const bool restir = estimatorInfo(est).reuse;
     const bool manyFrames = s.render.frames > 1;
     auto step = [&](std::string_view name, bool runs, std::string why, bool isPass = true, bool nested = false) {
         plan.steps.push_back({std::string(name), runs, std::move(why), isPass, nested});
@@ -65,8 +61,9 @@ void describe(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
          plan.previousBvh ? "basic_visibility tests history samples against last frame's geometry"
                           : "not needed (no basic_visibility with history and visibility reuse)", false);
     const bool dark = !plan.lighting;
-    const std::string noLight = !facts.emissive ? "no lighting passes: no particle emits"
-                                                : "no lighting passes: albedo 0";
+    const std::string noLight = facts.lightingSkipped ? "no lighting passes: skipped by the command (geometry timed alone)"
+                                : !facts.emissive ? "no lighting passes: no particle emits"
+                                                  : "no lighting passes: albedo 0";
     step(pass::buildLightSampler, plan.sampler != LightSamplerKind::none,
          plan.sampler == LightSamplerKind::tree    ? "light tree"
          : plan.sampler == LightSamplerKind::power ? "alias table over light power"
@@ -101,7 +98,7 @@ void describe(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
         step("shadow rays", plan.shadowRays,
              plan.shadowRays ? "V by occlusion queries" : (dark ? noLight : "visibility off: no shadow rays"), false);
     }
-    const bool reservoirs = plan.lighting && (est == EstimatorKind::ris || restir);
+    const bool reservoirs = plan.lighting && estimatorInfo(est).resampling;
     step("reservoirs", reservoirs,
          reservoirs ? fmt::format("{} B each", restir ? ReservoirCodec(s.restir).bytes() : 16)
                     : fmt::format("estimator {}: no reservoirs", enumName(est)), false);
@@ -125,7 +122,7 @@ bool emissive(const Particles& particles) {
 }
 
 bool needsPreviousBvh(const Settings& s) {
-    return s.render.estimator == EstimatorKind::restir && s.restir.temporal &&
+    return estimatorInfo(s.render.estimator).reuse && s.restir.temporal &&
            s.restir.bias_correction == BiasCorrection::basic && s.restir.basic_visibility &&
            (s.restir.visibility_reuse || s.restir.candidate_visibility) &&
            (s.geometry.build == BuildPolicy::rebuild || s.geometry.build == BuildPolicy::fast_trace);

@@ -6,9 +6,11 @@
 // per-pass GPU times (CUDA events, median of --repeat launches) as
 // calibrate's timings CSV, and a stats JSON.
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <memory>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -23,10 +25,12 @@
 #include "accretion/geometry/camera_track.h"
 #include "accretion/geometry/clustering.h"
 #include "accretion/io/gpu_frame_file.h"
+#include "accretion/io/provenance.h"
 #include "accretion/lighting/light_sampler.h"
 #include "accretion/particles/particle_source.h"
 #include "accretion/render/accumulation.h"
 #include "accretion/render/compose_pixel.h"
+#include "accretion/render/frame_plan.h"
 #include "accretion/render/upsample_pixel.h"
 #include "accretion/scene/scene_parser.h"
 #include "launch_params.h"
@@ -65,10 +69,8 @@ void requireSupported(const Settings& s, bool lighting) {
         refuse(fmt::format("geometry.build = \"{}\" with geometry.layout = \"instances\" (rebuild or refit the TLAS)",
                            enumName(g.build)));
     const EstimatorKind e = s.render.estimator;
-    if (lighting && e != EstimatorKind::exact && e != EstimatorKind::uniform && e != EstimatorKind::power &&
-        e != EstimatorKind::restir)
-        refuse(fmt::format("render.estimator = \"{}\"", enumName(e)));
-    if (lighting && e == EstimatorKind::restir) {
+    if (lighting && !estimatorInfo(e).twin) refuse(fmt::format("render.estimator = \"{}\"", enumName(e)));
+    if (lighting && estimatorInfo(e).reuse) {
         const RestirSettings& r = s.restir;
         if (s.render.source == LightSource::tree) refuse("render.source = \"tree\"");
         if (s.render.source == LightSource::tiles) refuse("render.source = \"tiles\"");
@@ -97,42 +99,302 @@ void copyDevice(DeviceBuffer& to, const DeviceBuffer& from, std::size_t bytes, c
     CUDA_CHECK(cudaMemcpyAsync(to.as<void>(), from.as<void>(), bytes, cudaMemcpyDeviceToDevice, stream));
 }
 
-/// The restir passes of a frame after the G-buffer (the CPU's runPasses):
-/// generateCandidates, temporalResampling (with a history),
-/// spatialResampling x iterations, traceShadowRays. Returns the final
-/// reservoirs (the next frame's history).
-StoredReservoir* runRestir(LaunchParams& lp, FrameBuffers& buf, const Settings& s, Raygen shade, const TwinPipeline& pipeline,
-                           cudaStream_t stream, GpuTimer& timer) {
+/// Medians of a frame's timed steps (GpuTimer names), in ms.
+using StepTimes = std::map<std::string, std::vector<double>>;
+
+/// A run of the twin: the device state kept from frame to frame, and the
+/// frame's plan (the CPU's FramePlan, planned from the same settings and
+/// facts) executed pass by pass on the GPU.
+class TwinRun {
+public:
+    TwinRun(const Args& a, const Settings& settings);
+    ~TwinRun() { cudaStreamDestroy(stream_); }
+    TwinRun(const TwinRun&) = delete;
+    TwinRun& operator=(const TwinRun&) = delete;
+
+    /// The next seed's run starts from scratch: no BVH, no history.
+    void restart() {
+        history_ = built_ = false;
+        prevCount_ = 0;
+    }
+    /// Render, time and write one frame (a .gpuframe and its stats record).
+    void renderFrame(std::uint32_t frame, std::uint64_t seed);
+    /// The run's stats JSON and, with --timings, the last frame's timings CSV.
+    void writeRunOutputs() const;
+
+private:
+    Particles particlesOf(std::uint32_t frame);
+    FramePlan planFor(const Particles& particles) const;
+    void uploadParticles(const Particles& particles, const Camera& camera);
+    void uploadClusterHint(const Particles& particles, bool recluster, bool first);
+    LaunchParams launchParams(const FramePlan& plan, const Camera& camera, const Particles& particles,
+                              std::uint32_t frame, std::uint64_t seed);
+    StoredReservoir* runRestir(LaunchParams& lp);
+    StepTimes runPasses(const FramePlan& plan, LaunchParams& lp, const Clusters& clusters, bool recluster,
+                        LaunchCounters& counters, StoredReservoir*& finalReservoirs);
+    void keepHistory(const Camera& camera, std::size_t particleCount, const StoredReservoir* finalReservoirs);
+    GpuFrame composeFrame(const FramePlan& plan, const Particles& particles, std::uint32_t frame, const CameraPose& pose,
+                          std::size_t& hits, std::size_t& nonFinite) const;
+
+    const Args& a_;
+    const Settings& s_;
+    const std::string settingsToml_;
+    const ParticleSource source_;
+    const CameraTrack cameras_;
+    const std::uint32_t W_, H_;
+    const FramePlan runPlan_;  ///< the run-wide decisions (buffers, history)
+    const bool sampling_;      ///< uniform / power: stderr, spp and rejections per pixel (zero when unlit)
+    const LightingPlan lightingPlan_;
+    AccelOptions accelOptions_;
+    const bool omm_;
+    const bool persistent_;    ///< refit or partial: one BVH updated in place
+    Raygen shade_ = Raygen::shade;
+    std::uint32_t gridW_, gridH_;  ///< restir's lighting grid (resolution_scale)
+    std::string device_;
+    std::unique_ptr<TwinPipeline> pipeline_;
+    cudaStream_t stream_{};
+    std::unique_ptr<GpuTimer> timer_;
+    std::unique_ptr<ParticleAccel> accel_;
+    FrameBuffers buf_;
+    // Across frames.
+    bool history_ = false, built_ = false;
+    Camera prevCamera_{};
+    std::uint32_t prevCount_ = 0;
+    Clusters clusters_;
+    Vec3 origin_{0.0f};
+    std::map<std::uint32_t, Particles> loaded_;  ///< --seeds: each frame's particles, loaded once
+    nlohmann::json stats_;
+    std::string timingsCsv_ = "config,pass,ms\n";
+};
+
+FrameFacts planningFacts(const Args& a) {
+    FrameFacts facts;
+    facts.lightingSkipped = a.skipLighting;
+    return facts;
+}
+
+TwinRun::TwinRun(const Args& a, const Settings& settings)
+    : a_(a), s_(settings), settingsToml_(settingsToToml(settings)), source_(settings), cameras_(settings.camera),
+      W_(settings.camera.width), H_(settings.camera.height), runPlan_(planFrame(settings, planningFacts(a))),
+      sampling_(!a.skipLighting && (settings.render.estimator == EstimatorKind::uniform ||
+                                    settings.render.estimator == EstimatorKind::power)),
+      lightingPlan_(planLighting(settings.render, H_)),
+      omm_(settings.geometry.alpha == AlphaMode::disc && settings.gpu.omm != OmmMode::off),
+      persistent_(settings.geometry.build == BuildPolicy::refit || settings.geometry.build == BuildPolicy::partial) {
+    if (a.shadowRays == "traverse" || a.shadowRays == "reorder") shade_ = Raygen::shadeTraverse;
+    else if (a.shadowRays != "trace")
+        throw InputError(fmt::format("command line --shadow-rays {}: expected trace, traverse or reorder", a.shadowRays));
+    cudaDeviceProp prop{};
+    CUDA_CHECK(cudaGetDeviceProperties(&prop, 0));
+    device_ = prop.name;
+    const GeometrySettings& geometry = settings.geometry;
+    accelOptions_.layout = geometry.layout;
+    accelOptions_.spheres = geometry.primitive == Primitive::sphere;
+    accelOptions_.build = geometry.build;
+    accelOptions_.rebuildFraction = geometry.rebuild_fraction;
+    accelOptions_.pooled = !a.perBlas;
+    accelOptions_.compact = a.compact;
+    accelOptions_.streams = a.buildStreams;
+    accelOptions_.hostThreads = a.buildThreads;
+    accelOptions_.omm = omm_ ? settings.gpu.omm : OmmMode::off;
+    accelOptions_.ommLevel = settings.gpu.omm_level;
+    pipeline_ = std::make_unique<TwinPipeline>(a.programs, a.validation, omm_, geometry.layout, accelOptions_.spheres,
+                                               blasBuildFlags(accelOptions_));
+    CUDA_CHECK(cudaStreamCreate(&stream_));
+    timer_ = std::make_unique<GpuTimer>(stream_);
+    accel_ = std::make_unique<ParticleAccel>(pipeline_->context(), accelOptions_);
+
+    const std::size_t pixels = std::size_t(W_) * H_;
+    buf_.gbuffer.resize(pixels * sizeof(GBufferTexel));
+    buf_.Lr.resize(pixels * sizeof(Vec3));
+    buf_.counters.resize(sizeof(LaunchCounters));
+    buf_.params.resize(sizeof(LaunchParams));
+    if (sampling_) {
+        buf_.Lr_stderr.resize(pixels * sizeof(Vec3));
+        buf_.spp.resize(pixels * sizeof(float));
+        buf_.rejectedSamples.resize(pixels * sizeof(std::uint32_t));
+    }
+    // The lighting grid (the CPU's Restir::render): the image at resolution_scale.
+    const float scale = static_cast<float>(settings.restir.resolution_scale);
+    gridW_ = runPlan_.upsample ? lightingGridExtent(W_, scale) : W_;
+    gridH_ = runPlan_.upsample ? lightingGridExtent(H_, scale) : H_;
+    const std::size_t gridPixels = std::size_t(gridW_) * gridH_;
+    if (runPlan_.restir) {
+        buf_.resA.resize(gridPixels * sizeof(StoredReservoir));
+        buf_.resB.resize(gridPixels * sizeof(StoredReservoir));
+        buf_.rejected.resize(gridPixels * sizeof(std::uint32_t));
+        if (runPlan_.upsample) {
+            buf_.gridGbuffer.resize(gridPixels * sizeof(GBufferTexel));
+            buf_.gridLr.resize(gridPixels * sizeof(Vec3));
+        }
+    }
+    stats_ = statsHeader(settings, settingsToml_);
+    stats_.update({{"renderer", "accretion-optix"}, {"device", device_}, {"optix_device", pipeline_->deviceProperties()},
+                   {"repeat", a.repeat}, {"allocation", a.perBlas ? "per_blas" : "pooled"}, {"compact", a.compact},
+                   {"build_streams", a.buildStreams}, {"build_threads", a.buildThreads},
+                   {"layout", std::string(enumName(geometry.layout))},
+                   {"primitive", std::string(enumName(geometry.primitive))}, {"seeds", a.seeds}});
+}
+
+/// With --seeds every seed runs the same frames: their particles are loaded once.
+Particles TwinRun::particlesOf(std::uint32_t frame) {
+    if (a_.seeds == 1) return source_.frame(frame);
+    auto it = loaded_.find(frame);
+    if (it == loaded_.end()) it = loaded_.emplace(frame, source_.frame(frame)).first;
+    return it->second;  // a copy: rebased by the caller
+}
+
+FramePlan TwinRun::planFor(const Particles& particles) const {
+    FrameFacts facts = planningFacts(a_);
+    facts.geometryBuilt = built_;
+    facts.historyAvailable = history_;
+    facts.emissive = emissive(particles);
+    return planFrame(s_, facts);
+}
+
+/// The particle arrays the programs read, with each billboard's frame.
+void TwinRun::uploadParticles(const Particles& particles, const Camera& camera) {
+    const std::size_t n = particles.size();
+    std::vector<BillboardFrame> frames(n);
+    std::vector<float> dmin2(n);
+    const float dmin = static_cast<float>(s_.shading.dmin);
+    for (std::size_t i = 0; i < n; ++i) {
+        frames[i] = billboardFrame(s_.geometry.orientation, camera, particles.position[i], particles.velocity[i]);
+        const float d = std::max(particles.radius[i], dmin);
+        dmin2[i] = d * d;
+    }
+    buf_.position.upload(particles.position);
+    buf_.emission.upload(particles.emission);
+    buf_.albedo.upload(particles.albedo);
+    buf_.radius.upload(particles.radius);
+    buf_.dmin2.upload(dmin2);
+    buf_.frames.upload(frames);
+}
+
+/// The SER hint of restir's shadow rays: each particle's BLAS (instances: its own).
+void TwinRun::uploadClusterHint(const Particles& particles, bool recluster, bool first) {
+    if (!runPlan_.restir || !(recluster || first)) return;
+    const std::size_t n = particles.size();
+    std::vector<std::uint32_t> of(n, 0);
+    if (s_.geometry.layout == AccelLayout::instances)
+        for (std::size_t i = 0; i < n; ++i) of[i] = static_cast<std::uint32_t>(i);
+    for (std::size_t c = 0; c < clusters_.count(); ++c)
+        for (std::uint32_t i : clusters_.members(c)) of[i] = static_cast<std::uint32_t>(c);
+    buf_.particleCluster.upload(of);
+}
+
+LaunchParams TwinRun::launchParams(const FramePlan& plan, const Camera& camera, const Particles& particles,
+                                   std::uint32_t frame, std::uint64_t seed) {
+    const std::size_t n = particles.size();
+    LaunchParams lp;
+    lp.camera = camera;
+    lp.model = s_.shading.model;
+    lp.discAlpha = s_.geometry.alpha == AlphaMode::disc;
+    lp.shadows = plan.shadowRays;
+    lp.visibility = VisibilityOptions::from(s_.render);
+    lp.omm = omm_;
+    lp.layout = s_.geometry.layout;
+    lp.spheres = accelOptions_.spheres;
+    lp.particleCount = static_cast<std::uint32_t>(n);
+    lp.position = buf_.position.as<Vec3>();
+    lp.emission = buf_.emission.as<Vec3>();
+    lp.albedo = buf_.albedo.as<Vec3>();
+    lp.radius = buf_.radius.as<float>();
+    lp.dmin2 = buf_.dmin2.as<float>();
+    lp.frames = buf_.frames.as<BillboardFrame>();
+    lp.gbuffer = buf_.gbuffer.as<GBufferTexel>();
+    lp.Lr = buf_.Lr.as<Vec3>();
+    lp.lights = {static_cast<std::uint32_t>(n), n ? 1.0f / float(n) : 0.0f, lp.position, lp.emission, lp.albedo, lp.dmin2};
+    if (plan.sampler == LightSamplerKind::power) {  // buildLightSampler's alias table, as the CPU samples it
+        const AliasTable table = buildPowerTable(particles);
+        buf_.aliasProb.upload(table.probabilities());
+        buf_.aliasAlias.upload(table.aliases());
+        buf_.aliasPmf.upload(table.pmfs());
+        lp.source.power = true;
+        lp.source.table = {buf_.aliasProb.as<float>(), buf_.aliasAlias.as<std::uint32_t>(), buf_.aliasPmf.as<float>()};
+    }
+    lp.source.count = lp.lights.count;
+    lp.source.uniformPdf = lp.lights.uniformPdf;
+    if (sampling_) {
+        SamplingParams& sp = lp.sampling;
+        sp.frame = frame;
+        sp.seed = seed;
+        sp.plan = lightingPlan_;
+        sp.maxSamples = s_.render.max_samples;
+        sp.targetStderr = s_.render.target_stderr;
+        sp.discardNonFinite = s_.render.nonfinite == NonFinitePolicy::discard;
+        sp.Lr_stderr = buf_.Lr_stderr.as<Vec3>();
+        sp.spp = buf_.spp.as<float>();
+        sp.rejected = buf_.rejectedSamples.as<std::uint32_t>();
+    }
+    if (plan.restir) {
+        RestirParams& rp = lp.restir;
+        const RestirSettings& rs = s_.restir;
+        rp.frame = frame;
+        rp.seed = seed;
+        rp.candidates = s_.render.candidates;
+        rp.width = gridW_;
+        rp.height = gridH_;
+        rp.scale = plan.upsample ? float(gridW_) / float(W_) : 1.0f;
+        rp.gbuffer = plan.upsample ? buf_.gridGbuffer.as<GBufferTexel>() : lp.gbuffer;
+        rp.Lr = plan.upsample ? buf_.gridLr.as<Vec3>() : lp.Lr;
+        rp.temporal = plan.temporal;
+        rp.neighbours = rs.spatial_neighbours;
+        rp.radius = std::max(1.0f, float(rs.spatial_radius) * rp.scale);
+        rp.normalThreshold = float(rs.normal_threshold);
+        rp.depthThreshold = float(rs.depth_threshold);
+        rp.mCap = rs.m_cap;
+        rp.bias = rs.bias_correction;
+        rp.visibilityReuse = rs.visibility_reuse;
+        rp.discardNonFinite = s_.render.nonfinite == NonFinitePolicy::discard;
+        rp.reorder = a_.shadowRays == "reorder";
+        rp.serHintBits = s_.gpu.ser_hint_bits;
+        rp.rejected = buf_.rejected.as<std::uint32_t>();
+        rp.particleCluster = buf_.particleCluster.as<std::uint32_t>();
+        rp.prevLights = {prevCount_, prevCount_ ? 1.0f / float(prevCount_) : 0.0f, buf_.prevPosition.as<Vec3>(),
+                         buf_.prevEmission.as<Vec3>(), buf_.prevAlbedo.as<Vec3>(), buf_.prevDmin2.as<float>()};
+        rp.prevGbuffer = buf_.prevGbuffer.as<GBufferTexel>();
+        rp.prevReservoirs = buf_.prevReservoirs.as<StoredReservoir>();
+        rp.prevCamera = prevCamera_;
+    }
+    return lp;
+}
+
+/// The restir passes of a frame after the G-buffer, as the plan has them
+/// (the CPU's Restir::render): generateCandidates, temporalResampling,
+/// spatialResampling x iterations, traceShadowRays, upsampleLighting.
+/// Returns the final reservoirs (the next frame's history).
+StoredReservoir* TwinRun::runRestir(LaunchParams& lp) {
     RestirParams& rp = lp.restir;
     const std::size_t pixels = std::size_t(rp.width) * rp.height;
-    const bool upsample = rp.width != s.camera.width || rp.height != s.camera.height;
-    if (upsample) {
+    GpuTimer& timer = *timer_;
+    if (runPlan_.upsample) {
         GpuScope t(timer, Pass::upsampleLighting, "reduceGBuffer");
-        reduceGBuffer(lp, buf.gridGbuffer.as<GBufferTexel>(), stream);
+        reduceGBuffer(lp, buf_.gridGbuffer.as<GBufferTexel>(), stream_);
     }
-    StoredReservoir* a = buf.resA.as<StoredReservoir>();
-    StoredReservoir* b = buf.resB.as<StoredReservoir>();
-    CUDA_CHECK(cudaMemsetAsync(buf.rejected.as<void>(), 0, pixels * sizeof(std::uint32_t), stream));
+    StoredReservoir* a = buf_.resA.as<StoredReservoir>();
+    StoredReservoir* b = buf_.resB.as<StoredReservoir>();
+    CUDA_CHECK(cudaMemsetAsync(buf_.rejected.as<void>(), 0, pixels * sizeof(std::uint32_t), stream_));
     {
         GpuScope t(timer, Pass::generateCandidates);
         rp.in = nullptr;
         rp.out = a;
-        generateCandidates(lp, stream);
+        generateCandidates(lp, stream_);
     }
     if (rp.temporal) {
         GpuScope t(timer, Pass::temporalResampling);
         rp.in = a;
         rp.out = b;
-        temporalResampling(lp, stream);
+        temporalResampling(lp, stream_);
         std::swap(a, b);
     }
-    const std::uint32_t iterations = s.restir.spatial_neighbours > 0 ? s.restir.spatial_iterations : 0;
+    const std::uint32_t iterations = s_.restir.spatial_neighbours > 0 ? s_.restir.spatial_iterations : 0;
     if (iterations > 0) {
         GpuScope t(timer, Pass::spatialResampling);
         for (std::uint32_t it = 0; it < iterations; ++it) {
             rp.in = a;
             rp.out = b;
-            spatialResampling(lp, it, stream);
+            spatialResampling(lp, it, stream_);
             std::swap(a, b);
         }
     }
@@ -140,15 +402,210 @@ StoredReservoir* runRestir(LaunchParams& lp, FrameBuffers& buf, const Settings& 
         GpuScope t(timer, Pass::traceShadowRays);
         rp.in = nullptr;
         rp.out = a;
-        CUDA_CHECK(cudaMemcpyAsync(buf.params.as<void>(), &lp, sizeof lp, cudaMemcpyHostToDevice, stream));
-        pipeline.launch(shade, buf.params.address(), sizeof lp, rp.width, rp.height, stream);
+        CUDA_CHECK(cudaMemcpyAsync(buf_.params.as<void>(), &lp, sizeof lp, cudaMemcpyHostToDevice, stream_));
+        pipeline_->launch(shade_, buf_.params.address(), sizeof lp, rp.width, rp.height, stream_);
     }
-    if (upsample) {
+    if (runPlan_.upsample) {
         GpuScope t(timer, Pass::upsampleLighting);
-        upsampleLighting(lp, stream);
+        upsampleLighting(lp, stream_);
     }
     CUDA_CHECK(cudaGetLastError());
     return a;
+}
+
+/// The frame's passes: one counting run (its atomics would be timed too),
+/// then `repeat` timed runs when repeat > 1. A refit or partial build
+/// changes state: it runs once per frame, in the first run, whose time it
+/// keeps.
+StepTimes TwinRun::runPasses(const FramePlan& plan, LaunchParams& lp, const Clusters& clusters, bool recluster,
+                             LaunchCounters& counters, StoredReservoir*& finalReservoirs) {
+    StepTimes ms, counted;
+    const DeviceParticles dp{lp.particleCount, lp.position, lp.radius, lp.frames};
+    const bool instances = s_.geometry.layout == AccelLayout::instances;
+    const std::size_t pixels = std::size_t(W_) * H_;
+    const unsigned runs = a_.repeat > 1 ? a_.repeat + 1 : 1;
+    for (unsigned r = 0; r < runs; ++r) {
+        lp.counters = r == 0 ? buf_.counters.as<LaunchCounters>() : nullptr;
+        if (plan.buildClusters && (r == 0 || !persistent_))
+            accel_->build(recluster || instances ? &clusters : nullptr, dp, stream_, *timer_);
+        lp.tlas = accel_->tlas();
+        lp.clusterParticle = accel_->clusterParticle();
+        lp.clusterOffset = accel_->clusterOffset();
+        CUDA_CHECK(cudaMemcpyAsync(buf_.params.as<void>(), &lp, sizeof lp, cudaMemcpyHostToDevice, stream_));
+        CUDA_CHECK(cudaMemsetAsync(buf_.counters.as<void>(), 0, sizeof(LaunchCounters), stream_));
+        {
+            GpuScope s(*timer_, Pass::traceGBuffer);
+            pipeline_->launch(Raygen::gbuffer, buf_.params.address(), sizeof lp, W_, H_, stream_);
+        }
+        if (plan.restir) {
+            finalReservoirs = runRestir(lp);
+        } else if (plan.lighting) {
+            GpuScope s(*timer_, Pass::estimateLighting);
+            pipeline_->launch(sampling_ ? Raygen::sample : Raygen::exact, buf_.params.address(), sizeof lp, W_, H_, stream_);
+        } else {  // nothing lights the frame: Lr = 0, as the CPU's lightFrame
+            CUDA_CHECK(cudaMemsetAsync(buf_.Lr.as<void>(), 0, pixels * sizeof(Vec3), stream_));
+            if (sampling_) {
+                CUDA_CHECK(cudaMemsetAsync(buf_.Lr_stderr.as<void>(), 0, pixels * sizeof(Vec3), stream_));
+                CUDA_CHECK(cudaMemsetAsync(buf_.spp.as<void>(), 0, pixels * sizeof(float), stream_));
+                CUDA_CHECK(cudaMemsetAsync(buf_.rejectedSamples.as<void>(), 0, pixels * sizeof(std::uint32_t), stream_));
+            }
+        }
+        for (const auto& [step, t] : timer_->read()) (r == 0 ? counted : ms)[step].push_back(t);
+        if (r == 0) counters = buf_.counters.download<LaunchCounters>(1)[0];
+    }
+    for (auto& [step, t] : counted)
+        if (!ms.count(step)) ms[step] = t;  // single run, or a step only the first run has
+    return ms;
+}
+
+/// This frame becomes the previous one of restir's temporal reuse.
+void TwinRun::keepHistory(const Camera& camera, std::size_t n, const StoredReservoir* finalReservoirs) {
+    if (!runPlan_.keepHistory) return;
+    if (!finalReservoirs) {  // an unlit frame leaves no reservoirs to reuse
+        history_ = false;
+        return;
+    }
+    const std::size_t gridPixels = std::size_t(gridW_) * gridH_;
+    copyDevice(buf_.prevPosition, buf_.position, n * sizeof(Vec3), stream_);
+    copyDevice(buf_.prevEmission, buf_.emission, n * sizeof(Vec3), stream_);
+    copyDevice(buf_.prevAlbedo, buf_.albedo, n * sizeof(Vec3), stream_);
+    copyDevice(buf_.prevDmin2, buf_.dmin2, n * sizeof(float), stream_);
+    copyDevice(buf_.prevGbuffer, runPlan_.upsample ? buf_.gridGbuffer : buf_.gbuffer, gridPixels * sizeof(GBufferTexel), stream_);
+    buf_.prevReservoirs.reserve(gridPixels * sizeof(StoredReservoir));
+    CUDA_CHECK(cudaMemcpyAsync(buf_.prevReservoirs.as<void>(), finalReservoirs, gridPixels * sizeof(StoredReservoir),
+                               cudaMemcpyDeviceToDevice, stream_));
+    CUDA_CHECK(cudaStreamSynchronize(stream_));
+    prevCamera_ = camera;
+    prevCount_ = static_cast<std::uint32_t>(n);
+    history_ = true;
+}
+
+/// The frame's layers, composed (L = Le + Lr, the background on a miss) by composeImage's rule.
+GpuFrame TwinRun::composeFrame(const FramePlan& plan, const Particles& particles, std::uint32_t frame,
+                               const CameraPose& pose, std::size_t& hits, std::size_t& nonFinite) const {
+    const std::size_t pixels = std::size_t(W_) * H_;
+    const std::vector<GBufferTexel> gb = buf_.gbuffer.download<GBufferTexel>(pixels);
+    GpuFrame out;
+    out.width = W_;
+    out.height = H_;
+    out.frame = frame;
+    out.camera = pose;
+    out.Lr = buf_.Lr.download<Vec3>(pixels);
+    out.L.resize(pixels);
+    out.Le.assign(pixels, Vec3(0.0f));
+    out.normal.assign(pixels, Vec3(0.0f));
+    out.depth.resize(pixels);
+    out.particle.resize(pixels);
+    if (sampling_) {
+        out.Lr_stderr = buf_.Lr_stderr.download<Vec3>(pixels);
+        out.spp = buf_.spp.download<float>(pixels);
+        const std::vector<std::uint32_t> rejected = buf_.rejectedSamples.download<std::uint32_t>(pixels);
+        out.rejected.assign(rejected.begin(), rejected.end());
+    }
+    const float se = static_cast<float>(s_.shading.self_emission);
+    hits = nonFinite = 0;
+    for (std::size_t px = 0; px < pixels; ++px) {
+        const GBufferTexel& g = gb[px];
+        out.particle[px] = g.particle;
+        if (!g.hit()) {
+            out.L[px] = s_.shading.background;
+            out.depth[px] = std::numeric_limits<float>::infinity();
+            out.Lr[px] = Vec3(0.0f);
+            continue;
+        }
+        ++hits;
+        if (!composeHit(se, particles.emission[g.particle], out.Lr[px], out.Le[px], out.L[px])) {
+            ++nonFinite;
+            if (sampling_) {  // as composeImage
+                out.Lr_stderr[px] = Vec3(0.0f);
+                out.rejected[px] += 1.0f;
+            }
+        }
+        out.depth[px] = g.depth;
+        out.normal[px] = g.normal;
+    }
+    if (a_.lrOnly) {
+        out.L.clear();
+        out.Le.clear();
+        out.normal.clear();
+        out.depth.clear();
+        out.particle.clear();
+        out.Lr_stderr.clear();
+        out.spp.clear();
+        out.rejected.clear();
+    }
+    return out;
+}
+
+void TwinRun::renderFrame(std::uint32_t frame, std::uint64_t seed) {
+    const auto wall0 = std::chrono::steady_clock::now();
+    const CameraPose pose = cameras_.pose(frame);
+    const Camera world = Camera::fromPose(pose, W_, H_);
+    if (!built_ || !persistent_) origin_ = world.position;
+    const Camera camera = world.rebased(origin_);
+    Particles particles = particlesOf(frame);
+    for (Vec3& p : particles.position) p -= origin_;
+    const std::size_t n = particles.size();
+    const FramePlan plan = planFor(particles);
+    const bool instances = s_.geometry.layout == AccelLayout::instances;
+    const bool recluster = plan.buildClusters && !instances && (!built_ || !persistent_);
+    const Clusters clusters = recluster ? clusterParticles(particles.position, s_.geometry.cluster_size) : Clusters{};
+    if (plan.loadParticles) uploadParticles(particles, camera);
+    if (recluster) clusters_ = clusters;
+    uploadClusterHint(particles, recluster, frame == s_.render.frame_start);
+
+    LaunchParams lp = launchParams(plan, camera, particles, frame, seed);
+    LaunchCounters counters{};
+    StoredReservoir* finalReservoirs = nullptr;
+    const StepTimes ms = runPasses(plan, lp, clusters, recluster, counters, finalReservoirs);
+    built_ = true;
+    keepHistory(camera, n, finalReservoirs);
+
+    std::size_t hits = 0, nonFinite = 0;
+    GpuFrame out = composeFrame(plan, particles, frame, pose, hits, nonFinite);
+    nlohmann::json timing;
+    std::map<std::string, double> calibrated;  // by the pass names of `accretion cost`
+    for (const auto& [step, v] : ms) {
+        timing[step] = {{"median_ms", median(v)}, {"ms", v}};
+        calibrated[std::string(passName(timer_->passOf(step)))] += median(v);
+    }
+    timingsCsv_ = "config,pass,ms\n";  // the last frame's
+    if (!a_.config.empty())
+        for (const auto& [p, t] : calibrated) timingsCsv_ += fmt::format("{},{},{:.6f}\n", a_.config, p, t);
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    out.metadata = frameMetadata(s_, settingsToml_, frame, seed, "", wall);
+    out.metadata.insert({{"lighting", a_.skipLighting ? "skipped" : std::string(enumName(s_.render.estimator))},
+                         {"shadow_rays", a_.shadowRays}, {"renderer", "accretion-optix"}, {"device", device_},
+                         {"tonemap", std::string(enumName(s_.render.tonemap))}});
+    std::filesystem::path file = expandPattern(s_.render.output, s_.sceneName, frame);
+    file = file.parent_path() /
+           (file.stem().string() + (a_.seeds > 1 ? fmt::format(".seed{}", seed) : std::string()) + ".gpuframe");
+    if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+    writeGpuFrame(file, out);
+    const AccelStats& as = accel_->stats();
+    stats_["frames"].push_back({{"frame", frame}, {"output", file.string()}, {"passes", plan.passes()}, {"particles", n},
+                                {"hit_pixels", hits}, {"blases", as.blases}, {"instances", as.instances},
+                                {"primitives", as.primitives}, {"largest_blas_primitives", as.largestBlas},
+                                {"rebuilt_blases", as.rebuiltBlases}, {"refitted", as.refitted}, {"partial", as.partial},
+                                {"blas_bytes", as.blasBytes}, {"blas_memory_bytes", as.poolBytes},
+                                {"scratch_bytes", as.tempBytes}, {"blas_enqueue_ms", as.blasEnqueueMs}, {"tlas_bytes", as.tlasBytes},
+                                {"input_bytes", as.inputBytes}, {"accel_total_bytes", as.totalBytes()},
+                                {"primary_rays", std::size_t(W_) * H_}, {"shadow_rays", counters.rays},
+                                {"any_hits", counters.anyHits}, {"compose_nonfinite", nonFinite},
+                                {"shadow_occluded", counters.occluded}, {"light_terms", counters.lightTerms},
+                                {"shadow_retests", counters.retests}, {"seed", seed}, {"omm_bytes", as.ommBytes},
+                                {"gpu_ms", timing}, {"wall_s", wall}});
+    if (!a_.quiet) {
+        std::string line;
+        for (const auto& [step, v] : ms) line += fmt::format(" {} {:.3f}", step, median(v));
+        fmt::print(stderr, "frame {}: {} ({} BLAS, {} instances; ms:{})\n", frame, file.string(), as.blases, as.instances, line);
+    }
+}
+
+void TwinRun::writeRunOutputs() const {
+    const std::filesystem::path first = expandPattern(s_.render.output, s_.sceneName, s_.render.frame_start);
+    writeJson((first.parent_path() / first.stem()).string() + ".gpu_stats.json", stats_);
+    if (!a_.timings.empty()) writeFileAtomic(a_.timings, timingsCsv_);
 }
 
 int run(const Args& a) {
@@ -157,359 +614,17 @@ int run(const Args& a) {
         flags.push_back({"render.output", "-o " + a.output, [o = a.output](Settings& s) { s.render.output = o; }});
     const Settings settings = loadScene(a.scene, a.defines, flags);
     requireSupported(settings, !a.skipLighting);
-    const std::string settingsToml = settingsToToml(settings);
-    const ParticleSource source(settings);
-    const CameraTrack cameras(settings.camera);
-    const std::uint32_t W = settings.camera.width, H = settings.camera.height;
-    const std::size_t pixels = std::size_t(W) * H;
-
-    cudaDeviceProp prop{};
-    CUDA_CHECK(cudaGetDeviceProperties(&prop, 0));
-    const std::string device = prop.name;
-    const bool omm = settings.geometry.alpha == AlphaMode::disc && settings.gpu.omm != OmmMode::off;
-    const GeometrySettings& geometry = settings.geometry;
-    AccelOptions accelOptions;
-    accelOptions.layout = geometry.layout;
-    accelOptions.spheres = geometry.primitive == Primitive::sphere;
-    accelOptions.build = geometry.build;
-    accelOptions.rebuildFraction = geometry.rebuild_fraction;
-    accelOptions.pooled = !a.perBlas;
-    accelOptions.compact = a.compact;
-    accelOptions.streams = a.buildStreams;
-    accelOptions.hostThreads = a.buildThreads;
-    accelOptions.omm = omm ? settings.gpu.omm : OmmMode::off;
-    accelOptions.ommLevel = settings.gpu.omm_level;
-    TwinPipeline pipeline(a.programs, a.validation, omm, geometry.layout, accelOptions.spheres, blasBuildFlags(accelOptions));
-    cudaStream_t stream;
-    CUDA_CHECK(cudaStreamCreate(&stream));
-    GpuTimer timer(stream);
-    ParticleAccel accel(pipeline.context(), accelOptions);
-    FrameBuffers buf;
-    buf.gbuffer.resize(pixels * sizeof(GBufferTexel));
-    buf.Lr.resize(pixels * sizeof(Vec3));
-    buf.counters.resize(sizeof(LaunchCounters));
-    buf.params.resize(sizeof(LaunchParams));
-
-    const bool restir = !a.skipLighting && settings.render.estimator == EstimatorKind::restir;
-    const bool sampling = !a.skipLighting && (settings.render.estimator == EstimatorKind::uniform ||
-                                              settings.render.estimator == EstimatorKind::power);
-    const bool powerSource = !a.skipLighting && (settings.render.estimator == EstimatorKind::power ||
-                                                 (restir && settings.render.source == LightSource::power));
-    const LightingPlan plan = planLighting(settings.render, H);
-    if (sampling) {
-        buf.Lr_stderr.resize(pixels * sizeof(Vec3));
-        buf.spp.resize(pixels * sizeof(float));
-        buf.rejectedSamples.resize(pixels * sizeof(std::uint32_t));
-    }
-    const bool keepHistory = restir && settings.restir.temporal && settings.render.frames > 1;
-    Raygen shade = Raygen::shade;
-    if (a.shadowRays == "traverse" || a.shadowRays == "reorder") shade = Raygen::shadeTraverse;
-    else if (a.shadowRays != "trace")
-        throw InputError(fmt::format("command line --shadow-rays {}: expected trace, traverse or reorder", a.shadowRays));
-    // The lighting grid (the CPU's Restir::render): the image at resolution_scale.
-    const float scale = static_cast<float>(settings.restir.resolution_scale);
-    const bool upsample = restir && scale < 1.0f;
-    const std::uint32_t gridW = upsample ? lightingGridExtent(W, scale) : W;
-    const std::uint32_t gridH = upsample ? lightingGridExtent(H, scale) : H;
-    const std::size_t gridPixels = std::size_t(gridW) * gridH;
-    if (restir) {
-        buf.resA.resize(gridPixels * sizeof(StoredReservoir));
-        buf.resB.resize(gridPixels * sizeof(StoredReservoir));
-        buf.rejected.resize(gridPixels * sizeof(std::uint32_t));
-        if (upsample) {
-            buf.gridGbuffer.resize(gridPixels * sizeof(GBufferTexel));
-            buf.gridLr.resize(gridPixels * sizeof(Vec3));
-        }
-    }
-    bool history = false;
-    Camera prevCamera{};
-    std::uint32_t prevCount = 0;
-    Clusters current;
-    const BuildPolicy policy = settings.geometry.build;
-    const bool persistent = policy == BuildPolicy::refit || policy == BuildPolicy::partial;
-    const bool statelessBuild = !persistent;
-    Vec3 origin(0.0f);
-    bool built = false;
-    std::string timingsCsv = "config,pass,ms\n";
-    nlohmann::json stats = {{"version", std::string(version())}, {"renderer", "accretion-optix"}, {"device", device},
-                            {"optix_device", pipeline.deviceProperties()}, {"scene", settings.scenePath}, {"repeat", a.repeat}, {"allocation", a.perBlas ? "per_blas" : "pooled"},
-                            {"compact", a.compact}, {"build_streams", a.buildStreams}, {"build_threads", a.buildThreads},
-                            {"layout", std::string(enumName(settings.geometry.layout))},
-                            {"primitive", std::string(enumName(settings.geometry.primitive))}, {"seeds", a.seeds}, {"frames", nlohmann::json::array()}};
+    TwinRun twin(a, settings);
     const std::uint32_t first = settings.render.frame_start, frameCount = settings.render.frames;
-    // With --seeds every seed runs the same frames: their particles are loaded once.
-    std::map<std::uint32_t, Particles> loaded;
-    auto loadParticles = [&](std::uint32_t f) {
-        if (a.seeds == 1) return source.frame(f);
-        auto it = loaded.find(f);
-        if (it == loaded.end()) it = loaded.emplace(f, source.frame(f)).first;
-        return it->second;  // a copy: rebased below
-    };
     // --seeds: the frames again per seed (render.seed + k), each run from scratch.
     for (std::uint64_t step = 0; step < std::uint64_t(a.seeds) * frameCount; ++step) {
         const std::uint32_t frame = first + std::uint32_t(step % frameCount);
-        const std::uint64_t seed = settings.render.seed + step / frameCount;
-        if (frame == first) {
-            history = built = false;
-            prevCount = 0;
-        }
-        const auto wall0 = std::chrono::steady_clock::now();
-        const CameraPose pose = cameras.pose(frame);
-        const Camera world = Camera::fromPose(pose, W, H);
-        if (!built || !persistent) origin = world.position;
-        const Camera camera = world.rebased(origin);
-        Particles particles = loadParticles(frame);
-        for (Vec3& p : particles.position) p -= origin;
-        const std::size_t n = particles.size();
-        std::vector<BillboardFrame> frames(n);
-        std::vector<float> dmin2(n);
-        const float dmin = static_cast<float>(settings.shading.dmin);
-        for (std::size_t i = 0; i < n; ++i) {
-            frames[i] = billboardFrame(settings.geometry.orientation, camera, particles.position[i], particles.velocity[i]);
-            const float d = std::max(particles.radius[i], dmin);
-            dmin2[i] = d * d;
-        }
-        buf.position.upload(particles.position);
-        buf.emission.upload(particles.emission);
-        buf.albedo.upload(particles.albedo);
-        buf.radius.upload(particles.radius);
-        buf.dmin2.upload(dmin2);
-        buf.frames.upload(frames);
-        const bool instances = geometry.layout == AccelLayout::instances;
-        const bool recluster = !instances && (!built || !persistent);
-        const Clusters clusters = recluster ? clusterParticles(particles.position, geometry.cluster_size) : Clusters{};
-        if (recluster) current = clusters;
-        if (restir && (recluster || frame == first)) {  // the SER hint: each particle's BLAS (instances: its own)
-            std::vector<std::uint32_t> of(n, 0);
-            if (instances)
-                for (std::size_t i = 0; i < n; ++i) of[i] = static_cast<std::uint32_t>(i);
-            for (std::size_t c = 0; c < current.count(); ++c)
-                for (std::uint32_t i : current.members(c)) of[i] = static_cast<std::uint32_t>(c);
-            buf.particleCluster.upload(of);
-        }
-
-        LaunchParams lp;
-        lp.camera = camera;
-        lp.model = settings.shading.model;
-        lp.discAlpha = settings.geometry.alpha == AlphaMode::disc;
-        lp.shadows = settings.shading.visibility;
-        lp.visibility = VisibilityOptions::from(settings.render);
-        lp.omm = omm;
-        lp.layout = geometry.layout;
-        lp.spheres = accelOptions.spheres;
-        lp.particleCount = static_cast<std::uint32_t>(n);
-        lp.position = buf.position.as<Vec3>();
-        lp.emission = buf.emission.as<Vec3>();
-        lp.albedo = buf.albedo.as<Vec3>();
-        lp.radius = buf.radius.as<float>();
-        lp.dmin2 = buf.dmin2.as<float>();
-        lp.frames = buf.frames.as<BillboardFrame>();
-        lp.gbuffer = buf.gbuffer.as<GBufferTexel>();
-        lp.Lr = buf.Lr.as<Vec3>();
-        lp.lights = {static_cast<std::uint32_t>(n), n ? 1.0f / float(n) : 0.0f, lp.position, lp.emission, lp.albedo, lp.dmin2};
-        if (powerSource) {  // buildPowerTable's arrays, as the CPU samples them
-            const AliasTable table = buildPowerTable(particles);
-            buf.aliasProb.upload(table.probabilities());
-            buf.aliasAlias.upload(table.aliases());
-            buf.aliasPmf.upload(table.pmfs());
-            lp.source.power = true;
-            lp.source.table = {buf.aliasProb.as<float>(), buf.aliasAlias.as<std::uint32_t>(), buf.aliasPmf.as<float>()};
-        }
-        lp.source.count = lp.lights.count;
-        lp.source.uniformPdf = lp.lights.uniformPdf;
-        if (sampling) {
-            SamplingParams& sp = lp.sampling;
-            sp.frame = frame;
-            sp.seed = seed;
-            sp.plan = plan;
-            sp.maxSamples = settings.render.max_samples;
-            sp.targetStderr = settings.render.target_stderr;
-            sp.discardNonFinite = settings.render.nonfinite == NonFinitePolicy::discard;
-            sp.Lr_stderr = buf.Lr_stderr.as<Vec3>();
-            sp.spp = buf.spp.as<float>();
-            sp.rejected = buf.rejectedSamples.as<std::uint32_t>();
-        }
-        if (restir) {
-            RestirParams& rp = lp.restir;
-            const RestirSettings& rs = settings.restir;
-            rp.frame = frame;
-            rp.seed = seed;
-            rp.candidates = settings.render.candidates;
-            rp.width = gridW;
-            rp.height = gridH;
-            rp.scale = upsample ? float(gridW) / float(W) : 1.0f;
-            rp.gbuffer = upsample ? buf.gridGbuffer.as<GBufferTexel>() : lp.gbuffer;
-            rp.Lr = upsample ? buf.gridLr.as<Vec3>() : lp.Lr;
-            rp.temporal = keepHistory && history;
-            rp.neighbours = rs.spatial_neighbours;
-            rp.radius = std::max(1.0f, float(rs.spatial_radius) * rp.scale);
-            rp.normalThreshold = float(rs.normal_threshold);
-            rp.depthThreshold = float(rs.depth_threshold);
-            rp.mCap = rs.m_cap;
-            rp.bias = rs.bias_correction;
-            rp.visibilityReuse = rs.visibility_reuse;
-            rp.discardNonFinite = settings.render.nonfinite == NonFinitePolicy::discard;
-            rp.reorder = a.shadowRays == "reorder";
-            rp.serHintBits = settings.gpu.ser_hint_bits;
-            rp.rejected = buf.rejected.as<std::uint32_t>();
-            rp.particleCluster = buf.particleCluster.as<std::uint32_t>();
-            rp.prevLights = {prevCount, prevCount ? 1.0f / float(prevCount) : 0.0f, buf.prevPosition.as<Vec3>(),
-                             buf.prevEmission.as<Vec3>(), buf.prevAlbedo.as<Vec3>(), buf.prevDmin2.as<float>()};
-            rp.prevGbuffer = buf.prevGbuffer.as<GBufferTexel>();
-            rp.prevReservoirs = buf.prevReservoirs.as<StoredReservoir>();
-            rp.prevCamera = prevCamera;
-        }
-
-        // The frame's passes: one counting run (its atomics would be timed too),
-        // then `repeat` timed runs when repeat > 1. A refit or partial build
-        // changes state: it runs once per frame, in the first run, whose time
-        // it keeps.
-        std::map<std::string, std::vector<double>> ms, counted;
-        LaunchCounters counters{};
-        StoredReservoir* finalReservoirs = nullptr;
-        const DeviceParticles dp{lp.particleCount, lp.position, lp.radius, lp.frames};
-        const unsigned runs = a.repeat > 1 ? a.repeat + 1 : 1;
-        for (unsigned r = 0; r < runs; ++r) {
-            lp.counters = r == 0 ? buf.counters.as<LaunchCounters>() : nullptr;
-            if (r == 0 || statelessBuild) accel.build(recluster || instances ? &clusters : nullptr, dp, stream, timer);
-            lp.tlas = accel.tlas();
-            lp.clusterParticle = accel.clusterParticle();
-            lp.clusterOffset = accel.clusterOffset();
-            CUDA_CHECK(cudaMemcpyAsync(buf.params.as<void>(), &lp, sizeof lp, cudaMemcpyHostToDevice, stream));
-            CUDA_CHECK(cudaMemsetAsync(buf.counters.as<void>(), 0, sizeof(LaunchCounters), stream));
-            {
-                GpuScope s(timer, Pass::traceGBuffer);
-                pipeline.launch(Raygen::gbuffer, buf.params.address(), sizeof lp, W, H, stream);
-            }
-            if (restir) {
-                finalReservoirs = runRestir(lp, buf, settings, shade, pipeline, stream, timer);
-            } else if (!a.skipLighting) {
-                GpuScope s(timer, Pass::estimateLighting);
-                pipeline.launch(sampling ? Raygen::sample : Raygen::exact, buf.params.address(), sizeof lp, W, H, stream);
-            } else {
-                CUDA_CHECK(cudaMemsetAsync(buf.Lr.as<void>(), 0, pixels * sizeof(Vec3), stream));
-            }
-            for (const auto& [pass, t] : timer.read()) (r == 0 ? counted : ms)[pass].push_back(t);
-            if (r == 0) counters = buf.counters.download<LaunchCounters>(1)[0];
-        }
-        for (auto& [pass, t] : counted)
-            if (!ms.count(pass)) ms[pass] = t;  // single run, or a pass only the first run has
-        built = true;
-        if (keepHistory) {  // this frame becomes the previous one
-            copyDevice(buf.prevPosition, buf.position, n * sizeof(Vec3), stream);
-            copyDevice(buf.prevEmission, buf.emission, n * sizeof(Vec3), stream);
-            copyDevice(buf.prevAlbedo, buf.albedo, n * sizeof(Vec3), stream);
-            copyDevice(buf.prevDmin2, buf.dmin2, n * sizeof(float), stream);
-            copyDevice(buf.prevGbuffer, upsample ? buf.gridGbuffer : buf.gbuffer, gridPixels * sizeof(GBufferTexel), stream);
-            buf.prevReservoirs.reserve(gridPixels * sizeof(StoredReservoir));
-            CUDA_CHECK(cudaMemcpyAsync(buf.prevReservoirs.as<void>(), finalReservoirs, gridPixels * sizeof(StoredReservoir),
-                                       cudaMemcpyDeviceToDevice, stream));
-            CUDA_CHECK(cudaStreamSynchronize(stream));
-            prevCamera = camera;
-            prevCount = static_cast<std::uint32_t>(n);
-            history = true;
-        }
-
-        // Compose (L = Le + Lr, the background on a miss) by composeImage's rule.
-        const std::vector<GBufferTexel> gb = buf.gbuffer.download<GBufferTexel>(pixels);
-        GpuFrame out;
-        out.width = W;
-        out.height = H;
-        out.frame = frame;
-        out.camera = pose;
-        out.Lr = buf.Lr.download<Vec3>(pixels);
-        out.L.resize(pixels);
-        out.Le.assign(pixels, Vec3(0.0f));
-        out.normal.assign(pixels, Vec3(0.0f));
-        out.depth.resize(pixels);
-        out.particle.resize(pixels);
-        if (sampling) {
-            out.Lr_stderr = buf.Lr_stderr.download<Vec3>(pixels);
-            out.spp = buf.spp.download<float>(pixels);
-            const std::vector<std::uint32_t> rejected = buf.rejectedSamples.download<std::uint32_t>(pixels);
-            out.rejected.assign(rejected.begin(), rejected.end());
-        }
-        const float se = static_cast<float>(settings.shading.self_emission);
-        std::size_t hits = 0, nonFinite = 0;
-        for (std::size_t px = 0; px < pixels; ++px) {
-            const GBufferTexel& g = gb[px];
-            out.particle[px] = g.particle;
-            if (!g.hit()) {
-                out.L[px] = settings.shading.background;
-                out.depth[px] = std::numeric_limits<float>::infinity();
-                out.Lr[px] = Vec3(0.0f);
-                continue;
-            }
-            ++hits;
-            if (!composeHit(se, particles.emission[g.particle], out.Lr[px], out.Le[px], out.L[px])) {
-                ++nonFinite;
-                if (sampling) {  // as composeImage
-                    out.Lr_stderr[px] = Vec3(0.0f);
-                    out.rejected[px] += 1.0f;
-                }
-            }
-            out.depth[px] = g.depth;
-            out.normal[px] = g.normal;
-        }
-        nlohmann::json timing;
-        std::map<std::string, double> calibrated;  // by the pass names of `accretion cost`
-        for (const auto& [pass, v] : ms) {
-            timing[pass] = {{"median_ms", median(v)}, {"ms", v}};
-            calibrated[std::string(passName(timer.passOf(pass)))] += median(v);
-        }
-        timingsCsv = "config,pass,ms\n";  // the last frame's
-        if (!a.config.empty())
-            for (const auto& [pass, t] : calibrated) timingsCsv += fmt::format("{},{},{:.6f}\n", a.config, pass, t);
-        const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-        out.metadata = {{"lighting", a.skipLighting ? "skipped" : std::string(enumName(settings.render.estimator))},
-                        {"shadow_rays", a.shadowRays}, {"version", std::string(version())}, {"scene", settings.scenePath},
-                        {"frame", std::to_string(frame)}, {"estimator", std::string(enumName(settings.render.estimator))},
-                        {"samples", std::to_string(settings.render.samples)}, {"seed", std::to_string(seed)},
-                        {"shard", ""}, {"render_time_s", fmt::format("{:.6f}", wall)}, {"settings", settingsToml},
-                        {"renderer", "accretion-optix"}, {"device", device},
-                        {"tonemap", std::string(enumName(settings.render.tonemap))}};
-        std::filesystem::path file = expandPattern(settings.render.output, settings.sceneName, frame);
-        file = file.parent_path() /
-               (file.stem().string() + (a.seeds > 1 ? fmt::format(".seed{}", seed) : std::string()) + ".gpuframe");
-        if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
-        if (a.lrOnly) {
-            out.L.clear();
-            out.Le.clear();
-            out.normal.clear();
-            out.depth.clear();
-            out.particle.clear();
-            out.Lr_stderr.clear();
-            out.spp.clear();
-            out.rejected.clear();
-        }
-        writeGpuFrame(file, out);
-        const AccelStats& as = accel.stats();
-        stats["frames"].push_back({{"frame", frame}, {"output", file.string()}, {"particles", n}, {"hit_pixels", hits},
-                                   {"blases", as.blases}, {"instances", as.instances}, {"primitives", as.primitives},
-                                   {"largest_blas_primitives", as.largestBlas},
-                                   {"rebuilt_blases", as.rebuiltBlases}, {"refitted", as.refitted}, {"partial", as.partial},
-                                   {"blas_bytes", as.blasBytes}, {"blas_memory_bytes", as.poolBytes},
-                                   {"scratch_bytes", as.tempBytes}, {"blas_enqueue_ms", as.blasEnqueueMs}, {"tlas_bytes", as.tlasBytes},
-                                   {"input_bytes", as.inputBytes}, {"accel_total_bytes", as.totalBytes()},
-                                   {"primary_rays", pixels}, {"shadow_rays", counters.rays}, {"any_hits", counters.anyHits},
-                                   {"compose_nonfinite", nonFinite},
-                                   {"shadow_occluded", counters.occluded}, {"light_terms", counters.lightTerms},
-                                   {"shadow_retests", counters.retests}, {"seed", seed}, {"omm_bytes", as.ommBytes},
-                                   {"gpu_ms", timing}, {"wall_s", wall}});
-        if (!a.quiet) {
-            std::string line;
-            for (const auto& [pass, v] : ms) line += fmt::format(" {} {:.3f}", pass, median(v));
-            fmt::print(stderr, "frame {}: {} ({} BLAS, {} instances; ms:{})\n", frame, file.string(), as.blases, as.instances, line);
-        }
+        if (frame == first) twin.restart();
+        twin.renderFrame(frame, settings.render.seed + step / frameCount);
     }
-    const std::filesystem::path first_ = expandPattern(settings.render.output, settings.sceneName, first);
-    const std::string stem = (first_.parent_path() / first_.stem()).string();
-    writeFileAtomic(stem + ".gpu_stats.json", stats.dump(2));
-    if (!a.timings.empty()) writeFileAtomic(a.timings, timingsCsv);
-    CUDA_CHECK(cudaStreamDestroy(stream));
+    twin.writeRunOutputs();
     return 0;
 }
-
 }  // namespace
 }  // namespace accretion::twin
 

@@ -3,6 +3,8 @@
 
 #include <cstring>
 #include <fstream>
+#include <iterator>
+#include <string>
 
 #include <OpenImageIO/imageio.h>
 #include <nlohmann/json.hpp>
@@ -139,6 +141,18 @@ TEST_CASE("accretion plan prints every pass, the skipped ones with their reason"
     CHECK_THAT(out, Catch::Matches("(.|\n)*temporalResampling +skipped +one frame: no history buffers or motion(.|\n)*"));
     CHECK(accretion::test::runCommand(std::string(ACCRETION_BINARY) + " plan no_such_scene.toml", out) == 1);
     CHECK_THAT(out, Catch::Contains("no_such_scene.toml"));
+}
+
+TEST_CASE("docs/rendering.md carries the estimator table accretion estimators prints", "[cli][docs]") {
+    std::string out;
+    REQUIRE(accretion::test::runCommand(std::string(ACCRETION_BINARY) + " estimators", out) == 0);
+    std::ifstream docs(std::string(ACCRETION_SOURCE_DIR) + "/docs/rendering.md");
+    REQUIRE(docs);
+    const std::string text((std::istreambuf_iterator<char>(docs)), std::istreambuf_iterator<char>());
+    CHECK_THAT(out, Catch::StartsWith("| estimator |"));
+    CHECK_THAT(text, Catch::Contains(out));
+    for (const char* name : {"exact", "uniform", "power", "ris", "restir", "tree", "split"})
+        CHECK_THAT(out, Catch::Contains(std::string("| `") + name + "` |"));
 }
 
 TEST_CASE("a camera file written from the orbit path renders bit-identically to orbit, in every convention",

@@ -52,7 +52,7 @@ TEST_CASE("accretion cost writes every counter, SER, any-hit/OMM and BLAS memory
     REQUIRE(runCommand(cmd, out) == 0);
     INFO(out);
     const nlohmann::json j = nlohmann::json::parse(slurp(dir / "c.json"));
-    for (const char* key : {"passes", "blas_bytes", "omm", "layouts", "ser_sweep", "any_hit_omm", "coefficients"})
+    for (const char* key : {"passes", "blas_memory", "omm", "layouts", "ser_sweep", "any_hit_omm", "coefficients"})
         CHECK(j.contains(key));
     std::set<std::string> passes;
     for (const auto& p : j["passes"]) {

@@ -251,3 +251,31 @@ TEST_CASE("restir sources tiles and regir: their presampling passes run, are tim
         CHECK(seen == std::size_t(tiles) + std::size_t(regir));
     }
 }
+
+TEST_CASE("every estimator and source: the plan builds the light sampler the estimator draws from, and no other", "[plan]") {
+    // What each estimator draws from, spelled out here rather than read from
+    // the estimator table: tree and split their light tree, power its alias
+    // table, ris and restir their render.source's (tiles and the ReGIR grid
+    // are presampled from the power table).
+    for (const EstimatorKind e : {EstimatorKind::exact, EstimatorKind::uniform, EstimatorKind::power, EstimatorKind::ris,
+                                  EstimatorKind::restir, EstimatorKind::tree, EstimatorKind::split})
+        for (const LightSource src : {LightSource::uniform, LightSource::power, LightSource::tree, LightSource::tiles,
+                                      LightSource::regir}) {
+            const bool resampling = e == EstimatorKind::ris || e == EstimatorKind::restir;
+            if (e == EstimatorKind::ris && (src == LightSource::tiles || src == LightSource::regir)) continue;  // refused
+            if (!resampling && src != LightSource::uniform) continue;  // the source is not read
+            Settings s = small();
+            s.render.estimator = e;
+            s.render.source = src;
+            s.render.samples = 2;
+            const LightSamplerKind expected =
+                e == EstimatorKind::tree || e == EstimatorKind::split || (resampling && src == LightSource::tree) ? LightSamplerKind::tree
+                : e == EstimatorKind::power || (resampling && src != LightSource::uniform)                       ? LightSamplerKind::power
+                                                                                                                  : LightSamplerKind::none;
+            INFO(enumName(e) << " from " << enumName(src));
+            CHECK(planPasses(s).sampler == expected);
+            const auto stats = render(s);  // a sampler missing for its estimator is an internal error
+            CHECK((stats[0].lightTreeNodes > 0) == (expected == LightSamplerKind::tree));
+            CHECK(stats[0].timer.all().contains(pass::buildLightSampler) == (expected != LightSamplerKind::none));
+        }
+}

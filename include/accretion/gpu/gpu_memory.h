@@ -2,6 +2,8 @@
 #include <cstdint>
 #include <span>
 
+#include <nlohmann/json.hpp>
+
 #include "accretion/scene/settings.h"
 
 namespace accretion {
@@ -21,6 +23,10 @@ struct BlasMemory {
     double perBlasWaste() const { return perBlasAllocBytes ? 1.0 - double(gpuBytes) / double(perBlasAllocBytes) : 0.0; }
     double pooledWaste() const { return pooledBytes ? 1.0 - double(gpuBytes) / double(pooledBytes) : 0.0; }
 };
+
+/// The one JSON form of BLAS memory (`accretion cost`'s memory sweep and
+/// its GPU report): byte counts end in _bytes, waste is a fraction.
+nlohmann::json toJson(const BlasMemory& memory);
 
 /// The GPU estimate of one BLAS of `triangles` primitives.
 std::uint64_t gpuBlasBytes(std::uint64_t triangles, const GpuSettings& gpu);

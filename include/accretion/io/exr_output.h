@@ -5,12 +5,10 @@
 #include <string>
 #include <vector>
 
+#include "accretion/io/provenance.h"
 #include "accretion/render/frame_renderer.h"
 
 namespace accretion {
-
-/// Metadata stored in every output (string attributes `accretion:<key>`).
-using OutputMetadata = std::map<std::string, std::string>;
 
 /// OpenEXR's standard camera attributes of a frame, as Imath stores them
 /// (row vectors: p' = p M, 16 floats row by row). worldToCamera maps into a

@@ -1,18 +1,12 @@
 #pragma once
-#include <filesystem>
-#include <string>
-#include <vector>
-
 #include <nlohmann/json.hpp>
 
+#include "accretion/io/provenance.h"
 #include "accretion/render/frame_renderer.h"
 
 namespace accretion {
 
 /// JSON of one frame's counts and pass times.
 nlohmann::json frameStatsJson(const FrameStats& stats);
-
-/// Write a JSON document atomically, pretty-printed.
-void writeJson(const std::filesystem::path& file, const nlohmann::json& doc);
 
 }  // namespace accretion

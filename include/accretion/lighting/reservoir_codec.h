@@ -41,9 +41,13 @@ class ReservoirCodec {
 public:
     using Words = std::array<std::uint32_t, 4>;
 
-    explicit ReservoirCodec(const RestirSettings& s);
+    explicit ReservoirCodec(const RestirSettings& s)
+        : layout_(s.layout), lightBits_(s.light_bits), half_(s.half_weights),
+          maxM_(s.layout == ReservoirLayout::full ? 0xffffffffu : (1u << (32 - s.light_bits)) - 1u) {}
 
-    std::size_t bytes() const;
+    /// Bytes per reservoir in the buffer (inline: the frame plan states it
+    /// without linking the codec).
+    std::size_t bytes() const { return layout_ == ReservoirLayout::full ? 16 : half_ ? 8 : 12; }
     std::uint32_t maxM() const { return maxM_; }
     /// Throws InputError (naming `where`) if the light index field cannot
     /// address `lights` lights, saying how many bits it needs.

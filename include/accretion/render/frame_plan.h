@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "accretion/particles/particles.h"
+#include "accretion/render/estimator_table.h"
 #include "accretion/scene/settings.h"
 
 namespace accretion {
@@ -24,10 +25,8 @@ struct FrameFacts {
     bool geometryBuilt = false;     ///< a static scene's particles and BVH are already built
     bool historyAvailable = false;  ///< restir: a previous frame's reservoirs are kept
     bool emissive = true;           ///< some particle emits (luminance > 0)
+    bool lightingSkipped = false;   ///< the command times the geometry alone (accretion-optix --skip-lighting)
 };
-
-/// The light sampler buildLightSampler builds.
-enum class LightSamplerKind { none, power, tree };
 
 /// Everything a frame runs, decided once from the settings and the facts;
 /// FrameRenderer and Restir execute it and decide nothing themselves.
