@@ -305,6 +305,11 @@ step_identity() {
 -D render.source="power" -D restir.resolution_scale=0.5
 -D geometry.alpha="disc" -D restir.spatial_neighbours=64
 -D geometry.layout="aabbs" -D restir.m_cap=5
+-D geometry.layout="instances" -D geometry.build="refit"
+-D geometry.build="partial" -D render.source="power"
+-D render.estimator="exact"
+-D render.estimator="power" -D render.samples=8 -D geometry.alpha="disc"
+-D render.estimator="uniform" -D render.samples=4 -D render.target_stderr=0.05 -D render.max_samples=16
 CONFIGS
     rm -f "$t"/*.gpuframe
     return $differ
