@@ -415,6 +415,29 @@ std::string machine() {
     return "unknown";
 }
 
+/// A long split render (k = 1024 near lights, 1024 spp, 128 when quick) of
+/// frame `frame`: the reference where exact is unaffordable, with its
+/// description for the figures.
+struct SplitReference {
+    FrameImage image;
+    nlohmann::json json;
+};
+SplitReference renderSplitReference(const Settings& base, const ParticleSource& src, std::uint32_t frame, bool quick) {
+    Settings ref = base;
+    ref.render.estimator = EstimatorKind::split;
+    ref.render.near_lights = 1024;
+    ref.render.samples = quick ? 128 : 1024;
+    ref.render.seed = 1000;
+    ref.render.frame_start = frame;
+    FrameRenderer renderer(ref, src, RenderOptions{true});
+    FrameStats stats;
+    SplitReference r{renderer.render(frame, stats), {}};
+    r.json = {{"estimator", "split"}, {"near_lights", ref.render.near_lights}, {"samples", ref.render.samples},
+              {"frame", frame}, {"seconds", stats.seconds},
+              {"relMSE_floor", computeErrors(r.image.lighting.Lr, r.image.lighting.Lr, &r.image.lighting.Lr_stderr).relMSEFloor}};
+    return r;
+}
+
 }  // namespace
 
 /// What the sections of the suite share: the options, the 100K disk frame and the results.
@@ -606,25 +629,16 @@ void Suite::benchSplitReference() {
         log("split against tree to relMSE 1e-3, 100K particles at 320x180 (minutes)");
         Settings base = diskScene(scene, 100'000, 320, 180);
         const ParticleSource src(base);
-        Settings ref = base;
-        ref.render.estimator = EstimatorKind::split;
-        ref.render.near_lights = 1024;
-        ref.render.samples = quick ? 128 : 1024;
-        ref.render.seed = 1000;
-        FrameRenderer refRenderer(ref, src, RenderOptions{true});
-        FrameStats refStats;
-        const FrameImage reference = refRenderer.render(0, refStats);
+        const SplitReference ref = renderSplitReference(base, src, 0, quick);
         Settings tree = base, split = base;
         tree.render.estimator = EstimatorKind::tree;
         split.render.estimator = EstimatorKind::split;
         split.render.near_lights = 1024;  // the automatic k of a long render, fixed so that the cost is a + b S
-        const auto c = measureErrorCosts({tree, split}, src, 8, 32, reference, quick ? 1 : 3);
+        const auto c = measureErrorCosts({tree, split}, src, 8, 32, ref.image, quick ? 1 : 3);
         const ErrorCost& t = c[0];
         const ErrorCost& sp = c[1];
         figures["split_vs_tree_100k_320x180"] = {
-            {"reference", {{"estimator", "split"}, {"near_lights", ref.render.near_lights}, {"samples", ref.render.samples},
-                           {"seconds", refStats.seconds},
-                           {"relMSE_floor", computeErrors(reference.lighting.Lr, reference.lighting.Lr, &reference.lighting.Lr_stderr).relMSEFloor}}},
+            {"reference", ref.json},
             {"near_lights", split.render.near_lights},
             {"tree", t.json(kTarget)},
             {"split", sp.json(kTarget)},
@@ -665,15 +679,7 @@ void Suite::benchRestirSources() {
     log("restir (pairwise, light tree candidates) against uniform at equal time, 100K at 320x180");
     Settings base = diskScene(scene, 100'000, 320, 180);
     const ParticleSource src(base);
-    Settings ref = base;
-    ref.render.estimator = EstimatorKind::split;
-    ref.render.near_lights = 1024;
-    ref.render.samples = quick ? 128 : 1024;
-    ref.render.seed = 1000;
-    ref.render.frame_start = 1;
-    FrameRenderer refRenderer(ref, src, RenderOptions{true});
-    FrameStats refStats;
-    const FrameImage reference = refRenderer.render(1, refStats);
+    const SplitReference ref = renderSplitReference(base, src, 1, quick);
     Settings uniform = base, restir = base;
     uniform.render.estimator = EstimatorKind::uniform;
     uniform.render.samples = 16;
@@ -686,8 +692,8 @@ void Suite::benchRestirSources() {
         uniform.render.seed = restir.render.seed = k;
         const ExperimentRender u = renderForExperiment(uniform, src, 1, 1);
         const ExperimentRender r = renderForExperiment(restir, src, 1, 1);
-        eu.push_back(correctedRelMse(u.image, reference));
-        er.push_back(correctedRelMse(r.image, reference));
+        eu.push_back(correctedRelMse(u.image, ref.image));
+        er.push_back(correctedRelMse(r.image, ref.image));
         tu.push_back(u.frameSeconds);
         tr.push_back(r.frameSeconds);
         gains.push_back(eu.back() * tu.back() / tr.back() / er.back());
@@ -695,7 +701,7 @@ void Suite::benchRestirSources() {
     const double gain = median(gains), t = median(tr);
     figures["restir_vs_uniform_100k_320x180"] = {
         {"configuration", "restir:pairwise:tree"}, {"seeds", seeds},
-        {"reference", {{"estimator", "split"}, {"near_lights", ref.render.near_lights}, {"samples", ref.render.samples}, {"frame", 1}}},
+        {"reference", ref.json},
         {"restir_relMSE_median", median(er)}, {"restir_frame_s_median", t},
         {"uniform_16spp_relMSE_median", median(eu)}, {"uniform_frame_s_median", median(tu)},
         {"equal_time_gains", gains}, {"equal_time_gain_median", gain}};

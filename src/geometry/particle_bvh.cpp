@@ -244,6 +244,24 @@ RTCBuildQuality sceneQuality(BuildPolicy p) {
     return p == BuildPolicy::fast_trace ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_LOW;
 }
 
+/// An Embree ray from o along d over [tnear, tfar], every mask bit set.
+RTCRay embreeRay(const Vec3& o, const Vec3& d, float tnear, float tfar) {
+    RTCRay ray;
+    ray.org_x = o.x;
+    ray.org_y = o.y;
+    ray.org_z = o.z;
+    ray.dir_x = d.x;
+    ray.dir_y = d.y;
+    ray.dir_z = d.z;
+    ray.tnear = tnear;
+    ray.tfar = tfar;
+    ray.time = 0.0f;
+    ray.mask = ~0u;
+    ray.id = 0;
+    ray.flags = 0;
+    return ray;
+}
+
 }  // namespace
 
 ParticleBvh::ParticleBvh(const EmbreeDevice& device, const GeometrySettings& settings, const GpuSettings& gpu)
@@ -461,18 +479,7 @@ void ParticleBvh::build(const Particles& particles, const Camera& camera) {
 bool ParticleBvh::intersect(const Vec3& o, const Vec3& d, float tfar, SurfaceHit& hit, RayCounters* counters) const {
     QueryContext context = queryContext(counters);
     RTCRayHit rh;
-    rh.ray.org_x = o.x;
-    rh.ray.org_y = o.y;
-    rh.ray.org_z = o.z;
-    rh.ray.dir_x = d.x;
-    rh.ray.dir_y = d.y;
-    rh.ray.dir_z = d.z;
-    rh.ray.tnear = 0.0f;
-    rh.ray.tfar = tfar;
-    rh.ray.time = 0.0f;
-    rh.ray.mask = ~0u;
-    rh.ray.id = 0;
-    rh.ray.flags = 0;
+    rh.ray = embreeRay(o, d, 0.0f, tfar);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(counters && countingTlas_ ? countingTlas_ : tlas_, &context.base, &rh);
@@ -528,19 +535,7 @@ bool ParticleBvh::occluded(const Vec3& o, const Vec3& d, float tnear, float tfar
                            RayCounters* counters) const {
     QueryContext context = queryContext(counters, exclude.receiver == kNotExcluded ? kNoKey : where_[exclude.receiver],
                                         exclude.light == kNotExcluded ? kNoKey : where_[exclude.light]);
-    RTCRay ray;
-    ray.org_x = o.x;
-    ray.org_y = o.y;
-    ray.org_z = o.z;
-    ray.dir_x = d.x;
-    ray.dir_y = d.y;
-    ray.dir_z = d.z;
-    ray.tnear = tnear;
-    ray.tfar = tfar;
-    ray.time = 0.0f;
-    ray.mask = ~0u;
-    ray.id = 0;
-    ray.flags = 0;
+    RTCRay ray = embreeRay(o, d, tnear, tfar);
     rtcOccluded1(counters && countingTlas_ ? countingTlas_ : tlas_, &context.base, &ray);
     return ray.tfar < 0.0f;
 }

@@ -6,16 +6,20 @@ namespace {
 constexpr unsigned kThreads = 256;
 unsigned blocksFor(std::uint32_t n) { return (n + kThreads - 1) / kThreads; }
 
+/// The thread's slot of the cluster order in [begin, end), false past its end.
+__device__ inline bool slotOf(std::uint32_t begin, std::uint32_t end, std::uint32_t& slot) {
+    slot = begin + blockIdx.x * blockDim.x + threadIdx.x;
+    return slot < end;
+}
+
 __global__ void expandBillboardsKernel(const std::uint32_t* clusterParticle, std::uint32_t begin, std::uint32_t end,
                                        const Vec3* position, const float* radius, const BillboardFrame* frames,
                                        Vec3* vertices) {
-    const std::uint32_t slot = begin + blockIdx.x * blockDim.x + threadIdx.x;
-    if (slot >= end) return;
+    std::uint32_t slot;
+    if (!slotOf(begin, end, slot)) return;
     const std::uint32_t i = clusterParticle[slot];
     const Vec3 p = position[i];
-    const float r = radius[i];
-    const BillboardFrame f = frames[i];
-    const Vec3 a = r * f.right, b = r * f.up;
+    const Vec3 a = radius[i] * frames[i].right, b = radius[i] * frames[i].up;
     Vec3* v = vertices + 4 * std::size_t(slot);
     v[0] = p - a - b;
     v[1] = p + a - b;
@@ -25,8 +29,8 @@ __global__ void expandBillboardsKernel(const std::uint32_t* clusterParticle, std
 
 __global__ void expandSpheresKernel(const std::uint32_t* clusterParticle, std::uint32_t begin, std::uint32_t end,
                                     const Vec3* position, const float* radius, Vec3* centres, float* radii) {
-    const std::uint32_t slot = begin + blockIdx.x * blockDim.x + threadIdx.x;
-    if (slot >= end) return;
+    std::uint32_t slot;
+    if (!slotOf(begin, end, slot)) return;
     const std::uint32_t i = clusterParticle[slot];
     centres[slot] = position[i];
     radii[slot] = radius[i];
@@ -35,14 +39,11 @@ __global__ void expandSpheresKernel(const std::uint32_t* clusterParticle, std::u
 __global__ void expandBillboardBoxesKernel(const std::uint32_t* clusterParticle, std::uint32_t begin, std::uint32_t end,
                                            const Vec3* position, const float* radius, const BillboardFrame* frames,
                                            OptixAabb* boxes) {
-    const std::uint32_t slot = begin + blockIdx.x * blockDim.x + threadIdx.x;
-    if (slot >= end) return;
+    std::uint32_t slot;
+    if (!slotOf(begin, end, slot)) return;
     const std::uint32_t i = clusterParticle[slot];
-    const Vec3 p = position[i];
-    const float r = radius[i];
-    const BillboardFrame f = frames[i];
-    const Vec3 e = billboardExtent(r, f);
-    const Vec3 lo = p - e, hi = p + e;
+    const Vec3 e = billboardExtent(radius[i], frames[i]);
+    const Vec3 lo = position[i] - e, hi = position[i] + e;
     boxes[slot] = {nextafterf(lo.x, -INFINITY), nextafterf(lo.y, -INFINITY), nextafterf(lo.z, -INFINITY),
                    nextafterf(hi.x, INFINITY),  nextafterf(hi.y, INFINITY),  nextafterf(hi.z, INFINITY)};
 }

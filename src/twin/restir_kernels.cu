@@ -14,82 +14,96 @@ __device__ inline bool pixelOf(const LaunchParams& p, std::uint32_t& x, std::uin
     return x < p.restir.width && y < p.restir.height;
 }
 
+/// A texel of the lighting grid as a restir kernel sees it: its
+/// coordinates, index and G-buffer texel.
+struct Texel {
+    std::uint32_t x, y;
+    std::size_t px;
+    GBufferTexel g;
+};
+
+/// step(texel) on the thread's texel of the lighting grid, if it has one.
+template <class Step>
+__device__ inline void onTexel(const LaunchParams& p, Step&& step) {
+    Texel t;
+    if (!pixelOf(p, t.x, t.y, t.px)) return;
+    t.g = p.restir.gbuffer[t.px];
+    step(t);
+}
+
 /// generateCandidates: RIS of `candidates` lights from the source pmf (render.source) with target p_hat.
 template <ShadingModel SM>
 __global__ void generateCandidatesKernel(LaunchParams p) {
-    std::uint32_t x, y;
-    std::size_t px;
-    if (!pixelOf(p, x, y, px)) return;
-    const RestirParams& rp = p.restir;
-    const GBufferTexel g = rp.gbuffer[px];
-    rp.out[px] = StoredReservoir{};
-    if (!g.hit()) return;
-    const ShadingPoint sp = shadingPointOf(g, p.lights);
-    PortableRng rng(px, rp.frame, RngPass::restirCandidates, rp.seed);
-    const auto draw = [&](PortableRng& g) { return p.source.sample(g); };
-    const auto target = [&](std::uint32_t i) { return targetPdf<SM>(p.lights, sp, i); };
-    Reservoir r;
-    if (!restir::resampleCandidates(rp.candidates, rng, draw, target, [&] { return rejectAt(rp, px); }, r)) return;
-    rp.out[px] = StoredReservoir::of(r);
+    onTexel(p, [&](const Texel& t) {
+        const auto& [x, y, px, g] = t;
+        const RestirParams& rp = p.restir;
+        rp.out[px] = StoredReservoir{};
+        if (!g.hit()) return;
+        const ShadingPoint sp = shadingPointOf(g, p.lights);
+        PortableRng rng(px, rp.frame, RngPass::restirCandidates, rp.seed);
+        const auto draw = [&](PortableRng& g) { return p.source.sample(g); };
+        const auto target = [&](std::uint32_t i) { return targetPdf<SM>(p.lights, sp, i); };
+        Reservoir r;
+        if (!restir::resampleCandidates(rp.candidates, rng, draw, target, [&] { return rejectAt(rp, px); }, r)) return;
+        rp.out[px] = StoredReservoir::of(r);
+    });
 }
 
 /// temporalResampling: last frame's reservoir at the reprojected point.
 template <ShadingModel SM>
 __global__ void temporalResamplingKernel(LaunchParams p) {
-    std::uint32_t x, y;
-    std::size_t px;
-    if (!pixelOf(p, x, y, px)) return;
-    const RestirParams& rp = p.restir;
-    const GBufferTexel g = rp.gbuffer[px];
-    const StoredReservoir cur = rp.in[px];
-    rp.out[px] = cur;
-    if (!g.hit()) return;
-    const std::uint32_t j = g.particle;
-    if (j >= rp.prevLights.count) return;
-    const Vec3 xPrev = rp.prevLights.position[j] + g.local;
-    float depth;
-    std::size_t q = 0;
-    bool ok = restir::reprojectPoint(rp.prevCamera, xPrev, rp.scale, rp.width, rp.height, q, depth);
-    if (ok) {
-        const GBufferTexel gp = rp.prevGbuffer[q];
-        ok = gp.particle == j &&
-             resampling::similarSurface(g.normal, depth, gp.normal, gp.depth, rp.normalThreshold, rp.depthThreshold);
-    }
-    if (!ok) return;
-    Offer offers[2];
-    offers[0] = {cur, shadingPointOf(g, p.lights), &p.lights};
-    StoredReservoir prev = rp.prevReservoirs[q];
-    prev.M = restir::capHistoryM(prev.M, cur.M, rp.mCap);
-    offers[1] = {prev, shadingPointOf(rp.prevGbuffer[q], rp.prevLights), &rp.prevLights};
-    PortableRng rng(px, rp.frame, RngPass::restirTemporal, rp.seed);
-    rp.out[px] = sanitize(rp, restir::combineReservoirs(DeviceDomains<SM>{offers, 2}, rp.bias, rng), px);
+    onTexel(p, [&](const Texel& t) {
+        const auto& [x, y, px, g] = t;
+        const RestirParams& rp = p.restir;
+        const StoredReservoir cur = rp.in[px];
+        rp.out[px] = cur;
+        if (!g.hit()) return;
+        const std::uint32_t j = g.particle;
+        if (j >= rp.prevLights.count) return;
+        const Vec3 xPrev = rp.prevLights.position[j] + g.local;
+        float depth;
+        std::size_t q = 0;
+        bool ok = restir::reprojectPoint(rp.prevCamera, xPrev, rp.scale, rp.width, rp.height, q, depth);
+        if (ok) {
+            const GBufferTexel gp = rp.prevGbuffer[q];
+            ok = gp.particle == j &&
+                 resampling::similarSurface(g.normal, depth, gp.normal, gp.depth, rp.normalThreshold, rp.depthThreshold);
+        }
+        if (!ok) return;
+        Offer offers[2];
+        offers[0] = {cur, shadingPointOf(g, p.lights), &p.lights};
+        StoredReservoir prev = rp.prevReservoirs[q];
+        prev.M = restir::capHistoryM(prev.M, cur.M, rp.mCap);
+        offers[1] = {prev, shadingPointOf(rp.prevGbuffer[q], rp.prevLights), &rp.prevLights};
+        PortableRng rng(px, rp.frame, RngPass::restirTemporal, rp.seed);
+        rp.out[px] = sanitize(rp, restir::combineReservoirs(DeviceDomains<SM>{offers, 2}, rp.bias, rng), px);
+    });
 }
 
 /// spatialResampling: k neighbours uniform in a disc of the radius.
 template <ShadingModel SM>
 __global__ void spatialResamplingKernel(LaunchParams p, std::uint32_t iteration) {
-    std::uint32_t x, y;
-    std::size_t px;
-    if (!pixelOf(p, x, y, px)) return;
-    const RestirParams& rp = p.restir;
-    const GBufferTexel g = rp.gbuffer[px];
-    rp.out[px] = rp.in[px];
-    if (!g.hit()) return;
-    const std::uint32_t W = rp.width, H = rp.height;
-    PortableRng rng(px ^ (std::uint64_t(iteration) << 40), rp.frame, RngPass::restirSpatial, rp.seed);
-    Offer offers[kMaxOffers];
-    std::uint32_t n = 0;
-    offers[n++] = {rp.in[px], shadingPointOf(g, p.lights), &p.lights};
-    for (std::uint32_t s = 0; s < rp.neighbours; ++s) {
-        std::size_t q;
-        if (!restir::drawNeighbour(rng, rp.radius, x, y, W, H, q)) continue;
-        const GBufferTexel gn = rp.gbuffer[q];
-        if (!gn.hit() ||
-            !resampling::similarSurface(g.normal, g.depth, gn.normal, gn.depth, rp.normalThreshold, rp.depthThreshold))
-            continue;
-        offers[n++] = {rp.in[q], shadingPointOf(gn, p.lights), &p.lights};
-    }
-    rp.out[px] = sanitize(rp, restir::combineReservoirs(DeviceDomains<SM>{offers, n}, rp.bias, rng), px);
+    onTexel(p, [&](const Texel& t) {
+        const auto& [x, y, px, g] = t;
+        const RestirParams& rp = p.restir;
+        rp.out[px] = rp.in[px];
+        if (!g.hit()) return;
+        const std::uint32_t W = rp.width, H = rp.height;
+        PortableRng rng(px ^ (std::uint64_t(iteration) << 40), rp.frame, RngPass::restirSpatial, rp.seed);
+        Offer offers[kMaxOffers];
+        std::uint32_t n = 0;
+        offers[n++] = {rp.in[px], shadingPointOf(g, p.lights), &p.lights};
+        for (std::uint32_t s = 0; s < rp.neighbours; ++s) {
+            std::size_t q;
+            if (!restir::drawNeighbour(rng, rp.radius, x, y, W, H, q)) continue;
+            const GBufferTexel gn = rp.gbuffer[q];
+            if (!gn.hit() ||
+                !resampling::similarSurface(g.normal, g.depth, gn.normal, gn.depth, rp.normalThreshold, rp.depthThreshold))
+                continue;
+            offers[n++] = {rp.in[q], shadingPointOf(gn, p.lights), &p.lights};
+        }
+        rp.out[px] = sanitize(rp, restir::combineReservoirs(DeviceDomains<SM>{offers, n}, rp.bias, rng), px);
+    });
 }
 
 dim3 blocks(const LaunchParams& p) { return dim3((p.restir.width + 7) / 8, (p.restir.height + 7) / 8); }

@@ -59,18 +59,29 @@ void checkSampler(const SamplerUnderTest& s, std::uint32_t lights, const std::ve
     CHECK(accretion::test::chiSquarePValue(observed, expected) > 1e-4);
 }
 
+/// 300 particles of the small disk with their light arrays and power
+/// table, and a receiver on particle 3 whose tilted normal leaves some
+/// lights below its horizon.
+struct SamplerScene {
+    Settings s = [] {
+        Settings d = accretion::test::smallDiskSettings();
+        d.particles.count = 300;
+        return d;
+    }();
+    Particles particles = ParticleSource(s).frame(0);
+    std::uint32_t N = static_cast<std::uint32_t>(particles.size());
+    LightArrays L{particles, s.shading};
+    AliasTable power = buildPowerTable(particles);
+    ShadingPoint sp{particles.position[3], glm::normalize(Vec3(0.3f, 1.0f, 0.2f)), Vec3(0, 1, 0), Vec3(0.8f), 3,
+                    particles.position[3], Vec3(0.0f)};
+};
+
 }  // namespace
 
 TEST_CASE("every light sampler draws in proportion to its pdf (one chi-square harness)", "[lighting][sampler][statistical]") {
-    Settings s = accretion::test::smallDiskSettings();
-    s.particles.count = 300;
-    Particles particles = ParticleSource(s).frame(0);
-    const auto N = static_cast<std::uint32_t>(particles.size());
-    const LightArrays L(particles, s.shading);
-    const AliasTable power = buildPowerTable(particles);
+    const SamplerScene scene;
+    const auto& [s, particles, N, L, power, sp] = scene;
     const LightTree tree(particles, s.shading);
-    const ShadingPoint sp{particles.position[3], glm::normalize(Vec3(0.3f, 1.0f, 0.2f)), Vec3(0, 1, 0), Vec3(0.8f), 3,
-                          particles.position[3], Vec3(0.0f)};
     std::vector<bool> lit(N), emits(N);
     for (std::uint32_t i = 0; i < N; ++i) {
         LightTerm t;
@@ -135,14 +146,8 @@ TEST_CASE("ReGIR cell reservoirs: W is an unbiased estimate of 1 / p_src for eve
     // |z| < 4.4 (p ~ 1e-5 each); each test resolves a 5% bias (5.4 stderr below
     // 5% of the expectation), and a grid of W = w_sum / M (without the 1 / p_hat
     // of the contribution weight) fails them.
-    Settings s = accretion::test::smallDiskSettings();
-    s.particles.count = 300;
-    Particles particles = ParticleSource(s).frame(0);
-    const auto N = static_cast<std::uint32_t>(particles.size());
-    const LightArrays L(particles, s.shading);
-    const AliasTable power = buildPowerTable(particles);
-    const ShadingPoint sp{particles.position[3], glm::normalize(Vec3(0.3f, 1.0f, 0.2f)), Vec3(0, 1, 0), Vec3(0.8f), 3,
-                          particles.position[3], Vec3(0.0f)};
+    const SamplerScene scene;
+    const auto& [s, particles, N, L, power, sp] = scene;
     std::vector<double> f(N, 0.0);
     double fTotal = 0.0, emitting = 0.0;
     std::vector<double> groupSize(6, 0.0);

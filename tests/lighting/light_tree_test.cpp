@@ -12,10 +12,8 @@ using namespace accretion;
 TEST_CASE("light tree pdf equals sampling frequency, sums to 1, covers every lit light", "[lighttree][statistical]") {
     const ShadingModel model = GENERATE(ShadingModel::lambert, ShadingModel::isotropic);
     INFO("model " << enumName(model));
-    Settings s = accretion::test::smallDiskSettings();
-    s.shading.model = model;
-    const Particles particles = ParticleSource(s).frame(0);
-    const LightTree tree(particles, s.shading);
+    const accretion::test::DiskLights disk(model);
+    const auto& [s, particles, tree] = disk;
     const auto N = static_cast<std::uint32_t>(particles.size());
     REQUIRE(tree.nodeCount() == 2 * std::size_t(N) - 1);
 

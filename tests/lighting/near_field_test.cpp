@@ -72,10 +72,8 @@ TEST_CASE("nearest: the k nearest lights but the receiver's own, against a brute
 TEST_CASE("pdfFar: zero on the near lights, sums to 1 over the far ones, covers every lit far light", "[lighting][nearfield]") {
     const ShadingModel model = GENERATE(ShadingModel::lambert, ShadingModel::isotropic);
     INFO("model " << enumName(model));
-    Settings s = accretion::test::smallDiskSettings();
-    s.shading.model = model;
-    const Particles particles = ParticleSource(s).frame(0);
-    const LightTree tree(particles, s.shading);
+    const accretion::test::DiskLights disk(model);
+    const auto& [s, particles, tree] = disk;
     const auto N = static_cast<std::uint32_t>(particles.size());
     NearField near;
     for (const std::uint32_t j : {1u, 40u, 99u}) {

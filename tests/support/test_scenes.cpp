@@ -38,6 +38,15 @@ Settings smallDiskSettings() {
     return s;
 }
 
+DiskLights::DiskLights(ShadingModel model)
+    : settings([model] {
+          Settings s = smallDiskSettings();
+          s.shading.model = model;
+          return s;
+      }()),
+      particles(ParticleSource(settings).frame(0)),
+      tree(particles, settings.shading) {}
+
 FrameImage renderParticles(const Settings& settings, const Particles& particles, std::uint32_t frame) {
     FrameRenderer renderer(settings, ParticleSource::fixed(particles), RenderOptions{true});
     FrameStats stats;

@@ -2,6 +2,7 @@
 #include <filesystem>
 #include <string>
 
+#include "accretion/lighting/light_tree.h"
 #include "accretion/render/frame_renderer.h"
 #include "accretion/scene/settings.h"
 
@@ -15,6 +16,14 @@ Settings axisCameraSettings(float dist = 10.0f, std::uint32_t size = 33, double 
 /// occlusion, a dmin clamp that bounds the tails of one-sample estimates (so
 /// per-pixel standard errors are reliable), mild emission contrast.
 Settings smallDiskSettings();
+
+/// The small disk shaded with `model`: frame 0's particles and their light tree.
+struct DiskLights {
+    explicit DiskLights(ShadingModel model);
+    Settings settings;
+    Particles particles;
+    LightTree tree;
+};
 
 /// Render one frame of a fixed particle set.
 FrameImage renderParticles(const Settings& settings, const Particles& particles, std::uint32_t frame = 0);
