@@ -251,7 +251,7 @@ std::string ensureReference(TuneContext& t, std::size_t particles) {
 }
 
 /// A measured configuration of the front's search.
-struct Point {
+struct ParetoPoint {
     Option lighting;
     double ms = 0.0;
     ErrorRow error;
@@ -259,7 +259,7 @@ struct Point {
 };
 
 /// Marks the Pareto front: no other point is both faster and better.
-void markFront(std::vector<Point>& points) {
+void markFront(std::vector<ParetoPoint>& points) {
     std::vector<std::size_t> order(points.size());
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
     std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
@@ -328,9 +328,9 @@ void runTune(const TuneArgs& a) {
                 ms.count("traceShadowRays") ? ms.at("traceShadowRays") : 0.0, total(ms)});
 
     // Lighting: error on the CPU, GPU time on the chosen geometry.
-    std::vector<Point> points;
+    std::vector<ParetoPoint> points;
     for (const Option& l : lighting) {
-        Point p{l};
+        ParetoPoint p{l};
         std::vector<std::string> defines = chosen.defines;
         defines.insert(defines.end(), l.defines.begin(), l.defines.end());
         p.ms = total(predictMs(t, defines, l.label));
@@ -338,11 +338,11 @@ void runTune(const TuneArgs& a) {
         points.push_back(std::move(p));
     }
     markFront(points);
-    std::sort(points.begin(), points.end(), [](const Point& p, const Point& q) { return p.ms < q.ms; });
+    std::sort(points.begin(), points.end(), [](const ParetoPoint& p, const ParetoPoint& q) { return p.ms < q.ms; });
     // The recommendation: under the budget (and --max-error), unbiased unless
     // allowed; the lowest error, or with --max-error the fastest that meets it.
-    const Point* best = nullptr;
-    for (const Point& p : points) {
+    const ParetoPoint* best = nullptr;
+    for (const ParetoPoint& p : points) {
         if (p.ms > a.budgetMs || (p.error.biased && !a.allowBiased)) continue;
         if (a.maxError && p.error.relMse > *a.maxError) continue;
         if (!best || (a.maxError ? p.ms < best->ms : p.error.relMse < best->error.relMse)) best = &p;
@@ -353,7 +353,7 @@ void runTune(const TuneArgs& a) {
               {"energy_loss_pct", "loss %", 7, "{:.1f}", "{:.5g}"}, {"cpu_s", "CPU s", 7, "{:.2f}", "{:.5g}"},
               {"biased", "", 0, "{}", "{}", false}, {"front", "", 0, "{}", "{}", false},
               {"", "", 0, "{}", "{}", true, "  "}});
-    for (const Point& p : points)
+    for (const ParetoPoint& p : points)
         lt.add({p.lighting.label, p.ms, p.error.relMse, p.error.z, p.error.energyLossPct, p.error.cpuSecondsPerFrame, p.error.biased,
                 p.front,
                 std::string(p.front ? "front" : "") + (p.error.biased ? " BIASED" : "") + (&p == best ? " <- recommended" : "")});
