@@ -31,6 +31,12 @@ nvcc=${NVCC:-$(command -v nvcc || true)}
 [ -z "$nvcc" ] || nvcc=$(readlink -f "$nvcc")
 cuda_inc=
 [ -z "$nvcc" ] || cuda_inc=$(cuda_include "$nvcc")
+# Else the runtime headers installed apart from it (e.g. the cudart wheel in
+# another site-packages folder than the nvcc wheel's).
+if [ -n "$nvcc" ] && [ -z "$cuda_inc" ]; then
+    h=$(find /usr/local /usr/lib /opt "$HOME/.local" -name cuda_runtime.h -path '*include*' 2>/dev/null | head -1 || true)
+    [ -z "$h" ] || cuda_inc=$(dirname "$h")
+fi
 if [ -z "$cuda_inc" ]; then
     [ -z "$nvcc" ] || echo "compile_twin: $nvcc has no cuda_runtime.h on its include path; using the PyPI wheels" >&2
     venv=.cache/cuda
@@ -53,7 +59,7 @@ echo "compile_twin: $nvcc ($("$nvcc" --version | tail -2 | head -1)), CUDA heade
 # The flags of src/twin/CMakeLists.txt: no FMA contraction, so that the
 # shared ACC_HD functions round as the CPU's do.
 cuflags=(-std=c++20 -O3 -fmad=false --expt-relaxed-constexpr -diag-suppress=20012,20011,20014,20044 -arch=sm_90
-         -Iinclude -Isrc/twin -I"$optix" -I"$build/generated")
+         -Iinclude -Isrc/twin -I"$optix" -I"$build/generated" -I"$cuda_inc")
 cxxflags=(-std=c++20 -O2 -Wall -Wextra -Wno-unused-parameter -Iinclude -Isrc/twin -I"$optix" -I"$cuda_inc")
 
 pids=()
@@ -65,7 +71,7 @@ for f in twin_main optix_pipeline particle_accel; do
     g++ "${cxxflags[@]}" -DACCRETION_TWIN_PROGRAMS="\"$out/programs.optixir\"" -c src/twin/$f.cpp -o "$out/$f.o" & pids+=($!)
 done
 for p in "${pids[@]}"; do wait "$p"; done
-cudart=$(find "$cuda" -name 'libcudart.so*' -o -name 'libcudart_static.a' | head -1)
+cudart=$(find "$cuda" "$(dirname "$cuda_inc")" \( -name 'libcudart.so*' -o -name 'libcudart_static.a' \) 2>/dev/null | head -1)
 "$nvcc" -arch=sm_90 "$out"/{twin_main,optix_pipeline,particle_accel,kernels,restir_kernels}.o \
     "$build/libaccretion_base.a" -L"$(dirname "$cudart")" -ltomlplusplus -ltbb -lfmt -ldl -lpthread -o "$out/accretion-optix"
 echo "compile_twin: $out/accretion-optix and $out/programs.optixir" >&2

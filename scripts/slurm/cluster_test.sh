@@ -126,10 +126,19 @@ done
 grep -q "checkpoint" "$LOG" || fail "no checkpoint after SIGTERM: $(tail -5 "$LOG")"
 cp "$LOG" "$WORK/first_run.log"
 scontrol requeue "$JOB" 2>/dev/null || scontrol requeue "${JOB}_0"
-scontrol update JobId="$JOB" StartTime=now 2>/dev/null || true  # a requeued job otherwise waits a few minutes before it is eligible
-# Right after the requeue squeue may list the job under no state for a
-# moment: wait for the second run to start before waiting for it to end.
-for _ in $(seq 240); do grep -q "resuming" "$LOG" 2>/dev/null && break; sleep 0.5; done
+# A requeued job otherwise waits a few minutes before it is eligible; the
+# array task may take the update under either id, and not at once after the
+# requeue: ask again until the second run starts. Right after the requeue
+# squeue may list the job under no state for a moment: wait for the second
+# run to start before waiting for it to end.
+for k in $(seq 480); do
+    grep -q "resuming" "$LOG" 2>/dev/null && break
+    if (( k % 10 == 1 )); then
+        scontrol update JobId="$JOB" StartTime=now 2>/dev/null || true
+        scontrol update JobId="${JOB}_0" StartTime=now 2>/dev/null || true
+    fi
+    sleep 0.5
+done
 wait_job "$JOB"
 grep -q "resuming .* at frame 0, chunk [1-9]" "$LOG" || fail "the requeued task did not resume from its checkpoint: $(grep -i resum "$LOG" || tail -5 "$LOG")"
 grep -q "^stats:" "$LOG" || fail "the requeued task did not finish: $(tail -5 "$LOG")"
