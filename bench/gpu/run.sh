@@ -310,6 +310,7 @@ step_identity() {
 -D render.estimator="exact"
 -D render.estimator="power" -D render.samples=8 -D geometry.alpha="disc"
 -D render.estimator="uniform" -D render.samples=4 -D render.target_stderr=0.05 -D render.max_samples=16
+-D particles.gm=0 -D camera.path="static"
 CONFIGS
     rm -f "$t"/*.gpuframe
     return $differ

@@ -34,9 +34,9 @@
 #include "accretion/core/version.h"
 #include "accretion/gpu/cost_model.h"
 #include "accretion/io/plot.h"
-#include "accretion/particles/particle_source.h"
 #include "accretion/io/report_table.h"
 #include "accretion/io/stats_writer.h"
+#include "accretion/particles/particle_source.h"
 #include "child_process.h"
 #include "commands.h"
 

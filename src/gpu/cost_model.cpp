@@ -24,7 +24,6 @@ namespace {
 std::string knownPasses() { return fmt::format("passes: {}", fmt::join(kPassNames, ", ")); }
 }  // namespace
 
-
 double coldWork(double rays, double bytes, double workingSetBytes, double cacheBytes) {
     if (!(workingSetBytes > cacheBytes) || !(cacheBytes > 0.0)) return 0.0;
     return (rays > 0.0 ? rays : bytes) * std::log2(workingSetBytes / cacheBytes);

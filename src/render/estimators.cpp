@@ -492,9 +492,10 @@ void checkSamplerInputs(const LightingInputs& in) {
     const LightSamplerKind need = samplerFor(in.render);
     ACC_CHECK(!e.reuse);  // restir runs its own passes
     ACC_CHECK(need != LightSamplerKind::tree || in.lightTree);
-    // ris draws its candidates in proportion to power exactly when given the table: it must be the configured source.
-    ACC_CHECK((need == LightSamplerKind::power) == (in.powerTable != nullptr) || !e.resampling);
-    ACC_CHECK(need != LightSamplerKind::power || in.powerTable);
+    // ris draws its candidates in proportion to power exactly when given the
+    // table: for it the table is there exactly when its source needs one.
+    ACC_CHECK(e.resampling ? (need == LightSamplerKind::power) == (in.powerTable != nullptr)
+                           : need != LightSamplerKind::power || in.powerTable);
     ACC_CHECK(!e.resampling || (in.render.source != LightSource::tiles && in.render.source != LightSource::regir));
 }
 }  // namespace

@@ -8,6 +8,7 @@
 
 #include "accretion/counters/gpu_layouts.h"
 #include "accretion/render/compose_pixel.h"
+#include "accretion/render/estimator_table.h"
 
 namespace accretion {
 namespace {
@@ -122,7 +123,7 @@ FrameRenderer::FrameRenderer(const Settings& settings, ParticleSource source, Re
     : settings_(settings), cameras_(settings.camera), plan_(planFrame(settings, FrameFacts{})), source_(std::move(source)), options_(options),
       device_(std::make_unique<EmbreeDevice>()),
       bvh_(newBvh(*device_, settings)) {
-    if (settings_.render.estimator == EstimatorKind::restir) restir_ = std::make_unique<Restir>(settings_, plan_.keepHistory);
+    if (estimatorInfo(settings_.render.estimator).reuse) restir_ = std::make_unique<Restir>(settings_, plan_.keepHistory);
 }
 
 FrameRenderer::~FrameRenderer() = default;

@@ -124,7 +124,7 @@ public:
 
 private:
     Particles particlesOf(std::uint32_t frame);
-    FramePlan planFor(const Particles& particles) const;
+    FramePlan planFrameAndLoad(std::uint32_t frame);
     void uploadParticles(const Particles& particles, const Camera& camera);
     void uploadClusterHint(const Particles& particles, bool recluster, bool first);
     LaunchParams launchParams(const FramePlan& plan, const Camera& camera, const Particles& particles,
@@ -162,6 +162,7 @@ private:
     std::uint32_t prevCount_ = 0;
     Clusters clusters_;
     Vec3 origin_{0.0f};
+    Particles particles_;  ///< this frame's, rebased to origin_
     std::map<std::uint32_t, Particles> loaded_;  ///< --seeds: each frame's particles, loaded once
     nlohmann::json stats_;
     std::string timingsCsv_ = "config,pass,ms\n";
@@ -244,11 +245,17 @@ Particles TwinRun::particlesOf(std::uint32_t frame) {
     return it->second;  // a copy: rebased by the caller
 }
 
-FramePlan TwinRun::planFor(const Particles& particles) const {
+/// The frame's plan, with its particles loaded (rebased) where the plan
+/// loads them; a static scene's stay from its first frame, as the CPU's do.
+FramePlan TwinRun::planFrameAndLoad(std::uint32_t frame) {
     FrameFacts facts = planningFacts(a_);
     facts.geometryBuilt = built_;
     facts.historyAvailable = history_;
-    facts.emissive = emissive(particles);
+    if (planFrame(s_, facts).loadParticles) {
+        particles_ = particlesOf(frame);
+        for (Vec3& p : particles_.position) p -= origin_;
+    }
+    facts.emissive = emissive(particles_);
     return planFrame(s_, facts);
 }
 
@@ -543,10 +550,9 @@ void TwinRun::renderFrame(std::uint32_t frame, std::uint64_t seed) {
     const Camera world = Camera::fromPose(pose, W_, H_);
     if (!built_ || !persistent_) origin_ = world.position;
     const Camera camera = world.rebased(origin_);
-    Particles particles = particlesOf(frame);
-    for (Vec3& p : particles.position) p -= origin_;
+    const FramePlan plan = planFrameAndLoad(frame);
+    const Particles& particles = particles_;
     const std::size_t n = particles.size();
-    const FramePlan plan = planFor(particles);
     const bool instances = s_.geometry.layout == AccelLayout::instances;
     const bool recluster = plan.buildClusters && !instances && (!built_ || !persistent_);
     const Clusters clusters = recluster ? clusterParticles(particles.position, s_.geometry.cluster_size) : Clusters{};

@@ -1,5 +1,6 @@
 #pragma once
 #include <cmath>
+#include <concepts>
 #include <cstdint>
 
 #include <glm/glm.hpp>
@@ -35,15 +36,10 @@ inline std::uint32_t indexBits(std::uint64_t n) {
 
 inline bool isFinite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
-/// std::isfinite on the host, CUDA's isfinite on the device.
-ACC_HD inline bool isFiniteNumber(double x) {
-#if defined(__CUDA_ARCH__)
-    return isfinite(x);
-#else
-    return std::isfinite(x);
-#endif
-}
-ACC_HD inline bool isFiniteNumber(float x) {
+/// std::isfinite on the host, CUDA's isfinite on the device (float stays
+/// float: no widening per candidate).
+template <std::floating_point T>
+ACC_HD inline bool isFiniteNumber(T x) {
 #if defined(__CUDA_ARCH__)
     return isfinite(x);
 #else
