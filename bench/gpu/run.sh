@@ -205,16 +205,18 @@ step_layout_images() {
 # Seed 004's decision matrix (bench/gpu/layouts.txt): every layout at 10K,
 # 100K and 1M particles, 720p and 1080p, restir (frame 1 after a history
 # frame), per-pass GPU ms (`accretion-optix --timings`) and the acceleration
-# structure's memory (the stats JSON). LAYOUT_PARTS=i/n runs the i-th of n parts.
+# structure's memory (the stats JSON). LAYOUT_PARTS=i/n runs the i-th of n parts;
+# LAYOUT_LIST another list (bench/gpu/layouts_refit.txt); REPEAT the timed runs
+# per frame (3; a pass's time is their median).
 step_layouts() {
     local t="$W/layouts" part=${LAYOUT_PARTS:-1/1} k=0
     mkdir -p "$t"
-    grep -v '^#' bench/gpu/layouts.txt | while read -r name args; do
+    grep -v '^#' "${LAYOUT_LIST:-bench/gpu/layouts.txt}" | while read -r name args; do
         [ -z "$name" ] && continue
         k=$((k + 1))
         [ $(((k - 1) % ${part#*/})) -eq $((${part%/*} - 1)) ] || continue
         # shellcheck disable=SC2086  # the overrides are words
-        timeout 120 $BIN scenes/disk_100k.toml -D render.estimator=restir $args --frames 0:2 --repeat 3 -q \
+        timeout 120 $BIN scenes/disk_100k.toml -D render.estimator=restir $args --frames 0:2 --repeat "${REPEAT:-3}" -q \
             -o "$t/$name.{frame}.exr" --timings "$t/$name.timings.csv" --config "$name" < /dev/null \
             || echo "layouts: $name failed"
         rm -f "$t"/*.gpuframe
