@@ -68,19 +68,17 @@ std::vector<Option> geometryOptions(const Settings& s) {
     struct Layout {
         std::string label;
         std::vector<std::string> defines;
-        bool refit;  ///< a refit of this layout is worth pricing
     };
     const std::string all = "geometry.cluster_size=10000000";
-    std::vector<Layout> layouts = {{"clusters of 100", {"geometry.layout=clusters", "geometry.cluster_size=100"}, false},
-                                   {"clusters of 1000", {"geometry.layout=clusters", "geometry.cluster_size=1000"}, false},
-                                   {"clusters of 10000", {"geometry.layout=clusters", "geometry.cluster_size=10000"}, false},
-                                   {"one BLAS", {"geometry.layout=clusters", all}, true},
-                                   {"instance per particle", {"geometry.layout=instances"}, true}};
-    if (s.geometry.primitive == Primitive::billboard) layouts.push_back({"one BLAS of boxes", {"geometry.layout=aabbs", all}, false});
+    std::vector<Layout> layouts = {{"clusters of 100", {"geometry.layout=clusters", "geometry.cluster_size=100"}},
+                                   {"clusters of 1000", {"geometry.layout=clusters", "geometry.cluster_size=1000"}},
+                                   {"clusters of 10000", {"geometry.layout=clusters", "geometry.cluster_size=10000"}},
+                                   {"one BLAS", {"geometry.layout=clusters", all}},
+                                   {"instance per particle", {"geometry.layout=instances"}}};
+    if (s.geometry.primitive == Primitive::billboard) layouts.push_back({"one BLAS of boxes", {"geometry.layout=aabbs", all}});
     std::vector<Option> out;
     for (const Layout& l : layouts)
-        for (const char* build : {"rebuild", "refit"}) {
-            if (std::string(build) == "refit" && !l.refit) continue;
+        for (const char* build : {"rebuild", "refit"}) {  // every layout's refit is timed (bench/gpu/layouts_refit.txt)
             std::vector<std::string> alphas = {""};
             if (s.geometry.alpha == AlphaMode::disc && l.defines[0] != "geometry.layout=aabbs") alphas.push_back("omm");
             for (const std::string& alpha : alphas) {

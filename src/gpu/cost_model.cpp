@@ -31,12 +31,14 @@ double coldWork(double rays, double bytes, double workingSetBytes, double cacheB
 
 CostFeatures costFeatures(const PassReport& p, double cacheBytes) {
     const double bytes = double(p.bytesRead + p.bytesWritten);
-    return {double(p.threads),     double(p.warpSteps()), double(p.rays),
-            double(p.blasEntries), double(p.anyHits),     bytes,
-            double(p.blasLevels),  double(p.ommLookups),  double(p.dispatches),
-            double(p.blasBuilds),  double(p.blasRefits),  coldWork(double(p.rays), bytes, p.workingSetBytes, cacheBytes),
-            double(p.build.primitives), double(p.build.primitivesSmall), double(p.build.primitivesMid),
-            double(p.build.customBuilds), double(p.build.tlasInstances), double(p.intersections), double(p.tlasLevels)};
+    const BuildCounters& b = p.build;
+    return {double(p.threads),       double(p.warpSteps()),     double(p.rays),          double(p.blasEntries),
+            double(p.anyHits),       bytes,                     double(p.blasLevels),    double(p.ommLookups),
+            double(p.dispatches),    double(b.builds),          double(b.refits),
+            coldWork(double(p.rays), bytes, p.workingSetBytes, cacheBytes),
+            double(b.elements),      double(b.elementsSmall),   double(b.elementsMid),   double(b.primitives),
+            double(b.primitivesSmall), double(b.primitivesMid), double(b.customBuilds),  double(p.intersections),
+            double(p.tlasLevels),    double(p.misses)};
 }
 
 CostCoefficients CostCoefficients::defaults() {
@@ -306,6 +308,20 @@ FeatureMask firstFeatures(std::size_t n) {
     return m;
 }
 
+std::size_t featureIndex(std::string_view name) {
+    return std::size_t(std::find(kCostFeatures.begin(), kCostFeatures.end(), name) - kCostFeatures.begin());
+}
+
+/// The counters a pass family is fitted on: buildClusters its builds and
+/// dispatches, every other pass all but the builds (isBuildFeature).
+FeatureMask passFeatures(const std::string& family) {
+    const bool build = family == pass::buildClusters;
+    FeatureMask m{};
+    for (std::size_t k = 0; k < m.size(); ++k) m[k] = isBuildFeature(k) == build;
+    m[featureIndex("dispatches")] = true;
+    return m;
+}
+
 /// NNLS of one set of rows over the features of `mask` (the others held at
 /// 0); with `relative`, each row weighted by 1 / its measured time.
 CostFeatures fitRows(const std::vector<const CostRow*>& rows, const FeatureMask& mask, bool relative) {
@@ -365,19 +381,20 @@ double leaveOneConfigOut(const std::vector<const CostRow*>& rows, const FeatureM
 /// until none lowers it by more than its standard error; then the fit over
 /// the chosen counters. With fewer than 4 configurations, every counter
 /// (per_pass).
-CostFeatures fitSelected(const std::vector<const CostRow*>& rows) {
+CostFeatures fitSelected(const std::vector<const CostRow*>& rows, const FeatureMask& allowed) {
     const std::size_t nConfigs = distinctConfigs(rows).size();
-    const FeatureMask all = firstFeatures(kCostFeatures.size());
-    if (nConfigs < 4) return fitRows(rows, all, true);
+    if (nConfigs < 4) return fitRows(rows, allowed, true);
     FeatureMask chosen{};
-    for (std::string_view launch : {"dispatches", "blas_builds", "blas_refits"})
-        chosen[std::size_t(std::find(kCostFeatures.begin(), kCostFeatures.end(), launch) - kCostFeatures.begin())] = true;
+    for (std::string_view launch : {"dispatches", "build_launches", "refit_launches"}) {
+        const std::size_t k = featureIndex(launch);
+        chosen[k] = allowed[k];
+    }
     double best = leaveOneConfigOut(rows, chosen);
     for (std::size_t step = 0; step < kCostFeatures.size() && step + 2 < nConfigs; ++step) {
         std::size_t pick = kCostFeatures.size();
         double pickError = best;
         for (std::size_t k = 0; k < kCostFeatures.size(); ++k) {
-            if (chosen[k] || std::none_of(rows.begin(), rows.end(), [&](const CostRow* r) { return r->features[k] > 0.0; }))
+            if (chosen[k] || !allowed[k] || std::none_of(rows.begin(), rows.end(), [&](const CostRow* r) { return r->features[k] > 0.0; }))
                 continue;
             FeatureMask m = chosen;
             m[k] = true;
@@ -420,7 +437,7 @@ double chooseCache(const std::vector<CostRow>& rows) {
         const double cache = std::ldexp(1024.0 * 1024.0, k);
         const std::vector<CostRow> trial = withCache(rows, cache);
         double error = 0.0;
-        for (const auto& [pass, rs] : rowsByPass(trial)) error += leaveOneConfigOut(rs, firstFeatures(kCostFeatures.size()));
+        for (const auto& [pass, rs] : rowsByPass(trial)) error += leaveOneConfigOut(rs, passFeatures(pass));
         if (error < bestError) {
             bestError = error;
             best = cache;
@@ -446,7 +463,7 @@ CostCoefficients fit(const std::vector<CostRow>& input, CostModelForm form) {
     for (const CostRow& r : rows) all.push_back(&r);
     c.ns = fitRows(all, firstFeatures(kCostFeatures.size()), true);  // for a pass no row has
     for (const auto& [pass, rs] : rowsByPass(rows))
-        c.perPass[pass] = form == CostModelForm::selected ? fitSelected(rs) : fitRows(rs, firstFeatures(kCostFeatures.size()), true);
+        c.perPass[pass] = form == CostModelForm::selected ? fitSelected(rs, passFeatures(pass)) : fitRows(rs, passFeatures(pass), true);
     c.source = fmt::format("calibrated ({})", costModelFormName(form));
     return c;
 }

@@ -66,6 +66,7 @@ PassReport summarise(const PassCounters& pc, const GpuSettings& gpu, const SerKe
         p.blasLevels += t.blasLevels;
         p.ommLookups += t.ommLookups;
         p.intersections += t.intersections;
+        p.misses += t.misses;
         p.bytesRead += t.bytesRead;
         p.bytesWritten += t.bytesWritten;
     }
@@ -96,7 +97,7 @@ GpuReport makeGpuReport(const FrameCounters& counters, const Settings& settings,
 
     const AccelCounters& accel = counters.accel;
     r.blas = blasMemory(accel.blasPrimitives, gpu, accel.embreeBytes);
-    // Working sets: the BLAS bytes for traced passes; the light records (and
+    // Working sets: the BLAS and TLAS bytes for traced passes; the light records (and
     // alias entries with power candidates) for the resampling passes.
     const std::uint64_t lights = accel.particles;
     const LightSource source = settings.render.source;
@@ -111,7 +112,7 @@ GpuReport makeGpuReport(const FrameCounters& counters, const Settings& settings,
     const std::uint32_t tlasDepth = accel.tlasInstances > 1 ? std::uint32_t(std::bit_width(accel.tlasInstances - 1)) : 0u;
     for (PassReport& p : r.passes) {
         p.tlasLevels = p.rays * tlasDepth;
-        if (p.rays > 0) p.workingSetBytes = double(r.blas.gpuBytes);
+        if (p.rays > 0) p.workingSetBytes = double(r.blas.gpuBytes) + double(accel.tlasInstances) * gpu_layout::kTlasInstanceBytes;
         else if (p.pass == pass::generateCandidates || p.pass == pass::presampleLightTiles || p.pass == pass::presampleRegirGrid || p.pass == pass::temporalResampling || passFamily(p.pass) == pass::spatialResampling)
             p.workingSetBytes = lightBytes;
     }
@@ -152,10 +153,14 @@ nlohmann::json toJson(const PassReport& p) {
             {"dispatches", p.dispatches},
             {"blas_builds", p.blasBuilds},
             {"blas_refits", p.blasRefits},
+            {"build_launches", p.build.builds},
+            {"refit_launches", p.build.refits},
+            {"accel_elements", p.build.elements},
             {"build_primitives", p.build.primitives},
             {"custom_builds", p.build.customBuilds},
             {"tlas_instances", p.build.tlasInstances},
             {"intersections", p.intersections},
+            {"misses", p.misses},
             {"tlas_levels", p.tlasLevels},
             {"working_set_bytes", p.workingSetBytes},
             {"trips", p.trips},

@@ -17,7 +17,9 @@ namespace {
 /// its primitives as loop trips, particle records read, BLAS bytes written;
 /// the builds as the cost model prices them (BuildCounters). The instances
 /// layout is one thread per particle writing its instance record; its BLAS
-/// (the unit billboard) is built once, so only the TLAS is built per frame.
+/// (the unit billboard) is built once, so only the TLAS is built, or with
+/// the refit policy refitted, per frame. Every other layout rebuilds its
+/// small TLAS over the clusters.
 void recordClusterBuild(const ParticleBvh& bvh, const Particles& particles, FrameCounters& counters) {
     const Clusters& clusters = bvh.clusters();
     const BvhStats& s = bvh.stats();
@@ -25,13 +27,8 @@ void recordClusterBuild(const ParticleBvh& bvh, const Particles& particles, Fram
     if (g.layout == AccelLayout::instances) {
         const auto n = static_cast<std::uint32_t>(particles.size());
         PassCounters& pc = counters.add(pass::buildClusters, n, 1);
-        pc.dispatches = 2;  // the instance records, the TLAS
-        if (s.refitted) {   // the TLAS updated: one refit launch over the instances
-            pc.blasRefits = 1;
-            pc.build.addBlas(n, false);
-        } else {
-            pc.build.tlasInstances = n;
-        }
+        pc.dispatches = 1;  // the instance records
+        pc.build.addTlas(n, s.refitted);
         for (ThreadCounters& t : pc.threads) {
             t.active = 1;
             t.trips = 1;
@@ -41,10 +38,8 @@ void recordClusterBuild(const ParticleBvh& bvh, const Particles& particles, Fram
         return;
     }
     PassCounters& pc = counters.add(pass::buildClusters, static_cast<std::uint32_t>(clusters.count()), 1);
-    // The GPU's launches: one build (or refit) per BLAS updated, the primitive expansion and the TLAS.
-    pc.dispatches = 2;
+    pc.dispatches = 1;  // the primitive expansion; the builds are counted apart
     (s.refitted ? pc.blasRefits : pc.blasBuilds) = s.rebuiltClusters;
-    pc.build.tlasInstances = clusters.count();
     const bool triangles = g.primitive == Primitive::billboard && g.layout == AccelLayout::clusters;
     const bool custom = !triangles;  // boxes or spheres
     for (std::size_t c = 0; c < clusters.count(); ++c) {
@@ -57,8 +52,9 @@ void recordClusterBuild(const ParticleBvh& bvh, const Particles& particles, Fram
         // vertex + index buffers, sphere points, or boxes (OptixAabb)
         t.bytesWritten = triangles ? n * (4 * 12 + 2 * 12) : g.layout == AccelLayout::aabbs ? n * 24 : n * 16;
         // The partial policy rebuilds a window of the clusters: their sizes are alike, so the first ones stand in.
-        if (c < s.rebuiltClusters) pc.build.addBlas(t.trips, custom);
+        if (c < s.rebuiltClusters) pc.build.addBlas(t.trips, custom, s.refitted);
     }
+    pc.build.addTlas(clusters.count(), false);
 }
 
 /// The structure the CPU traces for these settings (cpuGeometry).

@@ -54,6 +54,7 @@ void trace(const ParticleBvh& bvh, const Particles& particles, const Camera& cam
                         RayCounters rc;
                         SurfaceHit single;
                         bvh.intersect(camera.position, dirs[k], std::numeric_limits<float>::infinity(), single, &rc);
+                        rc.misses = found[k] ? 0u : 1u;
                         rec.ray(rc);
                         rec.write(gpu_layout::kGBufferTexel);
                         if (!found[k]) continue;

@@ -209,13 +209,18 @@ TEST_CASE("cost counts the launches of the builds: one per BLAS rebuilt, refitte
     }
     const double clusters = build["rebuild"]["threads"];
     REQUIRE(clusters > 2);
-    CHECK(build["rebuild"]["blas_builds"] == clusters);
-    CHECK(build["rebuild"]["blas_refits"] == 0);
-    CHECK(build["refit"]["blas_builds"] == 0);  // frame 1 refits what frame 0 built
-    CHECK(build["refit"]["blas_refits"] == build["refit"]["threads"]);
-    CHECK(build["partial"]["blas_builds"] == std::ceil(0.7 * build["partial"]["threads"]));  // geometry.rebuild_fraction
-    CHECK(build["partial"]["blas_refits"] == 0);
-    for (const auto& [policy, columns] : build) CHECK(columns.at("dispatches") == 2);
+    // Every BLAS updated is a launch, and so is the TLAS over the clusters, rebuilt every frame.
+    CHECK(build["rebuild"]["build_launches"] == clusters + 1);
+    CHECK(build["rebuild"]["refit_launches"] == 0);
+    CHECK(build["refit"]["build_launches"] == 1);  // frame 1 refits what frame 0 built
+    CHECK(build["refit"]["refit_launches"] == clusters);
+    CHECK(build["partial"]["build_launches"] == std::ceil(0.7 * clusters) + 1);  // geometry.rebuild_fraction
+    CHECK(build["partial"]["refit_launches"] == 0);
+    // Elements: a rebuild builds all it updates; a refit builds only the TLAS's instances.
+    CHECK(build["rebuild"]["build_primitives"] == build["rebuild"]["accel_elements"]);
+    CHECK(build["refit"]["build_primitives"] == clusters);
+    CHECK(build["refit"]["accel_elements"] == build["rebuild"]["accel_elements"]);
+    for (const auto& [policy, columns] : build) CHECK(columns.at("dispatches") == 1);
 }
 
 TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbiased one under the budget, cached",
@@ -264,7 +269,7 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
             ++measurements;
             CHECK_THAT(line, Contains("(cached)"));
         }
-    CHECK(measurements == 1 + 8 + 2 * 34);  // the reference, the geometry options, then cost and bias per lighting option
+    CHECK(measurements == 1 + 12 + 2 * 34);  // the reference, 6 layouts rebuilt and refitted, then cost and bias per lighting option
     CHECK(slurp(dir / "t.csv") == first);
 
     // Bad input: one clear error each, exit 1, nothing written.

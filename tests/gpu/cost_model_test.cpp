@@ -100,7 +100,7 @@ TEST_CASE("the per-pass form predicts held-out configurations its form made exac
     CostCoefficients truth;
     truth.perPass["buildClusters"] = {};
     truth.perPass["buildClusters"][8] = 5000.0;    // dispatches
-    truth.perPass["buildClusters"][9] = 75000.0;   // blas_builds
+    truth.perPass["buildClusters"][9] = 75000.0;   // build_launches
     truth.perPass["traceShadowRays"] = {};
     truth.perPass["traceShadowRays"][2] = 1.5;     // rays
     truth.perPass["traceShadowRays"][6] = 0.03;    // blas_levels
@@ -245,15 +245,55 @@ TEST_CASE("a presampling pass without timings is priced with generateCandidates'
     CHECK(c.predictMs("presampleRegirGrid", f) == Approx(0.0));
 }
 
-TEST_CASE("a build's primitives are counted whole and clamped at the knots", "[gpu][cost]") {
+TEST_CASE("a build's elements are counted whole and clamped at the knots, refits and the TLAS apart", "[gpu][cost]") {
     BuildCounters b;
     b.addBlas(50, false);        // below both knots
     b.addBlas(2000, true);       // between them
     b.addBlas(2000000, false);   // above both
-    REQUIRE(b.primitives == 50u + 2000u + 2000000u);
-    REQUIRE(b.primitivesSmall == 50u + 1024u + 1024u);
-    REQUIRE(b.primitivesMid == 50u + 2000u + 32768u);
-    REQUIRE(b.customBuilds == 1u);
+    b.addBlas(5000, true, true); // a refit: an element updated, not built
+    b.addTlas(4, false);
+    CHECK(b.builds == 4u);
+    CHECK(b.refits == 1u);
+    CHECK(b.primitives == 50u + 2000u + 2000000u + 4u);
+    CHECK(b.primitivesSmall == 50u + 1024u + 1024u + 4u);
+    CHECK(b.primitivesMid == 50u + 2000u + 32768u + 4u);
+    CHECK(b.elements == b.primitives + 5000u);
+    CHECK(b.elementsSmall == b.primitivesSmall + 1024u);
+    CHECK(b.elementsMid == b.primitivesMid + 5000u);
+    CHECK(b.customBuilds == 2u);
+    CHECK(b.tlasInstances == 4u);
+    BuildCounters refitTlas;
+    refitTlas.addTlas(100000, true);
+    CHECK(refitTlas.refits == 1u);
+    CHECK(refitTlas.builds == 0u);
+    CHECK(refitTlas.primitives == 0u);
+    CHECK(refitTlas.elements == 100000u);
+}
+
+TEST_CASE("the build pass is fitted on the build counters, the other passes on the rest", "[gpu][cost]") {
+    // Builds whose threads (one per cluster) track their launches: a fit
+    // free to use threads could price the launches through them and then
+    // charge a layout of one thread per particle (instances) for launches it
+    // does not make. Fitted on build counters alone, it cannot.
+    std::vector<CostRow> rows;
+    for (int c = 0; c < 24; ++c) {  // at least one row per coefficient
+        const double clusters = 10.0 + 100.0 * c;
+        CostRow b{"c" + std::to_string(c), "buildClusters", {}, 0.0};
+        b.features[0] = clusters;  // threads
+        b.features[8] = 1.0;       // dispatches
+        b.features[9] = clusters;  // build_launches
+        b.measuredMs = 0.01 + 0.075 * clusters;
+        rows.push_back(b);
+    }
+    const Calibration c = calibrate(rows, CostModelForm::per_pass);
+    const CostFeatures& ns = c.coefficients.perPass.at("buildClusters");
+    CHECK(ns[0] == 0.0);
+    CHECK(ns[9] == Approx(75000.0).epsilon(1e-6));
+    CostFeatures instances{};
+    instances[0] = 1e6;  // a thread per particle, one launch
+    instances[8] = 1.0;
+    instances[9] = 1.0;
+    CHECK(c.coefficients.predictMs("buildClusters", instances) == Approx(0.085).epsilon(1e-6));
 }
 
 TEST_CASE("cost prices with the committed calibration, the uncalibrated guess only on request", "[gpu][cost]") {

@@ -14,6 +14,7 @@ struct RayCounters {
     std::uint32_t blasLevels = 0;   ///< per BLAS entered, its depth: ceil(log2(primitives)) (traversal inside it)
     std::uint32_t ommLookups = 0;   ///< candidate hits on micromapped triangles (the micromap looked up)
     std::uint32_t intersections = 0;///< intersection-program invocations: boxes (aabbs layout) or spheres whose bounds the ray entered
+    std::uint32_t misses = 0;       ///< 1 when the query found nothing (a shadow ray unblocked): it traversed its whole segment
 };
 
 /// The work of one pixel's thread in one pass (docs/MODEL.md section 6). The
@@ -33,6 +34,7 @@ struct ThreadCounters {
     std::uint32_t blasLevels = 0;   ///< BLAS depths entered, summed over the thread's rays
     std::uint32_t ommLookups = 0;   ///< micromap lookups, summed over the thread's rays
     std::uint32_t intersections = 0;///< intersection-program invocations, summed over the thread's rays
+    std::uint32_t misses = 0;       ///< rays that found nothing (RayCounters::misses)
     std::uint32_t bytesRead = 0;    ///< G-buffer, reservoirs, particle records read
     std::uint32_t bytesWritten = 0; ///< G-buffer, reservoirs, radiance written
 
@@ -46,27 +48,50 @@ struct ThreadCounters {
         blasLevels += r.blasLevels;
         ommLookups += r.ommLookups;
         intersections += r.intersections;
+        misses += r.misses;
     }
     void addRay(const RayCounters& r) { addRays(r, 1); }
 };
 
-/// buildClusters' acceleration-structure work as the cost model prices it:
-/// a build's time is a launch plus a cost per primitive that falls as the
-/// build grows (a small build leaves the GPU idle, a big one fills it), so
-/// its primitives are counted whole and clamped at two knots (Sigma n,
-/// Sigma min(n, 1024), Sigma min(n, 32768) over the BLAS built or refitted);
-/// the BLAS of boxes or spheres built, and the TLAS's instances.
+/// buildClusters' acceleration-structure work as the cost model prices it.
+/// Every build or refit, of a BLAS or of the TLAS, is a launch plus a cost
+/// per element (primitive or instance) that falls as the build grows (a
+/// small build leaves the GPU idle, a big one fills it): its elements are
+/// counted whole and clamped at two knots (Sigma n, Sigma min(n, 1024),
+/// Sigma min(n, 32768)), once over everything built or refitted and once
+/// more over what was built (a build does more per element than a refit,
+/// which only recomputes boxes). The TLAS counts as a build of its
+/// instances like any other: an OptiX TLAS is a BVH over instance boxes.
 struct BuildCounters {
-    std::uint64_t primitives = 0, primitivesSmall = 0, primitivesMid = 0;
-    std::uint64_t customBuilds = 0;   ///< BLAS builds or refits of procedural boxes or spheres
+    std::uint64_t builds = 0, refits = 0;   ///< launches, BLAS and TLAS
+    std::uint64_t elements = 0, elementsSmall = 0, elementsMid = 0;      ///< built or refitted
+    std::uint64_t primitives = 0, primitivesSmall = 0, primitivesMid = 0;  ///< built
+    std::uint64_t customBuilds = 0;  ///< BLAS builds or refits of procedural boxes or spheres
     std::uint64_t tlasInstances = 0;
     static constexpr std::uint64_t kSmallKnot = 1024, kMidKnot = 32768;
-    /// One BLAS of n primitives built or refitted.
-    void addBlas(std::uint64_t n, bool custom) {
-        primitives += n;
-        primitivesSmall += n < kSmallKnot ? n : kSmallKnot;
-        primitivesMid += n < kMidKnot ? n : kMidKnot;
+    static std::uint64_t small(std::uint64_t n) { return n < kSmallKnot ? n : kSmallKnot; }
+    static std::uint64_t mid(std::uint64_t n) { return n < kMidKnot ? n : kMidKnot; }
+    /// One BLAS of n primitives built, or refitted.
+    void addBlas(std::uint64_t n, bool custom, bool refit = false) {
+        add(n, refit);
         customBuilds += custom;
+    }
+    /// The TLAS over n instances built, or refitted.
+    void addTlas(std::uint64_t n, bool refit) {
+        add(n, refit);
+        tlasInstances = n;
+    }
+
+private:
+    void add(std::uint64_t n, bool refit) {
+        (refit ? refits : builds) += 1;
+        elements += n;
+        elementsSmall += small(n);
+        elementsMid += mid(n);
+        if (refit) return;
+        primitives += n;
+        primitivesSmall += small(n);
+        primitivesMid += mid(n);
     }
 };
 

@@ -16,23 +16,30 @@ namespace accretion {
 /// 6). The first six are the model's first form; the others came with
 /// measurements on a GPU (bench/gpu): the traversal inside the BLAS entered
 /// (their depths), micromap lookups (software on a GPU without RT cores),
-/// the launches (kernel dispatches, BLAS builds and refits: a constant
-/// cost each; the number of builds, not their triangles, set the build
-/// time), and cold_work (coldWork: random reads of a working set larger
-/// than a cache). The layouts (one BLAS to one per particle, boxes,
-/// spheres, instances) added the build's primitives whole and clamped per
-/// BLAS at 1024 and 32768 (BuildCounters: a build's cost per primitive
-/// falls as it fills the GPU), the builds of boxes or spheres, the TLAS's
-/// instances, the intersection-program invocations and the TLAS levels a
-/// ray descends (rays x log2 of the instances). Counter CSVs
-/// without them read as 0.
-inline constexpr std::array<std::string_view, 19> kCostFeatures = {
-    "threads",          "warp_steps",          "rays",        "blas_entries",   "any_hits",    "bytes",
-    "blas_levels",      "omm_lookups",         "dispatches",  "blas_builds",    "blas_refits", "cold_work",
-    "build_primitives", "build_primitives_1k", "build_primitives_32k", "custom_builds", "tlas_instances", "intersections",
-    "tlas_levels"};
+/// kernel dispatches, cold_work (coldWork: random reads of a working set
+/// larger than a cache), the TLAS levels a ray descends (rays x log2 of the
+/// instances), the intersection-program invocations and the rays that found
+/// nothing (a ray that misses, or a shadow ray unblocked, traverses its
+/// whole segment; a blocked one stops at its first blocker). The builds
+/// (BuildCounters): launches of builds and refits, BLAS or TLAS, each a
+/// constant; the elements built or refitted, whole and clamped per build at
+/// 1024 and 32768 (a build's cost per element falls as it fills the GPU);
+/// the same over the builds alone (what a build does beyond a refit); the
+/// builds of boxes or spheres. Counter CSVs without a column read it as 0.
+inline constexpr std::array<std::string_view, 22> kCostFeatures = {
+    "threads",          "warp_steps",          "rays",                 "blas_entries",     "any_hits",
+    "bytes",            "blas_levels",         "omm_lookups",          "dispatches",       "build_launches",
+    "refit_launches",   "cold_work",           "accel_elements",       "accel_elements_1k", "accel_elements_32k",
+    "build_primitives", "build_primitives_1k", "build_primitives_32k", "custom_builds",    "intersections",
+    "tlas_levels",      "misses"};
 inline constexpr std::size_t kBaseCostFeatures = 6;
 inline constexpr std::size_t kColdWork = 11;
+/// Whether feature k prices acceleration-structure builds: buildClusters is
+/// fitted on these (and dispatches) alone, every other pass on the rest.
+/// A pass's counters of the other kind are 0 or, like the build pass's
+/// threads (one per cluster: collinear with its launches), say nothing of
+/// its time, and a fit that gives them weight extrapolates badly.
+constexpr bool isBuildFeature(std::size_t k) { return (k >= 9 && k <= 10) || (k >= 12 && k <= 18); }
 using CostFeatures = std::array<double, kCostFeatures.size()>;
 
 /// The committed calibration (compiled in from this file of the source tree).

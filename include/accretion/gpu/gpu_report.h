@@ -22,6 +22,7 @@ struct PassReport {
     std::uint64_t bytesRead = 0, bytesWritten = 0;
     std::uint64_t blasLevels = 0, ommLookups = 0;                 ///< BLAS depths entered, micromap lookups
     std::uint64_t intersections = 0;                             ///< intersection-program invocations (boxes, spheres)
+    std::uint64_t misses = 0;                                    ///< rays that found nothing (a shadow ray unblocked)
     std::uint64_t tlasLevels = 0;                                ///< rays x the TLAS's depth (log2 of its instances)
     std::uint64_t dispatches = 1, blasBuilds = 0, blasRefits = 0;  ///< launches beside the threads (PassCounters)
     BuildCounters build;                                          ///< buildClusters: primitives built, TLAS instances

@@ -18,7 +18,9 @@ inline bool visible(const ParticleBvh& bvh, const VisibilityOptions& v, const Sh
                     const Vec3& p, float r, const LightTerm& t, RayCounters* counters = nullptr) {
     const ShadowQuery q = shadowQuery<P>(v, sp, i, p, r, t);
     if (!(q.tfar > q.tnear)) return true;
-    return !bvh.occluded(q.o, q.d, q.tnear, q.tfar, q.exclude, counters);
+    const bool blocked = bvh.occluded(q.o, q.d, q.tnear, q.tfar, q.exclude, counters);
+    if (counters) counters->misses += !blocked;
+    return !blocked;
 }
 
 }  // namespace accretion
