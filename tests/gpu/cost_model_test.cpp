@@ -260,7 +260,7 @@ TEST_CASE("a build's elements are counted whole and clamped at the knots, refits
     CHECK(b.elements == b.primitives + 5000u);
     CHECK(b.elementsSmall == b.primitivesSmall + 1024u);
     CHECK(b.elementsMid == b.primitivesMid + 5000u);
-    CHECK(b.customBuilds == 2u);
+    CHECK(b.customBuilds == 1u);  // a refit of boxes costs what a refit of triangles does
     CHECK(b.tlasInstances == 4u);
     BuildCounters refitTlas;
     refitTlas.addTlas(100000, true);
