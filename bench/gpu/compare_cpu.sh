@@ -84,6 +84,7 @@ restir_case basic_scale0.75 basic_scale0.75 -D restir.resolution_scale=0.75
 restir_case basic_omm4 basic_omm4 "${disc[@]}" -D gpu.omm=4state -D gpu.omm_level=4
 restir_case basic_omm4_traverse basic_omm4
 restir_case restir_power restir_power -D render.source=power
+restir_case restir_tree restir_tree -D render.source=tree
 
 # uniform and power (one frame): Lr, its standard error and the samples taken.
 declare -A sampled=(

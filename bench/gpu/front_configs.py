@@ -1,10 +1,8 @@
 #!/usr/bin/env python3
 """The configurations `accretion tune` put on its Pareto front, as lines for
 bench/gpu/run.sh's front step ("name  -D overrides...", on
-scenes/disk_100k.toml). The twin has no light tree: a front configuration
-whose candidates come from the tree is timed with candidates by power (the
-same passes and counts; the tree's extra reads are the model's alone), and
-its name says so (_as_power).
+scenes/disk_100k.toml), each timed as tune priced it (the twin draws
+candidates from the CPU's light tree, tiles and ReGIR excepted).
 Usage: front_configs.py OUT.txt TUNE.json..."""
 import json
 import sys
@@ -30,11 +28,10 @@ def main():
             bc = lighting[3].replace("+vis", "")
             vis = "+vis" in lighting[3]
             scale = lighting[4].rstrip("x")
-            twin_src = "power" if src == "tree" else src
-            defines += [f"render.source={twin_src}", f"render.candidates={m}", f"restir.spatial_neighbours={nb}",
+            defines += [f"render.source={src}", f"render.candidates={m}", f"restir.spatial_neighbours={nb}",
                         f"restir.spatial_iterations={it}", f"restir.bias_correction={bc}",
                         f"restir.visibility_reuse={'true' if vis else 'false'}", f"restir.resolution_scale={scale}"]
-            name = f"{tag}_f{k}" + ("_as_power" if src == "tree" else "")
+            name = f"{tag}_f{k}"
             lines.append(f"{name:40} " + " ".join(f"-D {d}" for d in defines) + f"   # {row['lighting']}")
     open(out, "w").write("\n".join(lines) + "\n")
     print(f"{out}: {len(lines) - 1} configurations")

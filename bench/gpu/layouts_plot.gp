@@ -6,7 +6,7 @@
 set datafile separator ','
 set terminal pngcairo size 1400,560 font ',11'
 set output 'bench/gpu/results/layouts.png'
-set multiplot layout 1,2 title "Seed 004's decision matrix on an H100 without RT cores (software traversal), restir at 1920x1080, frame 1 (bench/gpu/results/layouts.csv)"
+set multiplot layout 1,2 title "Seed 004's decision matrix on an H100 without RT cores (software traversal), restir at 1920x1080, frame 1 (bench/gpu/results/layouts.csv, at b34c03169a)"
 set logscale xy
 set grid
 set key top left
@@ -18,8 +18,8 @@ plot for [p in '10000 100000 1000000'] 'bench/gpu/results/layouts.csv' \
      using (single(p) ? column(13) : NaN):(column(20)) with linespoints pt 7 title sprintf('%s particles, triangle clusters', p), \
      '' using ((strcol(5) eq '1920' && strcol(7) eq 'instances' && strcol(10) eq 'rebuild') ? column(13) : NaN):(column(20)) \
         with points pt 5 ps 1.5 title 'one instance per particle (TLAS build)', \
-     '' using ((strcol(5) eq '1920' && strcol(7) eq 'aabbs') ? column(13) : NaN):(column(20)) with points pt 9 ps 1.5 title 'procedural boxes', \
-     '' using ((strcol(5) eq '1920' && strcol(8) eq 'sphere') ? column(13) : NaN):(column(20)) with points pt 11 ps 1.5 title 'built-in spheres'
+     '' using ((strcol(5) eq '1920' && strcol(7) eq 'aabbs' && strcol(10) eq 'rebuild') ? column(13) : NaN):(column(20)) with points pt 9 ps 1.5 title 'procedural boxes', \
+     '' using ((strcol(5) eq '1920' && strcol(8) eq 'sphere' && strcol(10) eq 'rebuild') ? column(13) : NaN):(column(20)) with points pt 11 ps 1.5 title 'built-in spheres'
 unset logscale x
 set logscale y
 set xlabel 'particles'
@@ -35,5 +35,7 @@ plot 'bench/gpu/results/layouts.csv' using (row('clusters','billboard','100','re
      '' using (row('clusters','billboard','all','refit') ? column(4) : NaN):(column(24)) w lp pt 6 title 'one triangle BLAS, refit', \
      '' using (row('instances','billboard','1 (instance)','refit') ? column(4) : NaN):(column(24)) w lp pt 5 title 'instance per particle, TLAS refit', \
      '' using (row('aabbs','billboard','all','rebuild') ? column(4) : NaN):(column(24)) w lp pt 9 title 'one BLAS of procedural boxes', \
-     '' using (row('clusters','sphere','all','rebuild') ? column(4) : NaN):(column(24)) w lp pt 11 title 'one BLAS of built-in spheres'
+     '' using (row('aabbs','billboard','all','refit') ? column(4) : NaN):(column(24)) w lp pt 8 title 'one BLAS of procedural boxes, refit', \
+     '' using (row('clusters','sphere','all','rebuild') ? column(4) : NaN):(column(24)) w lp pt 11 title 'one BLAS of built-in spheres', \
+     '' using (row('clusters','sphere','all','refit') ? column(4) : NaN):(column(24)) w lp pt 10 title 'one BLAS of built-in spheres, refit'
 unset multiplot

@@ -94,6 +94,7 @@ step_sampling() {
     $BIN $q $small -D render.estimator=power -D render.samples=16 -D geometry.alpha=disc --frames 0:1 --repeat 3 \
         -o "$t/power_disc.{frame}.exr"
     $BIN $q $small -D render.estimator=restir -D render.source=power --frames 0:3 --repeat 3 -o "$t/restir_power.{frame}.exr"
+    $BIN $q $small -D render.estimator=restir -D render.source=tree --frames 0:3 --repeat 3 -o "$t/restir_tree.{frame}.exr"
     $BIN scenes/disk_100k.toml --frames 0:1 --repeat 5 -o "$t/disk_100k_power64.{frame}.exr" \
         --timings "$t/disk_100k_power64.csv" --config power64
 }

@@ -6,6 +6,7 @@
 #include <optix_types.h>
 
 #include "accretion/geometry/billboard.h"
+#include "accretion/lighting/light_tree_view.h"
 #include "accretion/lighting/source_pmf.h"
 #include "accretion/lighting/reservoir_codec.h"
 #include "accretion/render/accumulation.h"
@@ -115,6 +116,7 @@ struct LaunchParams {
 
     LightView lights;                    ///< this frame's lights (the same arrays as above)
     SourcePmf source;                    ///< power's lights and restir's candidates (render.source) of this frame
+    LightTreeView tree;                  ///< render.source = "tree": the CPU's light tree (nodes null otherwise)
     SamplingParams sampling;
     RestirParams restir;
 

@@ -31,7 +31,7 @@ __device__ inline void onTexel(const LaunchParams& p, Step&& step) {
     step(t);
 }
 
-/// generateCandidates: RIS of `candidates` lights from the source pmf (render.source) with target p_hat.
+/// generateCandidates: RIS of `candidates` lights from the source pmf or the light tree (render.source) with target p_hat.
 template <ShadingModel SM>
 __global__ void generateCandidatesKernel(LaunchParams p) {
     onTexel(p, [&](const Texel& t) {
@@ -41,7 +41,7 @@ __global__ void generateCandidatesKernel(LaunchParams p) {
         if (!g.hit()) return;
         const ShadingPoint sp = shadingPointOf(g, p.lights);
         PortableRng rng(px, rp.frame, RngPass::restirCandidates, rp.seed);
-        const auto draw = [&](PortableRng& g) { return p.source.sample(g); };
+        const auto draw = [&](PortableRng& g) { return p.tree.nodes ? p.tree.sample(sp, g) : p.source.sample(g); };
         const auto target = [&](std::uint32_t i) { return targetPdf<SM>(p.lights, sp, i); };
         Reservoir r;
         if (!restir::resampleCandidates(rp.candidates, rng, draw, target, [&] { return rejectAt(rp, px); }, r)) return;

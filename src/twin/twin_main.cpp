@@ -27,6 +27,7 @@
 #include "accretion/io/gpu_frame_file.h"
 #include "accretion/io/provenance.h"
 #include "accretion/lighting/light_sampler.h"
+#include "accretion/lighting/light_tree.h"
 #include "accretion/particles/particle_source.h"
 #include "accretion/render/accumulation.h"
 #include "accretion/render/compose_pixel.h"
@@ -72,7 +73,6 @@ void requireSupported(const Settings& s, bool lighting) {
     if (lighting && !estimatorInfo(e).twin) refuse(fmt::format("render.estimator = \"{}\"", enumName(e)));
     if (lighting && estimatorInfo(e).reuse) {
         const RestirSettings& r = s.restir;
-        if (s.render.source == LightSource::tree) refuse("render.source = \"tree\"");
         if (s.render.source == LightSource::tiles) refuse("render.source = \"tiles\"");
         if (s.render.source == LightSource::regir) refuse("render.source = \"regir\"");
         if (r.layout != ReservoirLayout::full) refuse("restir.layout = \"packed\"");
@@ -91,6 +91,7 @@ struct FrameBuffers {
     DeviceBuffer gridGbuffer, gridLr;  // restir.resolution_scale < 1: the lighting grid
     DeviceBuffer prevPosition, prevEmission, prevAlbedo, prevDmin2, prevGbuffer, prevReservoirs;
     DeviceBuffer aliasProb, aliasAlias, aliasPmf;  // power: the alias table
+    DeviceBuffer treeNodes;                       // tree: the light tree's nodes
     DeviceBuffer Lr_stderr, spp, rejectedSamples;  // uniform / power
 };
 
@@ -319,6 +320,12 @@ LaunchParams TwinRun::launchParams(const FramePlan& plan, const Camera& camera, 
         buf_.aliasPmf.upload(table.pmfs());
         lp.source.power = true;
         lp.source.table = {buf_.aliasProb.as<float>(), buf_.aliasAlias.as<std::uint32_t>(), buf_.aliasPmf.as<float>()};
+    }
+    if (plan.sampler == LightSamplerKind::tree) {  // buildLightSampler's light tree: the CPU's nodes, the same descent
+        const LightTree tree(particles, s_.shading);
+        buf_.treeNodes.upload(tree.nodes());
+        lp.tree = tree.view();
+        lp.tree.nodes = buf_.treeNodes.as<LightTreeNode>();
     }
     lp.source.count = lp.lights.count;
     lp.source.uniformPdf = lp.lights.uniformPdf;

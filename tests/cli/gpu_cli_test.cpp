@@ -223,6 +223,36 @@ TEST_CASE("cost counts the launches of the builds: one per BLAS rebuilt, refitte
     for (const auto& [policy, columns] : build) CHECK(columns.at("dispatches") == 1);
 }
 
+TEST_CASE("cost counts the rays that found nothing, and a traced pass's working set holds the TLAS", "[cli][gpu]") {
+    const auto dir = accretion::test::scratchDir("cost_misses");
+    std::string out;
+    const std::string run = kBin + " cost " + tinyScene() + " --quiet --frames 1 --history 1 --overhead 0 --cluster-sizes \"\" " +
+                            "--omm-levels \"\" -D render.estimator=\\\"restir\\\" -D geometry.layout=\\\"instances\\\" -o " +
+                            (dir / "c.json").string();
+    INFO(run);
+    REQUIRE(runCommand(run, out) == 0);
+    const nlohmann::json j = nlohmann::json::parse(slurp(dir / "c.json"));
+    std::map<std::string, nlohmann::json> pass;
+    for (const auto& p : j["passes"]) pass[p["pass"].get<std::string>()] = p;
+    // A primary ray misses on exactly the pixels whose thread found no hit
+    // (hit_threads is counted apart, by the shading that follows a hit).
+    const nlohmann::json& g = pass.at("traceGBuffer");
+    CHECK(g["misses"].get<double>() == g["threads"].get<double>() - g["hit_threads"].get<double>());
+    CHECK(g["misses"].get<double>() > 0.0);
+    // Shadow rays in a cloud of particles: some are blocked, some not.
+    const nlohmann::json& s = pass.at("traceShadowRays");
+    CHECK(s["misses"].get<double>() > 0.0);
+    CHECK(s["misses"].get<double>() < s["rays"].get<double>());
+    // Passes without rays have none.
+    CHECK(pass.at("temporalResampling")["misses"].get<double>() == 0.0);
+    // One instance per particle: the traced passes read the TLAS, 208 B an
+    // instance, beside one BLAS of two triangles.
+    const double particles = pass.at("buildClusters")["threads"].get<double>();
+    REQUIRE(particles > 100);
+    CHECK(g["working_set_bytes"].get<double>() >= 208.0 * particles);
+    CHECK(g["working_set_bytes"].get<double>() < 208.0 * particles + 4096.0);
+}
+
 TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbiased one under the budget, cached",
           "[cli][gpu][tune]") {
     const auto dir = accretion::test::scratchDir("tune");

@@ -6,6 +6,7 @@
 #include "accretion/core/math.h"
 #include "accretion/core/rng.h"
 #include "accretion/lighting/light_sample.h"
+#include "accretion/lighting/light_tree_view.h"
 #include "accretion/lighting/near_field.h"
 #include "accretion/particles/particles.h"
 #include "accretion/lighting/shading.h"
@@ -27,8 +28,8 @@ public:
     LightTree(const Particles& particles, const ShadingSettings& shading);
 
     /// Draw a light for the receiver: one uniform per level down to a node of
-    /// at most kExactBelow lights, then one among its leaves.
-    LightSample sample(const ShadingPoint& sp, Rng& rng) const;
+    /// at most kExactBelow lights, then one among its leaves (LightTreeView::sample).
+    LightSample sample(const ShadingPoint& sp, Rng& rng) const { return view().sample(sp, rng); }
     /// Probability that sample() returns light i at this receiver.
     float pdf(const ShadingPoint& sp, std::uint32_t i) const;
 
@@ -49,20 +50,15 @@ public:
     /// Probability that sampleFar() returns light i (0 for a near light).
     float pdfFar(const ShadingPoint& sp, const NearField& near, std::uint32_t i) const;
 
+    /// The descent over the node array, as plain data (what the OptiX twin uploads).
+    LightTreeView view() const { return {nodes_.data(), static_cast<std::uint32_t>(nodes_.size()), model_}; }
+    const std::vector<LightTreeNode>& nodes() const { return nodes_; }
     std::size_t nodeCount() const { return nodes_.size(); }
     std::uint32_t depth() const { return depth_; }
     std::size_t bytes() const { return nodes_.size() * sizeof(Node) + trail_.size() * sizeof(Trail); }
 
 private:
-    struct Node {
-        Vec3 center;          ///< centre of the bounding sphere of the positions
-        float radius;         ///< bounding sphere radius (0 for a leaf)
-        float power;          ///< sum of luminance(I) below
-        float dmin2;          ///< leaf: the light's squared distance clamp
-        std::uint32_t child;  ///< interior: left child (right = child + 1); leaf: light index
-        std::uint32_t count;  ///< lights below (1: a leaf)
-        Vec3 lo, hi;          ///< box of the positions below (a leaf: its position)
-    };
+    using Node = LightTreeNode;
     struct Trail {
         std::uint64_t bits;   ///< bit k: went right at depth k
         std::uint32_t depth;
@@ -71,24 +67,19 @@ private:
 
     void build(std::uint32_t node, std::vector<std::uint32_t>& ids, std::uint32_t begin, std::uint32_t end,
                const Particles& particles, std::uint64_t bits, std::uint32_t depth);
-    /// The node's bound of the terms below it with `power` in place of its
-    /// own, every light below being at least sqrt(minDist2) away (split: the
-    /// far lights lie beyond the near field's farthest).
-    float importance(const Node& node, float power, const ShadingPoint& sp, float minDist2 = 0.0f) const;
-    /// The importance a descent gives node n: importance() for a large node;
-    /// for a node of at most kExactBelow lights, the sum of its leaves' own
-    /// (the lights in `excluded` left out), so that a descent never ends
-    /// below it on lights that all have no term.
+    /// LightTreeView::importance, descentImportance and smallNodeLeaves over this tree.
+    float importance(const Node& node, float power, const ShadingPoint& sp, float minDist2 = 0.0f) const {
+        return view().importance(node, power, sp, minDist2);
+    }
     float descentImportance(std::uint32_t n, float power, const ShadingPoint& sp, float minDist2 = 0.0f,
-                            const std::uint32_t* excluded = nullptr, std::uint32_t excludedCount = 0) const;
-    static constexpr std::uint32_t kExactBelow = 8;
-    /// The leaves of a node of at most kExactBelow lights, with their importances.
-    struct SmallNode {
-        std::uint32_t leaf[kExactBelow];
-        float importance[kExactBelow];
-        float total;
-    };
-    std::uint32_t smallNodeLeaves(std::uint32_t n, const ShadingPoint& sp, SmallNode& out) const;
+                            const std::uint32_t* excluded = nullptr, std::uint32_t excludedCount = 0) const {
+        return view().descentImportance(n, power, sp, minDist2, excluded, excludedCount);
+    }
+    static constexpr std::uint32_t kExactBelow = LightTreeView::kExactBelow;
+    using SmallNode = LightTreeSmallNode;
+    std::uint32_t smallNodeLeaves(std::uint32_t n, const ShadingPoint& sp, SmallNode& out) const {
+        return view().smallNodeLeaves(n, sp, out);
+    }
     /// The far importances of children c and c + 1, whose near lights are
     /// near.light[lo, mid) and [mid, hi): one step of sampleFar / pdfFar.
     std::pair<float, float> farChildren(std::uint32_t c, const NearField& near, std::uint32_t lo, std::uint32_t mid,
