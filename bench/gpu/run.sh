@@ -120,7 +120,7 @@ step_seeds() {
 step_sweep() {
     local t="$W/sweep" part=${SWEEP_PART:-1/1} k=0
     mkdir -p "$t"
-    grep -v '^#' bench/gpu/sweep.txt | while read -r name args; do
+    grep -v '^#' "${SWEEP_LIST:-bench/gpu/sweep.txt}" | while read -r name args; do
         [ -z "$name" ] && continue
         k=$((k + 1))
         [ $(((k - 1) % ${part#*/})) -eq $((${part%/*} - 1)) ] || continue
