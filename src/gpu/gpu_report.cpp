@@ -51,8 +51,6 @@ PassReport summarise(const PassCounters& pc, const GpuSettings& gpu, const SerKe
     p.width = pc.width;
     p.height = pc.height;
     p.dispatches = pc.dispatches;
-    p.blasBuilds = pc.blasBuilds;
-    p.blasRefits = pc.blasRefits;
     p.build = pc.build;
     for (const ThreadCounters& t : pc.threads) {
         p.threads += t.active;
@@ -151,8 +149,8 @@ nlohmann::json toJson(const PassReport& p) {
             {"blas_levels", p.blasLevels},
             {"omm_lookups", p.ommLookups},
             {"dispatches", p.dispatches},
-            {"blas_builds", p.blasBuilds},
-            {"blas_refits", p.blasRefits},
+            {"blas_builds", p.build.blasBuilds},
+            {"blas_refits", p.build.blasRefits},
             {"build_launches", p.build.builds},
             {"refit_launches", p.build.refits},
             {"accel_elements", p.build.elements},

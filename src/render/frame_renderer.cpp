@@ -39,7 +39,6 @@ void recordClusterBuild(const ParticleBvh& bvh, const Particles& particles, Fram
     }
     PassCounters& pc = counters.add(pass::buildClusters, static_cast<std::uint32_t>(clusters.count()), 1);
     pc.dispatches = 1;  // the primitive expansion; the builds are counted apart
-    (s.refitted ? pc.blasRefits : pc.blasBuilds) = s.rebuiltClusters;
     const bool triangles = g.primitive == Primitive::billboard && g.layout == AccelLayout::clusters;
     const bool custom = !triangles;  // boxes or spheres
     for (std::size_t c = 0; c < clusters.count(); ++c) {

@@ -254,6 +254,8 @@ TEST_CASE("a build's elements are counted whole and clamped at the knots, refits
     b.addTlas(4, false);
     CHECK(b.builds == 4u);
     CHECK(b.refits == 1u);
+    CHECK(b.blasBuilds == 3u);  // the TLAS is a launch, not a BLAS
+    CHECK(b.blasRefits == 1u);
     CHECK(b.primitives == 50u + 2000u + 2000000u + 4u);
     CHECK(b.primitivesSmall == 50u + 1024u + 1024u + 4u);
     CHECK(b.primitivesMid == 50u + 2000u + 32768u + 4u);

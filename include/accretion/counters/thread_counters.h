@@ -64,6 +64,7 @@ struct ThreadCounters {
 /// instances like any other: an OptiX TLAS is a BVH over instance boxes.
 struct BuildCounters {
     std::uint64_t builds = 0, refits = 0;   ///< launches, BLAS and TLAS
+    std::uint64_t blasBuilds = 0, blasRefits = 0;  ///< of them, the BLAS's
     std::uint64_t elements = 0, elementsSmall = 0, elementsMid = 0;      ///< built or refitted
     std::uint64_t primitives = 0, primitivesSmall = 0, primitivesMid = 0;  ///< built
     std::uint64_t customBuilds = 0;  ///< BLAS builds of procedural boxes or spheres (dearer than triangles'; their refits are not)
@@ -74,6 +75,7 @@ struct BuildCounters {
     /// One BLAS of n primitives built, or refitted.
     void addBlas(std::uint64_t n, bool custom, bool refit = false) {
         add(n, refit);
+        (refit ? blasRefits : blasBuilds) += 1;
         customBuilds += custom && !refit;
     }
     /// The TLAS over n instances built, or refitted.
@@ -102,10 +104,8 @@ struct PassCounters {
     std::uint32_t run = 1;  ///< 1 for a pass's first run in the frame, 2 for its second (spatial iterations)...
     std::uint32_t width = 0, height = 0;
     std::vector<ThreadCounters> threads;
-    // Launches beside the threads (cost model features): kernel dispatches,
-    // and for buildClusters the BLAS built and refitted (one launch each).
-    std::uint64_t dispatches = 1, blasBuilds = 0, blasRefits = 0;
-    BuildCounters build;  ///< buildClusters only
+    std::uint64_t dispatches = 1;  ///< kernel dispatches (a cost model feature); builds are in `build`
+    BuildCounters build;           ///< buildClusters only
 
     PassCounters() = default;
     PassCounters(std::string_view name, std::uint32_t w, std::uint32_t h)

@@ -39,7 +39,14 @@ inline constexpr std::size_t kColdWork = 11;
 /// A pass's counters of the other kind are 0 or, like the build pass's
 /// threads (one per cluster: collinear with its launches), say nothing of
 /// its time, and a fit that gives them weight extrapolates badly.
-constexpr bool isBuildFeature(std::size_t k) { return (k >= 9 && k <= 10) || (k >= 12 && k <= 18); }
+constexpr bool isBuildFeature(std::size_t k) {
+    constexpr std::string_view build[] = {"build_launches",   "refit_launches",      "accel_elements",
+                                          "accel_elements_1k", "accel_elements_32k", "build_primitives",
+                                          "build_primitives_1k", "build_primitives_32k", "custom_builds"};
+    for (std::string_view b : build)
+        if (kCostFeatures[k] == b) return true;
+    return false;
+}
 using CostFeatures = std::array<double, kCostFeatures.size()>;
 
 /// The committed calibration (compiled in from this file of the source tree).

@@ -24,8 +24,8 @@ struct PassReport {
     std::uint64_t intersections = 0;                             ///< intersection-program invocations (boxes, spheres)
     std::uint64_t misses = 0;                                    ///< rays that found nothing (a shadow ray unblocked)
     std::uint64_t tlasLevels = 0;                                ///< rays x the TLAS's depth (log2 of its instances)
-    std::uint64_t dispatches = 1, blasBuilds = 0, blasRefits = 0;  ///< launches beside the threads (PassCounters)
-    BuildCounters build;                                          ///< buildClusters: primitives built, TLAS instances
+    std::uint64_t dispatches = 1;                                ///< kernel dispatches (PassCounters)
+    BuildCounters build;                                          ///< buildClusters: launches, elements, TLAS instances
     /// Bytes of what the pass reads at random: the acceleration structures
     /// (traced passes), the light records (restir's resampling passes), else
     /// 0. With more of it than a cache holds, its reads miss (the cost model's

@@ -67,10 +67,7 @@ private:
 
     void build(std::uint32_t node, std::vector<std::uint32_t>& ids, std::uint32_t begin, std::uint32_t end,
                const Particles& particles, std::uint64_t bits, std::uint32_t depth);
-    /// LightTreeView::importance, descentImportance and smallNodeLeaves over this tree.
-    float importance(const Node& node, float power, const ShadingPoint& sp, float minDist2 = 0.0f) const {
-        return view().importance(node, power, sp, minDist2);
-    }
+    /// LightTreeView::descentImportance and smallNodeLeaves over this tree.
     float descentImportance(std::uint32_t n, float power, const ShadingPoint& sp, float minDist2 = 0.0f,
                             const std::uint32_t* excluded = nullptr, std::uint32_t excludedCount = 0) const {
         return view().descentImportance(n, power, sp, minDist2, excluded, excludedCount);
