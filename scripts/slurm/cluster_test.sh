@@ -78,7 +78,7 @@ for _ in $(seq 60); do
     sinfo -h -o %T 2>/dev/null | grep -q idle && break
     sleep 1
 done
-sinfo -h -o %T 2>/dev/null | grep -q idle || fail "the node never became idle: $(tail -3 "$WORK/slurmctld.log" "$WORK/slurmd.log" 2>&1)"
+sinfo -h -o %T 2>/dev/null | grep -q idle || fail "the node never became idle: $(tail -n 3 "$WORK/slurmctld.log" "$WORK/slurmd.log" 2>&1)"
 say "one-node cluster up ($NODE, $CPUS CPUs)"
 
 # Wait for job $1 (all its array tasks) to leave the queue.
@@ -88,6 +88,10 @@ wait_job() {
         sleep 1
     done
     fail "job $1 still queued after 10 minutes"
+}
+# One field of job $1's record in slurmctld ("" once slurmctld has forgotten it).
+job_field() {
+    scontrol -o show job "$1" 2>/dev/null | head -1 | grep -o " $2=[^ ]*" | cut -d= -f2
 }
 # The pixels of two EXRs are bit-identical (every channel, float compare at 0 tolerance).
 same_pixels() {
@@ -104,7 +108,7 @@ JOB=$(sbatch --parsable --array=0-3 --cpus-per-task=1 --time=10 "$WORK/reference
 say "job array $JOB submitted"
 wait_job "$JOB"
 for t in 0 1 2 3; do
-    grep -q "^stats:" "slurm-${JOB}_$t.out" || fail "task $t did not finish: $(tail -5 "slurm-${JOB}_$t.out")"
+    grep -q "^stats:" "slurm-${JOB}_$t.out" || fail "task $t did not finish: $(tail -n 5 "slurm-${JOB}_$t.out")"
 done
 "$BIN" merge "$OUT"/quickstart.0000.shard*of4.exr -o "$WORK/out/merged.exr" >/dev/null
 "$BIN" render "$SCENE" "${SCENE_ARGS[@]}" --quiet --estimator tree --spp 256 --frames 0 -o "$WORK/out/single.exr" >/dev/null
@@ -113,35 +117,41 @@ say "PASS: the merged job array equals a single run bit for bit"
 
 # Signal, requeue, resume: one task with enough samples to be stopped mid-frame.
 export SPP=131072 SHARDS=1 OUT=$WORK/out/requeue
-JOB=$(sbatch --parsable --array=0-0 --cpus-per-task=$CPUS --time=10 "$WORK/reference.sbatch")
+JOB=$(sbatch --parsable --requeue --array=0-0 --cpus-per-task=$CPUS --time=10 "$WORK/reference.sbatch")
 LOG=slurm-${JOB}_0.out
 for _ in $(seq 120); do grep -q "accretion: frame 0" "$LOG" 2>/dev/null && break; sleep 0.5; done
-grep -q "accretion: frame 0" "$LOG" || fail "the task never started: $(tail -3 "$LOG" 2>&1)"
+grep -q "accretion: frame 0" "$LOG" || fail "the task never started: $(tail -n 3 "$LOG" 2>&1)"
 sleep 3
-scancel --signal=TERM "$JOB" || fail "the task ended before it could be signalled: $(tail -3 "$LOG")"
-for _ in $(seq 120); do
-    [[ $(squeue -h -j "$JOB" -o %T 2>/dev/null) == "" || $(squeue -h -j "$JOB" -o %T) =~ ^(COMPLETED|FAILED)$ ]] && break
+scancel --signal=TERM "$JOB" || fail "the task ended before it could be signalled: $(tail -n 3 "$LOG")"
+# The first run must be over (a final state, not COMPLETING) before the requeue.
+for _ in $(seq 240); do
+    [[ $(job_field "$JOB" JobState) =~ ^(FAILED|COMPLETED|CANCELLED|)$ ]] && break
     sleep 0.5
 done
-grep -q "checkpoint" "$LOG" || fail "no checkpoint after SIGTERM: $(tail -5 "$LOG")"
+grep -q "checkpoint" "$LOG" || fail "no checkpoint after SIGTERM: $(tail -n 5 "$LOG")"
 cp "$LOG" "$WORK/first_run.log"
-scontrol requeue "$JOB" 2>/dev/null || scontrol requeue "${JOB}_0"
-# A requeued job otherwise waits a few minutes before it is eligible; the
-# array task may take the update under either id, and not at once after the
-# requeue: ask again until the second run starts. Right after the requeue
-# squeue may list the job under no state for a moment: wait for the second
-# run to start before waiting for it to end.
+# Requeue, and again while the job sits in a final state without having
+# resumed: a requeue within the second of the kill can be allocated at once and
+# refused by slurmd ("Job credential revoked"), which ends the job again. A
+# requeued job otherwise waits a few minutes before it is eligible, so its
+# start time is moved to now (the array task takes the update under either id).
+sleep 2
 for k in $(seq 480); do
     grep -q "resuming" "$LOG" 2>/dev/null && break
     if (( k % 10 == 1 )); then
+        if [[ $(job_field "$JOB" JobState) =~ ^(FAILED|COMPLETED|CANCELLED|)$ ]]; then
+            scontrol requeue "$JOB" 2>/dev/null || scontrol requeue "${JOB}_0" 2>/dev/null || true
+        fi
         scontrol update JobId="$JOB" StartTime=now 2>/dev/null || true
         scontrol update JobId="${JOB}_0" StartTime=now 2>/dev/null || true
     fi
     sleep 0.5
 done
+grep -q "resuming" "$LOG" || fail "the requeued task never started: $(scontrol -o show job "$JOB" 2>&1 | grep -o 'JobState=[^ ]* Reason=[^ ]*\|Restarts=[^ ]*' | tr '\n' ' ')
+$(grep -i "JobId=${JOB}" "$WORK/slurmctld.log" | tail -8)"
 wait_job "$JOB"
-grep -q "resuming .* at frame 0, chunk [1-9]" "$LOG" || fail "the requeued task did not resume from its checkpoint: $(grep -i resum "$LOG" || tail -5 "$LOG")"
-grep -q "^stats:" "$LOG" || fail "the requeued task did not finish: $(tail -5 "$LOG")"
+grep -q "resuming .* at frame 0, chunk [1-9]" "$LOG" || fail "the requeued task did not resume from its checkpoint: $(grep -i resum "$LOG" || tail -n 5 "$LOG")"
+grep -q "^stats:" "$LOG" || fail "the requeued task did not finish: $(tail -n 5 "$LOG")"
 "$BIN" render "$SCENE" "${SCENE_ARGS[@]}" --quiet --estimator tree --spp 131072 --frames 0 -o "$WORK/out/uninterrupted.exr" >/dev/null
 same_pixels "$OUT/quickstart.0000.exr" "$WORK/out/uninterrupted.exr"
 say "PASS: scancel --signal=TERM, requeue, resume: $(grep -o 'resuming .*' "$LOG" | head -1); image equals an uninterrupted run bit for bit"
