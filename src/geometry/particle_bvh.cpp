@@ -240,6 +240,27 @@ void instanceOccluded(const RTCOccludedFunctionNArguments* args) {
     args->context->instID[0] = RTC_INVALID_GEOMETRY_ID;
 }
 
+/// The probe's query: counts the particles' boxes the ray passes through and
+/// reports none, so that Embree visits every one along the segment.
+struct ProbeContext {
+    RTCIntersectContext base;
+    const RTCBounds* boxes;
+    std::uint32_t crossed;
+};
+
+void probeBounds(const RTCBoundsFunctionArguments* args) {
+    *args->bounds_o = static_cast<const RTCBounds*>(args->geometryUserPtr)[args->primID];
+}
+
+void probeIntersect(const RTCIntersectFunctionNArguments* args) {
+    if (args->N != 1 || args->valid[0] != -1) return;
+    auto* context = reinterpret_cast<ProbeContext*>(args->context);
+    const auto* ray = reinterpret_cast<const RTCRay*>(args->rayhit);
+    const float org[3] = {ray->org_x, ray->org_y, ray->org_z}, dir[3] = {ray->dir_x, ray->dir_y, ray->dir_z};
+    // Embree hands over every primitive of a leaf it enters: count the boxes the ray enters.
+    context->crossed += overlapsBounds(context->boxes[args->primID], org, dir, ray->tnear, ray->tfar);
+}
+
 RTCBuildQuality sceneQuality(BuildPolicy p) {
     return p == BuildPolicy::fast_trace ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_LOW;
 }
@@ -280,6 +301,8 @@ void ParticleBvh::releaseBlas() {
     tlas_ = nullptr;
     if (countingTlas_) rtcReleaseScene(countingTlas_);
     countingTlas_ = nullptr;
+    if (probe_) rtcReleaseScene(probe_);
+    probe_ = nullptr;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blas_.size(), 16), [&](const auto& r) {
         for (std::size_t c = r.begin(); c != r.end(); ++c) rtcReleaseScene(blas_[c]);
     });
@@ -408,6 +431,45 @@ void ParticleBvh::buildCountingTlas() {
     rtcCommitScene(countingTlas_);
 }
 
+void ParticleBvh::buildProbe(const Particles& particles) {
+    const std::size_t n = particles.size();
+    probeBoxes_.resize(n);
+    const bool billboards = settings_.primitive == Primitive::billboard;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const auto& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const Vec3 p = particles.position[i];
+            const float rad = particles.radius[i];
+            // The quad's box (its corners p +- a +- b), or the sphere's.
+            const Vec3 h = billboards ? billboardExtent(rad, frames_[i]) : Vec3(rad);
+            probeBoxes_[i] = {p.x - h.x, p.y - h.y, p.z - h.z, 0.0f, p.x + h.x, p.y + h.y, p.z + h.z, 0.0f};
+        }
+    });
+    if (probe_) rtcReleaseScene(probe_);
+    probe_ = rtcNewScene(device_.get());
+    RTCGeometry g = rtcNewGeometry(device_.get(), RTC_GEOMETRY_TYPE_USER);
+    rtcSetGeometryUserPrimitiveCount(g, static_cast<unsigned>(n));
+    rtcSetGeometryUserData(g, probeBoxes_.data());
+    rtcSetGeometryBoundsFunction(g, &probeBounds, probeBoxes_.data());
+    rtcSetGeometryIntersectFunction(g, &probeIntersect);
+    rtcCommitGeometry(g);
+    rtcAttachGeometryByID(probe_, g, 0);
+    rtcReleaseGeometry(g);
+    rtcCommitScene(probe_);
+}
+
+std::uint32_t ParticleBvh::boxesAlong(const Vec3& o, const Vec3& d, float tnear, float tfar) const {
+    ProbeContext context;
+    rtcInitIntersectContext(&context.base);
+    context.boxes = probeBoxes_.data();
+    context.crossed = 0;
+    RTCRayHit rh;
+    rh.ray = embreeRay(o, d, tnear, tfar);
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(probe_, &context.base, &rh);
+    return context.crossed;
+}
+
 void ParticleBvh::build(const Particles& particles, const Camera& camera) {
     stats_ = BvhStats{};
     const std::size_t n = particles.size();
@@ -462,7 +524,10 @@ void ParticleBvh::build(const Particles& particles, const Camera& camera) {
 
     t0 = std::chrono::steady_clock::now();
     buildTlas();
-    if (counting_) buildCountingTlas();
+    if (counting_) {
+        buildCountingTlas();
+        buildProbe(particles);
+    }
     device_.check("buildClusters (TLAS)");
     stats_.tlasSeconds = secondsSince(t0);
 
@@ -483,6 +548,7 @@ bool ParticleBvh::intersect(const Vec3& o, const Vec3& d, float tfar, SurfaceHit
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(counters && countingTlas_ ? countingTlas_ : tlas_, &context.base, &rh);
+    if (counters && probe_) counters->segmentBoxes += boxesAlong(o, d, 0.0f, rh.ray.tfar);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
     const std::uint32_t c = rh.hit.instID[0];
     const std::uint32_t local = rh.hit.primID;
@@ -537,6 +603,7 @@ bool ParticleBvh::occluded(const Vec3& o, const Vec3& d, float tnear, float tfar
                                         exclude.light == kNotExcluded ? kNoKey : where_[exclude.light]);
     RTCRay ray = embreeRay(o, d, tnear, tfar);
     rtcOccluded1(counters && countingTlas_ ? countingTlas_ : tlas_, &context.base, &ray);
+    if (counters && probe_) counters->segmentBoxes += boxesAlong(o, d, tnear, tfar);
     return ray.tfar < 0.0f;
 }
 

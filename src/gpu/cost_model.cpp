@@ -38,7 +38,8 @@ CostFeatures costFeatures(const PassReport& p, double cacheBytes) {
             coldWork(double(p.rays), bytes, p.workingSetBytes, cacheBytes),
             double(b.elements),      double(b.elementsSmall),   double(b.elementsMid),   double(b.primitives),
             double(b.primitivesSmall), double(b.primitivesMid), double(b.customBuilds),  double(p.intersections),
-            double(p.tlasLevels),    double(p.misses)};
+            double(p.tlasLevels),    double(p.misses),          double(p.segmentBoxes),
+            double(p.gathers),       double(b.sphereRefits)};
 }
 
 CostCoefficients CostCoefficients::defaults() {

@@ -65,7 +65,9 @@ PassReport summarise(const PassCounters& pc, const GpuSettings& gpu, const SerKe
         p.ommLookups += t.ommLookups;
         p.intersections += t.intersections;
         p.misses += t.misses;
+        p.segmentBoxes += t.segmentBoxes;
         p.bytesRead += t.bytesRead;
+        p.gathers += t.gathers;
         p.bytesWritten += t.bytesWritten;
     }
     p.ser = serOf(pc, gpu, key);
@@ -156,9 +158,12 @@ nlohmann::json toJson(const PassReport& p) {
             {"accel_elements", p.build.elements},
             {"build_primitives", p.build.primitives},
             {"custom_builds", p.build.customBuilds},
+            {"sphere_refits", p.build.sphereRefits},
             {"tlas_instances", p.build.tlasInstances},
             {"intersections", p.intersections},
             {"misses", p.misses},
+            {"segment_boxes", p.segmentBoxes},
+            {"gathers", p.gathers},
             {"tlas_levels", p.tlasLevels},
             {"working_set_bytes", p.workingSetBytes},
             {"trips", p.trips},

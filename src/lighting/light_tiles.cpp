@@ -34,6 +34,7 @@ LightTiles presampleLightTiles(const AliasTable& power, std::uint32_t count, std
                 Recorder<true> rec(&counters->threads[e]);
                 rec.trip();
                 rec.read(gpu_layout::kAliasEntry + gpu_layout::kParticleRecord);
+                rec.gather(2);
                 rec.write(gpu_layout::kRisEntry);
             }
         }

@@ -80,6 +80,7 @@ RegirGrid presampleRegirGrid(const LightArrays& L, const LightTiles& tiles, Regi
                 Recorder<true> rec(&counters->threads[s]);
                 rec.trip(buildSamples);
                 rec.read(buildSamples * (gpu_layout::kRisEntry + gpu_layout::kParticleRecord));
+                rec.gather(2 * buildSamples);
                 rec.write(gpu_layout::kRisEntry);
             }
         }

@@ -41,6 +41,7 @@ void recordClusterBuild(const ParticleBvh& bvh, const Particles& particles, Fram
     pc.dispatches = 1;  // the primitive expansion; the builds are counted apart
     const bool triangles = g.primitive == Primitive::billboard && g.layout == AccelLayout::clusters;
     const bool custom = !triangles;  // boxes or spheres
+    const bool spheres = g.primitive == Primitive::sphere && g.layout == AccelLayout::clusters;  // OptiX's built-in spheres
     for (std::size_t c = 0; c < clusters.count(); ++c) {
         ThreadCounters& t = pc.threads[c];
         const auto n = static_cast<std::uint32_t>(clusters.members(c).size());
@@ -51,7 +52,7 @@ void recordClusterBuild(const ParticleBvh& bvh, const Particles& particles, Fram
         // vertex + index buffers, sphere points, or boxes (OptixAabb)
         t.bytesWritten = triangles ? n * (4 * 12 + 2 * 12) : g.layout == AccelLayout::aabbs ? n * 24 : n * 16;
         // The partial policy rebuilds a window of the clusters: their sizes are alike, so the first ones stand in.
-        if (c < s.rebuiltClusters) pc.build.addBlas(t.trips, custom, s.refitted);
+        if (c < s.rebuiltClusters) pc.build.addBlas(t.trips, custom, s.refitted, spheres);
     }
     pc.build.addTlas(clusters.count(), false);
 }

@@ -221,6 +221,40 @@ TEST_CASE("cost counts the launches of the builds: one per BLAS rebuilt, refitte
     CHECK(build["refit"]["build_primitives"] == clusters);
     CHECK(build["refit"]["accel_elements"] == build["rebuild"]["accel_elements"]);
     for (const auto& [policy, columns] : build) CHECK(columns.at("dispatches") == 1);
+    CHECK(build["refit"]["sphere_refits"] == 0);  // triangles
+}
+
+TEST_CASE("cost counts the refits of built-in spheres, and a candidate's gathers: its light, and its alias entry with power", "[cli][gpu]") {
+    const auto dir = accretion::test::scratchDir("cost_gathers");
+    std::string out;
+    std::map<std::string, nlohmann::json> passes;  // run -> pass -> its JSON
+    const std::string common = kBin + " cost " + tinyScene() + " --quiet --frames 1 --history 1 --overhead 0 --cluster-sizes \"\" " +
+                               "--omm-levels \"\" -D render.estimator=\\\"restir\\\" -D render.candidates=8 -D particles.gm=20 -D particles.time_step=0.02 ";
+    const std::map<std::string, std::string> runs = {
+        {"uniform", "-D render.source=\\\"uniform\\\""},
+        {"power", "-D render.source=\\\"power\\\""},
+        {"spheres", "-D geometry.primitive=\\\"sphere\\\" -D geometry.build=\\\"refit\\\""}};
+    for (const auto& [name, args] : runs) {
+        const std::string run = common + args + " -o " + (dir / (name + ".json")).string();
+        INFO(run);
+        REQUIRE(runCommand(run, out) == 0);
+        const nlohmann::json j = nlohmann::json::parse(slurp(dir / (name + ".json")));
+        for (const auto& p : j["passes"]) passes[name][p["pass"].get<std::string>()] = p;
+    }
+    // Every BLAS of spheres is refitted in frame 1, and counted.
+    const nlohmann::json& b = passes["spheres"]["buildClusters"];
+    CHECK(b["sphere_refits"].get<double>() == b["threads"].get<double>());
+    CHECK(b["sphere_refits"].get<double>() > 0.0);
+    // Per candidate of a hit pixel: its light's record, and with power its alias entry.
+    const nlohmann::json& u = passes["uniform"]["generateCandidates"];
+    const nlohmann::json& w = passes["power"]["generateCandidates"];
+    REQUIRE(u["hit_threads"].get<double>() > 10.0);
+    CHECK(u["gathers"].get<double>() == 8.0 * u["hit_threads"].get<double>());
+    CHECK(w["gathers"].get<double>() == 16.0 * w["hit_threads"].get<double>());
+    // A shadow ray reads its light at random, and crosses particles' boxes.
+    const nlohmann::json& s = passes["uniform"]["traceShadowRays"];
+    CHECK(s["gathers"].get<double>() >= s["rays"].get<double>());
+    CHECK(s["segment_boxes"].get<double>() > 0.0);
 }
 
 TEST_CASE("cost counts the rays that found nothing, and a traced pass's working set holds the TLAS", "[cli][gpu]") {

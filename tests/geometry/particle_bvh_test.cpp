@@ -278,6 +278,73 @@ TEST_CASE("box primitives: an instance entered per box is an intersection progra
     REQUIRE(programs >= hits);
 }
 
+TEST_CASE("segment boxes: the particles' boxes a ray crosses, whatever the layout, as a brute-force slab test counts them", "[geometry][bvh][gpu]") {
+    // A primary ray counts the boxes it crosses up to its hit, a shadow ray
+    // those of its whole segment; the count is the scene's, not the
+    // layout's: one BVH, clusters, boxes and instances give the same. Checked
+    // ray by ray against a slab test of every particle formed here, widened
+    // and narrowed by a relative margin (boxes grazed at float precision).
+    const auto [ps, cs] = accretion::test::smallView(400, 3.0, 0.1, Vec3(0.0f, 3.0f, 6.0f), 40, 30);
+    GpuSettings gpu;
+    gpu.counters = true;
+    EmbreeDevice device;
+    const Particles p = generateDisk(ps, 0);
+    const Camera cam = Camera::atFrame(cs, 0);
+    std::vector<std::unique_ptr<ParticleBvh>> bvhs;
+    for (const auto& [layout, size] : {std::pair{AccelLayout::clusters, 1u << 30}, std::pair{AccelLayout::clusters, 25u},
+                                       std::pair{AccelLayout::aabbs, 50u}, std::pair{AccelLayout::instances, 1u}}) {
+        GeometrySettings g;
+        g.layout = layout;
+        g.cluster_size = size;
+        bvhs.push_back(std::make_unique<ParticleBvh>(device, g, gpu));
+        bvhs.back()->build(p, cam);
+    }
+    auto crossed = [&](const Vec3& o, const Vec3& d, float tnear, float tfar, float slack) {
+        std::uint32_t n = 0;
+        for (std::uint32_t i = 0; i < p.size(); ++i) {
+            const BillboardFrame& f = bvhs[0]->frame(i);
+            const Vec3 e = p.radius[i] * (glm::abs(f.right) + glm::abs(f.up)) * (1.0f + slack);
+            float t0 = tnear, t1 = tfar;
+            for (int k = 0; k < 3; ++k) {
+                float lo = (p.position[i][k] - e[k] - o[k]) / d[k], hi = (p.position[i][k] + e[k] - o[k]) / d[k];
+                if (lo > hi) std::swap(lo, hi);
+                t0 = std::max(t0, lo);
+                t1 = std::min(t1, hi);
+            }
+            n += t0 <= t1;
+        }
+        return n;
+    };
+    std::uint64_t primary = 0, shadow = 0;
+    for (std::uint32_t y = 0; y < cam.height; y += 2)
+        for (std::uint32_t x = 0; x < cam.width; x += 2) {
+            const Vec3 d = cam.pixelDirection(x, y);
+            std::uint32_t first = 0;
+            for (std::size_t b = 0; b < bvhs.size(); ++b) {
+                SurfaceHit h;
+                RayCounters rc;
+                const bool hit = bvhs[b]->intersect(cam.position, d, 1e30f, h, &rc);
+                const float t = hit ? h.t : 1e30f;
+                REQUIRE(rc.segmentBoxes <= crossed(cam.position, d, 0.0f, t * (1.0f + 1e-4f), 1e-4f));
+                REQUIRE(rc.segmentBoxes >= crossed(cam.position, d, 0.0f, t * (1.0f - 1e-4f), -1e-4f));
+                if (b == 0) first = rc.segmentBoxes;
+                REQUIRE(rc.segmentBoxes == first);
+                if (!hit || b) continue;
+                primary += rc.segmentBoxes;
+                // A shadow ray from the hit to particle (x * 7 + y) % n: its whole segment.
+                const std::uint32_t light = (x * 7u + y) % std::uint32_t(p.size());
+                const Vec3 o = cam.position + h.t * d, to = p.position[light] - o;
+                RayCounters sc;
+                bvhs[b]->occluded(o, to, 1e-3f, 1.0f - 1e-3f, {}, &sc);
+                REQUIRE(sc.segmentBoxes <= crossed(o, to, 1e-3f * (1.0f - 1e-4f), (1.0f - 1e-3f) * (1.0f + 1e-4f), 1e-4f));
+                REQUIRE(sc.segmentBoxes >= crossed(o, to, 1e-3f * (1.0f + 1e-4f), (1.0f - 1e-3f) * (1.0f - 1e-4f), -1e-4f));
+                shadow += sc.segmentBoxes;
+            }
+        }
+    REQUIRE(primary > 20);
+    REQUIRE(shadow > primary);  // shadow segments cross the disk; primary rays stop at their first particle
+}
+
 TEST_CASE("the CPU traces one BVH unless counting, asked for the GPU's layout, or partial", "[geometry][bvh]") {
     GeometrySettings g;
     g.layout = AccelLayout::aabbs;

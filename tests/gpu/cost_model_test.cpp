@@ -203,7 +203,7 @@ TEST_CASE("calibrate finds the cache of the working-set term that made the timin
     std::mt19937 rng(5);
     std::uniform_real_distribution<double> u(0.0, 1.0);
     std::vector<CostRow> rows;
-    for (int c = 0; c < 24; ++c) {
+    for (int c = 0; c < int(kCostFeatures.size()) + 2; ++c) {  // at least one row per coefficient
         CostRow r{"c" + std::to_string(c), "traceGBuffer", {}, 0.0};
         r.features[0] = r.features[2] = 2e5 + 2e6 * u(rng);  // threads = rays
         r.features[8] = 1.0;
@@ -263,6 +263,11 @@ TEST_CASE("a build's elements are counted whole and clamped at the knots, refits
     CHECK(b.elementsSmall == b.primitivesSmall + 1024u);
     CHECK(b.elementsMid == b.primitivesMid + 5000u);
     CHECK(b.customBuilds == 1u);  // a refit of boxes costs what a refit of triangles does
+    CHECK(b.sphereRefits == 0u);
+    b.addBlas(700, true, true, true);  // built-in spheres refitted: dearer
+    b.addBlas(700, true, false, true); // and built: a custom build
+    CHECK(b.sphereRefits == 1u);
+    CHECK(b.customBuilds == 2u);
     CHECK(b.tlasInstances == 4u);
     BuildCounters refitTlas;
     refitTlas.addTlas(100000, true);
@@ -278,7 +283,7 @@ TEST_CASE("the build pass is fitted on the build counters, the other passes on t
     // charge a layout of one thread per particle (instances) for launches it
     // does not make. Fitted on build counters alone, it cannot.
     std::vector<CostRow> rows;
-    for (int c = 0; c < 24; ++c) {  // at least one row per coefficient
+    for (int c = 0; c < int(kCostFeatures.size()) + 2; ++c) {  // at least one row per coefficient
         const double clusters = 10.0 + 100.0 * c;
         CostRow b{"c" + std::to_string(c), "buildClusters", {}, 0.0};
         b.features[0] = clusters;  // threads

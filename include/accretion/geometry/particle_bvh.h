@@ -146,6 +146,10 @@ private:
     void buildBlas(std::size_t c, const Particles& particles, bool create);
     void buildTlas();
     void buildCountingTlas();
+    void buildProbe(const Particles& particles);
+    /// The particles' boxes that o + t d, t in [tnear, tfar], passes through
+    /// (the probe: every particle's box in one BVH, whatever the layout).
+    std::uint32_t boxesAlong(const Vec3& o, const Vec3& d, float tnear, float tfar) const;
     /// The BLAS hold box primitives (user geometry) rather than Embree's quads or spheres.
     bool boxPrimitives() const {
         return settings_.layout != AccelLayout::clusters || (counting_ && settings_.primitive == Primitive::sphere);
@@ -163,6 +167,8 @@ private:
     bool counting_ = false;
     RTCScene countingTlas_ = nullptr;      ///< user-geometry instances that count entries
     std::vector<RTCBounds> blasBounds_;
+    RTCScene probe_ = nullptr;           ///< counting: one BVH of every particle's box (RayCounters::segmentBoxes)
+    std::vector<RTCBounds> probeBoxes_;  ///< per particle, its primitive's world box
     /// particle -> (cluster << 32 | its primitive in the cluster's BLAS): the
     /// key an occlusion query's filter compares with Embree's (instID, primID)
     std::vector<std::uint64_t> where_;

@@ -20,18 +20,23 @@ namespace accretion {
 /// larger than a cache), the TLAS levels a ray descends (rays x log2 of the
 /// instances), the intersection-program invocations and the rays that found
 /// nothing (a ray that misses, or a shadow ray unblocked, traverses its
-/// whole segment; a blocked one stops at its first blocker). The builds
+/// whole segment; a blocked one stops at its first blocker) and the
+/// particles' boxes the rays crossed (segment_boxes: what a ray's length
+/// through the scene costs its traversal, whatever the layout), and the
+/// gathers (reads at a drawn or looked-up index, each a round trip: a
+/// power candidate's alias entry and light). The builds
 /// (BuildCounters): launches of builds and refits, BLAS or TLAS, each a
 /// constant; the elements built or refitted, whole and clamped per build at
 /// 1024 and 32768 (a build's cost per element falls as it fills the GPU);
 /// the same over the builds alone (what a build does beyond a refit); the
-/// builds of boxes or spheres. Counter CSVs without a column read it as 0.
-inline constexpr std::array<std::string_view, 22> kCostFeatures = {
+/// builds of boxes or spheres, and the refits of built-in spheres. Counter CSVs without a column read it as 0.
+inline constexpr std::array<std::string_view, 25> kCostFeatures = {
     "threads",          "warp_steps",          "rays",                 "blas_entries",     "any_hits",
     "bytes",            "blas_levels",         "omm_lookups",          "dispatches",       "build_launches",
     "refit_launches",   "cold_work",           "accel_elements",       "accel_elements_1k", "accel_elements_32k",
     "build_primitives", "build_primitives_1k", "build_primitives_32k", "custom_builds",    "intersections",
-    "tlas_levels",      "misses"};
+    "tlas_levels",      "misses",              "segment_boxes",    "gathers",
+    "sphere_refits"};
 inline constexpr std::size_t kBaseCostFeatures = 6;
 inline constexpr std::size_t kColdWork = 11;
 /// Whether feature k prices acceleration-structure builds: buildClusters is
@@ -42,7 +47,8 @@ inline constexpr std::size_t kColdWork = 11;
 constexpr bool isBuildFeature(std::size_t k) {
     constexpr std::string_view build[] = {"build_launches",   "refit_launches",      "accel_elements",
                                           "accel_elements_1k", "accel_elements_32k", "build_primitives",
-                                          "build_primitives_1k", "build_primitives_32k", "custom_builds"};
+                                          "build_primitives_1k", "build_primitives_32k", "custom_builds",
+                                          "sphere_refits"};
     for (std::string_view b : build)
         if (kCostFeatures[k] == b) return true;
     return false;

@@ -27,6 +27,8 @@ LightingCounters generateCandidatesKernel(const FrameContext& f, std::vector<Sto
         rec.read(Mc * (gpu_layout::kParticleRecord + (S == LightSource::power ? gpu_layout::kAliasEntry : 0u) +
                        (S == LightSource::tree ? 2u * gpu_layout::kLightTreeNode * f.in.lightTree->depth() : 0u) +
                        (presampled ? gpu_layout::kRisEntry : 0u)));
+        rec.gather(Mc * (1u + (S == LightSource::power ? 1u : 0u) + (S == LightSource::tree ? f.in.lightTree->depth() : 0u) +
+                         (presampled ? 1u : 0u)));
         rec.write(R);
         const ShadingPoint sp = shadingPoint(g, f.in.particles);
         Rng rng(px, f.in.frame, RngPass::restirCandidates, seed);

@@ -21,6 +21,7 @@ LightingCounters spatialResamplingKernel(const FrameContext& f, std::uint32_t it
         if (!g.hit()) return;
         rec.trip(k);
         rec.read(R + gpu_layout::kParticleRecord);
+        rec.gather(1);
         rec.write(R);
         Rng rng(px ^ (std::uint64_t(iteration) << 40), f.in.frame, RngPass::restirSpatial, f.in.settings.render.seed);
         const ShadingPoint sp = shadingPoint(g, f.in.particles);
@@ -47,6 +48,7 @@ LightingCounters spatialResamplingKernel(const FrameContext& f, std::uint32_t it
             }
             ++c.reuseAccepted;
             rec.read(R + gpu_layout::kParticleRecord);
+            rec.gather(1);
             offers.push_back({cur[q], {shadingPoint(gn, f.in.particles), &f.L, tested, &f.in.bvh}});
         }
         out[px] = f.codec.roundTrip(f.sanitize(combineOffers<SM, P, Count>(scratch, f, rng, c, rec), px, c));

@@ -20,6 +20,7 @@ LightingCounters temporalResamplingKernel(const FrameContext& f, const std::vect
         if (!g.hit()) return;
         rec.trip();
         rec.read(R + 2 * gpu_layout::kParticleRecord);  // the reservoir, the particle now and before
+        rec.gather(2);
         rec.write(R);
         // Where this surface point was: moved back by its particle's motion,
         // projected with the previous camera onto the previous lighting grid.
@@ -44,6 +45,7 @@ LightingCounters temporalResamplingKernel(const FrameContext& f, const std::vect
         }
         ++c.reuseAccepted;
         rec.read(R + gpu_layout::kParticleRecord);  // the previous reservoir and its light
+        rec.gather(1);
         const ShadingPoint sp = shadingPoint(g, particles);
         std::vector<Offer>& offers = scratch.offers;
         offers.clear();

@@ -20,6 +20,7 @@ LightingCounters traceShadowRaysKernel(const FrameContext& f, std::vector<Stored
         rec.read(R);
         if (!(r.W > 0.0f)) return;
         rec.read(gpu_layout::kParticleRecord);
+        rec.gather(1);
         if constexpr (Count) rec.hint(f.in.bvh.clusterOf(r.y));
         const ShadingPoint sp = shadingPoint(g, f.in.particles);
         LightTerm t;
