@@ -39,7 +39,8 @@ CostFeatures costFeatures(const PassReport& p, double cacheBytes) {
             double(b.elements),      double(b.elementsSmall),   double(b.elementsMid),   double(b.primitives),
             double(b.primitivesSmall), double(b.primitivesMid), double(b.customBuilds),  double(p.intersections),
             double(p.tlasLevels),    double(p.misses),          double(p.segmentBoxes),
-            double(p.gathers),       double(b.sphereRefits)};
+            double(p.gathers),       double(b.sphereRefits),    double(p.ser.traversalBefore.steps),
+            p.rays ? double(p.dispatches) * double(p.segmentBoxes) / double(p.rays) : 0.0};
 }
 
 CostCoefficients CostCoefficients::defaults() {

@@ -164,6 +164,7 @@ nlohmann::json toJson(const PassReport& p) {
             {"misses", p.misses},
             {"segment_boxes", p.segmentBoxes},
             {"gathers", p.gathers},
+            {"warp_segment_boxes", p.ser.traversalBefore.steps},
             {"tlas_levels", p.tlasLevels},
             {"working_set_bytes", p.workingSetBytes},
             {"trips", p.trips},

@@ -114,7 +114,7 @@ SerReport serReport(const PassCounters& pass, const WarpLayout& layout, const Se
                     double reorderCost) {
     const std::size_t n = pass.threads.size();
     std::vector<std::uint64_t> branchKey(n), sortKey(n), one(n, 0);
-    std::vector<std::uint32_t> branchWork(n), trips(n);
+    std::vector<std::uint32_t> branchWork(n), trips(n), boxes(n);
     std::size_t active = 0;
     for (std::size_t i = 0; i < n; ++i) {
         const ThreadCounters& t = pass.threads[i];
@@ -122,6 +122,7 @@ SerReport serReport(const PassCounters& pass, const WarpLayout& layout, const Se
         sortKey[i] = key.of(t);
         branchWork[i] = t.active;
         trips[i] = t.trips;
+        boxes[i] = t.segmentBoxes;
         active += t.active;
     }
     const std::vector<std::uint32_t> before = dispatchOrder(pass.width, pass.height, layout);
@@ -132,6 +133,7 @@ SerReport serReport(const PassCounters& pass, const WarpLayout& layout, const Se
     r.branchAfter = simtStats(after, branchKey, branchWork, layout.warpSize);
     r.loopBefore = simtStats(before, one, trips, layout.warpSize);
     r.loopAfter = simtStats(after, one, trips, layout.warpSize);
+    r.traversalBefore = simtStats(before, one, boxes, layout.warpSize);
     r.distinctSortKeysBefore = simtStats(before, sortKey, branchWork, layout.warpSize).distinctKeysPerWarp;
     r.distinctSortKeysAfter = simtStats(after, sortKey, branchWork, layout.warpSize).distinctKeysPerWarp;
     r.reorderSteps = reorderCost * double(active) / double(layout.warpSize);

@@ -255,6 +255,11 @@ TEST_CASE("cost counts the refits of built-in spheres, and a candidate's gathers
     const nlohmann::json& s = passes["uniform"]["traceShadowRays"];
     CHECK(s["gathers"].get<double>() >= s["rays"].get<double>());
     CHECK(s["segment_boxes"].get<double>() > 0.0);
+    // A warp runs as long as its longest lane's traversal: between the mean
+    // lane's (all 32 alike) and the sum of its lanes (one lane does it all).
+    CHECK(s["warp_segment_boxes"].get<double>() >= s["segment_boxes"].get<double>() / 32.0);
+    CHECK(s["warp_segment_boxes"].get<double>() <= s["segment_boxes"].get<double>());
+    CHECK(passes["uniform"]["generateCandidates"]["warp_segment_boxes"].get<double>() == 0.0);  // no rays
 }
 
 TEST_CASE("cost counts the rays that found nothing, and a traced pass's working set holds the TLAS", "[cli][gpu]") {

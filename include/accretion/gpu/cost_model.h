@@ -29,14 +29,20 @@ namespace accretion {
 /// constant; the elements built or refitted, whole and clamped per build at
 /// 1024 and 32768 (a build's cost per element falls as it fills the GPU);
 /// the same over the builds alone (what a build does beyond a refit); the
-/// builds of boxes or spheres, and the refits of built-in spheres. Counter CSVs without a column read it as 0.
-inline constexpr std::array<std::string_view, 25> kCostFeatures = {
+/// builds of boxes or spheres, and the refits of built-in spheres. Two
+/// terms of a traversal's length: warp_segment_boxes, per warp its longest
+/// lane's segment boxes summed over the warps (a warp waits for its longest
+/// ray), and dispatch_path, the dispatches times the mean segment boxes of
+/// a ray (a launch lasts at least one ray's traversal, whatever its size:
+/// what a launch of few rays costs beyond their throughput). Counter CSVs
+/// without a column read it as 0.
+inline constexpr std::array<std::string_view, 27> kCostFeatures = {
     "threads",          "warp_steps",          "rays",                 "blas_entries",     "any_hits",
     "bytes",            "blas_levels",         "omm_lookups",          "dispatches",       "build_launches",
     "refit_launches",   "cold_work",           "accel_elements",       "accel_elements_1k", "accel_elements_32k",
     "build_primitives", "build_primitives_1k", "build_primitives_32k", "custom_builds",    "intersections",
     "tlas_levels",      "misses",              "segment_boxes",    "gathers",
-    "sphere_refits"};
+    "sphere_refits",    "warp_segment_boxes",  "dispatch_path"};
 inline constexpr std::size_t kBaseCostFeatures = 6;
 inline constexpr std::size_t kColdWork = 11;
 /// Whether feature k prices acceleration-structure builds: buildClusters is

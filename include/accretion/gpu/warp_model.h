@@ -67,6 +67,10 @@ struct SerReport {
     std::string key;
     SimtStats branchBefore, branchAfter;   ///< the branch region (branch key, work 1)
     SimtStats loopBefore, loopAfter;       ///< the loop region (trips)
+    /// The rays' traversal in dispatch order, work = the particles' boxes a
+    /// lane's rays cross (segment boxes): a warp lasts as long as its
+    /// longest lane's traversal.
+    SimtStats traversalBefore;
     double distinctSortKeysBefore = 0, distinctSortKeysAfter = 0;  ///< per warp
     double reorderSteps = 0;               ///< cost of the reorder in warp steps
     double predictedSpeedup = 1.0;         ///< steps before / (steps after + reorder)
