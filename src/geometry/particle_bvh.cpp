@@ -240,25 +240,55 @@ void instanceOccluded(const RTCOccludedFunctionNArguments* args) {
     args->context->instID[0] = RTC_INVALID_GEOMETRY_ID;
 }
 
-/// The probe's query: counts the particles' boxes the ray passes through and
-/// reports none, so that Embree visits every one along the segment.
+/// The probe's queries. Counting: every particle's box the ray enters, no
+/// hit reported, so that Embree visits each along the segment. Blocker
+/// search: the nearest particle (not excluded) whose primitive the ray
+/// hits, reported as a hit so that Embree culls the boxes behind it.
 struct ProbeContext {
     RTCIntersectContext base;
-    const RTCBounds* boxes;
+    const ProbeData* probe;
     std::uint32_t crossed;
+    bool blockers;
+    std::uint32_t exclude[2];
 };
 
 void probeBounds(const RTCBoundsFunctionArguments* args) {
-    *args->bounds_o = static_cast<const RTCBounds*>(args->geometryUserPtr)[args->primID];
+    *args->bounds_o = static_cast<const ProbeData*>(args->geometryUserPtr)->boxes[args->primID];
 }
 
 void probeIntersect(const RTCIntersectFunctionNArguments* args) {
     if (args->N != 1 || args->valid[0] != -1) return;
     auto* context = reinterpret_cast<ProbeContext*>(args->context);
-    const auto* ray = reinterpret_cast<const RTCRay*>(args->rayhit);
-    const float org[3] = {ray->org_x, ray->org_y, ray->org_z}, dir[3] = {ray->dir_x, ray->dir_y, ray->dir_z};
-    // Embree hands over every primitive of a leaf it enters: count the boxes the ray enters.
-    context->crossed += overlapsBounds(context->boxes[args->primID], org, dir, ray->tnear, ray->tfar);
+    const ProbeData& probe = *context->probe;
+    auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
+    const RTCRay& ray = rh->ray;
+    const unsigned i = args->primID;
+    const float org[3] = {ray.org_x, ray.org_y, ray.org_z}, dir[3] = {ray.dir_x, ray.dir_y, ray.dir_z};
+    // Embree hands over every primitive of a leaf it enters: the ray's own box test first.
+    if (!overlapsBounds(probe.boxes[i], org, dir, ray.tnear, ray.tfar)) return;
+    if (!context->blockers) {
+        ++context->crossed;
+        return;
+    }
+    if (i == context->exclude[0] || i == context->exclude[1]) return;
+    const Vec3 o(org[0], org[1], org[2]), d(dir[0], dir[1], dir[2]);
+    const BoxPrimitive& b = probe.prims[i];
+    float t;
+    if (probe.sphere) {
+        const Vec3 oc = o - b.p;
+        const float a = glm::dot(d, d), h = glm::dot(d, oc), c = glm::dot(oc, oc) - b.r * b.r;
+        const float disc = h * h - a * c;
+        if (!(disc >= 0.0f)) return;
+        const float s = std::sqrt(disc), t0 = (-h - s) / a, t1 = (-h + s) / a;
+        t = t0 >= ray.tnear ? t0 : t1;
+    } else {
+        Vec2 uv;
+        if (!intersectBillboard(o, d, ray.tnear, ray.tfar, b.p, b.r, probe.frames[i], probe.disc, t, uv)) return;
+    }
+    if (!(t >= ray.tnear && t <= ray.tfar)) return;
+    rh->ray.tfar = t;
+    rh->hit.geomID = 0;
+    rh->hit.primID = i;
 }
 
 RTCBuildQuality sceneQuality(BuildPolicy p) {
@@ -434,6 +464,7 @@ void ParticleBvh::buildCountingTlas() {
 void ParticleBvh::buildProbe(const Particles& particles) {
     const std::size_t n = particles.size();
     probeBoxes_.resize(n);
+    probePrims_.resize(n);
     const bool billboards = settings_.primitive == Primitive::billboard;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const auto& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
@@ -442,14 +473,17 @@ void ParticleBvh::buildProbe(const Particles& particles) {
             // The quad's box (its corners p +- a +- b), or the sphere's.
             const Vec3 h = billboards ? billboardExtent(rad, frames_[i]) : Vec3(rad);
             probeBoxes_[i] = {p.x - h.x, p.y - h.y, p.z - h.z, 0.0f, p.x + h.x, p.y + h.y, p.z + h.z, 0.0f};
+            probePrims_[i] = {p, rad};
         }
     });
+    probeData_ = {probeBoxes_.data(), probePrims_.data(), frames_.data(), !billboards,
+             billboards && settings_.alpha == AlphaMode::disc};
     if (probe_) rtcReleaseScene(probe_);
     probe_ = rtcNewScene(device_.get());
     RTCGeometry g = rtcNewGeometry(device_.get(), RTC_GEOMETRY_TYPE_USER);
     rtcSetGeometryUserPrimitiveCount(g, static_cast<unsigned>(n));
-    rtcSetGeometryUserData(g, probeBoxes_.data());
-    rtcSetGeometryBoundsFunction(g, &probeBounds, probeBoxes_.data());
+    rtcSetGeometryUserData(g, &probeData_);
+    rtcSetGeometryBoundsFunction(g, &probeBounds, &probeData_);
     rtcSetGeometryIntersectFunction(g, &probeIntersect);
     rtcCommitGeometry(g);
     rtcAttachGeometryByID(probe_, g, 0);
@@ -457,15 +491,23 @@ void ParticleBvh::buildProbe(const Particles& particles) {
     rtcCommitScene(probe_);
 }
 
-std::uint32_t ParticleBvh::boxesAlong(const Vec3& o, const Vec3& d, float tnear, float tfar) const {
+std::uint32_t ParticleBvh::boxesAlong(const Vec3& o, const Vec3& d, float tnear, float tfar, const Exclusion* occlusion) const {
     ProbeContext context;
     rtcInitIntersectContext(&context.base);
-    context.boxes = probeBoxes_.data();
+    context.probe = &probeData_;
     context.crossed = 0;
     RTCRayHit rh;
     rh.ray = embreeRay(o, d, tnear, tfar);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    if (occlusion) {  // the first blocker ends the segment
+        context.blockers = true;
+        context.exclude[0] = occlusion->receiver;
+        context.exclude[1] = occlusion->light;
+        rtcIntersect1(probe_, &context.base, &rh);
+        rh.ray = embreeRay(o, d, tnear, rh.ray.tfar);
+    }
+    context.blockers = false;
     rtcIntersect1(probe_, &context.base, &rh);
     return context.crossed;
 }
@@ -548,7 +590,11 @@ bool ParticleBvh::intersect(const Vec3& o, const Vec3& d, float tfar, SurfaceHit
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(counters && countingTlas_ ? countingTlas_ : tlas_, &context.base, &rh);
-    if (counters && probe_) counters->segmentBoxes += boxesAlong(o, d, 0.0f, rh.ray.tfar);
+    if (counters && probe_) {
+        const std::uint32_t n = boxesAlong(o, d, 0.0f, rh.ray.tfar);
+        counters->segmentBoxes += n;
+        counters->wholeSegmentBoxes += n;
+    }
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
     const std::uint32_t c = rh.hit.instID[0];
     const std::uint32_t local = rh.hit.primID;
@@ -603,7 +649,10 @@ bool ParticleBvh::occluded(const Vec3& o, const Vec3& d, float tnear, float tfar
                                         exclude.light == kNotExcluded ? kNoKey : where_[exclude.light]);
     RTCRay ray = embreeRay(o, d, tnear, tfar);
     rtcOccluded1(counters && countingTlas_ ? countingTlas_ : tlas_, &context.base, &ray);
-    if (counters && probe_) counters->segmentBoxes += boxesAlong(o, d, tnear, tfar);
+    if (counters && probe_) {
+        counters->segmentBoxes += boxesAlong(o, d, tnear, tfar, &exclude);
+        counters->wholeSegmentBoxes += boxesAlong(o, d, tnear, tfar);
+    }
     return ray.tfar < 0.0f;
 }
 

@@ -40,7 +40,7 @@ CostFeatures costFeatures(const PassReport& p, double cacheBytes) {
             double(b.primitivesSmall), double(b.primitivesMid), double(b.customBuilds),  double(p.intersections),
             double(p.tlasLevels),    double(p.misses),          double(p.segmentBoxes),
             double(p.gathers),       double(b.sphereRefits),    double(p.ser.traversalBefore.steps),
-            p.rays ? double(p.dispatches) * double(p.segmentBoxes) / double(p.rays) : 0.0};
+            p.rays ? double(p.dispatches) * double(p.segmentBoxes) / double(p.rays) : 0.0, double(p.wholeSegmentBoxes)};
 }
 
 CostCoefficients CostCoefficients::defaults() {

@@ -66,6 +66,7 @@ PassReport summarise(const PassCounters& pc, const GpuSettings& gpu, const SerKe
         p.intersections += t.intersections;
         p.misses += t.misses;
         p.segmentBoxes += t.segmentBoxes;
+        p.wholeSegmentBoxes += t.wholeSegmentBoxes;
         p.bytesRead += t.bytesRead;
         p.gathers += t.gathers;
         p.bytesWritten += t.bytesWritten;
@@ -163,6 +164,7 @@ nlohmann::json toJson(const PassReport& p) {
             {"intersections", p.intersections},
             {"misses", p.misses},
             {"segment_boxes", p.segmentBoxes},
+            {"whole_segment_boxes", p.wholeSegmentBoxes},
             {"gathers", p.gathers},
             {"warp_segment_boxes", p.ser.traversalBefore.steps},
             {"tlas_levels", p.tlasLevels},

@@ -280,7 +280,8 @@ TEST_CASE("box primitives: an instance entered per box is an intersection progra
 
 TEST_CASE("segment boxes: the particles' boxes a ray crosses, whatever the layout, as a brute-force slab test counts them", "[geometry][bvh][gpu]") {
     // A primary ray counts the boxes it crosses up to its hit, a shadow ray
-    // those of its whole segment; the count is the scene's, not the
+    // those up to its first blocker and those of its whole segment, the
+    // blocker found here by testing every quad; the count is the scene's, not the
     // layout's: one BVH, clusters, boxes and instances give the same. Checked
     // ray by ray against a slab test of every particle formed here, widened
     // and narrowed by a relative margin (boxes grazed at float precision).
@@ -315,9 +316,9 @@ TEST_CASE("segment boxes: the particles' boxes a ray crosses, whatever the layou
         }
         return n;
     };
-    std::uint64_t primary = 0, shadow = 0;
-    for (std::uint32_t y = 0; y < cam.height; y += 2)
-        for (std::uint32_t x = 0; x < cam.width; x += 2) {
+    std::uint64_t primary = 0, shadow = 0, blockedRays = 0, shadowRays = 0, disagree = 0;
+    for (std::uint32_t y = 0; y < cam.height; ++y)
+        for (std::uint32_t x = 0; x < cam.width; ++x) {
             const Vec3 d = cam.pixelDirection(x, y);
             std::uint32_t first = 0;
             for (std::size_t b = 0; b < bvhs.size(); ++b) {
@@ -329,20 +330,39 @@ TEST_CASE("segment boxes: the particles' boxes a ray crosses, whatever the layou
                 REQUIRE(rc.segmentBoxes >= crossed(cam.position, d, 0.0f, t * (1.0f - 1e-4f), -1e-4f));
                 if (b == 0) first = rc.segmentBoxes;
                 REQUIRE(rc.segmentBoxes == first);
+                REQUIRE(rc.wholeSegmentBoxes == rc.segmentBoxes);  // a primary ray's segment ends at its hit
                 if (!hit || b) continue;
                 primary += rc.segmentBoxes;
                 // A shadow ray from the hit to particle (x * 7 + y) % n: its whole segment.
                 const std::uint32_t light = (x * 7u + y) % std::uint32_t(p.size());
                 const Vec3 o = cam.position + h.t * d, to = p.position[light] - o;
+                const float t0 = 1e-3f, t1 = 1.0f - 1e-3f;
                 RayCounters sc;
-                bvhs[b]->occluded(o, to, 1e-3f, 1.0f - 1e-3f, {}, &sc);
-                REQUIRE(sc.segmentBoxes <= crossed(o, to, 1e-3f * (1.0f - 1e-4f), (1.0f - 1e-3f) * (1.0f + 1e-4f), 1e-4f));
-                REQUIRE(sc.segmentBoxes >= crossed(o, to, 1e-3f * (1.0f + 1e-4f), (1.0f - 1e-3f) * (1.0f - 1e-4f), -1e-4f));
-                shadow += sc.segmentBoxes;
+                const bool blocked = bvhs[b]->occluded(o, to, t0, t1, {}, &sc);
+                REQUIRE(sc.wholeSegmentBoxes <= crossed(o, to, t0 * (1.0f - 1e-4f), t1 * (1.0f + 1e-4f), 1e-4f));
+                REQUIRE(sc.wholeSegmentBoxes >= crossed(o, to, t0 * (1.0f + 1e-4f), t1 * (1.0f - 1e-4f), -1e-4f));
+                // Up to the first blocker, found here by testing every particle's quad.
+                float first = t1;
+                for (std::uint32_t i = 0; i < p.size(); ++i) {
+                    float t;
+                    Vec2 uv;
+                    if (intersectBillboard(o, to, t0, t1, p.position[i], p.radius[i], bvhs[0]->frame(i), false, t, uv)) first = std::min(first, t);
+                }
+                disagree += blocked != (first < t1);  // a quad grazed at float precision
+                REQUIRE(sc.segmentBoxes <= crossed(o, to, t0 * (1.0f - 1e-4f), first * (1.0f + 1e-4f), 1e-4f));
+                REQUIRE(sc.segmentBoxes >= crossed(o, to, t0 * (1.0f + 1e-4f), first * (1.0f - 1e-4f), -1e-4f));
+                REQUIRE(sc.segmentBoxes <= sc.wholeSegmentBoxes);
+                if (!(first < t1)) REQUIRE(sc.segmentBoxes == sc.wholeSegmentBoxes);
+                blockedRays += blocked;
+                ++shadowRays;
+                shadow += sc.wholeSegmentBoxes;
             }
         }
     REQUIRE(primary > 20);
     REQUIRE(shadow > primary);  // shadow segments cross the disk; primary rays stop at their first particle
+    REQUIRE(blockedRays > 0);
+    REQUIRE(blockedRays < shadowRays);
+    REQUIRE(disagree * 50 <= shadowRays);  // the traced scene and the quads tested here agree on blockers
 }
 
 TEST_CASE("the CPU traces one BVH unless counting, asked for the GPU's layout, or partial", "[geometry][bvh]") {

@@ -16,11 +16,14 @@ struct RayCounters {
     std::uint32_t intersections = 0;///< intersection-program invocations: boxes (aabbs layout) or spheres whose bounds the ray entered
     std::uint32_t misses = 0;       ///< 1 when the query found nothing (a shadow ray unblocked): it traversed its whole segment
     /// Particles' boxes the ray passes through, whatever the layout: a
-    /// primary ray's up to its hit, a shadow ray's over its whole segment.
-    /// BLAS depths say how deep a ray descends; these say how much of the
-    /// scene it crosses (a long ray through the dense inner disk visits
-    /// many nodes whose boxes it enters and whose particles it misses).
+    /// primary ray's up to its hit, a shadow ray's up to its first blocker
+    /// (where the traversal of a terminate-on-first-hit ray may stop), and
+    /// over its whole segment (where it may have to look: a long ray
+    /// through the dense inner disk enters many boxes whose particles it
+    /// misses). BLAS depths say how deep a ray descends; these say how much
+    /// of the scene it crosses.
     std::uint32_t segmentBoxes = 0;
+    std::uint32_t wholeSegmentBoxes = 0;
 };
 
 /// The work of one pixel's thread in one pass (docs/MODEL.md section 6). The
@@ -42,6 +45,7 @@ struct ThreadCounters {
     std::uint32_t intersections = 0;///< intersection-program invocations, summed over the thread's rays
     std::uint32_t misses = 0;       ///< rays that found nothing (RayCounters::misses)
     std::uint32_t segmentBoxes = 0; ///< particles' boxes crossed, summed over the thread's rays (RayCounters::segmentBoxes)
+    std::uint32_t wholeSegmentBoxes = 0; ///< the same over whole segments (RayCounters::wholeSegmentBoxes)
     std::uint32_t bytesRead = 0;    ///< G-buffer, reservoirs, particle records read
     /// Reads at an index drawn or looked up, each a memory round trip the
     /// next step waits for: a light's record, an alias entry, a tree node,
@@ -62,6 +66,7 @@ struct ThreadCounters {
         intersections += r.intersections;
         misses += r.misses;
         segmentBoxes += r.segmentBoxes;
+        wholeSegmentBoxes += r.wholeSegmentBoxes;
     }
     void addRay(const RayCounters& r) { addRays(r, 1); }
 };

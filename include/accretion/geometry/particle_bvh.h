@@ -68,6 +68,16 @@ struct BoxBlas {
     bool instances = false;  ///< a box is a TLAS instance (instances layout), else an intersection program (aabbs, spheres)
 };
 
+/// What the counting probe reads (every particle's box, whatever the
+/// layout): per particle its box, centre and radius, and frame.
+struct ProbeData {
+    const RTCBounds* boxes = nullptr;
+    const BoxPrimitive* prims = nullptr;
+    const BillboardFrame* frames = nullptr;
+    bool sphere = false;  ///< spheres (else billboards)
+    bool disc = false;    ///< billboards with the disc alpha test
+};
+
 /// The structure the CPU traces for `g`: the GPU's layout when counting (its
 /// counters are the GPU's), when asked (cpu_layout = gpu), or under the
 /// partial policy (its stale clusters are part of the image); else the
@@ -148,8 +158,10 @@ private:
     void buildCountingTlas();
     void buildProbe(const Particles& particles);
     /// The particles' boxes that o + t d, t in [tnear, tfar], passes through
-    /// (the probe: every particle's box in one BVH, whatever the layout).
-    std::uint32_t boxesAlong(const Vec3& o, const Vec3& d, float tnear, float tfar) const;
+    /// (the probe: every particle's box in one BVH, whatever the layout); an
+    /// occlusion query's only up to its first blocker (other than the
+    /// excluded particles), where the GPU's traversal stops.
+    std::uint32_t boxesAlong(const Vec3& o, const Vec3& d, float tnear, float tfar, const Exclusion* occlusion = nullptr) const;
     /// The BLAS hold box primitives (user geometry) rather than Embree's quads or spheres.
     bool boxPrimitives() const {
         return settings_.layout != AccelLayout::clusters || (counting_ && settings_.primitive == Primitive::sphere);
@@ -169,6 +181,8 @@ private:
     std::vector<RTCBounds> blasBounds_;
     RTCScene probe_ = nullptr;           ///< counting: one BVH of every particle's box (RayCounters::segmentBoxes)
     std::vector<RTCBounds> probeBoxes_;  ///< per particle, its primitive's world box
+    std::vector<BoxPrimitive> probePrims_;  ///< per particle, its centre and radius
+    ProbeData probeData_{};                 ///< the probe geometry's user data
     /// particle -> (cluster << 32 | its primitive in the cluster's BLAS): the
     /// key an occlusion query's filter compares with Embree's (instID, primID)
     std::vector<std::uint64_t> where_;

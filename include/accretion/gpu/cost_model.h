@@ -21,8 +21,10 @@ namespace accretion {
 /// instances), the intersection-program invocations and the rays that found
 /// nothing (a ray that misses, or a shadow ray unblocked, traverses its
 /// whole segment; a blocked one stops at its first blocker) and the
-/// particles' boxes the rays crossed (segment_boxes: what a ray's length
-/// through the scene costs its traversal, whatever the layout), and the
+/// particles' boxes the rays crossed, whatever the layout (segment_boxes: a
+/// shadow ray's up to its first blocker; whole_segment_boxes: over its
+/// whole segment; what a ray's length through the scene costs its
+/// traversal), and the
 /// gathers (reads at a drawn or looked-up index, each a round trip: a
 /// power candidate's alias entry and light). The builds
 /// (BuildCounters): launches of builds and refits, BLAS or TLAS, each a
@@ -36,13 +38,14 @@ namespace accretion {
 /// a ray (a launch lasts at least one ray's traversal, whatever its size:
 /// what a launch of few rays costs beyond their throughput). Counter CSVs
 /// without a column read it as 0.
-inline constexpr std::array<std::string_view, 27> kCostFeatures = {
+inline constexpr std::array<std::string_view, 28> kCostFeatures = {
     "threads",          "warp_steps",          "rays",                 "blas_entries",     "any_hits",
     "bytes",            "blas_levels",         "omm_lookups",          "dispatches",       "build_launches",
     "refit_launches",   "cold_work",           "accel_elements",       "accel_elements_1k", "accel_elements_32k",
     "build_primitives", "build_primitives_1k", "build_primitives_32k", "custom_builds",    "intersections",
     "tlas_levels",      "misses",              "segment_boxes",    "gathers",
-    "sphere_refits",    "warp_segment_boxes",  "dispatch_path"};
+    "sphere_refits",    "warp_segment_boxes",  "dispatch_path",
+    "whole_segment_boxes"};
 inline constexpr std::size_t kBaseCostFeatures = 6;
 inline constexpr std::size_t kColdWork = 11;
 /// Whether feature k prices acceleration-structure builds: buildClusters is

@@ -25,6 +25,7 @@ struct PassReport {
     std::uint64_t intersections = 0;                             ///< intersection-program invocations (boxes, spheres)
     std::uint64_t misses = 0;                                    ///< rays that found nothing (a shadow ray unblocked)
     std::uint64_t segmentBoxes = 0;                              ///< particles' boxes the rays crossed (RayCounters::segmentBoxes)
+    std::uint64_t wholeSegmentBoxes = 0;                         ///< the same over whole segments
     std::uint64_t tlasLevels = 0;                                ///< rays x the TLAS's depth (log2 of its instances)
     std::uint64_t dispatches = 1;                                ///< kernel dispatches (PassCounters)
     BuildCounters build;                                          ///< buildClusters: launches, elements, TLAS instances
