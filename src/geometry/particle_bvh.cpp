@@ -477,7 +477,7 @@ void ParticleBvh::buildProbe(const Particles& particles) {
         }
     });
     probeData_ = {probeBoxes_.data(), probePrims_.data(), frames_.data(), !billboards,
-             billboards && settings_.alpha == AlphaMode::disc};
+                  billboards && settings_.alpha == AlphaMode::disc};
     if (probe_) rtcReleaseScene(probe_);
     probe_ = rtcNewScene(device_.get());
     RTCGeometry g = rtcNewGeometry(device_.get(), RTC_GEOMETRY_TYPE_USER);
@@ -566,12 +566,10 @@ void ParticleBvh::build(const Particles& particles, const Camera& camera) {
 
     t0 = std::chrono::steady_clock::now();
     buildTlas();
-    if (counting_) {
-        buildCountingTlas();
-        buildProbe(particles);
-    }
+    if (counting_) buildCountingTlas();
     device_.check("buildClusters (TLAS)");
     stats_.tlasSeconds = secondsSince(t0);
+    if (counting_) buildProbe(particles);  // counting's own structure: not the GPU's build, not timed as one
 
     stats_.refitted = refit;
     stats_.partial = keep && settings_.build == BuildPolicy::partial;
