@@ -103,8 +103,10 @@ void instanceBounds(const RTCBoundsFunctionArguments* args) {
 }
 
 /// The instance's box test, as GPU traversal does before entering a BLAS
-/// (Embree may call a leaf's callbacks without testing each primitive's box).
-bool overlapsBounds(const RTCBounds& b, const float org[3], const float dir[3], float tnear, float tfar) {
+/// (Embree may call a leaf's callbacks without testing each primitive's box);
+/// `entry`, when given, receives where the ray enters the box (tnear if inside).
+bool overlapsBounds(const RTCBounds& b, const float org[3], const float dir[3], float tnear, float tfar,
+                    float* entry = nullptr) {
     const float lo[3] = {b.lower_x, b.lower_y, b.lower_z}, hi[3] = {b.upper_x, b.upper_y, b.upper_z};
     float t0 = tnear, t1 = tfar;
     for (int k = 0; k < 3; ++k) {
@@ -115,7 +117,19 @@ bool overlapsBounds(const RTCBounds& b, const float org[3], const float dir[3], 
         t1 = std::min(t1, c * (1.0f + 2e-7f * 3.0f));  // conservative, as in robust slab tests
         if (t0 > t1) return false;
     }
+    if (entry) *entry = t0;
     return true;
+}
+
+/// The nearer of o + t d's crossings of the sphere (p, r) within [tnear, tfar].
+bool hitSphere(const Vec3& o, const Vec3& d, float tnear, float tfar, const Vec3& p, float r, float& t) {
+    const Vec3 oc = o - p;
+    const float a = glm::dot(d, d), h = glm::dot(d, oc), c = glm::dot(oc, oc) - r * r;
+    const float disc = h * h - a * c;
+    if (!(disc >= 0.0f)) return false;
+    const float s = std::sqrt(disc), t0 = (-h - s) / a, t1 = (-h + s) / a;
+    t = t0 >= tnear && t0 <= tfar ? t0 : t1;
+    return t >= tnear && t <= tfar;
 }
 
 /// A box primitive's bounds: the billboard's quad or the sphere.
@@ -151,14 +165,8 @@ bool hitBox(const BoxBlas& blas, unsigned prim, const float org[3], const float 
     }
     const Vec3 o(org[0], org[1], org[2]), d(dir[0], dir[1], dir[2]);
     if (blas.sphere) {
-        const Vec3 oc = o - b.p;
-        const float a = glm::dot(d, d), h = glm::dot(d, oc), c = glm::dot(oc, oc) - b.r * b.r;
-        const float disc = h * h - a * c;
-        if (!(disc >= 0.0f)) return false;
-        const float s = std::sqrt(disc), t0 = (-h - s) / a, t1 = (-h + s) / a;
-        t = t0 >= tnear && t0 <= tfar ? t0 : t1;
         uv = Vec2(0.0f);
-        return t >= tnear && t <= tfar;
+        return hitSphere(o, d, tnear, tfar, b.p, b.r, t);
     }
     const bool alphaInProgram = blas.disc && !blas.instances;
     if (!intersectBillboard(o, d, tnear, tfar, b.p, b.r, f, alphaInProgram, t, uv)) return false;
@@ -241,13 +249,15 @@ void instanceOccluded(const RTCOccludedFunctionNArguments* args) {
 }
 
 /// The probe's queries. Counting: every particle's box the ray enters, no
-/// hit reported, so that Embree visits each along the segment. Blocker
-/// search: the nearest particle (not excluded) whose primitive the ray
-/// hits, reported as a hit so that Embree culls the boxes behind it.
+/// hit reported, so that Embree visits each along the segment, and of them
+/// those entered before `blockedAt`. Blocker search: the nearest particle
+/// (not excluded) whose primitive the ray hits, reported as a hit so that
+/// Embree culls the boxes behind it.
 struct ProbeContext {
     RTCIntersectContext base;
     const ProbeData* probe;
-    std::uint32_t crossed;
+    BoxesCrossed crossed;
+    float blockedAt;
     bool blockers;
     std::uint32_t exclude[2];
 };
@@ -265,27 +275,21 @@ void probeIntersect(const RTCIntersectFunctionNArguments* args) {
     const unsigned i = args->primID;
     const float org[3] = {ray.org_x, ray.org_y, ray.org_z}, dir[3] = {ray.dir_x, ray.dir_y, ray.dir_z};
     // Embree hands over every primitive of a leaf it enters: the ray's own box test first.
-    if (!overlapsBounds(probe.boxes[i], org, dir, ray.tnear, ray.tfar)) return;
+    float entry;
+    if (!overlapsBounds(probe.boxes[i], org, dir, ray.tnear, ray.tfar, &entry)) return;
     if (!context->blockers) {
-        ++context->crossed;
+        ++context->crossed.whole;
+        context->crossed.untilBlocker += entry <= context->blockedAt;
         return;
     }
     if (i == context->exclude[0] || i == context->exclude[1]) return;
     const Vec3 o(org[0], org[1], org[2]), d(dir[0], dir[1], dir[2]);
     const BoxPrimitive& b = probe.prims[i];
     float t;
-    if (probe.sphere) {
-        const Vec3 oc = o - b.p;
-        const float a = glm::dot(d, d), h = glm::dot(d, oc), c = glm::dot(oc, oc) - b.r * b.r;
-        const float disc = h * h - a * c;
-        if (!(disc >= 0.0f)) return;
-        const float s = std::sqrt(disc), t0 = (-h - s) / a, t1 = (-h + s) / a;
-        t = t0 >= ray.tnear ? t0 : t1;
-    } else {
-        Vec2 uv;
-        if (!intersectBillboard(o, d, ray.tnear, ray.tfar, b.p, b.r, probe.frames[i], probe.disc, t, uv)) return;
-    }
-    if (!(t >= ray.tnear && t <= ray.tfar)) return;
+    Vec2 uv;
+    if (!(probe.sphere ? hitSphere(o, d, ray.tnear, ray.tfar, b.p, b.r, t)
+                       : intersectBillboard(o, d, ray.tnear, ray.tfar, b.p, b.r, probe.frames[i], probe.disc, t, uv)))
+        return;
     rh->ray.tfar = t;
     rh->hit.geomID = 0;
     rh->hit.primID = i;
@@ -491,23 +495,25 @@ void ParticleBvh::buildProbe(const Particles& particles) {
     rtcCommitScene(probe_);
 }
 
-std::uint32_t ParticleBvh::boxesAlong(const Vec3& o, const Vec3& d, float tnear, float tfar, const Exclusion* occlusion) const {
+BoxesCrossed ParticleBvh::boxesAlong(const Vec3& o, const Vec3& d, float tnear, float tfar, const Exclusion* occlusion) const {
     ProbeContext context;
     rtcInitIntersectContext(&context.base);
     context.probe = &probeData_;
-    context.crossed = 0;
+    context.crossed = {};
+    context.blockedAt = tfar;
     RTCRayHit rh;
-    rh.ray = embreeRay(o, d, tnear, tfar);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    if (occlusion) {  // the first blocker ends the segment
+    if (occlusion) {  // where the first blocker is
         context.blockers = true;
         context.exclude[0] = occlusion->receiver;
         context.exclude[1] = occlusion->light;
+        rh.ray = embreeRay(o, d, tnear, tfar);
         rtcIntersect1(probe_, &context.base, &rh);
-        rh.ray = embreeRay(o, d, tnear, rh.ray.tfar);
+        context.blockedAt = rh.ray.tfar;
     }
     context.blockers = false;
+    rh.ray = embreeRay(o, d, tnear, tfar);
     rtcIntersect1(probe_, &context.base, &rh);
     return context.crossed;
 }
@@ -589,9 +595,9 @@ bool ParticleBvh::intersect(const Vec3& o, const Vec3& d, float tfar, SurfaceHit
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(counters && countingTlas_ ? countingTlas_ : tlas_, &context.base, &rh);
     if (counters && probe_) {
-        const std::uint32_t n = boxesAlong(o, d, 0.0f, rh.ray.tfar);
-        counters->segmentBoxes += n;
-        counters->wholeSegmentBoxes += n;
+        const BoxesCrossed n = boxesAlong(o, d, 0.0f, rh.ray.tfar);  // up to the hit: no blocker search
+        counters->segmentBoxes += n.untilBlocker;
+        counters->wholeSegmentBoxes += n.whole;
     }
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
     const std::uint32_t c = rh.hit.instID[0];
@@ -648,8 +654,9 @@ bool ParticleBvh::occluded(const Vec3& o, const Vec3& d, float tnear, float tfar
     RTCRay ray = embreeRay(o, d, tnear, tfar);
     rtcOccluded1(counters && countingTlas_ ? countingTlas_ : tlas_, &context.base, &ray);
     if (counters && probe_) {
-        counters->segmentBoxes += boxesAlong(o, d, tnear, tfar, &exclude);
-        counters->wholeSegmentBoxes += boxesAlong(o, d, tnear, tfar);
+        const BoxesCrossed n = boxesAlong(o, d, tnear, tfar, &exclude);
+        counters->segmentBoxes += n.untilBlocker;
+        counters->wholeSegmentBoxes += n.whole;
     }
     return ray.tfar < 0.0f;
 }

@@ -13,9 +13,10 @@ using namespace accretion;
 
 namespace {
 
-/// Closest hit by brute force: billboard quads (optionally disc-tested) or spheres.
+/// Closest hit in [tnear, tfar) by brute force: billboard quads (optionally
+/// disc-tested) or spheres (d a unit vector).
 float bruteForce(const Particles& p, const std::vector<BillboardFrame>& frames, const GeometrySettings& g, const Vec3& o,
-                 const Vec3& d, float tfar, std::uint32_t& hitParticle) {
+                 const Vec3& d, float tfar, std::uint32_t& hitParticle, float tnear = 0.0f) {
     float best = tfar;
     hitParticle = std::numeric_limits<std::uint32_t>::max();
     for (std::uint32_t i = 0; i < p.size(); ++i) {
@@ -26,7 +27,7 @@ float bruteForce(const Particles& p, const std::vector<BillboardFrame>& frames, 
             const float disc = b * b - c;
             if (disc < 0.0f) continue;
             t = -b - std::sqrt(disc);
-            if (t < 0.0f) t = -b + std::sqrt(disc);
+            if (t < tnear) t = -b + std::sqrt(disc);
         } else {
             const Vec3 n = frames[i].normal();
             const float denom = glm::dot(n, d);
@@ -37,12 +38,33 @@ float bruteForce(const Particles& p, const std::vector<BillboardFrame>& frames, 
             if (std::fabs(a) > 1.0f || std::fabs(b) > 1.0f) continue;
             if (g.alpha == AlphaMode::disc && a * a + b * b > 1.0f) continue;
         }
-        if (t >= 0.0f && t < best) {
+        if (t >= tnear && t < best) {
             best = t;
             hitParticle = i;
         }
     }
     return best;
+}
+
+/// The particles' quad boxes, p -+ r (|right| + |up|), that o + t d, t in
+/// [tnear, tfar], overlaps: a slab test per particle, each box widened
+/// (slack > 0) or narrowed (< 0) by a relative margin.
+std::uint32_t overlappedBoxes(const Particles& p, const ParticleBvh& bvh, const Vec3& o, const Vec3& d, float tnear,
+                              float tfar, float slack) {
+    std::uint32_t n = 0;
+    for (std::uint32_t i = 0; i < p.size(); ++i) {
+        const BillboardFrame& f = bvh.frame(i);
+        const Vec3 e = p.radius[i] * (glm::abs(f.right) + glm::abs(f.up)) * (1.0f + slack);
+        float t0 = tnear, t1 = tfar;
+        for (int k = 0; k < 3; ++k) {
+            float lo = (p.position[i][k] - e[k] - o[k]) / d[k], hi = (p.position[i][k] + e[k] - o[k]) / d[k];
+            if (lo > hi) std::swap(lo, hi);
+            t0 = std::max(t0, lo);
+            t1 = std::min(t1, hi);
+        }
+        n += t0 <= t1;
+    }
+    return n;
 }
 
 }  // namespace
@@ -235,25 +257,6 @@ TEST_CASE("box primitives: an instance entered per box is an intersection progra
     const Camera cam = Camera::atFrame(cs, 0);
     instances.build(p, cam);
     boxes.build(p, cam);
-    // The boxes a ray o + t d, t in [0, tfar), overlaps: a slab test per
-    // particle of its quad's bounds, p -+ r (|right| + |up|), widened (slack
-    // > 0) or narrowed (< 0) by a relative margin.
-    auto overlapped = [&](const Vec3& o, const Vec3& d, float tfar, float slack) {
-        std::uint32_t n = 0;
-        for (std::uint32_t i = 0; i < p.size(); ++i) {
-            const BillboardFrame& f = boxes.frame(i);
-            const Vec3 e = p.radius[i] * (glm::abs(f.right) + glm::abs(f.up)) * (1.0f + slack);
-            float t0 = 0.0f, t1 = tfar;
-            for (int k = 0; k < 3; ++k) {
-                float lo = (p.position[i][k] - e[k] - o[k]) / d[k], hi = (p.position[i][k] + e[k] - o[k]) / d[k];
-                if (lo > hi) std::swap(lo, hi);
-                t0 = std::max(t0, lo);
-                t1 = std::min(t1, hi);
-            }
-            n += t0 <= t1;
-        }
-        return n;
-    };
     std::uint64_t hits = 0, entries = 0, programs = 0;
     for (std::uint32_t y = 0; y < cam.height; ++y)
         for (std::uint32_t x = 0; x < cam.width; ++x) {
@@ -267,8 +270,8 @@ TEST_CASE("box primitives: an instance entered per box is an intersection progra
             REQUIRE(ra.intersections == 0);
             REQUIRE(rb.blasEntries <= 1);  // the one BLAS of boxes, when its bounds are entered
             REQUIRE(ra.blasEntries == rb.intersections);
-            REQUIRE(rb.intersections <= overlapped(cam.position, d, 1e30f, 1e-4f));
-            REQUIRE(rb.intersections >= overlapped(cam.position, d, hb ? b.t * (1.0f - 1e-4f) : 1e30f, -1e-4f));
+            REQUIRE(rb.intersections <= overlappedBoxes(p, boxes, cam.position, d, 0.0f, 1e30f, 1e-4f));
+            REQUIRE(rb.intersections >= overlappedBoxes(p, boxes, cam.position, d, 0.0f, hb ? b.t * (1.0f - 1e-4f) : 1e30f, -1e-4f));
             hits += ha;
             entries += ra.blasEntries;
             programs += rb.intersections;
@@ -301,21 +304,10 @@ TEST_CASE("segment boxes: the particles' boxes a ray crosses, whatever the layou
         bvhs.back()->build(p, cam);
     }
     auto crossed = [&](const Vec3& o, const Vec3& d, float tnear, float tfar, float slack) {
-        std::uint32_t n = 0;
-        for (std::uint32_t i = 0; i < p.size(); ++i) {
-            const BillboardFrame& f = bvhs[0]->frame(i);
-            const Vec3 e = p.radius[i] * (glm::abs(f.right) + glm::abs(f.up)) * (1.0f + slack);
-            float t0 = tnear, t1 = tfar;
-            for (int k = 0; k < 3; ++k) {
-                float lo = (p.position[i][k] - e[k] - o[k]) / d[k], hi = (p.position[i][k] + e[k] - o[k]) / d[k];
-                if (lo > hi) std::swap(lo, hi);
-                t0 = std::max(t0, lo);
-                t1 = std::min(t1, hi);
-            }
-            n += t0 <= t1;
-        }
-        return n;
+        return overlappedBoxes(p, *bvhs[0], o, d, tnear, tfar, slack);
     };
+    std::vector<BillboardFrame> frames(p.size());
+    for (std::uint32_t i = 0; i < p.size(); ++i) frames[i] = bvhs[0]->frame(i);
     std::uint64_t primary = 0, shadow = 0, blockedRays = 0, shadowRays = 0, disagree = 0;
     for (std::uint32_t y = 0; y < cam.height; ++y)
         for (std::uint32_t x = 0; x < cam.width; ++x) {
@@ -342,12 +334,8 @@ TEST_CASE("segment boxes: the particles' boxes a ray crosses, whatever the layou
                 REQUIRE(sc.wholeSegmentBoxes <= crossed(o, to, t0 * (1.0f - 1e-4f), t1 * (1.0f + 1e-4f), 1e-4f));
                 REQUIRE(sc.wholeSegmentBoxes >= crossed(o, to, t0 * (1.0f + 1e-4f), t1 * (1.0f - 1e-4f), -1e-4f));
                 // Up to the first blocker, found here by testing every particle's quad.
-                float first = t1;
-                for (std::uint32_t i = 0; i < p.size(); ++i) {
-                    float t;
-                    Vec2 uv;
-                    if (intersectBillboard(o, to, t0, t1, p.position[i], p.radius[i], bvhs[0]->frame(i), false, t, uv)) first = std::min(first, t);
-                }
+                std::uint32_t blocker;
+                const float first = bruteForce(p, frames, GeometrySettings{}, o, to, t1, blocker, t0);
                 disagree += blocked != (first < t1);  // a quad grazed at float precision
                 REQUIRE(sc.segmentBoxes <= crossed(o, to, t0 * (1.0f - 1e-4f), first * (1.0f + 1e-4f), 1e-4f));
                 REQUIRE(sc.segmentBoxes >= crossed(o, to, t0 * (1.0f + 1e-4f), first * (1.0f - 1e-4f), -1e-4f));

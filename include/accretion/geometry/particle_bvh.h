@@ -78,6 +78,12 @@ struct ProbeData {
     bool disc = false;    ///< billboards with the disc alpha test
 };
 
+/// The particles' boxes a segment crosses: all of them, and those it enters
+/// before its first blocker (all when nothing blocks it).
+struct BoxesCrossed {
+    std::uint32_t untilBlocker = 0, whole = 0;
+};
+
 /// The structure the CPU traces for `g`: the GPU's layout when counting (its
 /// counters are the GPU's), when asked (cpu_layout = gpu), or under the
 /// partial policy (its stale clusters are part of the image); else the
@@ -158,10 +164,11 @@ private:
     void buildCountingTlas();
     void buildProbe(const Particles& particles);
     /// The particles' boxes that o + t d, t in [tnear, tfar], passes through
-    /// (the probe: every particle's box in one BVH, whatever the layout); an
-    /// occlusion query's only up to its first blocker (other than the
-    /// excluded particles), where the GPU's traversal stops.
-    std::uint32_t boxesAlong(const Vec3& o, const Vec3& d, float tnear, float tfar, const Exclusion* occlusion = nullptr) const;
+    /// (the probe: every particle's box in one BVH, whatever the layout),
+    /// and for an occlusion query those entered before its first blocker
+    /// (other than the excluded particles), where the GPU's traversal stops:
+    /// one blocker search, one count.
+    BoxesCrossed boxesAlong(const Vec3& o, const Vec3& d, float tnear, float tfar, const Exclusion* occlusion = nullptr) const;
     /// The BLAS hold box primitives (user geometry) rather than Embree's quads or spheres.
     bool boxPrimitives() const {
         return settings_.layout != AccelLayout::clusters || (counting_ && settings_.primitive == Primitive::sphere);
