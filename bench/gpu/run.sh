@@ -287,10 +287,13 @@ step_identity() {
     [ -d "$old" ] || { echo "identity: no $old (stage_deps.sh with an old commit)"; return 1; }
     mkdir -p "$t"
     build_twin "$old" "$(cat "$D/old.commit")" "$t/build_old.log" || { tail -20 "$t/build_old.log"; return 1; }
-    local q="scenes/quickstart.toml -D camera.width=320 -D camera.height=180 -D render.estimator=\"restir\" --frames 0:3 --repeat 1"
-    local k=0 differ=0
+    local q0="scenes/quickstart.toml -D camera.width=320 -D camera.height=180 -D render.estimator=\"restir\" --frames 0:3"
+    local k=0 differ=0 q
     while read -r opts; do
         k=$((k + 1))
+        # one run a frame, or the line's own --repeat (a persistent BVH refitted again in each run)
+        q="$q0 --repeat 1"
+        [[ $opts == *--repeat* ]] && q=$q0
         # shellcheck disable=SC2086  # the overrides are words
         $BIN $q $opts -o "$t/new$k.{frame}.exr" > "$t/new$k.log" 2>&1 || { echo "identity: new twin failed on: $opts"; tail -3 "$t/new$k.log"; differ=1; continue; }
         # shellcheck disable=SC2086
@@ -308,8 +311,9 @@ step_identity() {
 -D render.source="power" -D restir.resolution_scale=0.5
 -D geometry.alpha="disc" -D restir.spatial_neighbours=64
 -D geometry.layout="aabbs" -D restir.m_cap=5
--D geometry.layout="instances" -D geometry.build="refit"
--D geometry.build="partial" -D render.source="power"
+-D geometry.layout="instances" -D geometry.build="refit" --repeat 3
+-D geometry.build="partial" -D render.source="power" --repeat 3
+-D geometry.build="refit" -D geometry.cluster_size=1000 --repeat 3
 -D render.estimator="exact"
 -D render.estimator="power" -D render.samples=8 -D geometry.alpha="disc"
 -D render.estimator="uniform" -D render.samples=4 -D render.target_stderr=0.05 -D render.max_samples=16

@@ -40,7 +40,8 @@ CostFeatures costFeatures(const PassReport& p, double cacheBytes) {
             double(b.primitivesSmall), double(b.primitivesMid), double(b.customBuilds),  double(p.intersections),
             double(p.tlasLevels),    double(p.misses),          double(p.segmentBoxes),
             double(p.gathers),       double(b.sphereRefits),    double(p.ser.traversalBefore.steps),
-            p.rays ? double(p.dispatches) * double(p.segmentBoxes) / double(p.rays) : 0.0, double(p.wholeSegmentBoxes)};
+            p.rays ? double(p.dispatches) * double(p.segmentBoxes) / double(p.rays) : 0.0, double(p.wholeSegmentBoxes),
+            double(p.ser.gathersBefore.steps), double(p.ser.hitsBefore.warps), p.footprintBytes};
 }
 
 CostCoefficients CostCoefficients::defaults() {

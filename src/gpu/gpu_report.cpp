@@ -52,6 +52,7 @@ PassReport summarise(const PassCounters& pc, const GpuSettings& gpu, const SerKe
     p.height = pc.height;
     p.dispatches = pc.dispatches;
     p.build = pc.build;
+    p.footprintBytes = double(pc.footprintBytes);
     for (const ThreadCounters& t : pc.threads) {
         p.threads += t.active;
         p.hitThreads += t.hit;
@@ -167,6 +168,9 @@ nlohmann::json toJson(const PassReport& p) {
             {"whole_segment_boxes", p.wholeSegmentBoxes},
             {"gathers", p.gathers},
             {"warp_segment_boxes", p.ser.traversalBefore.steps},
+            {"warp_gathers", p.ser.gathersBefore.steps},
+            {"hit_warps", p.ser.hitsBefore.warps},
+            {"footprint_bytes", p.footprintBytes},
             {"tlas_levels", p.tlasLevels},
             {"working_set_bytes", p.workingSetBytes},
             {"trips", p.trips},

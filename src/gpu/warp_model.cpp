@@ -114,7 +114,7 @@ SerReport serReport(const PassCounters& pass, const WarpLayout& layout, const Se
                     double reorderCost) {
     const std::size_t n = pass.threads.size();
     std::vector<std::uint64_t> branchKey(n), sortKey(n), one(n, 0);
-    std::vector<std::uint32_t> branchWork(n), trips(n), boxes(n);
+    std::vector<std::uint32_t> branchWork(n), trips(n), boxes(n), gathers(n), hits(n);
     std::size_t active = 0;
     for (std::size_t i = 0; i < n; ++i) {
         const ThreadCounters& t = pass.threads[i];
@@ -123,6 +123,8 @@ SerReport serReport(const PassCounters& pass, const WarpLayout& layout, const Se
         branchWork[i] = t.active;
         trips[i] = t.trips;
         boxes[i] = t.segmentBoxes;
+        gathers[i] = t.gathers;
+        hits[i] = t.hit;
         active += t.active;
     }
     const std::vector<std::uint32_t> before = dispatchOrder(pass.width, pass.height, layout);
@@ -134,6 +136,8 @@ SerReport serReport(const PassCounters& pass, const WarpLayout& layout, const Se
     r.loopBefore = simtStats(before, one, trips, layout.warpSize);
     r.loopAfter = simtStats(after, one, trips, layout.warpSize);
     r.traversalBefore = simtStats(before, one, boxes, layout.warpSize);
+    r.gathersBefore = simtStats(before, one, gathers, layout.warpSize);
+    r.hitsBefore = simtStats(before, one, hits, layout.warpSize);
     r.distinctSortKeysBefore = simtStats(before, sortKey, branchWork, layout.warpSize).distinctKeysPerWarp;
     r.distinctSortKeysAfter = simtStats(after, sortKey, branchWork, layout.warpSize).distinctKeysPerWarp;
     r.reorderSteps = reorderCost * double(active) / double(layout.warpSize);

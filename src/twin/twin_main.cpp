@@ -428,9 +428,10 @@ StoredReservoir* TwinRun::runRestir(LaunchParams& lp) {
 }
 
 /// The frame's passes: one counting run (its atomics would be timed too),
-/// then `repeat` timed runs when repeat > 1. A refit or partial build
-/// changes state: it runs once per frame, in the first run, whose time it
-/// keeps.
+/// then `repeat` timed runs when repeat > 1. A rebuild runs in every run;
+/// so does a refit or partial rebuild (of positions that have not moved
+/// since the first run: the same boxes again), so that its time is a
+/// median as every other's. The first build of a refitted BVH runs once.
 StepTimes TwinRun::runPasses(const FramePlan& plan, LaunchParams& lp, const Clusters& clusters, bool recluster,
                              LaunchCounters& counters, StoredReservoir*& finalReservoirs) {
     StepTimes ms, counted;
@@ -440,7 +441,7 @@ StepTimes TwinRun::runPasses(const FramePlan& plan, LaunchParams& lp, const Clus
     const unsigned runs = a_.repeat > 1 ? a_.repeat + 1 : 1;
     for (unsigned r = 0; r < runs; ++r) {
         lp.counters = r == 0 ? buf_.counters.as<LaunchCounters>() : nullptr;
-        if (plan.buildClusters && (r == 0 || !persistent_))
+        if (plan.buildClusters && (r == 0 || !(recluster && persistent_)))
             accel_->build(recluster || instances ? &clusters : nullptr, dp, stream_, *timer_);
         lp.tlas = accel_->tlas();
         lp.clusterParticle = accel_->clusterParticle();

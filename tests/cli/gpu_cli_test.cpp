@@ -260,6 +260,38 @@ TEST_CASE("cost counts the refits of built-in spheres, and a candidate's gathers
     CHECK(s["warp_segment_boxes"].get<double>() >= s["segment_boxes"].get<double>() / 32.0);
     CHECK(s["warp_segment_boxes"].get<double>() <= s["segment_boxes"].get<double>());
     CHECK(passes["uniform"]["generateCandidates"]["warp_segment_boxes"].get<double>() == 0.0);  // no rays
+    // Uniform candidates: every hit lane reads 8 lights, so a warp with a
+    // hit lane waits for 8 gathers, and only such warps wait at all.
+    CHECK(u["warp_gathers"].get<double>() == 8.0 * u["hit_warps"].get<double>());
+    CHECK(w["warp_gathers"].get<double>() == 16.0 * w["hit_warps"].get<double>());
+    // A warp holds at most 32 hit lanes, and at least one.
+    CHECK(u["hit_warps"].get<double>() >= u["hit_threads"].get<double>() / 32.0);
+    CHECK(u["hit_warps"].get<double>() <= u["hit_threads"].get<double>());
+    CHECK(u["hit_warps"].get<double>() < u["hit_threads"].get<double>());  // the disk covers neighbouring pixels
+    CHECK(u["footprint_bytes"].get<double>() == 0.0);
+}
+
+TEST_CASE("cost counts upsampling's lighting grid once, whatever the pixels that share its texels", "[cli][gpu]") {
+    const auto dir = accretion::test::scratchDir("cost_footprint");
+    std::string out;
+    std::map<std::string, nlohmann::json> up;
+    for (const std::string scale : {"0.5", "0.75"}) {
+        const std::string run = kBin + " cost " + tinyScene() + " --quiet --frames 1 --history 1 --overhead 0 --cluster-sizes \"\" " +
+                                "--omm-levels \"\" -D render.estimator=\\\"restir\\\" -D camera.width=64 -D camera.height=36 " +
+                                "-D restir.resolution_scale=" + scale + " -o " + (dir / (scale + ".json")).string();
+        INFO(run);
+        REQUIRE(runCommand(run, out) == 0);
+        const nlohmann::json j = nlohmann::json::parse(slurp(dir / (scale + ".json")));
+        for (const auto& p : j["passes"])
+            if (p["pass"] == "upsampleLighting") up[scale] = p;
+    }
+    REQUIRE(up.size() == 2);
+    // The lighting grid (32 x 18, then 48 x 27 texels) of 24-byte texels and
+    // 8-byte radiance, each byte once; the threads ask the same bytes at
+    // both scales (four texels a hit pixel).
+    CHECK(up["0.5"]["footprint_bytes"].get<double>() == 32.0 * 18.0 * 32.0);
+    CHECK(up["0.75"]["footprint_bytes"].get<double>() == 48.0 * 27.0 * 32.0);
+    CHECK(up["0.5"]["bytes_read"] == up["0.75"]["bytes_read"]);
 }
 
 TEST_CASE("cost counts the rays that found nothing, and a traced pass's working set holds the TLAS", "[cli][gpu]") {

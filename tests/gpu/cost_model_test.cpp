@@ -165,7 +165,7 @@ TEST_CASE("the selected form keeps the counters that made the timings and drops 
     std::uniform_real_distribution<double> u(0.0, 1.0);
     std::normal_distribution<double> noise(0.0, 0.03);
     std::vector<CostRow> rows;
-    for (int c = 0; c < 30; ++c) {
+    for (int c = 0; c < 40; ++c) {
         CostRow t{"c" + std::to_string(c), "traceShadowRays", {}, 0.0};
         t.features[0] = 2e5 + 2e6 * u(rng);           // threads: unrelated here
         t.features[1] = 1e4 + 1e5 * u(rng);           // warp_steps: unrelated

@@ -127,6 +127,11 @@ struct PassCounters {
     std::vector<ThreadCounters> threads;
     std::uint64_t dispatches = 1;  ///< kernel dispatches (a cost model feature); builds are in `build`
     BuildCounters build;           ///< buildClusters only
+    /// Distinct bytes of the grids the pass's threads read at other threads'
+    /// texels, each once (upsampleLighting's lighting grid: four pixels share
+    /// a texel at half resolution, fewer at 0.75): its traffic from memory,
+    /// where the per-thread bytes count what the threads ask of the caches.
+    std::uint64_t footprintBytes = 0;
 
     PassCounters() = default;
     PassCounters(std::string_view name, std::uint32_t w, std::uint32_t h)

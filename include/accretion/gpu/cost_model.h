@@ -36,16 +36,23 @@ namespace accretion {
 /// lane's segment boxes summed over the warps (a warp waits for its longest
 /// ray), and dispatch_path, the dispatches times the mean segment boxes of
 /// a ray (a launch lasts at least one ray's traversal, whatever its size:
-/// what a launch of few rays costs beyond their throughput). Counter CSVs
-/// without a column read it as 0.
-inline constexpr std::array<std::string_view, 28> kCostFeatures = {
+/// what a launch of few rays costs beyond their throughput). Two terms of
+/// a warp's latency: warp_gathers, per warp its longest lane's gathers (a
+/// chain of dependent reads), and hit_warps, the warps with a lane on a
+/// particle (on the H100 the spatial pass at 720p costs 72, 86 and 78 ns
+/// per such warp at 10K, 100K and 1M particles, whose warps hold 6, 20 and
+/// 31 hit lanes). footprint_bytes:
+/// the distinct bytes of the grids read at other threads' texels (the
+/// lighting grid of upsampling: 1.5x the time at scale 0.75 as at 0.5, for
+/// the same bytes asked). Counter CSVs without a column read it as 0.
+inline constexpr std::array<std::string_view, 31> kCostFeatures = {
     "threads",          "warp_steps",          "rays",                 "blas_entries",     "any_hits",
     "bytes",            "blas_levels",         "omm_lookups",          "dispatches",       "build_launches",
     "refit_launches",   "cold_work",           "accel_elements",       "accel_elements_1k", "accel_elements_32k",
     "build_primitives", "build_primitives_1k", "build_primitives_32k", "custom_builds",    "intersections",
     "tlas_levels",      "misses",              "segment_boxes",    "gathers",
     "sphere_refits",    "warp_segment_boxes",  "dispatch_path",
-    "whole_segment_boxes"};
+    "whole_segment_boxes", "warp_gathers",     "hit_warps",           "footprint_bytes"};
 inline constexpr std::size_t kBaseCostFeatures = 6;
 inline constexpr std::size_t kColdWork = 11;
 /// Whether feature k prices acceleration-structure builds: buildClusters is

@@ -34,6 +34,9 @@ struct PassReport {
     /// 0. With more of it than a cache holds, its reads miss (the cost model's
     /// cold_work).
     double workingSetBytes = 0.0;
+    /// Distinct bytes of the grids the pass reads at other threads' texels
+    /// (PassCounters::footprintBytes).
+    double footprintBytes = 0.0;
     std::uint32_t maxTrips = 0;
     SerReport ser;
     std::string rayModel;  ///< "inline", "pipeline", or "-" (no rays)

@@ -71,6 +71,13 @@ struct SerReport {
     /// lane's rays cross (segment boxes): a warp lasts as long as its
     /// longest lane's traversal.
     SimtStats traversalBefore;
+    /// In dispatch order, work = a lane's gathers (reads at a drawn index,
+    /// each waiting for the last): a warp waits for its longest chain.
+    SimtStats gathersBefore;
+    /// In dispatch order, work = 1 on a lane whose pixel hit a particle: its
+    /// warps are those that run the pass's per-surface work at all (a warp
+    /// of one hit lane costs nearly what a full one does).
+    SimtStats hitsBefore;
     double distinctSortKeysBefore = 0, distinctSortKeysAfter = 0;  ///< per warp
     double reorderSteps = 0;               ///< cost of the reorder in warp steps
     double predictedSpeedup = 1.0;         ///< steps before / (steps after + reorder)

@@ -120,7 +120,7 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
     } else {
         auto t = timer.scope(pass::upsampleLighting);
         restir::upsampleLighting(full, *lg, in.particles, lowLr, f.scale, rs_, out.Lr);
-        if (in.counters) restir::recordUpsample(in, in.counters->add(pass::upsampleLighting, full.width, full.height));
+        if (in.counters) restir::recordUpsample(in, *lg, in.counters->add(pass::upsampleLighting, full.width, full.height));
     }
     aov.W.assign(pixels, 0.0f);
     aov.M.assign(pixels, 0.0f);

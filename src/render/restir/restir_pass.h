@@ -162,7 +162,7 @@ LightingCounters traceShadowRays(const FrameContext& f, std::vector<StoredReserv
 void upsampleLighting(const GBuffer& full, const GBuffer& lg, const Particles& particles, const std::vector<Vec3>& lowLr,
                       float scale, const RestirSettings& rs, std::vector<Vec3>& Lr);
 /// Counting mode: upsampleLighting's per-pixel work.
-void recordUpsample(const RestirInputs& in, PassCounters& pc);
+void recordUpsample(const RestirInputs& in, const GBuffer& lightingGrid, PassCounters& pc);
 
 }  // namespace restir
 }  // namespace accretion

@@ -18,9 +18,10 @@ void upsampleLighting(const GBuffer& full, const GBuffer& lg, const Particles& p
     });
 }
 
-void recordUpsample(const RestirInputs& in, PassCounters& pc) {
+void recordUpsample(const RestirInputs& in, const GBuffer& lightingGrid, PassCounters& pc) {
     // Per image pixel: its texel, then four lighting texels (G-buffer + radiance) as loop trips.
     const GBuffer& full = in.gbuffer;
+    pc.footprintBytes = std::uint64_t(lightingGrid.width) * lightingGrid.height * (gpu_layout::kGBufferTexel + gpu_layout::kRadiance);
     for (std::size_t px = 0; px < full.texels.size(); ++px) {
         const GBufferTexel& g = full.texels[px];
         ThreadCounters& t = pc.threads[px];
