@@ -429,9 +429,10 @@ StoredReservoir* TwinRun::runRestir(LaunchParams& lp) {
 
 /// The frame's passes: one counting run (its atomics would be timed too),
 /// then `repeat` timed runs when repeat > 1. A rebuild runs in every run;
-/// so does a refit or partial rebuild (of positions that have not moved
-/// since the first run: the same boxes again), so that its time is a
-/// median as every other's. The first build of a refitted BVH runs once.
+/// so does a refit (of positions that have not moved since the first run:
+/// the same boxes again), so that its time is a median as every other's.
+/// The first build of a persistent BVH runs once, and so does a partial
+/// rebuild (each moves its round-robin cursor: the stale clusters change).
 StepTimes TwinRun::runPasses(const FramePlan& plan, LaunchParams& lp, const Clusters& clusters, bool recluster,
                              LaunchCounters& counters, StoredReservoir*& finalReservoirs) {
     StepTimes ms, counted;
@@ -441,7 +442,8 @@ StepTimes TwinRun::runPasses(const FramePlan& plan, LaunchParams& lp, const Clus
     const unsigned runs = a_.repeat > 1 ? a_.repeat + 1 : 1;
     for (unsigned r = 0; r < runs; ++r) {
         lp.counters = r == 0 ? buf_.counters.as<LaunchCounters>() : nullptr;
-        if (plan.buildClusters && (r == 0 || !(recluster && persistent_)))
+        const bool once = persistent_ && (recluster || s_.geometry.build == BuildPolicy::partial);
+        if (plan.buildClusters && (r == 0 || !once))
             accel_->build(recluster || instances ? &clusters : nullptr, dp, stream_, *timer_);
         lp.tlas = accel_->tlas();
         lp.clusterParticle = accel_->clusterParticle();
