@@ -41,7 +41,8 @@ CostFeatures costFeatures(const PassReport& p, double cacheBytes) {
             double(p.tlasLevels),    double(p.misses),          double(p.segmentBoxes),
             double(p.gathers),       double(b.sphereRefits),    double(p.ser.traversalBefore.steps),
             p.rays ? double(p.dispatches) * double(p.segmentBoxes) / double(p.rays) : 0.0, double(p.wholeSegmentBoxes),
-            double(p.ser.gathersBefore.steps), double(p.ser.hitsBefore.warps), p.footprintBytes};
+            double(p.ser.gathersBefore.steps), double(p.ser.hitsBefore.warps), p.footprintBytes,
+            double(b.tlasInstancesMid)};
 }
 
 CostCoefficients CostCoefficients::defaults() {

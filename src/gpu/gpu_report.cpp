@@ -162,6 +162,7 @@ nlohmann::json toJson(const PassReport& p) {
             {"custom_builds", p.build.customBuilds},
             {"sphere_refits", p.build.sphereRefits},
             {"tlas_instances", p.build.tlasInstances},
+            {"tlas_instances_32k", p.build.tlasInstancesMid},
             {"intersections", p.intersections},
             {"misses", p.misses},
             {"segment_boxes", p.segmentBoxes},

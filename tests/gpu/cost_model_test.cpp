@@ -269,12 +269,17 @@ TEST_CASE("a build's elements are counted whole and clamped at the knots, refits
     CHECK(b.sphereRefits == 1u);
     CHECK(b.customBuilds == 2u);
     CHECK(b.tlasInstances == 4u);
+    CHECK(b.tlasInstancesMid == 4u);  // the TLAS's instances again, apart from the BLAS's primitives
     BuildCounters refitTlas;
     refitTlas.addTlas(100000, true);
     CHECK(refitTlas.refits == 1u);
     CHECK(refitTlas.builds == 0u);
     CHECK(refitTlas.primitives == 0u);
     CHECK(refitTlas.elements == 100000u);
+    CHECK(refitTlas.tlasInstancesMid == 0u);  // an update, not a build
+    BuildCounters bigTlas;
+    bigTlas.addTlas(1000000, false);
+    CHECK(bigTlas.tlasInstancesMid == 32768u);
 }
 
 TEST_CASE("the build pass is fitted on the build counters, the other passes on the rest", "[gpu][cost]") {

@@ -89,6 +89,10 @@ struct BuildCounters {
     /// BLAS refits of built-in spheres: 1.5x a refit of triangles or boxes on the H100 (1000 clusters of 1000: 57 ms against 38 and 36)
     std::uint64_t sphereRefits = 0;
     std::uint64_t tlasInstances = 0;
+    /// Instances of TLAS builds (not refits), clamped per build at 32768: on
+    /// the H100 a TLAS over 10K instances builds in 0.26 ms where a BLAS of
+    /// 20K triangles takes 0.15 (an instance's box is its child's, transformed).
+    std::uint64_t tlasInstancesMid = 0;
     static constexpr std::uint64_t kSmallKnot = 1024, kMidKnot = 32768;
     static std::uint64_t small(std::uint64_t n) { return n < kSmallKnot ? n : kSmallKnot; }
     static std::uint64_t mid(std::uint64_t n) { return n < kMidKnot ? n : kMidKnot; }
@@ -103,6 +107,7 @@ struct BuildCounters {
     void addTlas(std::uint64_t n, bool refit) {
         add(n, refit);
         tlasInstances = n;
+        if (!refit) tlasInstancesMid += mid(n);
     }
 
 private:

@@ -31,7 +31,8 @@ namespace accretion {
 /// constant; the elements built or refitted, whole and clamped per build at
 /// 1024 and 32768 (a build's cost per element falls as it fills the GPU);
 /// the same over the builds alone (what a build does beyond a refit); the
-/// builds of boxes or spheres, and the refits of built-in spheres. Two
+/// builds of boxes or spheres, the refits of built-in spheres, and the
+/// instances of TLAS builds clamped at 32768 (tlas_instances_32k). Two
 /// terms of a traversal's length: warp_segment_boxes, per warp its longest
 /// lane's segment boxes summed over the warps (a warp waits for its longest
 /// ray), and dispatch_path, the dispatches times the mean segment boxes of
@@ -45,14 +46,15 @@ namespace accretion {
 /// the distinct bytes of the grids read at other threads' texels (the
 /// lighting grid of upsampling: 1.5x the time at scale 0.75 as at 0.5, for
 /// the same bytes asked). Counter CSVs without a column read it as 0.
-inline constexpr std::array<std::string_view, 31> kCostFeatures = {
+inline constexpr std::array<std::string_view, 32> kCostFeatures = {
     "threads",          "warp_steps",          "rays",                 "blas_entries",     "any_hits",
     "bytes",            "blas_levels",         "omm_lookups",          "dispatches",       "build_launches",
     "refit_launches",   "cold_work",           "accel_elements",       "accel_elements_1k", "accel_elements_32k",
     "build_primitives", "build_primitives_1k", "build_primitives_32k", "custom_builds",    "intersections",
     "tlas_levels",      "misses",              "segment_boxes",    "gathers",
     "sphere_refits",    "warp_segment_boxes",  "dispatch_path",
-    "whole_segment_boxes", "warp_gathers",     "hit_warps",           "footprint_bytes"};
+    "whole_segment_boxes", "warp_gathers",     "hit_warps",           "footprint_bytes",
+    "tlas_instances_32k"};
 inline constexpr std::size_t kBaseCostFeatures = 6;
 inline constexpr std::size_t kColdWork = 11;
 /// Whether feature k prices acceleration-structure builds: buildClusters is
@@ -64,7 +66,7 @@ constexpr bool isBuildFeature(std::size_t k) {
     constexpr std::string_view build[] = {"build_launches",   "refit_launches",      "accel_elements",
                                           "accel_elements_1k", "accel_elements_32k", "build_primitives",
                                           "build_primitives_1k", "build_primitives_32k", "custom_builds",
-                                          "sphere_refits"};
+                                          "sphere_refits", "tlas_instances_32k"};
     for (std::string_view b : build)
         if (kCostFeatures[k] == b) return true;
     return false;
