@@ -42,10 +42,10 @@ namespace accretion {
 /// chain of dependent reads), and hit_warps, the warps with a lane on a
 /// particle (on the H100 the spatial pass at 720p costs 72, 86 and 78 ns
 /// per such warp at 10K, 100K and 1M particles, whose warps hold 6, 20 and
-/// 31 hit lanes). footprint_bytes:
-/// the distinct bytes of the grids read at other threads' texels (the
-/// lighting grid of upsampling: 1.5x the time at scale 0.75 as at 0.5, for
-/// the same bytes asked). Counter CSVs without a column read it as 0.
+/// 31 hit lanes). footprint_bytes: the distinct bytes of the grids read at
+/// other threads' texels (the lighting grid of upsampling: 1.5x the time at
+/// scale 0.75 as at 0.5, for the same bytes asked). Counter CSVs without a
+/// column read it as 0.
 inline constexpr std::array<std::string_view, 32> kCostFeatures = {
     "threads",          "warp_steps",          "rays",                 "blas_entries",     "any_hits",
     "bytes",            "blas_levels",         "omm_lookups",          "dispatches",       "build_launches",
