@@ -1,19 +1,20 @@
 #!/bin/bash
 # The cost model's timings, each configuration timed in separate processes:
-# the three lists of the fit (sweep.txt, layouts.txt, layouts_refit.txt),
-# once per run, as the layouts step times them (frame 1 after a history
+# the four lists of the fit (sweep.txt, layouts.txt, layouts_refit.txt,
+# sweep_bracket.txt), once per run, as the layouts step times them (frame 1 after a history
 # frame, each pass the median of 5 runs). A small build's time moves from
-# one process to the next by up to 50% on the H100 while it repeats within
-# a process; the fit takes each pass's median over the runs
+# one process to the next (on the H100 a 100K refit took 0.57 ms in one run,
+# 0.24 in two others) while it repeats within a process; the fit takes each
+# pass's median over the runs
 # (bench/gpu/replicate_median.py). On the GPU machine after
 # `bash bench/gpu/run.sh build`:
 #   UNITS="1:sweep 1:layouts 1:layouts_refit 2:sweep ..." DEADLINE=480 bash bench/gpu/retime_fit.sh
-# UNITS: run:list pairs (default: runs 1-3 of the three lists); a unit
+# UNITS: run:list pairs (default: runs 1-3 of the four lists); a unit
 # starts only before DEADLINE seconds (default: no limit). What finished
 # comes back as $OUT/retimed.tar.gz (run<N>/<list>/<config>.timings.csv).
 set -uo pipefail
 O=${OUT:?OUT: the folder that comes back}
-units=${UNITS:-1:sweep 1:layouts 1:layouts_refit 2:sweep 2:layouts 2:layouts_refit 3:sweep 3:layouts 3:layouts_refit}
+units=${UNITS:-$(for r in 1 2 3; do for l in sweep layouts layouts_refit sweep_bracket; do echo -n "$r:$l "; done; done)}
 T=$O/retimed
 start=$SECONDS
 for u in $units; do

@@ -440,10 +440,10 @@ StepTimes TwinRun::runPasses(const FramePlan& plan, LaunchParams& lp, const Clus
     const bool instances = s_.geometry.layout == AccelLayout::instances;
     const std::size_t pixels = std::size_t(W_) * H_;
     const unsigned runs = a_.repeat > 1 ? a_.repeat + 1 : 1;
+    const bool buildOnce = persistent_ && (recluster || s_.geometry.build == BuildPolicy::partial);
     for (unsigned r = 0; r < runs; ++r) {
         lp.counters = r == 0 ? buf_.counters.as<LaunchCounters>() : nullptr;
-        const bool once = persistent_ && (recluster || s_.geometry.build == BuildPolicy::partial);
-        if (plan.buildClusters && (r == 0 || !once))
+        if (plan.buildClusters && (r == 0 || !buildOnce))
             accel_->build(recluster || instances ? &clusters : nullptr, dp, stream_, *timer_);
         lp.tlas = accel_->tlas();
         lp.clusterParticle = accel_->clusterParticle();
