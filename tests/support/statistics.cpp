@@ -1,7 +1,10 @@
 #include "support/statistics.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <stdexcept>
+#include <string>
 
 namespace accretion::test {
 
@@ -61,5 +64,26 @@ double chiSquarePValue(const std::vector<double>& observed, const std::vector<do
 }
 
 double normalTwoSidedP(double z) { return std::erfc(std::fabs(z) / std::sqrt(2.0)); }
+
+namespace {
+
+std::uint32_t seedDivisor() {
+    const char* v = std::getenv("ACCRETION_TEST_SEED_DIVISOR");
+    if (v == nullptr || *v == '\0') return 1;
+    char* end = nullptr;
+    const long d = std::strtol(v, &end, 10);
+    if (*end != '\0' || d < 1 || d > 1000)
+        throw std::invalid_argument(std::string("ACCRETION_TEST_SEED_DIVISOR=") + v + ": expected an integer from 1 to 1000");
+    return static_cast<std::uint32_t>(d);
+}
+
+}  // namespace
+
+std::uint32_t statisticalSeeds(std::uint32_t full, std::uint32_t minimum) {
+    const std::uint32_t d = seedDivisor();
+    return d == 1 ? full : std::max(std::min(full, minimum), full / d);
+}
+
+bool fullStatisticalPower() { return seedDivisor() == 1; }
 
 }  // namespace accretion::test
