@@ -4,7 +4,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config
   libembree-dev libtbb-dev libglm-dev
-  libopenexr-dev libopenimageio-dev openimageio-tools
+  libopenexr-dev libpng-dev libfreetype-dev libopenimageio-dev openimageio-tools
   catch2 libtomlplusplus-dev nlohmann-json3-dev libcli11-dev libfmt-dev
   libpcg-cpp-dev libeigen3-dev libbenchmark-dev gnuplot-nox clang parallel fonts-dejavu-core
   python3 python3-venv

@@ -1,19 +1,18 @@
 #include "accretion/analysis/image_metrics.h"
 
+#include <bit>
 #include <fstream>
 
 #include <algorithm>
 #include <cmath>
 
-#include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include "accretion/core/error.h"
+#include "accretion/io/exr_file.h"
 
 namespace accretion {
-
-namespace OIIO = OIIO_NAMESPACE;
 
 ErrorMetrics computeErrors(const std::vector<Vec3>& x, const std::vector<Vec3>& ref, const std::vector<Vec3>* refStderr,
                            double eps, double tolerance) {
@@ -77,53 +76,50 @@ std::vector<std::string> layerChannels(const std::string& layer) {
 }  // namespace
 
 bool exrHasLayer(const std::filesystem::path& file, const std::string& layer) {
-    auto in = OIIO::ImageInput::open(file.string());
-    if (!in) return false;
-    const OIIO::ImageSpec& spec = in->spec();
+    ExrHeader h;
+    try {
+        h = readExrHeader(file);
+    } catch (const InputError&) {
+        return false;
+    }
     for (const std::string& c : layerChannels(layer))
-        if (spec.channelindex(c) < 0) return false;
+        if (h.channelIndex(c) < 0) return false;
     return true;
 }
 
 namespace {
 
-/// The three channels `channels(spec)` names, read from one opening of the file.
+/// The three channels `channels(header)` names, as floats, from one reading of the file.
 template <class Channels>
 RgbLayer readChannels(const std::filesystem::path& file, Channels&& channels) {
     requireExr(file);
-    auto in = OIIO::ImageInput::open(file.string());
-    if (!in) throw InputError(fmt::format("{}: cannot read image: {}", file.string(), OIIO::geterror()));
-    const OIIO::ImageSpec& spec = in->spec();
-    const std::vector<std::string> names = channels(spec);
+    const ExrHeader h = readExrHeader(file);
+    const std::vector<std::string> names = channels(h);
     ACC_CHECK(names.size() == 3);
-    RgbLayer out;
-    out.width = static_cast<std::uint32_t>(spec.full_width);
-    out.height = static_cast<std::uint32_t>(spec.full_height);
-    out.x0 = spec.x - spec.full_x;
-    out.y0 = spec.y - spec.full_y;
-    out.dataWidth = static_cast<std::uint32_t>(spec.width);
-    out.dataHeight = static_cast<std::uint32_t>(spec.height);
-    const std::size_t pixels = std::size_t(out.dataWidth) * out.dataHeight;
-    std::vector<float> all(pixels * std::size_t(spec.nchannels));
-    if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
-        throw InputError(fmt::format("{}: cannot read pixels: {}", file.string(), in->geterror()));
-    int idx[3];
+    for (const std::string& name : names)
+        if (h.channelIndex(name) < 0)
+            throw InputError(fmt::format("{}: no channel '{}' (it has {})", file.string(), name, fmt::join(h.channels, ", ")));
+    RgbLayer out{h.fullWidth, h.fullHeight, h.x0, h.y0, h.width, h.height, {}};
+    // Each channel read once (a layer of one channel names it three times).
+    std::vector<std::string> unique;
+    std::size_t slot[3];
     for (int c = 0; c < 3; ++c) {
-        idx[c] = spec.channelindex(names[c]);
-        if (idx[c] < 0)
-            throw InputError(fmt::format("{}: no channel '{}' (it has {})", file.string(), names[c],
-                                         fmt::join(spec.channelnames, ", ")));
+        const auto it = std::find(unique.begin(), unique.end(), names[std::size_t(c)]);
+        slot[c] = std::size_t(it - unique.begin());
+        if (it == unique.end()) unique.push_back(names[std::size_t(c)]);
     }
+    const std::vector<std::uint32_t> bits = readExrPixels(file, h, unique, true);
+    const std::size_t pixels = std::size_t(out.dataWidth) * out.dataHeight, n = unique.size();
     out.rgb.resize(pixels);
     for (std::size_t p = 0; p < pixels; ++p)
-        for (int c = 0; c < 3; ++c) out.rgb[p][c] = all[p * spec.nchannels + idx[c]];
+        for (int c = 0; c < 3; ++c) out.rgb[p][c] = std::bit_cast<float>(bits[p * n + slot[c]]);
     return out;
 }
 
 }  // namespace
 
 RgbLayer readExrChannels(const std::filesystem::path& file, const std::vector<std::string>& names) {
-    return readChannels(file, [&](const OIIO::ImageSpec&) { return names; });
+    return readChannels(file, [&](const ExrHeader&) { return names; });
 }
 
 std::vector<Vec3> RgbLayer::window(int x, int y, std::uint32_t w, std::uint32_t h) const {
@@ -136,33 +132,23 @@ std::vector<Vec3> RgbLayer::window(int x, int y, std::uint32_t w, std::uint32_t 
 }
 
 std::vector<std::uint32_t> readExrUintChannel(const std::filesystem::path& file, const std::string& name) {
-    auto in = OIIO::ImageInput::open(file.string());
-    if (!in) throw InputError(fmt::format("{}: cannot read image: {}", file.string(), OIIO::geterror()));
-    const OIIO::ImageSpec& spec = in->spec();
-    const int c = spec.channelindex(name);
-    if (c < 0 || spec.channelformat(c) != OIIO::TypeDesc::UINT) return {};
-    std::vector<std::uint32_t> v(std::size_t(spec.width) * spec.height);
-    if (!in->read_image(0, 0, c, c + 1, OIIO::TypeDesc::UINT, v.data()))
-        throw InputError(fmt::format("{}: cannot read pixels: {}", file.string(), in->geterror()));
-    return v;
+    const ExrHeader h = readExrHeader(file);
+    const int c = h.channelIndex(name);
+    if (c < 0 || h.types[std::size_t(c)] != ExrChannelType::uint32) return {};
+    return readExrPixels(file, h, {name}, false);
 }
 
 RgbLayer readExrLayer(const std::filesystem::path& file, const std::string& layer) {
-    return readChannels(file, [&](const OIIO::ImageSpec& spec) {
+    return readChannels(file, [&](const ExrHeader& h) {
         std::vector<std::string> names = layerChannels(layer);
-        if (!layer.empty() && spec.channelindex(names[0]) < 0 && spec.channelindex(layer) >= 0)
+        if (!layer.empty() && h.channelIndex(names[0]) < 0 && h.channelIndex(layer) >= 0)
             names = {layer, layer, layer};  // a channel of its own: spp, depth.Z
         return names;
     });
 }
 
 std::map<std::string, std::string> readExrAttributes(const std::filesystem::path& file) {
-    auto in = OIIO::ImageInput::open(file.string());
-    if (!in) throw InputError(fmt::format("{}: cannot read image: {}", file.string(), OIIO::geterror()));
-    std::map<std::string, std::string> out;
-    for (const auto& p : in->spec().extra_attribs)
-        out[p.name().string()] = p.get_string();  // strings as they are, numbers and matrices printed
-    return out;
+    return readExrHeader(file).printed;  // strings as they are, numbers and matrices printed
 }
 
 }  // namespace accretion

@@ -4,17 +4,15 @@
 #include <cstring>
 #include <functional>
 
-#include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 
 #include "accretion/core/error.h"
-#include "accretion/core/atomic_file.h"
+#include "accretion/io/exr_file.h"
 #include "accretion/io/false_colour.h"
+#include "accretion/io/png_file.h"
 #include "accretion/render/gbuffer.h"
 
 namespace accretion {
-
-namespace OIIO = OIIO_NAMESPACE;
 
 ExrCameraMatrices exrCameraMatrices(const CameraPose& c, std::uint32_t width, std::uint32_t height) {
     const DVec3 axis[3] = {c.right, c.up, c.forward};
@@ -43,21 +41,13 @@ ExrCameraMatrices exrCameraMatrices(const CameraPose& c, std::uint32_t width, st
 
 namespace {
 
-/// The EXR's data window at (x, y) inside a display window of the whole image.
-void setDataWindow(OIIO::ImageSpec& spec, int x, int y, std::uint32_t fullWidth, std::uint32_t fullHeight) {
-    spec.x = x;
-    spec.y = y;
-    spec.full_x = spec.full_y = 0;
-    spec.full_width = int(fullWidth);
-    spec.full_height = int(fullHeight);
-}
-
-void setCameraAttributes(OIIO::ImageSpec& spec, const CameraPose& c, std::uint32_t width, std::uint32_t height) {
+/// The camera's standard attributes (OpenEXR's worldToCamera and worldToNDC)
+/// and its jitter in pixels.
+void setCameraAttributes(ExrImage& exr, const CameraPose& c, std::uint32_t width, std::uint32_t height) {
     const ExrCameraMatrices m = exrCameraMatrices(c, width, height);
-    spec.attribute("worldToCamera", OIIO::TypeMatrix44, m.worldToCamera.data());
-    spec.attribute("worldToNDC", OIIO::TypeMatrix44, m.worldToNDC.data());
-    const float jitter[2] = {float(c.jitterX), float(c.jitterY)};
-    spec.attribute("accretion:jitter", OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, OIIO::TypeDesc::VEC2), jitter);
+    exr.floats["worldToCamera"] = {"m44f", std::vector<float>(m.worldToCamera.begin(), m.worldToCamera.end())};
+    exr.floats["worldToNDC"] = {"m44f", std::vector<float>(m.worldToNDC.begin(), m.worldToNDC.end())};
+    exr.floats["accretion:jitter"] = {"v2f", {float(c.jitterX), float(c.jitterY)}};
 }
 
 }  // namespace
@@ -103,18 +93,6 @@ void writeFrameExr(const std::filesystem::path& file, const FrameImage& img, boo
     // The data window is the rendered window (render.crop), inside the
     // display window of the whole image.
     const PixelWindow w = img.window.pixels() ? img.window : PixelWindow::whole(img.width, img.height);
-    OIIO::ImageSpec spec(int(w.width()), int(w.height()), nch, OIIO::TypeDesc::FLOAT);
-    setDataWindow(spec, int(w.x0), int(w.y0), img.width, img.height);
-    spec.channelnames.clear();
-    spec.channelformats.clear();
-    for (const Channel& c : channels) {
-        spec.channelnames.push_back(c.name);
-        spec.channelformats.push_back(c.isUint ? OIIO::TypeDesc::UINT : OIIO::TypeDesc::FLOAT);
-    }
-    spec.attribute("compression", "zip");
-    for (const auto& [k, v] : metadata) spec.attribute("accretion:" + k, v);
-    setCameraAttributes(spec, img.camera, img.width, img.height);
-
     // Interleaved pixels in the native per-channel formats (all 4 bytes).
     std::vector<std::uint32_t> buf(w.pixels() * nch);
     std::size_t k = 0;
@@ -122,35 +100,47 @@ void writeFrameExr(const std::filesystem::path& file, const FrameImage& img, boo
         for (std::uint32_t x = w.x0; x < w.x1; ++x, ++k)
             for (int ch = 0; ch < nch; ++ch) buf[k * nch + ch] = channels[ch].bits(std::size_t(y) * img.width + x);
 
-    writeAtomicWith(file, [&](const std::filesystem::path& tmp) {
-        auto out = OIIO::ImageOutput::create("openexr");
-        if (!out) throw InternalError("OpenImageIO has no OpenEXR writer");
-        if (!out->open(tmp.string(), spec) || !out->write_image(OIIO::TypeDesc::UNKNOWN, buf.data()) || !out->close())
-            throw InputError(fmt::format("{}: cannot write EXR: {}", file.string(), out->geterror()));
-    });
+    ExrImage exr;
+    exr.fullWidth = img.width;
+    exr.fullHeight = img.height;
+    exr.x0 = int(w.x0);
+    exr.y0 = int(w.y0);
+    exr.width = w.width();
+    exr.height = w.height();
+    for (const Channel& c : channels) {
+        exr.channels.push_back(c.name);
+        exr.uints.push_back(c.isUint);
+    }
+    exr.bits = buf.data();
+    for (const auto& [key, v] : metadata) exr.strings["accretion:" + key] = v;
+    setCameraAttributes(exr, img.camera, img.width, img.height);
+    writeExr(file, exr);
 }
 
 void writeChannelsExr(const std::filesystem::path& file, std::uint32_t width, std::uint32_t height,
                       const std::vector<FloatChannel>& channels, const OutputMetadata& metadata, DataWindow window) {
-    const int nch = static_cast<int>(channels.size());
-    OIIO::ImageSpec spec(int(width), int(height), nch, OIIO::TypeDesc::FLOAT);
-    if (window.fullWidth > 0) setDataWindow(spec, window.x, window.y, window.fullWidth, window.fullHeight);
-    spec.channelnames.clear();
-    for (const FloatChannel& c : channels) spec.channelnames.push_back(c.name);
-    spec.attribute("compression", "zip");
-    for (const auto& [k, v] : metadata) spec.attribute("accretion:" + k, v);
-    const std::size_t pixels = std::size_t(width) * height;
-    std::vector<float> buf(pixels * nch);
-    for (int ch = 0; ch < nch; ++ch) {
+    const std::size_t nch = channels.size(), pixels = std::size_t(width) * height;
+    std::vector<std::uint32_t> buf(pixels * nch);
+    for (std::size_t ch = 0; ch < nch; ++ch) {
         ACC_CHECK(channels[ch].values.size() == pixels);
-        for (std::size_t px = 0; px < pixels; ++px) buf[px * nch + ch] = channels[ch].values[px];
+        for (std::size_t px = 0; px < pixels; ++px) buf[px * nch + ch] = std::bit_cast<std::uint32_t>(channels[ch].values[px]);
     }
-    writeAtomicWith(file, [&](const std::filesystem::path& tmp) {
-        auto out = OIIO::ImageOutput::create("openexr");
-        if (!out) throw InternalError("OpenImageIO has no OpenEXR writer");
-        if (!out->open(tmp.string(), spec) || !out->write_image(OIIO::TypeDesc::FLOAT, buf.data()) || !out->close())
-            throw InputError(fmt::format("{}: cannot write EXR: {}", file.string(), out->geterror()));
-    });
+    ExrImage exr;
+    exr.fullWidth = window.fullWidth;
+    exr.fullHeight = window.fullHeight;
+    if (window.fullWidth > 0) {
+        exr.x0 = window.x;
+        exr.y0 = window.y;
+    }
+    exr.width = width;
+    exr.height = height;
+    for (const FloatChannel& c : channels) {
+        exr.channels.push_back(c.name);
+        exr.uints.push_back(false);
+    }
+    exr.bits = buf.data();
+    for (const auto& [key, v] : metadata) exr.strings["accretion:" + key] = v;
+    writeExr(file, exr);
 }
 
 namespace {
@@ -168,15 +158,8 @@ float percentile995(std::vector<float> v) {
 
 void writeRgb8Png(const std::filesystem::path& file, const std::vector<std::uint8_t>& px, std::uint32_t width,
                   std::uint32_t height) {
-    OIIO::ImageSpec spec(int(width), int(height), 3, OIIO::TypeDesc::UINT8);
-    writeAtomicWith(file, [&](const std::filesystem::path& tmp) {
-        auto out = OIIO::ImageOutput::create("png");
-        if (!out) throw InternalError("OpenImageIO has no PNG writer");
-        if (!out->open(tmp.string(), spec) || !out->write_image(OIIO::TypeDesc::UINT8, px.data()) || !out->close())
-            throw InputError(fmt::format("{}: cannot write PNG: {}", file.string(), out->geterror()));
-    });
+    writePng(file, px, width, height);
 }
-
 
 void writeHeatmapPng(const std::filesystem::path& file, const std::vector<float>& values, std::uint32_t width,
                      std::uint32_t height, const std::string& title) {
@@ -196,47 +179,33 @@ float RawExr::value(std::size_t px, std::size_t c) const { return std::bit_cast<
 void RawExr::set(std::size_t px, std::size_t c, float v) { bits[px * channels.size() + c] = std::bit_cast<std::uint32_t>(v); }
 
 RawExr readRawExr(const std::filesystem::path& file) {
-    auto in = OIIO::ImageInput::open(file.string());
-    if (!in) throw InputError(fmt::format("{}: cannot read EXR: {}", file.string(), OIIO::geterror()));
-    const OIIO::ImageSpec& spec = in->spec();
+    const ExrHeader h = readExrHeader(file);
     RawExr exr;
     exr.file = file.string();
-    exr.width = static_cast<std::uint32_t>(spec.width);
-    exr.height = static_cast<std::uint32_t>(spec.height);
-    exr.channels = spec.channelnames;
-    for (int c = 0; c < spec.nchannels; ++c) {
-        const OIIO::TypeDesc t = spec.channelformat(c);
-        if (t.size() != 4) throw InputError(fmt::format("{}: channel {} is not 32-bit", file.string(), spec.channelnames[c]));
-        exr.uints.push_back(t == OIIO::TypeDesc::UINT);
+    exr.width = h.width;
+    exr.height = h.height;
+    exr.channels = h.channels;
+    for (const ExrChannelType t : h.types) {
+        if (t == ExrChannelType::half)
+            throw InputError(fmt::format("{}: channel {} is not 32-bit", file.string(), h.channels[exr.uints.size()]));
+        exr.uints.push_back(t == ExrChannelType::uint32);
     }
-    for (const auto& p : spec.extra_attribs) {
-        if (p.type() == OIIO::TypeDesc::STRING) exr.attributes[p.name().string()] = p.get_string();
-        if (p.type().basetype == OIIO::TypeDesc::FLOAT) {
-            const auto* v = static_cast<const float*>(p.data());
-            const std::size_t n = std::size_t(p.nvalues()) * p.type().numelements() * p.type().aggregate;
-            exr.floatAttributes[p.name().string()] = {p.type().c_str(), std::vector<float>(v, v + n)};
-        }
-    }
-    exr.bits.resize(std::size_t(exr.width) * exr.height * exr.channels.size());
-    if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UNKNOWN, exr.bits.data()))
-        throw InputError(fmt::format("{}: cannot read EXR pixels: {}", file.string(), in->geterror()));
+    exr.attributes = h.strings;
+    exr.floatAttributes = h.floats;
+    exr.bits = readExrPixels(file, h, h.channels, false);
     return exr;
 }
 
-void writeRawExr(const std::filesystem::path& file, const RawExr& exr) {
-    OIIO::ImageSpec spec(int(exr.width), int(exr.height), int(exr.channels.size()), OIIO::TypeDesc::FLOAT);
-    spec.channelnames = exr.channels;
-    spec.channelformats.clear();
-    for (const bool u : exr.uints) spec.channelformats.push_back(u ? OIIO::TypeDesc::UINT : OIIO::TypeDesc::FLOAT);
-    spec.attribute("compression", "zip");
-    for (const auto& [k, v] : exr.attributes) spec.attribute(k, v);
-    for (const auto& [k, tv] : exr.floatAttributes) spec.attribute(k, OIIO::TypeDesc(tv.first), tv.second.data());
-    writeAtomicWith(file, [&](const std::filesystem::path& tmp) {
-        auto out = OIIO::ImageOutput::create("openexr");
-        if (!out) throw InternalError("OpenImageIO has no OpenEXR writer");
-        if (!out->open(tmp.string(), spec) || !out->write_image(OIIO::TypeDesc::UNKNOWN, exr.bits.data()) || !out->close())
-            throw InputError(fmt::format("{}: cannot write EXR: {}", file.string(), out->geterror()));
-    });
+void writeRawExr(const std::filesystem::path& file, const RawExr& raw) {
+    ExrImage exr;
+    exr.width = raw.width;
+    exr.height = raw.height;
+    exr.channels = raw.channels;
+    exr.uints = raw.uints;
+    exr.bits = raw.bits.data();
+    exr.strings = raw.attributes;
+    exr.floats = raw.floatAttributes;
+    writeExr(file, exr);
 }
 
 }  // namespace accretion

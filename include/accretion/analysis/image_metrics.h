@@ -38,7 +38,7 @@ ErrorMetrics computeErrors(const std::vector<Vec3>& x, const std::vector<Vec3>& 
                            const std::vector<Vec3>* refStderr = nullptr, double eps = kRelMseEpsilon,
                            double tolerance = kAgreementTolerance);
 
-/// An RGB layer of an EXR file, read back with OpenImageIO (half or float
+/// An RGB layer of an EXR file, read with OpenEXR (half, float or uint
 /// channels, as floats): the pixels of its data window, which may be any
 /// part of (or reach outside) the display window of the whole image.
 struct RgbLayer {

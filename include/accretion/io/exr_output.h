@@ -59,7 +59,7 @@ struct RawExr {
     std::vector<bool> uints;             ///< per channel: UINT (else FLOAT)
     std::map<std::string, std::string> attributes;  ///< string attributes (accretion:*)
     /// Float attributes as they were (the camera's worldToCamera, worldToNDC,
-    /// accretion:jitter): name -> (OpenImageIO type name, values).
+    /// accretion:jitter): name -> (OpenEXR type name, values).
     std::map<std::string, std::pair<std::string, std::vector<float>>> floatAttributes;
     std::string file;                    ///< where it was read (for messages)
 
