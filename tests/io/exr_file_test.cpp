@@ -80,7 +80,7 @@ TEST_CASE("EXR files: a window of uint and float channels with attributes, writt
     CHECK(std::bit_cast<float>(asFloat[3]) == float(0xfffffff0u + 3));
 }
 
-TEST_CASE("EXR files: half channels are read as floats, refused as 32-bit bits; other files are refused by name", "[io][exr]") {
+TEST_CASE("EXR files: half channels are read as floats and refused as 32-bit bits, other files are refused by name", "[io][exr]") {
     const auto dir = accretion::test::scratchDir("exr_file_half");
     const auto file = dir / "half.exr";
     {
