@@ -251,7 +251,7 @@ void addBiasCommand(CLI::App& app) {
                          "Comma-separated specs, as for converge",
                          "Output prefix (default out/<scene>.bias): .csv, .png, .json, bias-map EXRs");
     cmd->add_option("--seeds", args->seeds, "Independent renders per estimator")->check(CLI::Range(2u, 1000000u));
-    cmd->add_option("--z", args->zCritical, "Two-sided critical |z| for the verdict (3.29: 99.9%)");
+    cmd->add_option("--z", args->zCritical, "Two-sided critical |z| for the verdict (3.29: 99.9%)")->check(finiteIn(0.0, 1e6));
     cmd->add_option("--gpu-frames", args->gpuFrames,
                     "Read each seed's frame from the OptiX twin's .gpuframe files instead of rendering it: a pattern "
                     "with {estimator} (the spec, file-safe) and {seed} (render.seed + k)");

@@ -400,7 +400,7 @@ void addCompareCommand(CLI::App& app) {
     cmd->add_option("--csv", args->csv, "With --frames: the per-frame table (CSV), and a plot beside it (.png)");
     cmd->add_option("--tolerance", args->tolerance,
                     "Relative tolerance of the pixel agreement (pixels within tolerance: |x-ref| <= tol |ref| in each channel)")
-        ->check(CLI::Range(0.0, 1e30));
+        ->check(finiteIn(0.0, 1e30));
     cmd->add_flag("--strict", args->strict, "A different frame, scene, camera or scene settings is an error (else a warning)");
     cmd->add_flag("--json", args->json, "Machine-readable output");
     cmd->add_flag("--allow-nonfinite", args->allowNonFinite,

@@ -397,7 +397,7 @@ void addRenderCommand(CLI::App& app) {
     cmd->add_option("--target-stderr", args->targetStderr,
                     "Sample each pixel until its relative standard error is below this (e.g. 0.5%; = render.target_stderr)");
     cmd->add_option("--spp", args->spp, "Light samples per pixel (= render.samples)");
-    cmd->add_option("--seed", args->seed, "Render seed (= render.seed)");
+    cmd->add_option("--seed", args->seed, "Render seed (= render.seed)")->check(unsignedNumber());
     cmd->add_option("--shard", args->shard,
                     "Render part i/n (0 <= i < n) of the work: a sample range (exact: rows) with its own streams, "
                     "to combine with `accretion merge`; adaptive sampling and restir split frames");

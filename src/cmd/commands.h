@@ -60,6 +60,13 @@ void checkOutputs(const OutputGuard& guard, const std::string& prefix, const std
 /// --threads N as a TBB limit for the life of the result (none for 0).
 std::unique_ptr<tbb::global_control> limitThreads(int threads);
 
+/// A number option's check: finite and in [lo, hi] (CLI::Range lets NaN
+/// through, since every comparison with it is false).
+CLI::Validator finiteIn(double lo, double hi);
+/// An unsigned option's check: no sign (CLI11 reads "-1" into an unsigned
+/// option as 2^64 - 1).
+CLI::Validator unsignedNumber();
+
 /// The options of SceneArgs: scene, --frames (with its help), -D, and
 /// optionally --threads and --quiet.
 void addSceneOptions(CLI::App* cmd, SceneArgs& args, const std::string& framesHelp, bool threadsAndQuiet = true);

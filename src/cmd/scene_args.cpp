@@ -1,5 +1,7 @@
 // What the commands that load a scene share: its options, the flags that
 // set typed settings, the thread limit.
+#include <cmath>
+
 #include <fmt/format.h>
 
 #include "accretion/core/error.h"
@@ -41,6 +43,27 @@ void checkOutputs(const OutputGuard& guard, const std::string& prefix, const std
 std::unique_ptr<tbb::global_control> limitThreads(int threads) {
     if (threads <= 0) return nullptr;
     return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+}
+
+CLI::Validator finiteIn(double lo, double hi) {
+    return CLI::Validator(
+        [lo, hi](std::string& text) -> std::string {
+            double v = 0.0;
+            if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v) || v < lo || v > hi)
+                return fmt::format("{}: expected a finite number from {} to {}", text, lo, hi);
+            return {};
+        },
+        fmt::format("FINITE in [{} - {}]", lo, hi));
+}
+
+CLI::Validator unsignedNumber() {
+    return CLI::Validator(
+        [](std::string& text) -> std::string {
+            if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos)
+                return fmt::format("{}: expected a whole number of 0 or more, without a sign", text);
+            return {};
+        },
+        "UINT");
 }
 
 void addSceneOptions(CLI::App* cmd, SceneArgs& args, const std::string& framesHelp, bool threadsAndQuiet) {

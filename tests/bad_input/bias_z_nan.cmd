@@ -1,0 +1,1 @@
+bias ok.toml --z nan
