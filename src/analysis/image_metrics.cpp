@@ -93,7 +93,8 @@ namespace {
 template <class Channels>
 RgbLayer readChannels(const std::filesystem::path& file, Channels&& channels) {
     requireExr(file);
-    const ExrHeader h = readExrHeader(file);
+    ExrReader reader(file);
+    const ExrHeader& h = reader.header();
     const std::vector<std::string> names = channels(h);
     ACC_CHECK(names.size() == 3);
     for (const std::string& name : names)
@@ -108,7 +109,7 @@ RgbLayer readChannels(const std::filesystem::path& file, Channels&& channels) {
         slot[c] = std::size_t(it - unique.begin());
         if (it == unique.end()) unique.push_back(names[std::size_t(c)]);
     }
-    const std::vector<std::uint32_t> bits = readExrPixels(file, h, unique, true);
+    const std::vector<std::uint32_t> bits = reader.pixels(unique, true);
     const std::size_t pixels = std::size_t(out.dataWidth) * out.dataHeight, n = unique.size();
     out.rgb.resize(pixels);
     for (std::size_t p = 0; p < pixels; ++p)
@@ -132,10 +133,10 @@ std::vector<Vec3> RgbLayer::window(int x, int y, std::uint32_t w, std::uint32_t 
 }
 
 std::vector<std::uint32_t> readExrUintChannel(const std::filesystem::path& file, const std::string& name) {
-    const ExrHeader h = readExrHeader(file);
-    const int c = h.channelIndex(name);
-    if (c < 0 || h.types[std::size_t(c)] != ExrChannelType::uint32) return {};
-    return readExrPixels(file, h, {name}, false);
+    ExrReader reader(file);
+    const int c = reader.header().channelIndex(name);
+    if (c < 0 || reader.header().types[std::size_t(c)] != ExrChannelType::uint32) return {};
+    return reader.pixels({name}, false);
 }
 
 RgbLayer readExrLayer(const std::filesystem::path& file, const std::string& layer) {

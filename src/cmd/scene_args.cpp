@@ -1,6 +1,7 @@
 // What the commands that load a scene share: its options, the flags that
 // set typed settings, the thread limit.
 #include <cmath>
+#include <cstdlib>
 
 #include <fmt/format.h>
 
@@ -48,8 +49,9 @@ std::unique_ptr<tbb::global_control> limitThreads(int threads) {
 CLI::Validator finiteIn(double lo, double hi) {
     return CLI::Validator(
         [lo, hi](std::string& text) -> std::string {
-            double v = 0.0;
-            if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v) || v < lo || v > hi)
+            char* end = nullptr;
+            const double v = std::strtod(text.c_str(), &end);
+            if (text.empty() || *end != '\0' || !std::isfinite(v) || v < lo || v > hi)
                 return fmt::format("{}: expected a finite number from {} to {}", text, lo, hi);
             return {};
         },

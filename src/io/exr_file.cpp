@@ -83,13 +83,18 @@ int ExrHeader::channelIndex(const std::string& name) const {
     return -1;
 }
 
-ExrHeader readExrHeader(const std::filesystem::path& file) {
+struct ExrReader::File {
+    Imf::InputFile in;
+    explicit File(const std::filesystem::path& path) : in(path.c_str()) {}
+};
+
+ExrReader::ExrReader(const std::filesystem::path& file) : path_(file) {
     useAllCores();
     try {
-        const Imf::InputFile in(file.c_str());
-        const Imf::Header& h = in.header();
+        file_ = std::make_unique<File>(file);
+        const Imf::Header& h = file_->in.header();
         const Imath::Box2i data = h.dataWindow(), display = h.displayWindow();
-        ExrHeader out;
+        ExrHeader& out = header_;
         out.fullWidth = std::uint32_t(display.max.x - display.min.x + 1);
         out.fullHeight = std::uint32_t(display.max.y - display.min.y + 1);
         out.x0 = data.min.x - display.min.x;
@@ -115,42 +120,41 @@ ExrHeader readExrHeader(const std::filesystem::path& file) {
                 if (!isStandard(name)) out.floats[name] = std::move(floats);
             }
         }
-        return out;
     } catch (const std::exception& e) {
         throw InputError(fmt::format("{}: cannot read EXR: {}", file.string(), e.what()));
     }
 }
 
-std::vector<std::uint32_t> readExrPixels(const std::filesystem::path& file, const ExrHeader& header,
-                                         const std::vector<std::string>& channels, bool asFloat) {
-    const std::size_t n = channels.size(), pixels = std::size_t(header.width) * header.height;
-    std::vector<std::uint32_t> bits(pixels * n);
+ExrReader::~ExrReader() = default;
+
+std::vector<std::uint32_t> ExrReader::pixels(const std::vector<std::string>& channels, bool asFloat) {
+    const std::size_t n = channels.size(), count = std::size_t(header_.width) * header_.height;
+    std::vector<std::uint32_t> bits(count * n);
+    const Imath::Box2i data = file_->in.header().dataWindow();
+    const std::size_t xStride = n * 4, yStride = xStride * header_.width;
+    // The slice's base is where pixel (0, 0) of the file's coordinates would lie.
+    char* origin = reinterpret_cast<char*>(bits.data()) - std::ptrdiff_t(data.min.x) * std::ptrdiff_t(xStride) -
+                   std::ptrdiff_t(data.min.y) * std::ptrdiff_t(yStride);
+    Imf::FrameBuffer fb;
+    for (std::size_t c = 0; c < n; ++c) {
+        const int k = header_.channelIndex(channels[c]);
+        if (k < 0) throw InputError(fmt::format("{}: no channel {}", path_.string(), channels[c]));
+        const ExrChannelType t = header_.types[std::size_t(k)];
+        if (!asFloat && t == ExrChannelType::half)
+            throw InputError(fmt::format("{}: channel {} is not 32-bit", path_.string(), channels[c]));
+        const Imf::PixelType type = !asFloat && t == ExrChannelType::uint32 ? Imf::UINT : Imf::FLOAT;
+        fb.insert(channels[c], Imf::Slice(type, origin + c * 4, xStride, yStride));
+    }
     try {
-        Imf::InputFile in(file.c_str());
-        const Imath::Box2i data = in.header().dataWindow();
-        Imf::FrameBuffer fb;
-        const std::size_t xStride = n * 4, yStride = xStride * header.width;
-        // The slice's base is where pixel (0, 0) of the file's coordinates would lie.
-        char* origin = reinterpret_cast<char*>(bits.data()) - std::ptrdiff_t(data.min.x) * std::ptrdiff_t(xStride) -
-                       std::ptrdiff_t(data.min.y) * std::ptrdiff_t(yStride);
-        for (std::size_t c = 0; c < n; ++c) {
-            const int k = header.channelIndex(channels[c]);
-            if (k < 0) throw InputError(fmt::format("{}: no channel {}", file.string(), channels[c]));
-            const ExrChannelType t = header.types[std::size_t(k)];
-            if (!asFloat && t == ExrChannelType::half)
-                throw InputError(fmt::format("{}: channel {} is not 32-bit", file.string(), channels[c]));
-            const Imf::PixelType type = !asFloat && t == ExrChannelType::uint32 ? Imf::UINT : Imf::FLOAT;
-            fb.insert(channels[c], Imf::Slice(type, origin + c * 4, xStride, yStride));
-        }
-        in.setFrameBuffer(fb);
-        in.readPixels(data.min.y, data.max.y);
-    } catch (const InputError&) {
-        throw;
+        file_->in.setFrameBuffer(fb);
+        file_->in.readPixels(data.min.y, data.max.y);
     } catch (const std::exception& e) {
-        throw InputError(fmt::format("{}: cannot read EXR pixels: {}", file.string(), e.what()));
+        throw InputError(fmt::format("{}: cannot read EXR pixels: {}", path_.string(), e.what()));
     }
     return bits;
 }
+
+ExrHeader readExrHeader(const std::filesystem::path& file) { return ExrReader(file).header(); }
 
 void writeExr(const std::filesystem::path& file, const ExrImage& image) {
     useAllCores();

@@ -179,7 +179,8 @@ float RawExr::value(std::size_t px, std::size_t c) const { return std::bit_cast<
 void RawExr::set(std::size_t px, std::size_t c, float v) { bits[px * channels.size() + c] = std::bit_cast<std::uint32_t>(v); }
 
 RawExr readRawExr(const std::filesystem::path& file) {
-    const ExrHeader h = readExrHeader(file);
+    ExrReader reader(file);
+    const ExrHeader& h = reader.header();
     RawExr exr;
     exr.file = file.string();
     exr.width = h.width;
@@ -192,7 +193,7 @@ RawExr readRawExr(const std::filesystem::path& file) {
     }
     exr.attributes = h.strings;
     exr.floatAttributes = h.floats;
-    exr.bits = readExrPixels(file, h, h.channels, false);
+    exr.bits = reader.pixels(h.channels, false);
     return exr;
 }
 

@@ -39,15 +39,18 @@ struct Canvas {
     std::vector<float> rgb;
 
     Canvas(int w, int h) : width(w), height(h), rgb(std::size_t(w) * std::size_t(h) * 3, 0.0f) {}
+    /// Pixel (x, y)'s three floats, or null outside the canvas.
+    float* at(int x, int y) {
+        if (x < 0 || y < 0 || x >= width || y >= height) return nullptr;
+        return &rgb[(std::size_t(y) * std::size_t(width) + std::size_t(x)) * 3];
+    }
     void set(int x, int y, const float c[3]) {
-        if (x < 0 || y < 0 || x >= width || y >= height) return;
-        for (int k = 0; k < 3; ++k) rgb[(std::size_t(y) * std::size_t(width) + std::size_t(x)) * 3 + std::size_t(k)] = c[k];
+        if (float* p = at(x, y)) std::copy(c, c + 3, p);
     }
     /// White text covering a pixel by `alpha` (0..1).
     void blendWhite(int x, int y, float alpha) {
-        if (x < 0 || y < 0 || x >= width || y >= height) return;
-        float* p = &rgb[(std::size_t(y) * std::size_t(width) + std::size_t(x)) * 3];
-        for (int k = 0; k < 3; ++k) p[k] = p[k] * (1.0f - alpha) + alpha;
+        if (float* p = at(x, y))
+            for (int k = 0; k < 3; ++k) p[k] = p[k] * (1.0f - alpha) + alpha;
     }
     std::vector<std::uint8_t> bytes() const {
         std::vector<std::uint8_t> out(rgb.size());

@@ -69,14 +69,15 @@ TEST_CASE("EXR files: a window of uint and float channels with attributes, writt
     }
 
     // And this layer reads it back: the header, native bits, floats by value.
-    const ExrHeader h = readExrHeader(file);
+    ExrReader reader(file);
+    const ExrHeader& h = reader.header();
     CHECK((h.fullWidth == 9 && h.fullHeight == 6 && h.x0 == 2 && h.y0 == 1 && h.width == 5 && h.height == 3));
     CHECK(h.channels == std::vector<std::string>{"a", "b.id"});
     CHECK(h.strings.at("accretion:seed") == "42");
     CHECK(h.floats.at("worldToCamera") == img.floats.at("worldToCamera"));
     CHECK(h.printed.at("accretion:jitter") == "0.25 -0.5");
-    CHECK(readExrPixels(file, h, {"a", "b.id"}, false) == bits);
-    const std::vector<std::uint32_t> asFloat = readExrPixels(file, h, {"b.id"}, true);
+    CHECK(reader.pixels({"a", "b.id"}, false) == bits);
+    const std::vector<std::uint32_t> asFloat = reader.pixels({"b.id"}, true);
     CHECK(std::bit_cast<float>(asFloat[3]) == float(0xfffffff0u + 3));
 }
 
@@ -94,14 +95,15 @@ TEST_CASE("EXR files: half channels are read as floats and refused as 32-bit bit
         REQUIRE(out->write_image(OIIO::TypeDesc::FLOAT, px.data()));
         REQUIRE(out->close());
     }
-    const ExrHeader h = readExrHeader(file);
+    ExrReader reader(file);
+    const ExrHeader& h = reader.header();
     REQUIRE(h.types.size() == 3);
     CHECK(h.types[0] == ExrChannelType::half);
-    const std::vector<std::uint32_t> g = readExrPixels(file, h, {"G"}, true);
+    const std::vector<std::uint32_t> g = reader.pixels({"G"}, true);
     REQUIRE(g.size() == 8);
     for (std::size_t p = 0; p < 8; ++p) CHECK(std::bit_cast<float>(g[p]) == 0.5f * float(p * 3 + 1));
-    CHECK_THROWS_WITH(readExrPixels(file, h, {"G"}, false), Catch::Contains("half.exr: channel G is not 32-bit"));
-    CHECK_THROWS_WITH(readExrPixels(file, h, {"Z"}, true), Catch::Contains("half.exr: no channel Z"));
+    CHECK_THROWS_WITH(reader.pixels({"G"}, false), Catch::Contains("half.exr: channel G is not 32-bit"));
+    CHECK_THROWS_WITH(reader.pixels({"Z"}, true), Catch::Contains("half.exr: no channel Z"));
 
     const auto text = dir / "not.exr";
     std::ofstream(text) << "not an image";

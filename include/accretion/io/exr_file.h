@@ -2,6 +2,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -34,15 +35,32 @@ struct ExrHeader {
     int channelIndex(const std::string& name) const;
 };
 
-/// The header; throws InputError naming the file when it is not a readable EXR.
-ExrHeader readExrHeader(const std::filesystem::path& file);
+/// An EXR file opened once: its header, then the pixels of its channels.
+class ExrReader {
+public:
+    /// Throws InputError naming the file when it is not a readable EXR.
+    explicit ExrReader(const std::filesystem::path& file);
+    ~ExrReader();
+    ExrReader(const ExrReader&) = delete;
+    ExrReader& operator=(const ExrReader&) = delete;
 
-/// The data window's pixels of the named channels, interleaved, each as the
-/// bits of a 4-byte value: `asFloat` converts every channel to float (a
-/// half or uint channel by value); otherwise each keeps its own type (uint
-/// or float bits; a half channel is refused).
-std::vector<std::uint32_t> readExrPixels(const std::filesystem::path& file, const ExrHeader& header,
-                                         const std::vector<std::string>& channels, bool asFloat);
+    const ExrHeader& header() const { return header_; }
+
+    /// The data window's pixels of the named channels, interleaved, each as
+    /// the bits of a 4-byte value: `asFloat` converts every channel to float
+    /// (a half or uint channel by value); otherwise each keeps its own type
+    /// (uint or float bits; a half channel is refused).
+    std::vector<std::uint32_t> pixels(const std::vector<std::string>& channels, bool asFloat);
+
+private:
+    struct File;
+    std::filesystem::path path_;
+    std::unique_ptr<File> file_;
+    ExrHeader header_;
+};
+
+/// The header alone.
+ExrHeader readExrHeader(const std::filesystem::path& file);
 
 /// A file to write: 4-byte channels, interleaved pixels of the data window.
 struct ExrImage {
