@@ -67,12 +67,13 @@ ExperimentRender renderForExperiment(const Settings& settings, const ParticleSou
     run.render.frames = frame - first + 1;
     FrameRenderer renderer(run, source, RenderOptions{true});
     const auto start = std::chrono::steady_clock::now();
-    for (std::uint32_t f = first; f <= frame; ++f) {
+    for (std::uint32_t f = first;; ++f) {  // to `frame` inclusive, which may be the last 32-bit number
         FrameStats stats;
         r.image = renderer.render(f, stats);
         if (f == frame) {
             r.frameSeconds = stats.seconds;
             r.stats = std::move(stats);
+            break;
         }
     }
     r.totalSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -10,6 +10,7 @@
 #include <fmt/ranges.h>
 
 #include "accretion/core/error.h"
+#include "accretion/core/read_file.h"
 #include "accretion/io/exr_file.h"
 
 namespace accretion {
@@ -59,8 +60,7 @@ namespace {
 /// Refuse a file that is not an OpenEXR file, by its magic: a PNG or JPEG
 /// is display-referred and 8-bit, not a measurement.
 void requireExr(const std::filesystem::path& file) {
-    std::ifstream f(file, std::ios::binary);
-    if (!f) throw InputError(fmt::format("{}: cannot open image", file.string()));
+    std::ifstream f = openInputFile(file, "image");
     unsigned char magic[4] = {};
     f.read(reinterpret_cast<char*>(magic), 4);
     if (!(magic[0] == 0x76 && magic[1] == 0x2f && magic[2] == 0x31 && magic[3] == 0x01))

@@ -301,10 +301,13 @@ void runCompareSequence(const CompareArgs& a) {
     const std::string png = std::filesystem::path(a.csv).replace_extension(".png").string();
     OutputGuard guard;
     std::vector<std::pair<std::string, std::string>> files;
-    for (std::uint64_t f = first; f < end; ++f) {
+    for (std::uint64_t f = first; f < end; ++f) {  // each pair found before the next is named: no list of 4e9 names
         files.push_back({expandPattern(a.image, "", std::uint32_t(f)), expandPattern(a.reference, "", std::uint32_t(f))});
-        guard.addInput(files.back().first);
-        guard.addInput(files.back().second);
+        for (const std::string& file : {files.back().first, files.back().second}) {
+            if (!std::filesystem::is_regular_file(file))
+                throw InputError(fmt::format("{}: not found (frame {} of --frames {})", file, f, a.frames));
+            guard.addInput(file);
+        }
     }
     guard.check(a.csv, "--csv");
     guard.check(png, "--csv (its plot)");

@@ -303,6 +303,15 @@ void runConverge(const ConvergeArgs& a) {
     const auto specs = parseEstimatorSpecs(a.estimators, "--estimators");
     const double budget = parseSeconds(a.budget);
     const std::uint32_t frame = a.frame.value_or(scene.render.frame_start);
+    if (a.minEffort > a.maxEffort)
+        throw InputError(fmt::format("command line --min-effort {} --max-effort {}: no effort to try (the range is empty)",
+                                     a.minEffort, a.maxEffort));
+    if (a.sequence > 0 && a.reference.find("{frame}") == std::string::npos)
+        throw InputError(fmt::format("command line --reference {}: --sequence measures each frame against its own "
+                                     "reference; give a {{frame}} pattern", a.reference));
+    if (std::uint64_t(frame) + a.sequence > 0xffffffffull)
+        throw InputError(fmt::format("command line --frame {} --sequence {}: frames are 32-bit numbers (the last is "
+                                     "4294967294)", frame, a.sequence));
     const auto threads = limitThreads(a.threads);
     const std::string prefix = a.out.empty() ? "out/" + scene.sceneName + ".converge" : a.out;
     OutputGuard guard = sceneInputs(scene);
@@ -347,10 +356,14 @@ void addConvergeCommand(CLI::App& app) {
                          "restir[:none|basic|basic+vis|pairwise], options key=value override settings",
                          "Output prefix (default out/<scene>.converge): .csv, .png, .json");
     cmd->add_option("--budget", args->budget, "Time budget per estimator (e.g. 60s, 2m)");
-    cmd->add_option("--sequence", args->sequence, "Error per frame over N frames from --frame (one history per estimator)");
+    cmd->add_option("--sequence", args->sequence, "Error per frame over N frames from --frame (one history per estimator)")
+        ->check(unsignedNumber());
     cmd->add_option("--min-effort", args->minEffort, "First spp (restir: candidates) tried; doubled from there")
+        ->check(unsignedNumber())
         ->check(CLI::Range(1u, 1u << 30));
-    cmd->add_option("--max-effort", args->maxEffort, "Largest spp (restir: candidates) tried");
+    cmd->add_option("--max-effort", args->maxEffort, "Largest spp (restir: candidates) tried")
+        ->check(unsignedNumber())
+        ->check(CLI::Range(1u, 1u << 30));
     cmd->add_option("--seeds", args->seeds, "Renders per point: errors are their means, time their median")
         ->check(CLI::Range(1u, 100000u));
     cmd->footer("Effort doubles from --min-effort (spp; ris reservoirs; restir candidates) until the budget is spent.\n"

@@ -1,6 +1,7 @@
 // accretion import-gpu: a frame of accretion-optix (the GPU twin) as the EXR
 // and previews `render` writes, so that compare, bias and merge read it like
 // any frame.
+#include <algorithm>
 #include <filesystem>
 #include <memory>
 
@@ -67,6 +68,9 @@ void runImport(const ImportArgs& a) {
         std::filesystem::path p(in);
         const std::filesystem::path dir = a.outDir.empty() ? p.parent_path() : std::filesystem::path(a.outDir);
         const std::string base = (dir / p.stem()).string();
+        if (const auto k = std::find(outputs.begin(), outputs.end(), base); k != outputs.end())
+            throw InputError(fmt::format("{}: would be written to {}.exr, as {} is: outputs would collide (import them into "
+                                         "separate folders, or rename one)", in, base, a.inputs[std::size_t(k - outputs.begin())]));
         for (const char* ext : {".exr", ".png", ".Lr.png"}) guard.check(base + ext, "output");
         outputs.push_back(base);
     }

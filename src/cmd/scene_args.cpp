@@ -83,7 +83,9 @@ void addExperimentOptions(CLI::App* cmd, ExperimentArgs& args, const std::string
     addSceneOptions(cmd, args, "Frames A:B (= render.frame_start, render.frames); the first is measured");
     cmd->add_option("--reference", args.reference, referenceHelp)->required();
     cmd->add_option("--estimators", args.estimators, estimatorsHelp);
-    cmd->add_option("--frame", args.frame, "Frame measured (default render.frame_start)");
+    cmd->add_option("--frame", args.frame, "Frame measured (default render.frame_start)")
+        ->check(unsignedNumber())
+        ->check(CLI::Range(0u, 0xfffffffeu));
     cmd->add_option("--history", args.history, "restir: frames rendered before the measured one");
     cmd->add_option("-o,--out", args.out, outHelp);
 }

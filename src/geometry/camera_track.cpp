@@ -1,5 +1,7 @@
 #include "accretion/geometry/camera_track.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -14,6 +16,7 @@
 #include "accretion/core/atomic_file.h"
 #include "accretion/core/error.h"
 #include "accretion/core/parse.h"
+#include "accretion/io/json_text.h"
 #include "accretion/core/read_file.h"
 
 namespace accretion {
@@ -184,6 +187,15 @@ void pickValue(E& out, const std::string& v, std::initializer_list<std::pair<con
     throw InputError(fmt::format("{}: convention.{} \"{}\": expected one of {}", where, key, v, fmt::join(names, ", ")));
 }
 
+/// jitter_units: "pixels" or "ndc", in any case (a CSV's "# jitter_units = NDC").
+bool jitterInNdc(const std::string& value, const std::string& where) {
+    std::string units = value;
+    std::transform(units.begin(), units.end(), units.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    if (units != "pixels" && units != "ndc")
+        throw InputError(fmt::format("{}: jitter_units \"{}\": expected pixels or ndc", where, value));
+    return units == "ndc";
+}
+
 CameraConvention parseConvention(const nlohmann::json& j, const std::string& where) {
     CameraConvention c;
     if (j.is_string()) {
@@ -227,16 +239,14 @@ DVec3 vec3(const nlohmann::json& j, const std::string& where, const char* key) {
 }
 
 CameraFileContent readJsonCameras(const std::string& name, const std::string& text) {
-    const nlohmann::json root = nlohmann::json::parse(text, nullptr, false);
-    if (root.is_discarded() || !root.is_object())
+    const nlohmann::json root = parseJsonText(text, name, "camera file");
+    if (!root.is_object())
         throw InputError(fmt::format("{}: not a camera file (a JSON object with \"frames\")", name));
     CameraFileContent out;
     for (const auto& [key, value] : root.items()) {
         if (key == "convention") out.convention = parseConvention(value, name);
         else if (key == "jitter_units") {
-            const std::string u = value.is_string() ? value.get<std::string>() : "";
-            if (u != "pixels" && u != "ndc") throw InputError(fmt::format("{}: jitter_units \"{}\": expected pixels or ndc", name, u));
-            out.ndcJitter = u == "ndc";
+            out.ndcJitter = jitterInNdc(value.is_string() ? value.get<std::string>() : value.dump(), name);
         } else if (key != "frames" && key != "comment") {
             throw InputError(fmt::format("{}: {}: unknown key (convention, jitter_units, frames, comment)", name, key));
         }
@@ -336,7 +346,7 @@ CameraFileContent readCsvCameras(const std::string& name, const std::string& tex
             };
             const std::string key = trim(line.substr(0, eq)), value = trim(line.substr(eq + 1));
             if (key == "convention") out.convention = parseConvention(nlohmann::json(value), where);
-            else if (key == "jitter_units") out.ndcJitter = value == "ndc";
+            else if (key == "jitter_units") out.ndcJitter = jitterInNdc(value, where);
             continue;
         }
         const std::vector<std::string> cells = splitList(line, ',');
@@ -381,7 +391,8 @@ CameraFileContent readCsvCameras(const std::string& name, const std::string& tex
 CameraTrack::CameraTrack(const CameraSettings& settings) : settings_(settings) {
     if (settings.file.empty()) return;
     const std::string name = settings.file;
-    const std::string text = readWholeFile(settings.file, "camera file");
+    const std::string bytes = readWholeFile(settings.file, "camera file");
+    const std::string text(withoutBom(bytes));
     const auto first = text.find_first_not_of(" \t\r\n");
     const CameraFileContent content = first != std::string::npos && text[first] == '{' ? readJsonCameras(name, text)
                                                                                        : readCsvCameras(name, text);
@@ -392,6 +403,13 @@ CameraTrack::CameraTrack(const CameraSettings& settings) : settings_(settings) {
             pose = poseFromMatrices(fromStored(r.view, content.convention), fromStored(r.projection, content.convention),
                                     content.convention, settings.width, settings.height, where);
         } else {
+            // The renderer traces in float: beyond 1e15 a position keeps no digit of the disk's scale.
+            constexpr double kFar = 1e15;
+            for (const auto& [what, v] : {std::pair{"eye", r.eye}, std::pair{"look_at", r.lookAt}})
+                if (!(std::fabs(v.x) <= kFar && std::fabs(v.y) <= kFar && std::fabs(v.z) <= kFar))
+                    throw InputError(fmt::format("{}: {} ({:g}, {:g}, {:g}) is farther than 1e15 from the origin: the "
+                                                 "renderer's float rays would lose every digit of the scene", where, what,
+                                                 v.x, v.y, v.z));
             if (glm::length(r.lookAt - r.eye) <= 0.0)
                 throw InputError(fmt::format("{}: look_at must differ from eye", where));
             if (!(r.fov > 0.0 && r.fov < 179.0))
@@ -400,14 +418,25 @@ CameraTrack::CameraTrack(const CameraSettings& settings) : settings_(settings) {
             if (!(glm::length(r.up) > 0.0) || glm::length(glm::cross(f, glm::normalize(r.up))) < 1e-4)
                 throw InputError(fmt::format("{}: up must be non-zero and not parallel to the view direction", where));
             pose = CameraPose::lookAt(r.eye, r.lookAt, r.up, r.fov);
+            // A left-handed engine's look-at (DirectXMath's LookAtLH) puts
+            // right = up x forward: the mirror of the right-handed one. The
+            // record means what the engine's view matrix of it means, so a
+            // file may mix both forms without the image flipping between frames.
+            if (content.convention.handedness == CameraConvention::Handedness::left) pose.right = -pose.right;
         }
         if (r.hasJitter) {
             const double jx = content.ndcJitter ? r.jitter[0] * 0.5 * w : r.jitter[0];
             const double jy = content.ndcJitter ? -r.jitter[1] * up * 0.5 * h : r.jitter[1];
             if (r.matrices && (pose.jitterX != 0.0 || pose.jitterY != 0.0) &&
                 (std::fabs(pose.jitterX - jx) > 1e-6 || std::fabs(pose.jitterY - jy) > 1e-6))
-                throw InputError(fmt::format("{}: jitter ({}, {}) px differs from the projection's off-centre terms ({}, {}) px",
-                                             where, jx, jy, pose.jitterX, pose.jitterY));
+                throw InputError(fmt::format(
+                    "{}: jitter ({}, {}) px differs from the projection's off-centre terms ({}, {}) px{}", where, jx, jy,
+                    pose.jitterX, pose.jitterY,
+                    std::fabs(pose.jitterX + jx) <= 1e-6 && std::fabs(pose.jitterY + jy) <= 1e-6
+                        ? ": the opposite sign. accretion's jitter is where the sample lies from the pixel centre; "
+                          "a projection shifted by the TAA offset (proj[2][0] += 2 jx / W) samples at -jx. Give "
+                          "jitter = -jx, or leave jitter out: it is read from the projection (docs/gpu-frame-loop.md#jitter)"
+                        : ""));
             pose.jitterX = jx;
             pose.jitterY = jy;
         }
@@ -446,6 +475,9 @@ void writeCameraFile(const std::filesystem::path& file, const CameraTrack& track
                          {"clip", conv.clip == CameraConvention::Clip::vulkan ? "vulkan"
                                   : conv.clip == CameraConvention::Clip::d3d   ? "d3d"
                                                                                : "opengl"}};
+    if (!matrices && conv.handedness == CameraConvention::Handedness::left)
+        throw InputError("--pose with a left-handed convention: an engine's eye/look_at camera there is the mirror of "
+                         "accretion's right-handed one (right = up x forward); write matrices (leave out --pose)");
     doc["jitter_units"] = "pixels";
     doc["frames"] = nlohmann::json::array();
     for (std::uint32_t f = first; f < end; ++f) {

@@ -6,6 +6,7 @@
 #include <limits>
 #include <map>
 #include <random>
+#include <set>
 #include <sstream>
 
 #include <Eigen/Dense>
@@ -13,6 +14,8 @@
 #include <fmt/ranges.h>
 
 #include "accretion/core/error.h"
+#include "accretion/core/read_file.h"
+#include "accretion/io/json_text.h"
 #include "accretion/core/median.h"
 #include "accretion/core/parse.h"
 #include "accretion/core/pass_timer.h"
@@ -54,14 +57,7 @@ CostCoefficients CostCoefficients::defaults() {
 }
 
 CostCoefficients CostCoefficients::load(const std::string& path) {
-    std::ifstream in(path);
-    if (!in) throw InputError(fmt::format("{}: cannot open the cost coefficients", path));
-    nlohmann::json j;
-    try {
-        in >> j;
-    } catch (const nlohmann::json::exception& e) {
-        throw InputError(fmt::format("{}: not JSON: {}", path, e.what()));
-    }
+    const nlohmann::json j = parseJsonText(readWholeFile(path, "cost coefficients file"), path, "cost coefficients file");
     CostCoefficients out = fromJson(j, path);
     out.source = out.gpu.empty() ? path : fmt::format("{} ({}, measured at {})", path, out.gpu, out.measuredAt);
     return out;
@@ -80,6 +76,14 @@ CostCoefficients CostCoefficients::forSetting(const std::string& setting) {
 }
 
 CostCoefficients CostCoefficients::fromJson(const nlohmann::json& j, const std::string& path) {
+    if (!j.is_object()) throw InputError(fmt::format("{}: not a coefficients file (a JSON object)", path));
+    // What calibrate writes; any other key is a typo that would be ignored.
+    static const std::set<std::string> known = {"cache_bytes", "calibrated", "coefficients_ns", "counters", "form", "gpu",
+                                                "max_relative_error", "measured_at", "per_pass_ns", "r2", "residuals",
+                                                "rms_ms", "source", "timings", "version", "comment"};
+    for (const auto& item : j.items())
+        if (!known.count(item.key()))
+            throw InputError(fmt::format("{}: {}: unknown key ({})", path, item.key(), fmt::join(known, ", ")));
     const nlohmann::json* c = j.contains("coefficients_ns") ? &j["coefficients_ns"] : nullptr;
     if (!c || !c->is_object()) throw InputError(fmt::format("{}: no \"coefficients_ns\" object", path));
     CostCoefficients out;
@@ -88,6 +92,9 @@ CostCoefficients CostCoefficients::fromJson(const nlohmann::json& j, const std::
     if (j.contains("measured_at") && j["measured_at"].is_string()) out.measuredAt = j["measured_at"].get<std::string>();
     // The counters after the first six are optional (files of the first form lack them).
     auto read = [&](const nlohmann::json& obj, const std::string& where, CostFeatures& into) {
+        for (const auto& item : obj.items())
+            if (std::find(kCostFeatures.begin(), kCostFeatures.end(), item.key()) == kCostFeatures.end())
+                throw InputError(fmt::format("{}: {}.{}: not a counter of the cost model (docs/cost-model.md lists them)", path, where, item.key()));
         for (std::size_t k = 0; k < kCostFeatures.size(); ++k) {
             const std::string name(kCostFeatures[k]);
             if (!obj.contains(name) && k >= kBaseCostFeatures) continue;
@@ -211,14 +218,31 @@ std::vector<double> nonNegativeLeastSquares(const std::vector<CostFeatures>& row
 
 namespace {
 
-std::vector<std::string> splitCsv(const std::string& line) {
-    std::vector<std::string> out;
-    std::stringstream ss(line);
-    std::string cell;
-    while (std::getline(ss, cell, ',')) {
+/// One CSV line's cells (RFC 4180: a cell in double quotes may hold commas
+/// and "" for a quote, as Nsight and spreadsheets export them), trimmed.
+std::vector<std::string> splitCsv(const std::string& line, const std::string& where) {
+    std::vector<std::string> out(1);
+    bool quoted = false, wasQuoted = false;
+    for (std::size_t i = 0; i < line.size(); ++i) {
+        const char c = line[i];
+        if (quoted) {
+            if (c != '"') out.back() += c;
+            else if (i + 1 < line.size() && line[i + 1] == '"') out.back() += '"', ++i;
+            else quoted = false;
+        } else if (c == '"' && out.back().find_first_not_of(" ") == std::string::npos) {
+            out.back().clear();
+            quoted = wasQuoted = true;
+        } else if (c == ',') {
+            out.emplace_back();
+            wasQuoted = false;
+        } else if (!(wasQuoted && (c == ' ' || c == '\r'))) {
+            out.back() += c;
+        }
+    }
+    if (quoted) throw InputError(fmt::format("{}: a quoted cell is not closed", where));
+    for (std::string& cell : out) {
         while (!cell.empty() && (cell.back() == '\r' || cell.back() == ' ')) cell.pop_back();
         while (!cell.empty() && cell.front() == ' ') cell.erase(cell.begin());
-        out.push_back(cell);
     }
     return out;
 }
@@ -232,11 +256,10 @@ double parseNumber(const std::string& s, const std::string& where) {
 /// Rows of a CSV with a header; each row mapped by column name.
 std::vector<std::pair<int, std::map<std::string, std::string>>> readCsv(const std::string& path,
                                                                         const std::vector<std::string>& required) {
-    std::ifstream in(path);
-    if (!in) throw InputError(fmt::format("{}: cannot open", path));
+    std::ifstream in = openInputFile(path, "CSV file");
     std::string line;
     if (!std::getline(in, line)) throw InputError(fmt::format("{}: empty file", path));
-    const std::vector<std::string> header = splitCsv(line);
+    const std::vector<std::string> header = splitCsv(std::string(withoutBom(line)), path + ":1");
     for (const std::string& r : required)
         if (std::find(header.begin(), header.end(), r) == header.end())
             throw InputError(fmt::format("{}:1: missing column '{}'", path, r));
@@ -245,7 +268,7 @@ std::vector<std::pair<int, std::map<std::string, std::string>>> readCsv(const st
     while (std::getline(in, line)) {
         ++lineNo;
         if (line.empty() || line == "\r") continue;
-        const std::vector<std::string> cells = splitCsv(line);
+        const std::vector<std::string> cells = splitCsv(line, fmt::format("{}:{}", path, lineNo));
         if (cells.size() != header.size())
             throw InputError(fmt::format("{}:{}: {} cells, the header has {}", path, lineNo, cells.size(), header.size()));
         std::map<std::string, std::string> row;

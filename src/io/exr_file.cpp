@@ -83,6 +83,45 @@ int ExrHeader::channelIndex(const std::string& name) const {
     return -1;
 }
 
+namespace {
+
+/// The most a compression can shrink pixel data: NONE stores it, RLE's runs
+/// are 128 bytes in 2, deflate (ZIP, ZIPS, PXR24) reaches 1032:1, B44 a
+/// flat 4x4 block of halves in 3 bytes; PIZ and DWA end in run-length
+/// Huffman codes, bounded here generously.
+double maxCompression(Imf::Compression c) {
+    switch (c) {
+    case Imf::NO_COMPRESSION: return 1.0;
+    case Imf::RLE_COMPRESSION: return 64.0;
+    case Imf::ZIPS_COMPRESSION:
+    case Imf::ZIP_COMPRESSION:
+    case Imf::PXR24_COMPRESSION: return 1032.0;
+    case Imf::B44_COMPRESSION:
+    case Imf::B44A_COMPRESSION: return 32.0 / 3.0;
+    default: return 65536.0;
+    }
+}
+
+/// Refuse a header whose pixels the file cannot hold, before anything is
+/// allocated on its word (a 500-byte file claiming 100000 x 100000 pixels).
+void requireHeldBy(const std::filesystem::path& file, const Imf::Header& h) {
+    const Imath::Box2i data = h.dataWindow();
+    double bytesPerPixel = 0.0;
+    for (auto c = h.channels().begin(); c != h.channels().end(); ++c)
+        bytesPerPixel += c.channel().type == Imf::HALF ? 2.0 : 4.0;
+    const double pixels = (double(data.max.x) - data.min.x + 1.0) * (double(data.max.y) - data.min.y + 1.0);
+    std::error_code ec;
+    const double size = double(std::filesystem::file_size(file, ec));
+    const double most = ec ? 0.0 : size * maxCompression(h.compression());
+    if (pixels * bytesPerPixel > most)
+        throw InputError(fmt::format("{}: cannot read EXR: its header claims {:.0f}x{:.0f} pixels of {} bytes, more than "
+                                     "its {:.0f} bytes can hold (truncated or corrupt)", file.string(),
+                                     double(data.max.x) - data.min.x + 1.0, double(data.max.y) - data.min.y + 1.0,
+                                     bytesPerPixel, size));
+}
+
+}  // namespace
+
 struct ExrReader::File {
     Imf::InputFile in;
     explicit File(const std::filesystem::path& path) : in(path.c_str()) {}
@@ -107,6 +146,10 @@ ExrReader::ExrReader(const std::filesystem::path& file) : path_(file) {
                                 : c.channel().type == Imf::HALF ? ExrChannelType::half
                                                                 : ExrChannelType::float32);
         }
+        if (data.max.x < data.min.x || data.max.y < data.min.y || display.max.x < display.min.x ||
+            display.max.y < display.min.y)
+            throw InputError(fmt::format("{}: cannot read EXR: an empty or inverted data or display window", file.string()));
+        requireHeldBy(file, h);
         for (auto a = h.begin(); a != h.end(); ++a) {
             const std::string name = a.name();
             std::pair<std::string, std::vector<float>> floats;
@@ -120,6 +163,8 @@ ExrReader::ExrReader(const std::filesystem::path& file) : path_(file) {
                 if (!isStandard(name)) out.floats[name] = std::move(floats);
             }
         }
+    } catch (const InputError&) {
+        throw;
     } catch (const std::exception& e) {
         throw InputError(fmt::format("{}: cannot read EXR: {}", file.string(), e.what()));
     }
@@ -129,7 +174,13 @@ ExrReader::~ExrReader() = default;
 
 std::vector<std::uint32_t> ExrReader::pixels(const std::vector<std::string>& channels, bool asFloat) {
     const std::size_t n = channels.size(), count = std::size_t(header_.width) * header_.height;
-    std::vector<std::uint32_t> bits(count * n);
+    std::vector<std::uint32_t> bits;
+    try {
+        bits.resize(count * n);
+    } catch (const std::bad_alloc&) {
+        throw InputError(fmt::format("{}: out of memory for its {}x{} pixels of {} channels", path_.string(), header_.width,
+                                     header_.height, n));
+    }
     const Imath::Box2i data = file_->in.header().dataWindow();
     const std::size_t xStride = n * 4, yStride = xStride * header_.width;
     // The slice's base is where pixel (0, 0) of the file's coordinates would lie.

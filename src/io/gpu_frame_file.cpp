@@ -1,14 +1,17 @@
 #include "accretion/io/gpu_frame_file.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include "accretion/core/atomic_file.h"
 #include "accretion/core/error.h"
+#include "accretion/core/read_file.h"
 
 namespace accretion {
 namespace {
@@ -36,6 +39,22 @@ void forEachPlane(Frame& f, Visit&& visit) {
     visit("Lr_stderr", f.Lr_stderr);
     visit("spp", f.spp);
     visit("rejected", f.rejected);
+}
+
+/// A camera as the renderer needs it: finite, an orthonormal basis, a field
+/// of view, the jitter inside the pixel.
+void checkCamera(const CameraPose& c, const std::string& name) {
+    auto unit = [](const DVec3& v) { return std::fabs(glm::length(v) - 1.0) < 1e-4; };
+    auto square = [](const DVec3& a, const DVec3& b) { return std::fabs(glm::dot(a, b)) < 1e-4; };
+    const bool finite = std::isfinite(c.eye.x) && std::isfinite(c.eye.y) && std::isfinite(c.eye.z);
+    if (!finite || !unit(c.forward) || !unit(c.right) || !unit(c.up) || !square(c.forward, c.right) ||
+        !square(c.forward, c.up) || !square(c.right, c.up))
+        throw InputError(fmt::format("{}: camera: eye must be finite and forward, right, up an orthonormal basis", name));
+    if (!(c.tanHalfFov > 0.0 && c.tanHalfFov < 1e6))
+        throw InputError(fmt::format("{}: camera: tan_half_fov {} is not a field of view", name, c.tanHalfFov));
+    if (!(std::fabs(c.jitterX) <= 0.5 && std::fabs(c.jitterY) <= 0.5))
+        throw InputError(fmt::format("{}: camera: jitter ({}, {}) px is outside the pixel ([-0.5, 0.5])", name, c.jitterX,
+                                     c.jitterY));
 }
 
 }  // namespace
@@ -67,14 +86,15 @@ void writeGpuFrame(const std::filesystem::path& file, const GpuFrame& f) {
 
 GpuFrame readGpuFrame(const std::filesystem::path& file) {
     const std::string name = file.string();
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw InputError(fmt::format("{}: cannot open", name));
+    std::ifstream in = openInputFile(file, "GPU frame");
     char magic[sizeof kMagic];
     std::uint64_t len = 0;
     if (!in.read(magic, sizeof magic) || std::memcmp(magic, kMagic, sizeof kMagic) != 0)
         throw InputError(fmt::format("{}: not an accretion-optix frame (no ACCGPUF1 magic)", name));
     if (!in.read(reinterpret_cast<char*>(&len), sizeof len) || len > kMaxHeader)
         throw InputError(fmt::format("{}: bad header length", name));
+    if (const std::uint64_t left = bytesLeft(in); len > left)
+        throw InputError(fmt::format("{}: truncated header ({} bytes announced, the file holds {})", name, len, left));
     std::string text(len, '\0');
     if (!in.read(text.data(), std::streamsize(len))) throw InputError(fmt::format("{}: truncated header", name));
     GpuFrame f;
@@ -83,7 +103,10 @@ GpuFrame readGpuFrame(const std::filesystem::path& file) {
         const nlohmann::json h = nlohmann::json::parse(text);
         f.width = h.at("width").get<std::uint32_t>();
         f.height = h.at("height").get<std::uint32_t>();
-        f.frame = h.at("frame").get<std::uint32_t>();
+        const nlohmann::json& frame = h.at("frame");
+        if (!frame.is_number_unsigned() || frame.get<std::uint64_t>() > 0xffffffffull)
+            throw InputError(fmt::format("{}: header frame {}: expected a frame number from 0 to 4294967295", name, frame.dump()));
+        f.frame = frame.get<std::uint32_t>();
         const auto& c = h.at("camera");
         f.camera.eye = dvec(c.at("eye"));
         f.camera.forward = dvec(c.at("forward"));
@@ -99,7 +122,18 @@ GpuFrame readGpuFrame(const std::filesystem::path& file) {
     }
     if (f.width == 0 || f.height == 0 || f.width > 16384 || f.height > 16384)
         throw InputError(fmt::format("{}: bad size {}x{}", name, f.width, f.height));
+    checkCamera(f.camera, name);
+    if (const auto m = f.metadata.find("frame"); m != f.metadata.end() && m->second != std::to_string(f.frame))
+        throw InputError(fmt::format("{}: the header's frame {} disagrees with its metadata's frame {}", name, f.frame, m->second));
     const std::size_t n = std::size_t(f.width) * f.height;
+    // The planes' bytes, checked against the file before anything is allocated on the header's word.
+    std::uint64_t need = 0;
+    forEachPlane(f, [&](const char* what, const auto& plane) {
+        if (std::find(planes.begin(), planes.end(), what) != planes.end()) need += n * sizeof(plane[0]);
+    });
+    if (const std::uint64_t have = bytesLeft(in); need != have)
+        throw InputError(fmt::format("{}: the header's {}x{} planes ({}) take {} bytes, the file holds {}", name, f.width,
+                                     f.height, fmt::join(planes, ", "), need, have));
     auto read = [&](auto& plane, const char* what) {
         plane.resize(n);
         if (!in.read(reinterpret_cast<char*>(plane.data()), std::streamsize(n * sizeof(plane[0]))))

@@ -17,6 +17,7 @@
 #include <fmt/format.h>
 
 #include "accretion/core/error.h"
+#include "accretion/core/read_file.h"
 #include "accretion/core/atomic_file.h"
 #include "accretion/core/parse.h"
 
@@ -52,8 +53,7 @@ void storeRecord(const std::string& file, std::size_t index, const float* f, Par
 
 /// The first `limit` bytes of a file (all of it when smaller) and its size.
 std::string readHead(const std::filesystem::path& file, std::size_t limit, std::uint64_t& size) {
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw InputError(fmt::format("{}: cannot open particle file", file.string()));
+    std::ifstream in = openInputFile(file, "particle file");
     std::error_code ec;
     if (!std::filesystem::is_regular_file(file, ec))
         throw InputError(fmt::format("{}: not a regular file", file.string()));

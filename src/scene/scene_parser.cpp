@@ -455,13 +455,14 @@ std::pair<std::uint64_t, std::uint64_t> parseHalfOpen(const std::string& text, c
     const std::uint64_t b = colon == std::string::npos ? a + 1 : number(text.substr(colon + 1));
     if (b <= a)
         throw InputError(fmt::format("command line {} {}: end must be greater than start (half-open A:B)", option, text));
+    if (b > 0xffffffffull)
+        throw InputError(fmt::format("command line {} {}: frames are 32-bit numbers (the last is 4294967294)", option, text));
     return {a, b};
 }
 
 std::vector<FlagSetting> frameFlags(const std::string& frames) {
     if (frames.empty()) return {};
     const auto [a, b] = parseHalfOpen(frames, "--frames");
-    if (b > 0xffffffffull) throw InputError(fmt::format("command line --frames {}: frames are 32-bit numbers", frames));
     const std::string flag = "--frames " + frames;
     return {{"render.frame_start", flag, [a = a](Settings& s) { s.render.frame_start = std::uint32_t(a); }},
             {"render.frames", flag, [n = b - a](Settings& s) { s.render.frames = std::uint32_t(n); }}};

@@ -4,6 +4,8 @@
 
 #include <fmt/format.h>
 
+#include "accretion/core/error.h"
+
 namespace accretion {
 
 std::string expandPattern(std::string_view pattern, std::string_view scene, std::uint32_t frame) {
@@ -14,6 +16,9 @@ std::string expandPattern(std::string_view pattern, std::string_view scene, std:
             out += fmt::format("{:04d}", frame);
             i += 7;
         } else if (pattern.substr(i, 7) == "{scene}") {
+            if (scene.empty())
+                throw InputError(fmt::format("{}: {{scene}} stands for nothing here (no scene names this file); only "
+                                             "{{frame}} is expanded", pattern));
             out += scene;
             i += 7;
         } else {

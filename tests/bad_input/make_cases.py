@@ -87,3 +87,48 @@ import shutil
 shutil.copy("half.exr", "ref.power.exr")
 shutil.copy("seq_missing.0000.bin", "selfseq.0000.bin")
 shutil.copy("ok.toml", "conv.json")
+
+# Class 10: GPU frames (.gpuframe, docs/gpu-frame-format.md) whose header
+# says what the file cannot hold or what no camera is.
+import json
+
+def gpuframe(header, payload=None, w=2, h=1, planes=("L", "Le", "Lr", "normal", "depth", "particle")):
+    sizes = {"L": 12, "Le": 12, "Lr": 12, "normal": 12, "depth": 4, "particle": 4, "Lr_stderr": 12, "spp": 4, "rejected": 4}
+    base = {"width": w, "height": h, "frame": 0,
+            "camera": {"eye": [0, 1, 5], "forward": [0, 0, -1], "right": [1, 0, 0], "up": [0, 1, 0],
+                       "tan_half_fov": 0.4, "jitter": [0, 0]},
+            "metadata": {"frame": "0"}, "planes": list(planes)}
+    base.update(header)
+    text = json.dumps(base).encode()
+    if payload is None:
+        payload = b"".join(b"\0" * (sizes[p] * 2) for p in planes)
+    return b"ACCGPUF1" + struct.pack("<Q", len(text)) + text + payload
+
+write("gpu_ok.gpuframe", gpuframe({}))
+write("gpu_huge.gpuframe", gpuframe({"width": 16384, "height": 16384}))
+write("gpu_frame_negative.gpuframe", gpuframe({"frame": -1}))
+write("gpu_zero_camera.gpuframe", gpuframe({"camera": {"eye": [0, 0, 0], "forward": [0, 0, 0], "right": [0, 0, 0],
+                                                       "up": [0, 0, 0], "tan_half_fov": 0, "jitter": [0, 0]}}))
+write("gpu_frame_disagrees.gpuframe", gpuframe({"frame": 3}))
+os.makedirs("gpu_a", exist_ok=True)
+os.makedirs("gpu_b", exist_ok=True)
+write("gpu_a/frame.gpuframe", gpuframe({}))
+write("gpu_b/frame.gpuframe", gpuframe({}))
+
+# Class 10: an EXR whose data window claims 100000 x 100000 pixels in a file of a few hundred bytes.
+exr = bytearray(open("half.exr", "rb").read())
+at = exr.index(b"dataWindow\0box2i\0") + len(b"dataWindow\0box2i\0") + 4
+exr[at:at + 16] = struct.pack("<4i", 0, 0, 99999, 99999)
+at = exr.index(b"displayWindow\0box2i\0") + len(b"displayWindow\0box2i\0") + 4
+exr[at:at + 16] = struct.pack("<4i", 0, 0, 99999, 99999)
+write("huge_window.exr", bytes(exr))
+
+# Class 10: camera files with a BOM and a trailing comma, a number no double holds.
+write("cams_bom_comma.json", b'\xef\xbb\xbf{"frames": [{"frame": 0, "eye": [0, 1, 5], "look_at": [0, 0, 0],}]}\n')
+write("cams_overflow.json", '{"frames": [\n  {"frame": 0, "eye": [0, 1, 1e400], "look_at": [0, 0, 0]}\n]}\n')
+write("cams_far.csv", "frame,eye_x,eye_y,eye_z,look_at_x,look_at_y,look_at_z\n0,0,1e300,5e300,0,0,0\n")
+write("cams_units.csv", "# jitter_units = NDCs\nframe,eye_x,eye_y,eye_z,look_at_x,look_at_y,look_at_z\n0,0,1,5,0,0,0\n")
+write("coef_unknown.json", '{"coefficients_ns": {"threads": 1, "warp_steps": 1, "rays": 1, "blas_entries": 1, '
+                           '"any_hits": 1, "bytes": 1, "blas_entires": 1}}\n')
+shutil.copy("half.exr", "seqimg.0000.exr")
+shutil.copy("half.exr", "seqimg.0001.exr")

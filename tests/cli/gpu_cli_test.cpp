@@ -169,6 +169,27 @@ TEST_CASE("calibrate recovers the coefficients that made the timings of real cos
                            (dir / "coef.json").string() + "\\\" -o " + (dir / "again.json").string(), out) == 0);
     CHECK(nlohmann::json::parse(slurp(dir / "again.json"))["coefficients"]["source"] == (dir / "coef.json").string());
 
+    // The same timings as Nsight and spreadsheets export them: a byte-order
+    // mark, every cell quoted, CRLF line ends, a quoted comma in a config name
+    // that is not used: the same fit, number for number.
+    {
+        std::string quoted = "\xEF\xBB\xBF\"config\",\"pass\",\"ms\"\r\n";
+        std::istringstream rows(timings.substr(timings.find('\n') + 1));
+        for (std::string line; std::getline(rows, line);) {
+            std::string q = "\"";
+            for (const char c : line) q += c == ',' ? std::string("\",\"") : std::string(1, c);
+            quoted += q + "\"\r\n";
+        }
+        std::ofstream(dir / "nsight.csv") << quoted;
+    }
+    std::string nsight = kBin + " calibrate";
+    for (const std::string& c : csvs) nsight += " " + c;
+    REQUIRE(runCommand(nsight + " " + (dir / "nsight.csv").string() + " -o " + (dir / "coef_nsight.json").string(), out) == 0);
+    CHECK(CostCoefficients::load((dir / "coef_nsight.json").string()).ns == fitted.ns);
+    std::ofstream(dir / "bad3.csv") << "config,pass,ms\n\"restir_disc,traceGBuffer,1.0\n";
+    CHECK(runCommand(kBin + " calibrate " + csvs[0] + " " + (dir / "bad3.csv").string() + " -o " + (dir / "x.json").string(), out) == 1);
+    CHECK_THAT(out, Contains("bad3.csv:2: a quoted cell is not closed"));
+
     // Bad input: a name that is no pass (a pass renamed on one side), a
     // timing row without counters, a malformed number.
     std::ofstream(dir / "bad0.csv") << "config,pass,ms\npower,traceShadowRay,1.0\n";

@@ -114,6 +114,10 @@ TEST_CASE("camera files: JSON and CSV, poses and matrices, errors naming the rec
     write("c.csv", "# convention = opengl\n# jitter_units = ndc\nframe,eye_x,eye_y,eye_z,look_at_x,look_at_y,look_at_z,"
                    "up_x,up_y,up_z,fov,jitter_x,jitter_y\n4,3,7,17,0.5,-1,0.25,0,1,0,38,0.003125,0\n");
     CHECK(CameraTrack(s).pose(4).jitterX == Approx(0.5));
+    // The units in any case, as a hand-written CSV puts them; after a byte-order mark.
+    write("upper.csv", "\xEF\xBB\xBF# jitter_units = NDC\nframe,eye_x,eye_y,eye_z,look_at_x,look_at_y,look_at_z,"
+                       "up_x,up_y,up_z,fov,jitter_x,jitter_y\n4,3,7,17,0.5,-1,0.25,0,1,0,38,0.003125,0\n");
+    CHECK(CameraTrack(s).pose(4).jitterX == Approx(0.5));
     CHECK_THAT(refusal(s), Contains("no camera for frame 0 (the file holds frames 4..4)"));
 
     write("scaled.json", R"({"frames": [{"frame": 0, "view": [2,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1],
@@ -203,7 +207,10 @@ TEST_CASE("engine matrices from the APIs' own formulas project every point where
     const DVec3 eye(3.0, 7.0, 17.0), at(0.5, -1.0, 0.25), up(0.0, 1.0, 0.0);
     const double fov = 38.0, jx = 0.25, jy = -0.125;  // jitter of the engine's samples, pixels
     const char* api = GENERATE("opengl", "vulkan", "d3d");
-    INFO(api);
+    // The engine's camera as its matrices, or as the eye/look_at it made them
+    // from (a left-handed engine's look-at is the mirror of a right-handed one's).
+    const bool pose = GENERATE(false, true);
+    INFO(api << (pose ? ", eye/look_at record" : ", matrices"));
     const bool dx = std::string(api) == "d3d", vk = std::string(api) == "vulkan";
     M4 V, P;
     if (dx) {
@@ -221,6 +228,9 @@ TEST_CASE("engine matrices from the APIs' own formulas project every point where
     }
     nlohmann::json doc = {{"convention", api},
                           {"frames", {{{"frame", 0}, {"view", stored(V, dx)}, {"projection", stored(P, dx)}}}}};
+    if (pose)
+        doc["frames"][0] = {{"frame", 0}, {"eye", {eye.x, eye.y, eye.z}}, {"look_at", {at.x, at.y, at.z}},
+                            {"up", {up.x, up.y, up.z}}, {"fov", fov}, {"jitter", {jx, jy}}};
     std::ofstream(dir / "cams.json") << doc.dump();
     CameraSettings s;
     s.width = W;

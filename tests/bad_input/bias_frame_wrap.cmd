@@ -1,0 +1,1 @@
+bias ok.toml --reference half.exr --frame 4294967295

@@ -1,0 +1,1 @@
+cost ok.toml -D gpu.coefficients=\"coef_unknown.json\"

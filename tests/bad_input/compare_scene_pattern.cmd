@@ -1,0 +1,1 @@
+compare '{scene}.{frame}.exr' 'half{frame}.exr' --frames 0:2 --csv seq.csv

@@ -1,0 +1,1 @@
+converge ok.toml --reference half.exr --min-effort 8 --max-effort 2

@@ -1,0 +1,1 @@
+converge ok.toml --reference half.exr --frame 4294967295

@@ -1,0 +1,1 @@
+cost ok.toml -D gpu.coefficients=\"adir.exr\"

@@ -1,0 +1,1 @@
+compare huge_window.exr half.exr

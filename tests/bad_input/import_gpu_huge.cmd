@@ -1,0 +1,1 @@
+import-gpu gpu_huge.gpuframe
