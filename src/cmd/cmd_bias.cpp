@@ -2,6 +2,7 @@
 // its standard error, the energy loss, and a per-pixel bias map, so a bias
 // can be told apart from noise (docs/MODEL.md section 5).
 #include <cmath>
+#include <limits>
 #include <filesystem>
 #include <memory>
 
@@ -12,11 +13,14 @@
 
 #include "accretion/analysis/experiment.h"
 #include "accretion/analysis/image_metrics.h"
+#include "accretion/analysis/view_check.h"
 #include "accretion/core/error.h"
 #include "accretion/core/parse.h"
+#include "accretion/core/progress.h"
 #include "accretion/core/version.h"
 #include "accretion/core/atomic_file.h"
 #include "accretion/io/exr_output.h"
+#include "accretion/io/false_colour.h"
 #include "accretion/io/gpu_frame_file.h"
 #include "accretion/io/plot.h"
 #include "accretion/io/report_table.h"
@@ -34,6 +38,7 @@ struct BiasArgs : ExperimentArgs {
     }
     double zCritical = 3.29;  ///< two-sided 99.9%
     std::string gpuFrames;    ///< read each seed's image from these .gpuframe files instead of rendering it
+    bool strict = false;      ///< a view check that cannot be performed is an error
 };
 
 struct BiasRow {
@@ -47,6 +52,8 @@ struct BiasRow {
     double secondsPerFrame = 0.0;  ///< the measured frame alone (restir: without its history frames)
     double relMse = 0.0;       ///< mean over seeds of one render's relMSE, less the reference's own noise
     bool biased = false;
+    std::vector<FloatChannel> map;  ///< the bias map, written once every estimator has been measured
+    std::string settingsToml;       ///< the estimator's settings, recorded in its map
 };
 
 /// The reference: Lr, its per-pixel standard error when it has one, and its image mean.
@@ -55,6 +62,14 @@ struct BiasReference {
     std::vector<Vec3> stderr;  ///< empty without an Lr_stderr layer
     double mean = 0.0, meanStderr = 0.0;
 };
+
+/// A mean over pixels is NaN with one NaN pixel: refuse it, naming the first.
+void requireFinite(const std::vector<Vec3>& pixels, const std::string& file, const char* layer, std::uint32_t width) {
+    for (std::size_t p = 0; p < pixels.size(); ++p)
+        if (!(std::isfinite(pixels[p].x) && std::isfinite(pixels[p].y) && std::isfinite(pixels[p].z)))
+            throw InputError(fmt::format("{}: {} is not finite at pixel ({}, {}): bias measures finite images", file, layer,
+                                         p % width, p / width));
+}
 
 BiasReference loadBiasReference(const std::string& file, const Settings& scene) {
     BiasReference r;
@@ -66,6 +81,8 @@ BiasReference loadBiasReference(const std::string& file, const Settings& scene) 
         throw InputError(fmt::format("{}: reference is {}x{}, the scene renders {}x{}", file, r.image.width, r.image.height,
                                      scene.camera.width, scene.camera.height));
     if (exrHasLayer(file, "Lr_stderr")) r.stderr = readExrLayer(file, "Lr_stderr").rgb;
+    requireFinite(r.image.rgb, file, "Lr", r.image.width);
+    if (!r.stderr.empty()) requireFinite(r.stderr, file, "Lr_stderr", r.image.width);
     const std::size_t pixels = r.image.rgb.size();
     const double n = 3.0 * double(pixels);
     double var = 0.0;
@@ -81,8 +98,7 @@ BiasReference loadBiasReference(const std::string& file, const Settings& scene) 
 
 /// Per-pixel signed errors over the seeds: the bias map (mean signed error,
 /// its standard error with the reference's, z of the luminance).
-void writeBiasMap(const std::string& file, const std::vector<DVec3>& s1, const std::vector<DVec3>& s2, double S,
-                  const BiasReference& ref, const OutputMetadata& meta) {
+std::vector<FloatChannel> biasMap(const std::vector<DVec3>& s1, const std::vector<DVec3>& s2, double S, const BiasReference& ref) {
     const std::size_t pixels = s1.size();
     std::vector<FloatChannel> ch = {{"bias.R", {}}, {"bias.G", {}}, {"bias.B", {}},
                                     {"bias_stderr.R", {}}, {"bias_stderr.G", {}}, {"bias_stderr.B", {}}, {"bias_z.Y", {}}};
@@ -99,7 +115,7 @@ void writeBiasMap(const std::string& file, const std::vector<DVec3>& s1, const s
         const double mY = luminance(Vec3(m)), seY = luminance(Vec3(se));
         ch[6].values[p] = seY > 0.0 ? float(mY / seY) : 0.0f;
     }
-    writeChannelsExr(file, ref.image.width, ref.image.height, ch, meta);
+    return ch;
 }
 
 /// The <estimator> of prefix.<estimator>.exr: the spec's label, file-safe.
@@ -119,7 +135,8 @@ std::string gpuFramePath(std::string pattern, const std::string& estimator, std:
 
 /// Lr of seed `seed`'s frame as the OptiX twin rendered it (accretion-optix
 /// --seeds), checked against what bias expects of it.
-ExperimentRender readGpuRender(const std::string& file, const Settings& s, std::uint32_t frame, const BiasReference& ref) {
+ExperimentRender readGpuRender(const std::string& file, const Settings& s, std::uint32_t frame, const BiasReference& ref,
+                               bool strict) {
     GpuFrame g = readGpuFrame(file);
     auto meta = [&](const char* key) { return g.metadata.count(key) ? g.metadata.at(key) : std::string(); };
     if (g.width != ref.image.width || g.height != ref.image.height)
@@ -129,6 +146,16 @@ ExperimentRender readGpuRender(const std::string& file, const Settings& s, std::
         throw InputError(fmt::format("{}: seed {}, expected {}", file, meta("seed"), s.render.seed));
     if (meta("estimator") != enumName(s.render.estimator))
         throw InputError(fmt::format("{}: estimator {}, expected {}", file, meta("estimator"), enumName(s.render.estimator)));
+    if (g.metadata.count("settings")) {
+        // The scene the frame was rendered from: its scene-defining sections, as the reference's.
+        reportViewCheck(checkView({{"accretion:frame", std::to_string(g.frame)}, {"accretion:settings", meta("settings")}},
+                                  {{"accretion:frame", std::to_string(frame)}, {"accretion:settings", settingsToToml(s)}},
+                                  ViewKeys::frameAndSettings),
+                        file, "the scene", false, true);
+    } else {
+        reportViewCheck({{}, {"scene settings"}}, file, "the scene", strict);
+    }
+    requireFinite(g.Lr, file, "Lr", g.width);
     ExperimentRender r;
     r.image.lighting.Lr = std::move(g.Lr);
     r.totalSeconds = parseNumber(meta("render_time_s")).value_or(0.0);
@@ -143,12 +170,14 @@ BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vec
     const double n = 3.0 * double(pixels);
     std::vector<DVec3> s1(pixels, DVec3(0.0)), s2(pixels, DVec3(0.0));
     double e1 = 0.0, e2 = 0.0, seconds = 0.0, frameSeconds = 0.0, relMse = 0.0;
+    Progress progress("bias " + spec.label + " (seeds)", a.seeds, a.quiet);
     for (std::uint32_t k = 0; k < a.seeds; ++k) {
         Settings s = specBase;
         s.render.seed = specBase.render.seed + k;
         const ExperimentRender r = a.gpuFrames.empty()
                                        ? renderForExperiment(s, source, frame, a.history)
-                                       : readGpuRender(gpuFramePath(a.gpuFrames, biasMapName(spec), s.render.seed), s, frame, ref);
+                                       : readGpuRender(gpuFramePath(a.gpuFrames, biasMapName(spec), s.render.seed), s, frame,
+                                                       ref, a.strict);
         seconds += r.totalSeconds;
         frameSeconds += a.gpuFrames.empty() ? r.frameSeconds : r.totalSeconds;
         double e = 0.0;
@@ -163,9 +192,9 @@ BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vec
         relMse += m.relMSE - m.relMSEFloor;
         e1 += e;
         e2 += e * e;
-        if (!a.quiet) fmt::print(stderr, "\rbias: {} seed {}/{} ({:.2f} s)", spec.label, k + 1, a.seeds, r.totalSeconds);
+        progress.advance(1);
     }
-    if (!a.quiet) fmt::print(stderr, "\n");
+    progress.finish();
     const double S = a.seeds;
     BiasRow row;
     row.label = spec.label;
@@ -173,16 +202,19 @@ BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vec
     row.meanError = e1 / S;
     const double seedVar = std::max(0.0, (e2 / S - row.meanError * row.meanError) * S / (S - 1.0));
     row.stderr = std::sqrt(seedVar / S + ref.meanStderr * ref.meanStderr);
-    row.z = row.stderr > 0.0 ? row.meanError / row.stderr : 0.0;
+    // No spread at all (a deterministic estimator against an exact
+    // reference): any difference beyond float summation is a bias, not noise.
+    const double tiny = 1e-6 * std::max(std::fabs(ref.mean), 1e-30);
+    row.z = row.stderr > 0.0 ? row.meanError / row.stderr
+          : std::fabs(row.meanError) > tiny ? std::copysign(std::numeric_limits<double>::infinity(), row.meanError)
+                                            : 0.0;
     row.energyLossPct = ref.mean > 0.0 ? -100.0 * row.meanError / ref.mean : 0.0;
     row.secondsPerRender = seconds / S;
     row.relMse = relMse / S;
     row.secondsPerFrame = frameSeconds / S;
     row.biased = std::fabs(row.z) > a.zCritical;
-    writeBiasMap(prefix + "." + biasMapName(spec) + ".exr", s1, s2, S, ref,
-                 {{"version", std::string(version())}, {"estimator", spec.label}, {"seeds", std::to_string(a.seeds)},
-                  {"reference", a.reference}, {"settings", settingsToToml(specBase)},
-                  {"renderer", a.gpuFrames.empty() ? "accretion" : "accretion-optix (" + a.gpuFrames + ")"}});
+    row.map = biasMap(s1, s2, S, ref);
+    row.settingsToml = settingsToToml(specBase);
     return row;
 }
 
@@ -216,14 +248,33 @@ void runBias(const BiasArgs& a) {
     OutputGuard guard = sceneInputs(scene);
     guard.addInput(a.reference);
     std::vector<std::string> suffixes = {".csv", ".png", ".json"};
-    for (const EstimatorSpec& spec : specs) suffixes.push_back("." + biasMapName(spec) + ".exr");
+    for (const EstimatorSpec& spec : specs)
+        for (const char* ext : {".exr", ".z.png"}) suffixes.push_back("." + biasMapName(spec) + ext);
     checkOutputs(guard, prefix, suffixes, "-o");
-    if (auto dir = std::filesystem::path(prefix).parent_path(); !dir.empty()) std::filesystem::create_directories(dir);
 
     const BiasReference ref = loadBiasReference(a.reference, scene);
+    // The reference must be of the view measured: its frame and scene-defining settings.
+    reportViewCheck(checkView({{"accretion:frame", std::to_string(frame)}, {"accretion:settings", settingsToToml(scene)}},
+                              readExrAttributes(a.reference), ViewKeys::frameAndSettings),
+                    fmt::format("frame {} of {}", frame, scene.scenePath), a.reference, a.strict, true);
     const ParticleSource source(scene);
     std::vector<BiasRow> rows;
     for (const EstimatorSpec& spec : specs) rows.push_back(measureBias(a, spec, base, source, frame, ref, prefix));
+
+    // Every output once every estimator has been measured: a failure leaves none.
+    if (auto dir = std::filesystem::path(prefix).parent_path(); !dir.empty()) std::filesystem::create_directories(dir);
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+        const std::string map = prefix + "." + biasMapName(specs[k]);
+        writeChannelsExr(map + ".exr", ref.image.width, ref.image.height, rows[k].map,
+                         {{"version", std::string(version())}, {"estimator", rows[k].label},
+                          {"seeds", std::to_string(a.seeds)}, {"reference", a.reference}, {"frame", std::to_string(frame)},
+                          {"settings", rows[k].settingsToml},
+                          {"renderer", a.gpuFrames.empty() ? "accretion" : "accretion-optix (" + a.gpuFrames + ")"}});
+        const std::vector<float>& z = rows[k].map.back().values;
+        writeFalseColourPng(map + ".z.png", z, ref.image.width, ref.image.height,
+                            {-2.0 * a.zCritical, 2.0 * a.zCritical, true,
+                             fmt::format("{}: bias z per pixel (luminance), {} seeds", rows[k].label, a.seeds)});
+    }
 
     const Table table = biasTable(rows, ref.mean, a.zCritical);
     fmt::print("{}", table.console());
@@ -233,13 +284,18 @@ void runBias(const BiasArgs& a) {
                                  {"frame", frame}, {"history_frames", a.history}, {"z_critical", a.zCritical},
                                  {"reference_mean", ref.mean}, {"reference_mean_stderr", ref.meanStderr},
                                  {"settings", settingsToToml(scene)}, {"rows", table.json()}});
+    // Red bars: BIASED (|z| above the critical value); the title says what was measured.
     const std::string script = fmt::format(
         "set datafile separator ','\nset style fill solid 0.5\nset boxwidth 0.6\nset grid ytics\n"
-        "set ylabel 'energy loss % (bars: {0:.2f} standard errors)'\nset xtics rotate by -30\nset key off\n"
-        "plot {1} skip 1 using 0:6:xtic(1) with boxes, {1} skip 1 using 0:6:($7*{0}) with yerrorbars lc rgb 'black' pt 0\n",
-        a.zCritical, gnuplotQuote(prefix + ".csv"));
+        "set title {2}\nset ylabel 'energy loss % (bars: {0:.2f} standard errors)'\nset xtics rotate by -30\nset key off\n"
+        "plot {1} skip 1 using 0:(strcol(8) eq 'true' ? NaN : $6):xtic(1) with boxes lc rgb '#4682b4', "
+        "{1} skip 1 using 0:(strcol(8) eq 'true' ? $6 : NaN) with boxes lc rgb '#d62728', "
+        "{1} skip 1 using 0:6:($7*{0}) with yerrorbars lc rgb 'black' pt 0\n",
+        a.zCritical, gnuplotQuote(prefix + ".csv"),
+        gnuplotQuote(fmt::format("bias of {} frame {}, {} seeds (red: BIASED, |z| > {:.2f})",
+                                 std::filesystem::path(scene.scenePath).filename().string(), frame, a.seeds, a.zCritical)));
     plotPng(prefix + ".png", script);
-    fmt::print("bias: {}.csv, {}.png, {}.json, bias maps {}.<estimator>.exr\n", prefix, prefix, prefix, prefix);
+    fmt::print("bias: {}.csv, {}.png, {}.json, bias maps {}.<estimator>.exr (.z.png)\n", prefix, prefix, prefix, prefix);
 }
 
 }  // namespace
@@ -251,6 +307,8 @@ void addBiasCommand(CLI::App& app) {
                          "Comma-separated specs, as for converge",
                          "Output prefix (default out/<scene>.bias): .csv, .png, .json, bias-map EXRs");
     cmd->add_option("--seeds", args->seeds, "Independent renders per estimator")->check(CLI::Range(2u, 1000000u));
+    cmd->add_flag("--strict", args->strict,
+                  "A view check that cannot be made (a reference or GPU frame without accretion's metadata) is an error");
     cmd->add_option("--z", args->zCritical, "Two-sided critical |z| for the verdict (3.29: 99.9%)")->check(finiteIn(0.0, 1e6));
     cmd->add_option("--gpu-frames", args->gpuFrames,
                     "Read each seed's frame from the OptiX twin's .gpuframe files instead of rendering it: a pattern "

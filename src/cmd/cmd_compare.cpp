@@ -13,6 +13,7 @@
 
 #include "accretion/analysis/flip.h"
 #include "accretion/analysis/image_metrics.h"
+#include "accretion/analysis/view_check.h"
 #include "accretion/core/atomic_file.h"
 #include "accretion/core/error.h"
 #include "accretion/core/output_guard.h"
@@ -137,48 +138,6 @@ Comparison measure(const CompareArgs& a, const Pair& p) {
     return c;
 }
 
-/// The scene-defining sections of a settings TOML (what two renders of the
-/// same view share whatever their estimators): particles, camera, geometry, shading.
-std::vector<std::string> sceneLines(const std::string& toml) {
-    std::vector<std::string> out;
-    std::istringstream in(toml);
-    bool keep = false;
-    for (std::string line; std::getline(in, line);) {
-        if (!line.empty() && line[0] == '[')
-            keep = line == "[particles]" || line == "[camera]" || line == "[geometry]" || line == "[shading]";
-        if (keep) out.push_back(line);
-    }
-    return out;
-}
-
-/// What the two images' metadata say differently: frame, scene, camera,
-/// scene settings (only what both record; a GPU frame records little).
-std::vector<std::string> metadataDifferences(const std::string& image, const std::string& reference) {
-    const auto x = readExrAttributes(image), r = readExrAttributes(reference);
-    std::vector<std::string> diffs;
-    auto check = [&](const char* key, const char* what) {
-        const auto i = x.find(key), j = r.find(key);
-        if (i != x.end() && j != r.end() && i->second != j->second)
-            diffs.push_back(fmt::format("{}: {} here, {} in the reference", what, i->second.substr(0, 80), j->second.substr(0, 80)));
-    };
-    check("accretion:frame", "frame");
-    check("accretion:scene", "scene");
-    check("worldToCamera", "camera (worldToCamera)");
-    check("accretion:jitter", "jitter");
-    const auto i = x.find("accretion:settings"), j = r.find("accretion:settings");
-    if (i != x.end() && j != r.end()) {
-        const auto sx = sceneLines(i->second), sr = sceneLines(j->second);
-        for (std::size_t k = 0; k < std::max(sx.size(), sr.size()); ++k) {
-            const std::string lx = k < sx.size() ? sx[k] : "(none)", lr = k < sr.size() ? sr[k] : "(none)";
-            if (lx != lr) {
-                diffs.push_back(fmt::format("scene settings: `{}` here, `{}` in the reference", lx, lr));
-                break;
-            }
-        }
-    }
-    return diffs;
-}
-
 /// --error-map OUT.exr: signed error, relative error, (with the
 /// reference's Lr_stderr) z = error / stderr per channel, and FLIP, over the
 /// pixels compared (the EXR's data window); a false-colour PNG of each (the
@@ -230,10 +189,7 @@ void writeErrorMaps(const CompareArgs& a, const Pair& p, const Comparison& cmp) 
 
 /// Metadata differences: a warning each, or (--strict) an error.
 void checkMetadata(const CompareArgs& a, const std::string& image, const std::string& reference) {
-    for (const std::string& d : metadataDifferences(image, reference)) {
-        if (a.strict) throw InputError(fmt::format("{}: not the reference's view: {} (--strict)", image, d));
-        fmt::print(stderr, "accretion: warning: {}: {}\n", image, d);
-    }
+    reportViewCheck(checkView(readExrAttributes(image), readExrAttributes(reference)), image, reference, a.strict);
 }
 
 void checkFlipOption(const CompareArgs& a) {

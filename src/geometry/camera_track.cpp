@@ -16,7 +16,7 @@
 #include "accretion/core/atomic_file.h"
 #include "accretion/core/error.h"
 #include "accretion/core/parse.h"
-#include "accretion/io/json_text.h"
+#include "accretion/core/json_text.h"
 #include "accretion/core/read_file.h"
 
 namespace accretion {

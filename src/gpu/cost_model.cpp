@@ -15,7 +15,7 @@
 
 #include "accretion/core/error.h"
 #include "accretion/core/read_file.h"
-#include "accretion/io/json_text.h"
+#include "accretion/core/json_text.h"
 #include "accretion/core/median.h"
 #include "accretion/core/parse.h"
 #include "accretion/core/pass_timer.h"

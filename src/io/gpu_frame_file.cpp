@@ -148,7 +148,6 @@ GpuFrame readGpuFrame(const std::filesystem::path& file) {
     if (known != planes.size() || f.Lr.empty())
         throw InputError(fmt::format("{}: bad plane list (known planes: L, Le, Lr, normal, depth, particle, Lr_stderr, spp, "
                                      "rejected; Lr required)", name));
-    if (in.peek() != std::ifstream::traits_type::eof()) throw InputError(fmt::format("{}: trailing bytes", name));
     return f;
 }
 

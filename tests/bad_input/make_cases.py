@@ -132,3 +132,17 @@ write("coef_unknown.json", '{"coefficients_ns": {"threads": 1, "warp_steps": 1, 
                            '"any_hits": 1, "bytes": 1, "blas_entires": 1}}\n')
 shutil.copy("half.exr", "seqimg.0000.exr")
 shutil.copy("half.exr", "seqimg.0001.exr")
+
+# Class 11: references for bias and compare's view checks: one of ok.toml's
+# frame 0, one at another field of view, one with a NaN, one without metadata.
+subprocess.run([acc, "render", "ok.toml", "--quiet", "--estimator", "exact", "-o", "ref_ok.exr"], check=True,
+               stdout=subprocess.DEVNULL)
+subprocess.run([acc, "render", "ok.toml", "--quiet", "--estimator", "exact", "-D", "camera.fov=30", "-o", "ref_fov.exr"],
+               check=True, stdout=subprocess.DEVNULL)
+for f in os.listdir("."):
+    if (f.startswith("ref_ok") or f.startswith("ref_fov")) and not f.endswith(".exr"):
+        os.remove(f)
+subprocess.run(["oiiotool", "--pattern", "constant:color=-1,0.5,0.5", "32x16", "3", "--powc", "0.5,1,1",
+                "--chnames", "Lr.R,Lr.G,Lr.B", "-d", "float", "-o", "ref_nan.exr"], check=True)
+subprocess.run(["oiiotool", "--pattern", "constant:color=0.5,0.5,0.5", "32x16", "3",
+                "--chnames", "Lr.R,Lr.G,Lr.B", "-d", "float", "-o", "ref_plain.exr"], check=True)

@@ -1,4 +1,4 @@
-#include "accretion/io/json_text.h"
+#include "accretion/core/json_text.h"
 
 #include <cctype>
 #include <cmath>

@@ -1,0 +1,1 @@
+compare ref_fov.exr ref_ok.exr --strict

@@ -1,0 +1,1 @@
+compare half.exr half.exr --strict
