@@ -29,8 +29,10 @@ ErrorMetrics computeErrors(const std::vector<Vec3>& x, const std::vector<Vec3>& 
             if (m.nonFinite++ < ErrorMetrics::kNonFiniteListed) m.firstNonFinite.push_back(i);
             continue;
         }
-        m.identical += x[i] == ref[i];
-        bool within = true;
+        const bool lit = ref[i] != Vec3(0.0f);
+        m.lit += lit;
+        m.identical += lit && x[i] == ref[i];
+        bool within = lit;
         for (int c = 0; c < 3; ++c) {
             const double r = ref[i][c];
             const double d = double(x[i][c]) - r;

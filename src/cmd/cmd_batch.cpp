@@ -9,7 +9,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
+#include <set>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -148,6 +150,24 @@ std::vector<Job> batchJobs(BatchArgs& args) {
     return jobs;
 }
 
+/// A summary already there is this batch's (the same job names: run again
+/// or resumed), never another's, whose record it would replace.
+void refuseAnotherBatch(const std::string& summaryPath, const std::vector<Job>& jobs) {
+    if (!std::filesystem::exists(summaryPath)) return;
+    std::ifstream in(summaryPath);
+    const nlohmann::json old = nlohmann::json::parse(in, nullptr, false);
+    if (old.is_discarded() || !old.is_object())
+        throw InputError(fmt::format("{}: not a batch summary (JSON); it would be replaced", summaryPath));
+    std::set<std::string> before, now;
+    for (const auto& j : old.value("jobs", nlohmann::json::array())) before.insert(j.value("name", ""));
+    for (const Job& j : jobs) now.insert(j.name);
+    std::vector<std::string> other;
+    std::set_difference(before.begin(), before.end(), now.begin(), now.end(), std::back_inserter(other));
+    if (!other.empty())
+        throw InputError(fmt::format("{}: the summary of another batch (its job {} is not one of these); give --output-dir "
+                                     "for this one", summaryPath, other.front()));
+}
+
 /// --resume: the jobs that finished in an earlier batch (not run again), by name.
 std::map<std::string, nlohmann::json> finishedJobs(const std::string& summaryPath, bool resume) {
     std::map<std::string, nlohmann::json> previous;
@@ -192,6 +212,7 @@ void runBatch(BatchArgs args) {
     const std::filesystem::path outDir(args.outputDir);
     const std::string summaryPath = args.summary.empty() ? (outDir / "batch.json").string() : args.summary;
     guardBatch(args, jobs, summaryPath);
+    refuseAnotherBatch(summaryPath, jobs);
     const OutputLock lock(std::filesystem::path(summaryPath).replace_extension(".lock"));  // one batch per summary
     const std::map<std::string, nlohmann::json> previous = finishedJobs(summaryPath, args.resume);
 

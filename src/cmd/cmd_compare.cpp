@@ -1,7 +1,10 @@
 // accretion compare: error metrics of an image (a GPU frame, an estimate)
 // against a reference EXR; error maps; a check that the two show the same
 // frame of the same scene from the same camera.
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <sstream>
@@ -206,6 +209,42 @@ std::vector<std::string> parseChannels(const CompareArgs& a) {
     return channels;
 }
 
+/// The reference's pixels that the image misses most (relative squared
+/// error summed over channels, as relMSE weighs them), each with the command
+/// that explains it light by light: `render --pixel` on the reference's own
+/// settings (its .settings.toml beside it, else its scene and estimator).
+void printWorstPixels(const Pair& p, std::size_t count) {
+    std::vector<std::pair<double, std::size_t>> worst;
+    for (std::size_t q = 0; q < p.xs.size(); ++q) {
+        double e = 0.0;
+        for (int c = 0; c < 3; ++c) {
+            const double d = double(p.xs[q][c]) - p.rs[q][c];
+            e += d * d / (double(p.rs[q][c]) * p.rs[q][c] + kRelMseEpsilon);
+        }
+        if (std::isfinite(e) && e > 0.0) worst.emplace_back(e, q);
+    }
+    count = std::min(count, worst.size());
+    std::partial_sort(worst.begin(), worst.begin() + std::ptrdiff_t(count), worst.end(), std::greater<>());
+    if (count == 0) return;
+    const auto attrs = readExrAttributes(p.reference);
+    auto attr = [&](const char* key) { return attrs.count(key) ? attrs.at(key) : std::string(); };
+    const std::filesystem::path settings =
+        std::filesystem::path(p.reference).replace_extension().string() + ".settings.toml";
+    std::string scene;
+    if (std::filesystem::exists(settings)) scene = settings.string();
+    else if (!attr("accretion:scene").empty())
+        scene = fmt::format("{} --estimator {} --seed {}", attr("accretion:scene"), attr("accretion:estimator"), attr("accretion:seed"));
+    fmt::print("worst pixels (relative squared error){}:\n", scene.empty() ? " (the reference names no scene to explain them)" : "");
+    for (std::size_t k = 0; k < count; ++k) {
+        const std::size_t q = worst[k].second;
+        const int x = p.x0 + int(q % p.w), y = p.y0 + int(q / p.w);
+        if (scene.empty()) fmt::print("  {:>10.4g}  ({}, {})\n", worst[k].first, x, y);
+        else
+            fmt::print("  {:>10.4g}  accretion render {} --frames {} --pixel {},{}\n", worst[k].first, scene,
+                       attr("accretion:frame").empty() ? "0" : attr("accretion:frame"), x, y);
+    }
+}
+
 void runCompareOne(const CompareArgs& a) {
     if (!a.errorMap.empty()) {  // before any work: never over an input, and an EXR
         OutputGuard guard;
@@ -228,14 +267,16 @@ void runCompareOne(const CompareArgs& a) {
              {"MSE", "MSE", 0, "{:.9g}"}, {"MAPE", "MAPE", 0, "{:.9g}"},
              {"flip", flipName(a), 0, "{:.6f}"}, hidden("flip_variant"), hidden("ppd"),
              hidden("epsilon"), hidden("pixels"), hidden("nonfinite_pixels"), hidden("window"),
-             {"identical", "identical pixels (fraction)", 0, "{:.6f}"}, {"within_tolerance", "pixels within tolerance (fraction)", 0, "{:.6f}"},
+             hidden("lit_pixels"), {"identical", "identical lit pixels (fraction)", 0, "{:.6f}"},
+             {"within_tolerance", "lit pixels within tolerance (fraction)", 0, "{:.6f}"},
              hidden("tolerance")});
     t.add({a.image, a.reference, a.layer.empty() ? "RGB" : a.layer, c.m.relMSE, c.m.MSE, c.m.MAPE, c.flip, a.flip, a.ppd,
            kRelMseEpsilon, std::uint64_t(c.m.pixels), std::uint64_t(c.m.nonFinite),
-           fmt::format("{}x{}+{}+{}", p.w, p.h, p.x0, p.y0), fraction(c.m.identical, c.m.pixels),
-           fraction(c.m.withinTolerance, c.m.pixels), a.tolerance});
+           fmt::format("{}x{}+{}+{}", p.w, p.h, p.x0, p.y0), std::uint64_t(c.m.lit), fraction(c.m.identical, c.m.lit),
+           fraction(c.m.withinTolerance, c.m.lit), a.tolerance});
     if (!a.errorMap.empty()) writeErrorMaps(a, p, c);
     fmt::print("{}", a.json ? t.json()[0].dump(2) + "\n" : t.keyValues());
+    if (!a.json) printWorstPixels(p, 5);
     if (a.flip == "hdr" && !a.json)
         fmt::print("HDR-FLIP exposures: {} from {:.4f} to {:.4f} stops (ACES)\n", c.hdr.exposures, c.hdr.startExposure,
                    c.hdr.stopExposure);
@@ -254,6 +295,8 @@ void runCompareSequence(const CompareArgs& a) {
             throw InputError(fmt::format("command line --frames {}: {} has no {{frame}} pattern", a.frames, *pattern));
     if (a.csv.empty()) throw InputError(fmt::format("command line --frames {}: give --csv FILE for the per-frame table", a.frames));
     if (!a.errorMap.empty()) throw InputError("command line --error-map: maps one pair of images; give it without --frames");
+    if (std::filesystem::path(a.csv).extension() != ".csv")
+        throw InputError(fmt::format("command line --csv {}: must end in .csv (its plot goes beside it as .png)", a.csv));
     const std::string png = std::filesystem::path(a.csv).replace_extension(".png").string();
     OutputGuard guard;
     std::vector<std::pair<std::string, std::string>> files;
@@ -270,7 +313,7 @@ void runCompareSequence(const CompareArgs& a) {
     const std::vector<std::string> channels = parseChannels(a);
     Table t({{"frame", "frame", 6}, {"relMSE", "relMSE", 13, "{:.6g}", "{:.9g}"}, {"MSE", "MSE", 13, "{:.6g}", "{:.9g}"},
              {"MAPE", "MAPE", 11, "{:.6g}", "{:.9g}"}, {"flip", flipName(a), 10, "{:.5f}", "{:.6f}"},
-             {"flicker", "flicker", 13, "{:.6g}", "{:.9g}"}, {"flicker_pixels", "tracked", 8, "{:.3f}", "{:.6f}"},
+             {"flicker", "flicker", 13, "{:.6g}", "{:.9g}"}, {"tracked", "tracked", 8, "{:.3f}", "{:.6f}"},
              {"nonfinite_pixels", "nonfinite", 9},
              {"image", "", 0, "{}", "{}", false}, {"reference", "", 0, "{}", "{}", false}});
     std::vector<Vec3> lastError;

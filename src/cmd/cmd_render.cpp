@@ -327,8 +327,10 @@ void runRender(const RenderArgs& args) {
     }
 
     const auto start = std::chrono::steady_clock::now();
-    std::optional<StopSignal> stop;
-    if (sharding.accumulating) stop.emplace();
+    // One signal path for every estimator: SIGINT and SIGTERM stop at the next
+    // safe point (a chunk of an accumulating estimator, else the end of a
+    // frame), with the frames written so far whole and the lock released.
+    const StopSignal stop;
     auto lastCheckpoint = start;
     auto saveCheckpoint = [&](std::uint32_t frame, const Accumulation& acc) {
         checkpoint.save(frame, acc, stats["frames"]);
@@ -337,6 +339,14 @@ void runRender(const RenderArgs& args) {
     auto interrupt = [&](int signal, std::uint32_t frame, std::uint64_t chunk) {
         fmt::print(stderr, "accretion: {}: checkpoint {} (frame {}, chunk {}); continue with --resume\n",
                    StopSignal::name(signal), checkpoint.file().string(), frame, chunk);
+        throw Interrupted{signal};
+    };
+    // restir keeps reservoir history across frames: no checkpoint, the frames done are kept.
+    auto stopBetweenFrames = [&](int signal, std::uint32_t next) {
+        fmt::print(stderr, "accretion: {}: stopped before frame {}; frames {}..{} are written ({} keeps reservoir history "
+                           "across frames and is not checkpointed: render the rest with --frames {}:{})\n",
+                   StopSignal::name(signal), next, firstFrame, next - 1, enumName(settings.render.estimator), next,
+                   sharding.end);
         throw Interrupted{signal};
     };
 
@@ -353,7 +363,7 @@ void runRender(const RenderArgs& args) {
         session.result = &sums;
         if (resumed && resumed->header.at("frame").get<std::uint32_t>() == frame) session.resume = &resumed->acc;
         session.afterChunk = [&](const Accumulation& acc) {
-            const int signal = stop ? stop->pending() : 0;
+            const int signal = stop.pending();
             const double since = std::chrono::duration<double>(std::chrono::steady_clock::now() - lastCheckpoint).count();
             if (signal || (args.checkpointEvery > 0.0 && since >= args.checkpointEvery)) saveCheckpoint(frame, acc);
             if (signal) interrupt(signal, frame, acc.nextChunk);
@@ -368,7 +378,8 @@ void runRender(const RenderArgs& args) {
         lightingSeconds += fs.timer.seconds(pass::estimateLighting);
         printFrame(settings, frame, fj, fs);
         // Stopped between frames: the next frame starts from its first chunk.
-        if (const int signal = stop ? stop->pending() : 0; signal && frame + 1 < sharding.end) {
+        if (const int signal = stop.pending(); signal && frame + 1 < sharding.end) {
+            if (!sharding.accumulating) stopBetweenFrames(signal, frame + 1);
             Accumulation next;
             next.reset(settings.camera.width, settings.camera.height,
                        sharding.bySamples ? planLighting(settings.render, settings.camera.height, shard).begin : 0);

@@ -146,3 +146,7 @@ subprocess.run(["oiiotool", "--pattern", "constant:color=-1,0.5,0.5", "32x16", "
                 "--chnames", "Lr.R,Lr.G,Lr.B", "-d", "float", "-o", "ref_nan.exr"], check=True)
 subprocess.run(["oiiotool", "--pattern", "constant:color=0.5,0.5,0.5", "32x16", "3",
                 "--chnames", "Lr.R,Lr.G,Lr.B", "-d", "float", "-o", "ref_plain.exr"], check=True)
+
+# Class 12: the summary of another batch where this one would write its own.
+os.makedirs("batch_other", exist_ok=True)
+write("batch_other/batch.json", '{"version": "x", "jobs": [{"name": "other_job", "outcome": "ok"}]}\n')

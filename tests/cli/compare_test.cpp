@@ -135,7 +135,7 @@ TEST_CASE("compare a {frame} sequence: per-frame CSV with flicker, and a plot", 
     std::ifstream csv(dir / "seq.csv");
     std::string header, line;
     std::getline(csv, header);
-    CHECK(header.rfind("frame,relMSE,MSE,MAPE,flip,flicker,flicker_pixels,nonfinite_pixels", 0) == 0);
+    CHECK(header.rfind("frame,relMSE,MSE,MAPE,flip,flicker,tracked,nonfinite_pixels", 0) == 0);
     std::vector<std::vector<std::string>> rows;
     while (std::getline(csv, line)) {
         std::vector<std::string> cells;

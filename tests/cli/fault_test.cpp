@@ -90,3 +90,38 @@ TEST_CASE("two runs to one output: the second is refused naming the first's PID,
     CHECK(!fs::exists(dir / "x.checkpoint"));
     CHECK(!fs::exists(dir / "x.lock"));
 }
+
+TEST_CASE("restir stopped by SIGTERM or SIGINT: the frames done are whole with their previews, no lock, no temporary",
+          "[cli][fault][signal]") {
+    const std::string signal = GENERATE("TERM", "INT");
+    const fs::path dir = accretion::test::scratchDir("fault_restir_" + signal);
+    // Many frames: the signal comes once frame 0 is written, long before the last.
+    const std::string run = std::string(ACCRETION_BINARY) + " render " + ACCRETION_SOURCE_DIR +
+                            "/scenes/quickstart.toml --quiet --frames 0:400 -D camera.width=160 -D camera.height=90 "
+                            "-D particles.count=5000 --estimator restir -o " + (dir / "r.{frame}.exr").string();
+    const std::string script = run + " > /dev/null 2> " + (dir / "err").string() + " & P=$!\n" +
+                               "i=0; while [ ! -e " + (dir / "r.0000.Lr.png").string() + " ] && [ $i -lt 1200 ]; do sleep 0.05; i=$((i+1)); done\n" +
+                               "kill -" + signal + " $P; wait $P; echo \"status=$?\"\n";
+    std::ofstream(dir / "script.sh") << script;
+    std::string out;
+    accretion::test::runCommand("sh " + (dir / "script.sh").string() + " 2>&1", out);
+    const std::string err = accretion::test::readFile(dir / "err");
+    INFO(out << "\n" << err);
+    CHECK_THAT(out, Contains(signal == "TERM" ? "status=143" : "status=130"));
+    CHECK_THAT(err, Contains("SIG" + signal + ": stopped before frame") && Contains("render the rest with --frames"));
+    // Every frame written is whole: its EXR, both previews; nothing else is left.
+    std::size_t frames = 0;
+    for (const auto& e : fs::directory_iterator(dir)) {
+        const std::string name = e.path().filename().string();
+        CHECK(name.front() != '.');                    // no hidden temporary
+        CHECK(e.path().extension() != ".lock");
+        if (e.path().extension() == ".exr") {
+            ++frames;
+            const std::string stem = e.path().stem().string();
+            CHECK(fs::exists(dir / (stem + ".png")));
+            CHECK(fs::exists(dir / (stem + ".Lr.png")));
+        }
+    }
+    CHECK(frames >= 1);
+    CHECK(frames < 400);
+}

@@ -20,9 +20,13 @@ struct ErrorMetrics {
     /// adds to relMSE in expectation (0 without a stderr layer).
     double relMSEFloor = 0.0;
     std::size_t pixels = 0;      ///< pixels measured
-    /// Pixels (of those measured) equal to the reference in all three
-    /// channels, and within the relative tolerance of computeErrors in each
-    /// (|x - ref| <= tol |ref|): agreement of two renderers of one quantity.
+    /// Pixels (of those measured) the reference lights: not 0 in every
+    /// channel. The black background agrees trivially, so agreement is
+    /// counted over these alone:
+    std::size_t lit = 0;
+    /// lit pixels equal to the reference in all three channels, and within
+    /// the relative tolerance of computeErrors in each (|x - ref| <= tol
+    /// |ref|): agreement of two renderers of one quantity.
     std::size_t identical = 0, withinTolerance = 0;
     /// Pixels left out because a value of the image, the reference or its
     /// stderr is NaN or infinite, and the first few of them (row-major indices).

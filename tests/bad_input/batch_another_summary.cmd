@@ -1,0 +1,1 @@
+batch --scene ok.toml --output-dir batch_other
