@@ -274,7 +274,7 @@ Table sequenceTable(const std::vector<Point>& points, const std::vector<Estimato
 }
 
 /// relMSE against time and against shadow rays (or against frame).
-void plotConverge(const std::string& prefix, const std::vector<EstimatorSpec>& specs, bool sequence) {
+void plotConverge(const std::string& prefix, const std::vector<EstimatorSpec>& specs, bool sequence, const std::string& title) {
     std::string plots;
     for (const EstimatorSpec& spec : specs)
         plots += fmt::format("{}{} skip 1 using XCOL:(strcol(1) eq {} ? $8 : NaN) with linespoints title {}",
@@ -287,11 +287,11 @@ void plotConverge(const std::string& prefix, const std::vector<EstimatorSpec>& s
     };
     std::string script = "set datafile separator ','\nset key outside right\nset grid\nset ylabel 'relMSE'\nset logscale y\n";
     if (sequence) {
-        script += "set xlabel 'frame'\nplot " + withColumn("2") + "\n";
+        script += "set title " + gnuplotQuote(title) + "\nset xlabel 'frame'\nplot " + withColumn("2") + "\n";
         plotPng(prefix + ".png", script);
         return;
     }
-    script += "set multiplot layout 1,2\nset logscale x\nset xlabel 'seconds per frame'\nplot " + withColumn("4") +
+    script += "set multiplot layout 1,2 title " + gnuplotQuote(title) + "\nset logscale x\nset xlabel 'seconds per frame'\nplot " + withColumn("4") +
               "\nset xlabel 'shadow rays'\nplot " + withColumn("6") + "\nunset multiplot\n";
     plotPng(prefix + ".png", script, 1400, 600);
 }
@@ -342,7 +342,10 @@ void runConverge(const ConvergeArgs& a) {
                                  {"settings", settingsToToml(scene)},
                                  {"points", summary}});
     if (a.sequence > 0) fmt::print("{}", sequenceTable(points, specs, frame, a.sequence).console());
-    plotConverge(prefix, specs, a.sequence > 0);
+    plotConverge(prefix, specs, a.sequence > 0,
+                 fmt::format("{} frame {}{}, {} seed{} per point", std::filesystem::path(scene.scenePath).filename().string(),
+                             frame, a.sequence > 0 ? fmt::format(" (+{} frames)", a.sequence - 1) : std::string(), a.seeds,
+                             a.seeds == 1 ? " (times of one render: give --seeds 3 or more for smooth curves)" : "s"));
     fmt::print("converge: {}.csv, {}.png, {}.json\n", prefix, prefix, prefix);
 }
 

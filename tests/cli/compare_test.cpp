@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include <OpenImageIO/imageio.h>
+#include <nlohmann/json.hpp>
 
 #include "accretion/analysis/image_metrics.h"
 #include "support/cli.h"
@@ -65,13 +66,22 @@ TEST_CASE("compare measures the pixels both data windows hold, half or float", "
     CHECK(field(out, "MSE") == Approx(0.15).epsilon(1e-6));
     CHECK(field(out, "relMSE") == Approx(0.15 / 1.01).epsilon(1e-6));
     // 6 of 15 equal the reference; the other 9 are 50% off: outside 1e-4, inside --tolerance 0.5.
-    CHECK(field(out, "identical pixels (fraction)") == Approx(6.0 / 15.0));
-    CHECK(field(out, "pixels within tolerance (fraction)") == Approx(6.0 / 15.0));
+    CHECK(field(out, "identical lit pixels (fraction)") == Approx(6.0 / 15.0));
+    CHECK(field(out, "lit pixels within tolerance (fraction)") == Approx(6.0 / 15.0));
     std::string loose;
     REQUIRE(runCommand(kBin + " compare " + (dir / "gpu.exr").string() + " " + (dir / "ref.exr").string() +
                            " --flip none --tolerance 0.5", loose) == 0);
-    CHECK(field(loose, "pixels within tolerance (fraction)") == Approx(1.0));
-    CHECK(field(loose, "identical pixels (fraction)") == Approx(6.0 / 15.0));
+    CHECK(field(loose, "lit pixels within tolerance (fraction)") == Approx(1.0));
+    CHECK(field(loose, "identical lit pixels (fraction)") == Approx(6.0 / 15.0));
+    // Black in both (a background) is no agreement: only the 9 lit pixels count, none identical.
+    writeWindowExr(dir / "ref_dark.exr", 8, 6, 0, 0, 8, 6, false, [](int x, int) { return x >= 4 ? 1.0f : 0.0f; });
+    writeWindowExr(dir / "gpu_dark.exr", 8, 6, 2, 1, 5, 3, true, [](int x, int) { return x >= 4 ? 1.5f : 0.0f; });
+    std::string dark;
+    REQUIRE(runCommand(kBin + " compare " + (dir / "gpu_dark.exr").string() + " " + (dir / "ref_dark.exr").string() +
+                           " --flip none --json", dark) == 0);
+    const auto j = nlohmann::json::parse(dark.substr(dark.find('{')));
+    CHECK(j["lit_pixels"] == 9);
+    CHECK(j["identical"] == 0.0);
     // The error map is that window of the display window.
     auto in = OIIO::ImageInput::open((dir / "err.exr").string());
     REQUIRE(in);
