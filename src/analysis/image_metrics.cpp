@@ -15,6 +15,13 @@
 
 namespace accretion {
 
+void requireFinitePixels(const std::vector<Vec3>& pixels, const std::string& file, const char* layer, std::uint32_t width) {
+    for (std::size_t p = 0; p < pixels.size(); ++p)
+        if (!(std::isfinite(pixels[p].x) && std::isfinite(pixels[p].y) && std::isfinite(pixels[p].z)))
+            throw InputError(fmt::format("{}: {} is not finite at pixel ({}, {}): the experiments measure finite images", file,
+                                         layer, p % width, p / width));
+}
+
 ErrorMetrics computeErrors(const std::vector<Vec3>& x, const std::vector<Vec3>& ref, const std::vector<Vec3>* refStderr,
                            double eps, double tolerance) {
     ACC_CHECK(x.size() == ref.size());

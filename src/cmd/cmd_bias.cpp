@@ -63,14 +63,6 @@ struct BiasReference {
     double mean = 0.0, meanStderr = 0.0;
 };
 
-/// A mean over pixels is NaN with one NaN pixel: refuse it, naming the first.
-void requireFinite(const std::vector<Vec3>& pixels, const std::string& file, const char* layer, std::uint32_t width) {
-    for (std::size_t p = 0; p < pixels.size(); ++p)
-        if (!(std::isfinite(pixels[p].x) && std::isfinite(pixels[p].y) && std::isfinite(pixels[p].z)))
-            throw InputError(fmt::format("{}: {} is not finite at pixel ({}, {}): bias measures finite images", file, layer,
-                                         p % width, p / width));
-}
-
 BiasReference loadBiasReference(const std::string& file, const Settings& scene) {
     BiasReference r;
     r.image = readExrLayer(file, "Lr");
@@ -81,8 +73,8 @@ BiasReference loadBiasReference(const std::string& file, const Settings& scene) 
         throw InputError(fmt::format("{}: reference is {}x{}, the scene renders {}x{}", file, r.image.width, r.image.height,
                                      scene.camera.width, scene.camera.height));
     if (exrHasLayer(file, "Lr_stderr")) r.stderr = readExrLayer(file, "Lr_stderr").rgb;
-    requireFinite(r.image.rgb, file, "Lr", r.image.width);
-    if (!r.stderr.empty()) requireFinite(r.stderr, file, "Lr_stderr", r.image.width);
+    requireFinitePixels(r.image.rgb, file, "Lr", r.image.width);
+    if (!r.stderr.empty()) requireFinitePixels(r.stderr, file, "Lr_stderr", r.image.width);
     const std::size_t pixels = r.image.rgb.size();
     const double n = 3.0 * double(pixels);
     double var = 0.0;
@@ -155,7 +147,7 @@ ExperimentRender readGpuRender(const std::string& file, const Settings& s, std::
     } else {
         reportViewCheck({{}, {"scene settings"}}, file, "the scene", strict);
     }
-    requireFinite(g.Lr, file, "Lr", g.width);
+    requireFinitePixels(g.Lr, file, "Lr", g.width);
     ExperimentRender r;
     r.image.lighting.Lr = std::move(g.Lr);
     r.totalSeconds = parseNumber(meta("render_time_s")).value_or(0.0);

@@ -13,6 +13,7 @@
 
 #include "accretion/analysis/experiment.h"
 #include "accretion/analysis/image_metrics.h"
+#include "accretion/analysis/view_check.h"
 #include "accretion/core/error.h"
 #include "accretion/core/parse.h"
 #include "accretion/core/version.h"
@@ -28,7 +29,10 @@ namespace accretion::cmd {
 namespace {
 
 struct ConvergeArgs : ExperimentArgs {
-    ConvergeArgs() { estimators = "uniform,power,tree,split,ris,restir"; }
+    ConvergeArgs() {
+        estimators = "uniform,power,tree,split,ris,restir";
+        seeds = 3;  // a point's time is the median of 3 renders: one render's timing noise bends curves back
+    }
     std::string budget = "60s";
     std::uint32_t sequence = 0, minEffort = 1, maxEffort = 1u << 16;
 };
@@ -88,11 +92,17 @@ Reference loadReference(const std::string& pattern, const Settings& scene, std::
     if (L.width != scene.camera.width || L.height != scene.camera.height)
         throw InputError(fmt::format("{}: reference is {}x{}, the scene renders {}x{}", file, L.width, L.height,
                                      scene.camera.width, scene.camera.height));
+    // Of the frame measured and the scene's settings; finite.
+    reportViewCheck(checkView({{"accretion:frame", std::to_string(frame)}, {"accretion:settings", settingsToToml(scene)}},
+                              readExrAttributes(file), ViewKeys::frameAndSettings),
+                    fmt::format("frame {} of {}", frame, scene.scenePath), file, false, true);
     Reference r;
     r.Lr = L.rgb;
+    requireFinitePixels(r.Lr, file, "Lr", L.width);
     if (exrHasLayer(file, "Lr_stderr")) {
         r.stderr = readExrLayer(file, "Lr_stderr").rgb;
         r.hasStderr = true;
+        requireFinitePixels(r.stderr, file, "Lr_stderr", L.width);
     }
     return r;
 }
@@ -367,7 +377,7 @@ void addConvergeCommand(CLI::App& app) {
     cmd->add_option("--max-effort", args->maxEffort, "Largest spp (restir: candidates) tried")
         ->check(unsignedNumber())
         ->check(CLI::Range(1u, 1u << 30));
-    cmd->add_option("--seeds", args->seeds, "Renders per point: errors are their means, time their median")
+    cmd->add_option("--seeds", args->seeds, "Renders per point (default 3): errors are their means, time their median")
         ->check(CLI::Range(1u, 100000u));
     cmd->footer("Effort doubles from --min-effort (spp; ris reservoirs; restir candidates) until the budget is spent.\n"
                 "relMSE_corrected subtracts the reference's own noise (its Lr_stderr layer) in expectation.");

@@ -57,7 +57,7 @@ std::vector<std::uint32_t> parseInts(const std::string& text, std::size_t count,
     return v;
 }
 
-/// "out/x.0008.exr" -> "out/x.0008.shard2of4.exr".
+/// "out/x.0008.exr" -> "out/x.0008.shard1of4.exr" (--shard 1/4).
 std::string shardPath(const std::string& path, const Shard& shard) {
     if (shard.whole()) return path;
     std::filesystem::path p(path);

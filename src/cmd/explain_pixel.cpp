@@ -2,6 +2,7 @@
 #include "explain_pixel.h"
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 
 #include <fmt/core.h>
@@ -87,12 +88,18 @@ void printRis(const PixelTrace& t) {
     }
 }
 
-void printRestir(const PixelTrace& t) {
+void printRestir(const PixelTrace& t, const Settings& s) {
     fmt::print("restir: the pixel's reservoir after each pass\n");
     fmt::print("  {:<20} {:>9} {:>8} {:>14} {:>14}\n", "pass", "y", "M", "p_hat(y)", "W");
     for (const auto& p : t.passes)
         fmt::print("  {:<20} {:>9} {:>8} {:>14.8g} {:>14.8g}\n", p.pass, light(p.reservoir.y), p.reservoir.M, p.reservoir.p_hat,
                    p.reservoir.W);
+    // Why M stops growing over frames: the temporal pass caps the history's M.
+    const double cap = std::floor(s.restir.m_cap * double(std::max(1u, s.render.candidates)));
+    fmt::print("  M: the temporal pass keeps at most restir.m_cap x the frame's candidates of the history "
+               "({} x {} = {:.0f}; docs/MODEL.md section 4), so M levels off there{}; spatial reuse then adds its "
+               "neighbours' M\n",
+               s.restir.m_cap, s.render.candidates, cap, s.restir.temporal ? "" : " (temporal reuse is off here)");
 }
 
 }  // namespace
@@ -117,7 +124,7 @@ void explainPixel(const Settings& settings, std::uint32_t x, std::uint32_t y, bo
         return;
     }
     fmt::print("hit: particle {} at depth {}, shading normal {}\n", img.particle[px], img.depth[px], rgb(img.normal[px]));
-    if (restir) printRestir(trace);
+    if (restir) printRestir(trace, settings);
     else if (settings.render.estimator == EstimatorKind::exact) printExact(trace, img.lighting.Lr[px]);
     else if (settings.render.estimator == EstimatorKind::ris) printRis(trace);
     else if (settings.render.estimator == EstimatorKind::split) printSplit(trace);

@@ -433,9 +433,10 @@ CameraTrack::CameraTrack(const CameraSettings& settings) : settings_(settings) {
                     "{}: jitter ({}, {}) px differs from the projection's off-centre terms ({}, {}) px{}", where, jx, jy,
                     pose.jitterX, pose.jitterY,
                     std::fabs(pose.jitterX + jx) <= 1e-6 && std::fabs(pose.jitterY + jy) <= 1e-6
-                        ? ": the opposite sign. accretion's jitter is where the sample lies from the pixel centre; "
-                          "a projection shifted by the TAA offset (proj[2][0] += 2 jx / W) samples at -jx. Give "
-                          "jitter = -jx, or leave jitter out: it is read from the projection (docs/gpu-frame-loop.md#jitter)"
+                        ? ": the opposite sign. accretion's jitter is where the sample lies from the pixel centre; a "
+                          "projection that moves the image jx px right (Direct3D's TAA: _31 += 2 jx / W) samples at -jx. "
+                          "Leave jitter out (it is read from the projection) or give the sample's offset "
+                          "(docs/gpu-frame-loop.md#jitter)"
                         : ""));
             pose.jitterX = jx;
             pose.jitterY = jy;

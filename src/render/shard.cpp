@@ -9,7 +9,7 @@
 
 namespace accretion {
 
-std::string Shard::name() const { return fmt::format("shard{}of{}", index + 1, count); }
+std::string Shard::name() const { return fmt::format("shard{}of{}", index, count); }
 
 Shard parseShard(const std::string& text, const char* option) {
     const auto slash = text.find('/');

@@ -150,3 +150,10 @@ subprocess.run(["oiiotool", "--pattern", "constant:color=0.5,0.5,0.5", "32x16", 
 # Class 12: the summary of another batch where this one would write its own.
 os.makedirs("batch_other", exist_ok=True)
 write("batch_other/batch.json", '{"version": "x", "jobs": [{"name": "other_job", "outcome": "ok"}]}\n')
+
+# Class 10: a D3D projection offset by the usual TAA formula (_31 += 2 jx / W)
+# with the engine's jx given as the jitter: the samples lie at -jx.
+f = 2.414213562373095
+proj = [f / 2, 0, 0, 0, 0, f, 0, 0, 2 * 0.25 / 32, 0, 1.0001, 1, 0, 0, -0.010001, 0]
+write("cams_taa_sign.json", json.dumps({"convention": "d3d", "frames": [
+    {"frame": 0, "view": [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -1, 10, 1], "projection": proj, "jitter": [0.25, 0]}]}) + "\n")

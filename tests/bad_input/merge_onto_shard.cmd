@@ -1,1 +1,1 @@
-merge -o shard.shard1of2.exr shard.shard1of2.exr shard.shard2of2.exr
+merge -o shard.shard0of2.exr shard.shard0of2.exr shard.shard1of2.exr

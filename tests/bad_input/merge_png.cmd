@@ -1,1 +1,1 @@
-merge -o merged.png shard.shard1of2.exr shard.shard2of2.exr
+merge -o merged.png shard.shard0of2.exr shard.shard1of2.exr

@@ -198,3 +198,25 @@ TEST_CASE("compare --layer of one channel (spp) reads it in all three components
                        out) == 0);
     CHECK(field(out, "relMSE") == 0.0);
 }
+
+TEST_CASE("compare's worst pixels are ready-to-run render --pixel commands that explain those pixels", "[cli][compare]") {
+    const auto dir = scratchDir("compare_worst");
+    std::string out;
+    REQUIRE(runCommand(kBin + " render " + tinyScene() + " --quiet --estimator exact -o " + (dir / "ref.exr").string(), out) == 0);
+    REQUIRE(runCommand(kBin + " render " + tinyScene() + " --quiet --estimator uniform --spp 1 -o " + (dir / "x.exr").string(), out) ==
+            0);
+    REQUIRE(runCommand(kBin + " compare " + (dir / "x.exr").string() + " " + (dir / "ref.exr").string() + " --flip none", out) == 0);
+    INFO(out);
+    REQUIRE(out.find("worst pixels") != std::string::npos);
+    // The first one, as printed: "  <error>  accretion render <ref>.settings.toml --frames 0 --pixel X,Y".
+    const auto at = out.find("accretion render ", out.find("worst pixels"));
+    REQUIRE(at != std::string::npos);
+    const std::string command = out.substr(at + std::string("accretion ").size(), out.find('\n', at) - at - 10);
+    CHECK_THAT(command, Contains((dir / "ref.settings.toml").string()));
+    const auto pixel = command.substr(command.find("--pixel ") + 8);
+    const std::string xy = pixel.substr(0, pixel.find(','));
+    std::string explained;
+    REQUIRE(runCommand(kBin + " " + command + " --quiet", explained) == 0);
+    INFO(explained);
+    CHECK_THAT(explained, Contains("pixel (" + xy + ", " + pixel.substr(pixel.find(',') + 1) + ") of frame 0, exact estimator"));
+}

@@ -224,16 +224,16 @@ TEST_CASE("shards run with GNU parallel merge into the image of one run", "[cli]
         const std::string pattern = (dir / (std::string(estimator) + ".{frame}.exr")).string();
         REQUIRE(runCommand("parallel --will-cite -j2 -I@@ " + common + " -o '" + pattern + "' --shard @@/3 ::: 0 1 2", out) == 0);
         const fs::path merged = dir / (std::string(estimator) + ".merged.exr");
-        // Given out of order: the merge sums in shard order.
+        // Named as --shard I/3 gives them (shard0of3..shard2of3); given out of order: the merge sums in shard order.
         const auto shard = [&](int i) { return (dir / (std::string(estimator) + ".0001.shard" + std::to_string(i) + "of3.exr")).string(); };
-        REQUIRE(runCommand(std::string(ACCRETION_BINARY) + " merge " + shard(3) + " " + shard(1) + " " + shard(2) + " -o " + merged.string(), out) == 0);
+        REQUIRE(runCommand(std::string(ACCRETION_BINARY) + " merge " + shard(2) + " " + shard(0) + " " + shard(1) + " -o " + merged.string(), out) == 0);
         INFO(out);
         CHECK(sameImage(one, merged));
 
         // A missing or repeated shard is refused.
-        CHECK(runCommand(std::string(ACCRETION_BINARY) + " merge " + shard(1) + " " + shard(2) + " -o " + (dir / "x.exr").string(), out) == 1);
+        CHECK(runCommand(std::string(ACCRETION_BINARY) + " merge " + shard(0) + " " + shard(1) + " -o " + (dir / "x.exr").string(), out) == 1);
         CHECK_THAT(out, Contains("shard(s) 2/3 missing"));
-        CHECK(runCommand(std::string(ACCRETION_BINARY) + " merge " + shard(1) + " " + shard(1) + " " + shard(2) + " -o " + (dir / "x.exr").string(), out) == 1);
+        CHECK(runCommand(std::string(ACCRETION_BINARY) + " merge " + shard(0) + " " + shard(0) + " " + shard(1) + " -o " + (dir / "x.exr").string(), out) == 1);
         CHECK_THAT(out, Contains("given twice"));
         CHECK_FALSE(fs::exists(dir / "x.exr"));
     }

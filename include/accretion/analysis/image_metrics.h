@@ -35,6 +35,10 @@ struct ErrorMetrics {
     static constexpr std::size_t kNonFiniteListed = 5;
 };
 
+/// A mean over pixels is NaN with one NaN pixel: InputError "FILE: LAYER is
+/// not finite at pixel (x, y)" naming the first (`width`: the image's).
+void requireFinitePixels(const std::vector<Vec3>& pixels, const std::string& file, const char* layer, std::uint32_t width);
+
 inline constexpr double kRelMseEpsilon = 1e-2;
 inline constexpr double kAgreementTolerance = 1e-4;
 

@@ -9,7 +9,7 @@ struct Shard {
     std::uint32_t index = 0;  ///< 0-based
     std::uint32_t count = 1;
     bool whole() const { return count == 1; }
-    std::string name() const;  ///< "shard1of4" (1-based in names, as people count)
+    std::string name() const;  ///< "shard0of4": the index as --shard I/N gives it (0-based)
 };
 
 /// Parse "i/n" (0 <= i < n). Throws InputError naming `option`.
