@@ -228,11 +228,17 @@ void printWorstPixels(const Pair& p, std::size_t count) {
     if (count == 0) return;
     const auto attrs = readExrAttributes(p.reference);
     auto attr = [&](const char* key) { return attrs.count(key) ? attrs.at(key) : std::string(); };
-    const std::filesystem::path settings =
-        std::filesystem::path(p.reference).replace_extension().string() + ".settings.toml";
+    // The settings file of the run that wrote the reference: "ref.exr" ->
+    // "ref.settings.toml", "ref.0003.exr" (a {frame} run) -> "ref.settings.toml".
+    const std::string stem = std::filesystem::path(p.reference).replace_extension().string();
+    const std::size_t digits = stem.size() - std::min(stem.size(), stem.find_last_not_of("0123456789") + 1);
+    std::vector<std::string> candidates = {stem + ".settings.toml"};
+    if (digits >= 4 && digits < stem.size() && std::string_view("._-").find(stem[stem.size() - digits - 1]) != std::string_view::npos)
+        candidates.push_back(stem.substr(0, stem.size() - digits - 1) + ".settings.toml");
     std::string scene;
-    if (std::filesystem::exists(settings)) scene = settings.string();
-    else if (!attr("accretion:scene").empty())
+    for (const std::string& c : candidates)
+        if (scene.empty() && std::filesystem::exists(c)) scene = c;
+    if (scene.empty() && !attr("accretion:scene").empty())  // no settings file: the scene, without its -D overrides
         scene = fmt::format("{} --estimator {} --seed {}", attr("accretion:scene"), attr("accretion:estimator"), attr("accretion:seed"));
     fmt::print("worst pixels (relative squared error){}:\n", scene.empty() ? " (the reference names no scene to explain them)" : "");
     for (std::size_t k = 0; k < count; ++k) {
