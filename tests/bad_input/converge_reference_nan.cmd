@@ -1,0 +1,1 @@
+converge ok.toml --reference ref_nan.exr --estimators uniform -o conv_out/c
