@@ -327,11 +327,12 @@ void runConverge(const ConvergeArgs& a) {
     OutputGuard guard = sceneInputs(scene);
     guard.addInput(a.reference);
     checkOutputs(guard, prefix, {".csv", ".png", ".json"}, "-o");
-    if (auto dir = std::filesystem::path(prefix).parent_path(); !dir.empty()) std::filesystem::create_directories(dir);
 
     const ParticleSource source(scene);
     const ConvergeRun run{a, scene, base, source, frame, budget};
     const std::vector<Point> points = a.sequence > 0 ? measureSequence(run, specs) : measureLevels(run, specs);
+    // The folder once there is something to write: a refused reference leaves none.
+    if (auto dir = std::filesystem::path(prefix).parent_path(); !dir.empty()) std::filesystem::create_directories(dir);
     writeFileAtomic(prefix + ".csv", pointsTable(points).csv());
     nlohmann::json summary = nlohmann::json::array();
     if (a.sequence == 0) {

@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <fstream>
+#include <regex>
 #include <sstream>
 
 #include <OpenImageIO/imageio.h>
@@ -267,6 +268,16 @@ TEST_CASE("bias --gpu-frames: frames read from files give the figures of renderi
     std::filesystem::copy_file(dir / "restir_basic.5.gpuframe", dir / "restir_basic.8.gpuframe");
     CHECK(runCommand(kBin + common + (dir / "x").string() + " --gpu-frames " + (dir / "{estimator}.{seed}.gpuframe").string(), out) == 1);
     CHECK_THAT(out, Contains("restir_basic.8.gpuframe: seed 5, expected 8"));
+    // The first spec measured, the second's frames missing: exit 1 and no
+    // output at all, not the first spec's bias map.
+    std::filesystem::remove(dir / "restir_basic.8.gpuframe");
+    std::filesystem::rename(dir / "restir_basic.9.gpuframe", dir / "restir_basic.8.gpuframe");
+    const std::string two = std::regex_replace(common, std::regex("restir:basic"), "restir:basic,restir:pairwise");
+    CHECK(runCommand(kBin + two + (dir / "partial").string() + " --gpu-frames " + (dir / "{estimator}.{seed}.gpuframe").string(),
+                     out) == 1);
+    CHECK_THAT(out, Contains("restir_pairwise.5.gpuframe"));
+    for (const auto& e : std::filesystem::directory_iterator(dir))
+        CHECK(e.path().filename().string().rfind("partial", 0) == std::string::npos);
     // Lr alone cannot be imported as render's EXR.
     CHECK(runCommand(kBin + " import-gpu " + (dir / "restir_basic.5.gpuframe").string(), out) == 1);
     CHECK_THAT(out, Contains("holds Lr alone"));
