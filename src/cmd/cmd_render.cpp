@@ -336,9 +336,10 @@ void runRender(const RenderArgs& args) {
         checkpoint.save(frame, acc, stats["frames"]);
         lastCheckpoint = std::chrono::steady_clock::now();
     };
-    auto interrupt = [&](int signal, std::uint32_t frame, std::uint64_t chunk) {
-        fmt::print(stderr, "accretion: {}: checkpoint {} (frame {}, chunk {}); continue with --resume\n",
-                   StopSignal::name(signal), checkpoint.file().string(), frame, chunk);
+    auto interrupt = [&](int signal, std::uint32_t frame, const Accumulation& acc) {
+        fmt::print(stderr, "accretion: {}: checkpoint {} (frame {}, chunk {}{}); continue with --resume\n",
+                   StopSignal::name(signal), checkpoint.file().string(), frame, acc.nextChunk,
+                   acc.bandRows ? fmt::format(", rows 0..{} done", acc.bandRows - 1) : std::string());
         throw Interrupted{signal};
     };
     // restir keeps reservoir history across frames: no checkpoint, the frames done are kept.
@@ -366,7 +367,7 @@ void runRender(const RenderArgs& args) {
             const int signal = stop.pending();
             const double since = std::chrono::duration<double>(std::chrono::steady_clock::now() - lastCheckpoint).count();
             if (signal || (args.checkpointEvery > 0.0 && since >= args.checkpointEvery)) saveCheckpoint(frame, acc);
-            if (signal) interrupt(signal, frame, acc.nextChunk);
+            if (signal) interrupt(signal, frame, acc);
             return true;
         };
         FrameStats fs;
@@ -384,7 +385,7 @@ void runRender(const RenderArgs& args) {
             next.reset(settings.camera.width, settings.camera.height,
                        sharding.bySamples ? planLighting(settings.render, settings.camera.height, shard).begin : 0);
             saveCheckpoint(frame + 1, next);
-            interrupt(signal, frame + 1, next.nextChunk);
+            interrupt(signal, frame + 1, next);
         }
     }
     const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

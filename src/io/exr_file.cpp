@@ -1,5 +1,6 @@
 #include "accretion/io/exr_file.h"
 
+#include <iterator>
 #include <mutex>
 #include <thread>
 
@@ -41,7 +42,10 @@ bool isStandard(const std::string& name) {
 
 std::string joined(const float* v, int n) {
     std::string s;
-    for (int i = 0; i < n; ++i) s += (i ? " " : "") + fmt::format("{}", v[i]);
+    for (int i = 0; i < n; ++i) {
+        if (i) s += ' ';
+        fmt::format_to(std::back_inserter(s), "{}", v[i]);
+    }
     return s;
 }
 

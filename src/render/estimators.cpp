@@ -271,51 +271,22 @@ void runChunks(const LightingInputs& in, const LightArrays& L, const LightingPla
     }
 }
 
-/// split: each pixel's near field (its lights) and the exact sum of its
-/// terms, found in the frame's first sweep that reaches the pixel and kept
-/// for its later sweeps (a chunk's samples each add the sum). Both are
-/// deterministic, so a restart that finds them again gets the same image.
-/// The lights are kept only while they take at most kMaxLightBytes (beyond,
-/// every sweep searches them again).
-struct NearCache {
-    static constexpr std::size_t kMaxLightBytes = std::size_t(256) << 20;
-    std::uint32_t stride = 0;              ///< lights kept per pixel (0: none kept)
-    std::vector<DVec3> sum;
-    std::vector<std::uint16_t> count;      ///< lights kept, +1 (0: not yet found)
-    std::vector<std::uint32_t> lights;
-    NearCache(std::size_t pixels, std::uint32_t nearLights) : sum(pixels), count(pixels, 0) {
-        const std::uint32_t perPixel = std::min(nearLights, NearField::kMaxNear) + 1;  // and the receiver's own
-        if (pixels * perPixel * sizeof(std::uint32_t) <= kMaxLightBytes) {
-            stride = perPixel;
-            lights.resize(pixels * perPixel);
-        }
-    }
-};
-
-/// split: the receiver's near field and the exact sum of its terms (from
-/// the cache when an earlier sweep found them).
+/// split: the receiver's near field and the exact sum of its terms, found
+/// once per pixel per sweep; a sweep runs all of a pixel's chunks (a band of
+/// rows at a time), so nothing is kept between sweeps and k is bounded by
+/// NearField::kMaxNear alone, whatever the resolution.
 template <ShadingModel M, Primitive P, bool Count>
 void prepareNearField(const LightingInputs& in, const LightArrays& L, const VisibilityOptions& vis, bool shadows,
-                      NearCache* cache, GroupPixel& p) {
-    if (cache && cache->count[p.px]) {
-        p.near = cache->sum[p.px];
-        if (cache->stride) in.lightTree->nearField(p.sp, &cache->lights[p.px * cache->stride], cache->count[p.px] - 1u, p.field);
-        else in.lightTree->nearest(p.sp, nearLightCount(in.render), p.field);
-        return;
-    }
+                      GroupPixel& p) {
     in.lightTree->nearest(p.sp, nearLightCount(in.render), p.field);
     const std::span<const std::uint32_t> lights(p.field.light, p.field.count);
     RayCounters* rc = Count ? &p.rays : nullptr;
     p.near = p.sums.trace ? sumTerms<M, P, true>(in.bvh, L, p.sp, lights, vis, shadows, p.sums.c, rc, p.sums.trace)
                           : sumTerms<M, P>(in.bvh, L, p.sp, lights, vis, shadows, p.sums.c, rc);
-    if (cache) {
-        cache->sum[p.px] = p.near;
-        cache->count[p.px] = static_cast<std::uint16_t>(p.field.count + 1);
-        if (cache->stride) std::copy(p.field.light, p.field.light + p.field.count, &cache->lights[p.px * cache->stride]);
-    }
 }
 
-/// Runs chunks [c0, c1) over every pixel in one parallel sweep, each pixel's
+/// Runs chunks [c0, c1) over every pixel of rows [band0, band1) (Monte
+/// Carlo; exact's chunks are its rows) in one parallel sweep, each pixel's
 /// sums in registers: loaded from and stored to `acc`, or (acc null: the
 /// whole frame in one sweep) resolved straight into `out`. Pixels run in
 /// groups of a tile row (runChunk). Counters (counting mode): per pixel, its
@@ -323,15 +294,18 @@ void prepareNearField(const LightingInputs& in, const LightArrays& L, const Visi
 /// counts, and bytes.
 template <ShadingModel M, Primitive P, bool Count>
 LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const LightingPlan& plan, Accumulation* acc,
-                       LightingImage* out, std::uint64_t c0, std::uint64_t c1, Progress* progress, NearCache* nearCache) {
+                       LightingImage* out, std::uint64_t c0, std::uint64_t c1, Progress* progress,
+                       std::uint32_t band0 = 0, std::uint32_t band1 = ~0u) {
     const GBuffer& gb = in.gbuffer;
     const VisibilityOptions vis = VisibilityOptions::from(in.render);
     const EstimatorKind kind = in.render.estimator;
     const bool shadows = in.shading.visibility;  // off: V = 1, no shadow rays
     tbb::enumerable_thread_specific<LightingCounters> counters;
     // exact: chunks are row bands; Monte Carlo: every row, chunks are samples.
-    const std::uint32_t row0 = plan.exact ? static_cast<std::uint32_t>(std::min<std::uint64_t>(c0 * LightingPlan::kChunkRows, gb.height)) : 0;
-    const std::uint32_t row1 = plan.exact ? static_cast<std::uint32_t>(std::min<std::uint64_t>(c1 * LightingPlan::kChunkRows, gb.height)) : gb.height;
+    const std::uint32_t row0 = plan.exact ? static_cast<std::uint32_t>(std::min<std::uint64_t>(c0 * LightingPlan::kChunkRows, gb.height))
+                                          : std::min(band0, gb.height);
+    const std::uint32_t row1 = plan.exact ? static_cast<std::uint32_t>(std::min<std::uint64_t>(c1 * LightingPlan::kChunkRows, gb.height))
+                                          : std::min(band1, gb.height);
 
     // Counting mode: pixel px's thread, with its work (hit pixels: `p`).
     const auto record = [&](std::size_t px, const GroupPixel* p) {
@@ -406,7 +380,7 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
                     runChunks<M, P, Count, EstimatorKind::tree>(in, L, plan, vis, shadows, c0, c1, pix, n);
                 } else if (kind == EstimatorKind::split) {
                     for (std::uint32_t k = 0; k < n; ++k)
-                        if (!pix[k].sums.done) prepareNearField<M, P, Count>(in, L, vis, shadows, nearCache, pix[k]);
+                        if (!pix[k].sums.done) prepareNearField<M, P, Count>(in, L, vis, shadows, pix[k]);
                     runChunks<M, P, Count, EstimatorKind::split>(in, L, plan, vis, shadows, c0, c1, pix, n);
                 } else {
                     runChunks<M, P, Count, EstimatorKind::uniform>(in, L, plan, vis, shadows, c0, c1, pix, n);
@@ -430,31 +404,36 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
     return total;
 }
 
-/// All chunks of acc.nextChunk.. plan.end, one sweep per chunk (counting
-/// mode: one sweep), calling afterChunk between them.
+/// All chunks of acc.nextChunk.. plan.end, calling afterChunk between
+/// sweeps. Monte Carlo: band-major, every remaining chunk of a band of
+/// kChunkRows rows in one sweep (acc.bandRows: the rows already done), so a
+/// pixel's per-sweep work (split's near field) is done once per frame and a
+/// crop's empty rows are passed once, not once per chunk; the sums are those
+/// of chunk-major sweeps, in the same order. exact: one sweep per chunk (its
+/// chunks are row bands). Counting mode: one sweep.
 template <ShadingModel M, Primitive P, bool Count>
 LightingCounters run(const LightingInputs& in, const LightArrays& L, const LightingPlan& plan, Accumulation& acc,
                      const ChunkHook& afterChunk, Progress* progress) {
     LightingCounters total;
-    std::optional<NearCache> near;
-    if (in.render.estimator == EstimatorKind::split) near.emplace(acc.pixels(), nearLightCount(in.render));
-    NearCache* cache = near ? &*near : nullptr;
     if (Count) {
-        total += sweep<M, P, Count>(in, L, plan, &acc, nullptr, acc.nextChunk, plan.end, progress, cache);
+        total += sweep<M, P, Count>(in, L, plan, &acc, nullptr, acc.nextChunk, plan.end, progress);
         acc.nextChunk = plan.end;
         if (afterChunk) afterChunk(acc);
         return total;
     }
     while (acc.nextChunk < plan.end) {
         const std::uint64_t c = acc.nextChunk;
-        total += sweep<M, P, Count>(in, L, plan, &acc, nullptr, c, c + 1, progress, cache);
-        acc.nextChunk = c + 1;
-        // Adaptive: stop when every pixel is done at the end of a round.
-        if (plan.adaptive && acc.nextChunk % plan.chunksPerRound == 0) {
-            bool active = false;
-            for (std::size_t px = 0; px < acc.pixels() && !active; ++px)
-                active = in.gbuffer.texels[px].hit() && !acc.done[px];
-            if (!active) acc.nextChunk = plan.end;
+        if (plan.exact) {
+            total += sweep<M, P, Count>(in, L, plan, &acc, nullptr, c, c + 1, progress);
+            acc.nextChunk = c + 1;
+        } else {
+            const std::uint32_t band0 = acc.bandRows, band1 = std::min(acc.height, band0 + LightingPlan::kChunkRows);
+            total += sweep<M, P, Count>(in, L, plan, &acc, nullptr, c, plan.end, progress, band0, band1);
+            acc.bandRows = band1;
+            if (band1 >= acc.height) {
+                acc.nextChunk = plan.end;
+                acc.bandRows = 0;
+            }
         }
         if (afterChunk && !afterChunk(acc)) break;
     }
@@ -541,10 +520,10 @@ LightingCounters directPrimitive(const LightingInputs& in, const LightArrays& L,
     const bool spheres = in.bvh.settings().primitive == Primitive::sphere;
     const std::uint64_t c0 = plan.begin, c1 = plan.end;
     if (in.counters)
-        return spheres ? sweep<M, Primitive::sphere, true>(in, L, plan, nullptr, &out, c0, c1, p, nullptr)
-                       : sweep<M, Primitive::billboard, true>(in, L, plan, nullptr, &out, c0, c1, p, nullptr);
-    return spheres ? sweep<M, Primitive::sphere, false>(in, L, plan, nullptr, &out, c0, c1, p, nullptr)
-                   : sweep<M, Primitive::billboard, false>(in, L, plan, nullptr, &out, c0, c1, p, nullptr);
+        return spheres ? sweep<M, Primitive::sphere, true>(in, L, plan, nullptr, &out, c0, c1, p)
+                       : sweep<M, Primitive::billboard, true>(in, L, plan, nullptr, &out, c0, c1, p);
+    return spheres ? sweep<M, Primitive::sphere, false>(in, L, plan, nullptr, &out, c0, c1, p)
+                   : sweep<M, Primitive::billboard, false>(in, L, plan, nullptr, &out, c0, c1, p);
 }
 
 LightingCounters estimateLighting(const LightingInputs& in, LightingImage& out, Progress* progress) {

@@ -186,9 +186,11 @@ void FrameRenderer::lightFrame(std::uint32_t frame, const Camera& camera, const 
     // Progress by work: the hit pixels of the rows (exact) or the chunks
     // (samples) still to run, as the sweep counts them.
     const std::uint64_t firstChunk = session && session->resume ? session->resume->nextChunk : lp.begin;
+    const std::uint32_t firstRow = session && session->resume ? session->resume->bandRows : 0;  // band-major: rows done
     std::uint64_t work = 0;
     for (std::uint32_t y = 0; y < gbuffer.height; ++y) {
         if (lp.exact && (y / LightingPlan::kChunkRows < firstChunk || y / LightingPlan::kChunkRows >= lp.end)) continue;
+        if (!lp.exact && y < firstRow) continue;
         for (std::uint32_t x = 0; x < gbuffer.width; ++x) work += gbuffer.texels[std::size_t(y) * gbuffer.width + x].hit();
     }
     if (!lp.exact) work *= lp.end > firstChunk ? lp.end - firstChunk : 0;

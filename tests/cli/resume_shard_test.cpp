@@ -31,10 +31,11 @@ namespace {
 
 /// quickstart at 160x90, 2 frames of `uniform` at `spp` samples: spp/8
 /// chunks a frame (4096 samples: about 0.8 s on 2 cores).
-std::string renderCommand(const fs::path& dir, const std::string& extra = "", int spp = 4096) {
+std::string renderCommand(const fs::path& dir, const std::string& extra = "", int spp = 4096,
+                          const std::string& estimator = "uniform") {
     return std::string(ACCRETION_BINARY) + " render " + ACCRETION_SOURCE_DIR +
            "/scenes/quickstart.toml --quiet --frames 0:2 -D camera.width=160 -D camera.height=90 "
-           "-D particles.count=2000 --estimator uniform --spp " + std::to_string(spp) + " -o " +
+           "-D particles.count=2000 --estimator " + estimator + " --spp " + std::to_string(spp) + " -o " +
            (dir / "{scene}.{frame}.exr").string() + " " + extra;
 }
 
@@ -105,12 +106,17 @@ std::vector<std::string> brokenFiles(const fs::path& dir, std::size_t& checked) 
 }  // namespace
 
 TEST_CASE("SIGTERM writes a checkpoint and --resume gives the uninterrupted image bit for bit", "[cli][resume]") {
-    const fs::path ref = accretion::test::scratchDir("resume_reference");
-    const fs::path dir = accretion::test::scratchDir("resume_interrupted");
+    // Sweeps go band by band (every chunk of 8 rows at once): the checkpoint
+    // stops part-way down the frame; split's near field is found again on resume.
+    const std::string estimator = GENERATE("uniform", "split");
+    const int spp = estimator == "split" ? 1024 : 4096;
+    INFO(estimator);
+    const fs::path ref = accretion::test::scratchDir("resume_reference_" + estimator);
+    const fs::path dir = accretion::test::scratchDir("resume_interrupted_" + estimator);
     std::string out;
-    REQUIRE(runCommand(renderCommand(ref), out) == 0);
+    REQUIRE(runCommand(renderCommand(ref, "", spp, estimator), out) == 0);
 
-    Process p(renderCommand(dir, "--checkpoint-every 0.05"));
+    Process p(renderCommand(dir, "--checkpoint-every 0.05", spp, estimator));
     // Interrupt once a checkpoint exists (the run is part-way), before it ends.
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
     while (!fs::exists(dir / "quickstart.checkpoint") && p.running() && std::chrono::steady_clock::now() < deadline)
@@ -122,10 +128,10 @@ TEST_CASE("SIGTERM writes a checkpoint and --resume gives the uninterrupted imag
     CHECK_FALSE(fs::exists(dir / "quickstart.stats.json"));
 
     // Without --resume the checkpoint is kept and the run refused.
-    CHECK(runCommand(renderCommand(dir), out) == 1);
+    CHECK(runCommand(renderCommand(dir, "", spp, estimator), out) == 1);
     CHECK_THAT(out, Contains("quickstart.checkpoint: a checkpoint of an interrupted run is here"));
 
-    REQUIRE(runCommand(renderCommand(dir, "--resume"), out) == 0);
+    REQUIRE(runCommand(renderCommand(dir, "--resume", spp, estimator), out) == 0);
     INFO(out);
     for (const char* f : {"quickstart.0000.exr", "quickstart.0001.exr"}) {
         INFO(f);
