@@ -341,11 +341,14 @@ FrameTiming timeFrames(const Settings& s, const ParticleSource& source, std::uin
 /// the reference's own noise), fitted on two sample counts.
 struct ErrorCost {
     double a = 0.0, b = 0.0, v = 0.0;
+    std::uint32_t maxSamples = 0;  ///< the largest sample count measured
     nlohmann::json points = nlohmann::json::array();
-    double secondsTo(double relMSE) const { return a + b * v / relMSE; }
+    double samplesTo(double relMSE) const { return v / relMSE; }
+    double secondsTo(double relMSE) const { return a + b * samplesTo(relMSE); }
     nlohmann::json json(double target) const {
         return {{"fixed_s", a}, {"s_per_sample", b}, {"relMSE_times_samples", v}, {"seconds_to_target", secondsTo(target)},
-                {"points", points}};
+                {"samples_to_target", samplesTo(target)}, {"largest_samples_measured", maxSamples},
+                {"extrapolated", samplesTo(target) > 1.5 * maxSamples}, {"points", points}};
     }
 };
 
@@ -373,27 +376,50 @@ double correctedRelMse(const FrameImage& img, const FrameImage& ref) {
 }
 
 /// The ErrorCost of each setting from renders at s1 and s2 samples per pixel, all side by side.
-std::vector<ErrorCost> measureErrorCosts(const std::vector<Settings>& settings, const ParticleSource& src, std::uint32_t s1,
-                                         std::uint32_t s2, const FrameImage& ref, int runs) {
+std::vector<ErrorCost> measureErrorCosts(const std::vector<Settings>& settings, const ParticleSource& src,
+                                         const std::vector<std::vector<std::uint32_t>>& levels, const FrameImage& ref, int runs) {
     std::vector<Settings> all;
-    for (const Settings& s : settings)
-        for (const std::uint32_t S : {s1, s2}) {
-            all.push_back(s);
+    for (std::size_t i = 0; i < settings.size(); ++i)
+        for (const std::uint32_t S : levels[i]) {
+            all.push_back(settings[i]);
             all.back().render.samples = S;
         }
     const auto images = renderInterleaved(all, src, runs);
     std::vector<ErrorCost> costs(settings.size());
+    std::size_t at = 0;
     for (std::size_t i = 0; i < settings.size(); ++i) {
-        const auto& [img1, t1] = images[2 * i];
-        const auto& [img2, t2] = images[2 * i + 1];
-        const double e1 = correctedRelMse(img1, ref), e2 = correctedRelMse(img2, ref);
+        // Least squares of t = a + b S over the levels; v = the median of relMSE x S.
+        const std::size_t n = levels[i].size();
+        double sS = 0.0, sT = 0.0, sSS = 0.0, sST = 0.0;
+        std::vector<double> vs;
         ErrorCost& c = costs[i];
-        c.b = (t2 - t1) / double(s2 - s1);
-        c.a = std::max(0.0, t1 - c.b * s1);
-        c.v = 0.5 * (e1 * s1 + e2 * s2);  // the two agree when the error falls as 1 / S (both are reported)
-        c.points = {{{"samples", s1}, {"seconds", t1}, {"relMSE", e1}}, {{"samples", s2}, {"seconds", t2}, {"relMSE", e2}}};
+        for (std::size_t k = 0; k < n; ++k, ++at) {
+            const auto& [img, t] = images[at];
+            const double S = levels[i][k], e = correctedRelMse(img, ref);
+            sS += S, sT += t, sSS += S * S, sST += S * t;
+            vs.push_back(e * S);
+            c.points.push_back({{"samples", levels[i][k]}, {"seconds", t}, {"relMSE", e}});
+            c.maxSamples = std::max(c.maxSamples, levels[i][k]);
+        }
+        c.b = (double(n) * sST - sS * sT) / (double(n) * sSS - sS * sS);
+        c.a = std::max(0.0, (sT - c.b * sS) / double(n));
+        c.v = median(vs);
     }
     return costs;
+}
+
+/// Sample counts from `first`, x4 each, up to the first at or past the
+/// count that reaches `target` by a two-level estimate (capped at `most`):
+/// a fit that spans what it is used to predict.
+std::vector<std::uint32_t> levelsTo(const Settings& s, const ParticleSource& src, const FrameImage& ref, double target,
+                                    std::uint32_t first, std::uint32_t most) {
+    const ErrorCost probe = measureErrorCosts({s}, src, {{first, 4 * first}}, ref, 1)[0];
+    std::vector<std::uint32_t> out;
+    for (std::uint32_t S = first; S <= most; S *= 4) {
+        out.push_back(S);
+        if (S >= probe.samplesTo(target)) break;
+    }
+    return out;
 }
 
 /// Runs a child process; true if it exits 0.
@@ -620,7 +646,8 @@ void Suite::benchTreeReference() {
 
 /// split against tree (disk_100k) and against exact (the quickstart) at
 /// 320x180: the seconds each needs to reach relMSE 1e-3, from renders at
-/// two sample counts side by side (ErrorCost), against a reference that
+/// sample counts x4 apart up to the one that reaches it, side by side
+/// (ErrorCost: t = a + b S fitted over them all), against a reference that
 /// shares no sampling with them where one is affordable (exact, 10K) and a
 /// long split render otherwise (its noise subtracted).
 void Suite::benchSplitReference() {
@@ -634,7 +661,10 @@ void Suite::benchSplitReference() {
         tree.render.estimator = EstimatorKind::tree;
         split.render.estimator = EstimatorKind::split;
         split.render.near_lights = 1024;  // the automatic k of a long render, fixed so that the cost is a + b S
-        const auto c = measureErrorCosts({tree, split}, src, 8, 32, ref.image, quick ? 1 : 3);
+        const std::uint32_t most = quick ? 128 : 4096;
+        const auto c = measureErrorCosts({tree, split}, src,
+                                         {levelsTo(tree, src, ref.image, kTarget, 8, most), levelsTo(split, src, ref.image, kTarget, 8, most)},
+                                         ref.image, quick ? 1 : 3);
         const ErrorCost& t = c[0];
         const ErrorCost& sp = c[1];
         figures["split_vs_tree_100k_320x180"] = {
@@ -659,7 +689,8 @@ void Suite::benchSplitReference() {
         Settings split = base;
         split.render.estimator = EstimatorKind::split;
         split.render.near_lights = 1024;
-        const ErrorCost sp = measureErrorCosts({split}, src, 8, 32, ex[0].first, quick ? 1 : 3)[0];
+        const ErrorCost sp = measureErrorCosts({split}, src, {levelsTo(split, src, ex[0].first, kTarget, 8, quick ? 128 : 4096)},
+                                               ex[0].first, quick ? 1 : 3)[0];
         figures["split_vs_exact_10k_320x180"] = {{"exact_s", ex[0].second}, {"split", sp.json(kTarget)},
                                                  {"split_s_to_1e-4", sp.secondsTo(1e-4)}};
         // Bar: where exact is cheaper than tree (below relMSE 3e-3 here), split is no slower than exact.
