@@ -47,7 +47,10 @@ std::string Table::console() const {
 std::string Table::csv() const {
     std::string out;
     for (const Column& c : columns_)
-        if (!c.key.empty()) out += (out.empty() ? "" : ",") + c.key;
+        if (!c.key.empty()) {
+            if (!out.empty()) out += ',';
+            out += c.key;
+        }
     out += "\n";
     for (const auto& row : rows_) {
         std::string line;
@@ -55,8 +58,8 @@ std::string Table::csv() const {
         for (std::size_t k = 0; k < columns_.size(); ++k) {
             if (columns_[k].key.empty()) continue;
             const Cell& v = row[k];
-            line += (first ? "" : ",") + (std::holds_alternative<bool>(v) ? std::string(std::get<bool>(v) ? "1" : "0")
-                                                                          : formatCell(columns_[k].csvSpec, v));
+            if (!first) line += ',';
+            line += std::holds_alternative<bool>(v) ? std::string(std::get<bool>(v) ? "1" : "0") : formatCell(columns_[k].csvSpec, v);
             first = false;
         }
         out += line + "\n";

@@ -26,9 +26,10 @@ LightingPlan planLighting(const RenderSettings& render, std::uint32_t height, Sh
                                          "to stop, so its samples cannot be split; shard frames instead (--frames)",
                                          shard.index, shard.count));
         if (total < shard.count)
-            throw InputError(fmt::format("command line --shard {}/{}: the frame has only {} chunks of {} {} to split", shard.index,
-                                         shard.count, total, plan.exact ? LightingPlan::kChunkRows : LightingPlan::kChunkSamples,
-                                         plan.exact ? "rows" : "samples"));
+            throw InputError(fmt::format("command line --shard {}/{}: the frame has only {} chunks ({}) to split", shard.index,
+                                         shard.count, total,
+                                         plan.exact ? fmt::format("exact: {} row each", LightingPlan::kChunkRows)
+                                                    : fmt::format("{} samples each", LightingPlan::kChunkSamples)));
     }
     plan.begin = total * shard.index / shard.count;
     plan.end = total * (shard.index + 1) / shard.count;

@@ -406,7 +406,7 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
 
 /// All chunks of acc.nextChunk.. plan.end, calling afterChunk between
 /// sweeps. Monte Carlo: band-major, every remaining chunk of a band of
-/// kChunkRows rows in one sweep (acc.bandRows: the rows already done), so a
+/// kBandRows rows in one sweep (acc.bandRows: the rows already done), so a
 /// pixel's per-sweep work (split's near field) is done once per frame and a
 /// crop's empty rows are passed once, not once per chunk; the sums are those
 /// of chunk-major sweeps, in the same order. exact: one sweep per chunk (its
@@ -427,7 +427,7 @@ LightingCounters run(const LightingInputs& in, const LightArrays& L, const Light
             total += sweep<M, P, Count>(in, L, plan, &acc, nullptr, c, c + 1, progress);
             acc.nextChunk = c + 1;
         } else {
-            const std::uint32_t band0 = acc.bandRows, band1 = std::min(acc.height, band0 + LightingPlan::kChunkRows);
+            const std::uint32_t band0 = acc.bandRows, band1 = std::min(acc.height, band0 + LightingPlan::kBandRows);
             total += sweep<M, P, Count>(in, L, plan, &acc, nullptr, c, plan.end, progress, band0, band1);
             acc.bandRows = band1;
             if (band1 >= acc.height) {

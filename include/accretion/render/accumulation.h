@@ -13,12 +13,17 @@ namespace accretion {
 /// checkpointing and of sharding: for Monte Carlo estimators up to
 /// kChunkSamples samples (ris: reservoirs) of every pixel, drawn from the
 /// chunk's own stream, so that the image does not depend on how chunks are
-/// grouped into sweeps, processes or restarts; for `exact`, a band of
-/// kChunkRows rows. Adaptive sampling (target_stderr) runs rounds of
-/// `samples` and stops a pixel at the end of a round.
+/// grouped into sweeps, processes or restarts; for `exact`, kChunkRows rows.
+/// Adaptive sampling (target_stderr) runs rounds of `samples` and stops a
+/// pixel at the end of a round.
 struct LightingPlan {
     static constexpr std::uint32_t kChunkSamples = 8;
-    static constexpr std::uint32_t kChunkRows = 8;
+    /// exact: one row a chunk. A chunk is what a stop request waits for: a
+    /// 1080p row of disk_100k is about 15 s on 2 cores (8 rows were 2 min,
+    /// past a cluster's usual grace before SIGKILL).
+    static constexpr std::uint32_t kChunkRows = 1;
+    /// Monte Carlo sweeps: rows per band (every remaining chunk of a band at once).
+    static constexpr std::uint32_t kBandRows = 8;
     bool exact = false;
     bool adaptive = false;
     std::uint32_t samples = 0;          ///< samples per round (Monte Carlo)
