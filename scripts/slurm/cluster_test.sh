@@ -150,7 +150,8 @@ done
 grep -q "resuming" "$LOG" || fail "the requeued task never started: $(scontrol -o show job "$JOB" 2>&1 | grep -o 'JobState=[^ ]* Reason=[^ ]*\|Restarts=[^ ]*' | tr '\n' ' ')
 $(grep -i "JobId=${JOB}" "$WORK/slurmctld.log" | tail -8)"
 wait_job "$JOB"
-grep -q "resuming .* at frame 0, chunk [1-9]" "$LOG" || fail "the requeued task did not resume from its checkpoint: $(grep -i resum "$LOG" || tail -n 5 "$LOG")"
+# Band-major sweeps: part-way down the frame (rows done) or past its first chunk.
+grep -qE "resuming .* at frame 0, chunk ([1-9]|0, pixels before row [0-9]+ column [0-9]+ done)" "$LOG" || fail "the requeued task did not resume from its checkpoint: $(grep -i resum "$LOG" || tail -n 5 "$LOG")"
 grep -q "^stats:" "$LOG" || fail "the requeued task did not finish: $(tail -n 5 "$LOG")"
 "$BIN" render "$SCENE" "${SCENE_ARGS[@]}" --quiet --estimator tree --spp 131072 --frames 0 -o "$WORK/out/uninterrupted.exr" >/dev/null
 same_pixels "$OUT/quickstart.0000.exr" "$WORK/out/uninterrupted.exr"

@@ -318,8 +318,11 @@ void runRender(const RenderArgs& args) {
         for (const auto& f : resumed->header.at("finished_frames")) stats["frames"].push_back(f);
         firstFrame = resumed->header.at("frame").get<std::uint32_t>();
         if (!args.quiet)
-            fmt::print(stderr, "accretion: resuming {} at frame {}, chunk {}\n", checkpoint.file().string(), firstFrame,
-                       resumed->acc.nextChunk);
+            fmt::print(stderr, "accretion: resuming {} at frame {}, chunk {}{}\n", checkpoint.file().string(), firstFrame,
+                       resumed->acc.nextChunk,
+                       resumed->acc.bandRows || resumed->acc.bandCols
+                           ? fmt::format(", pixels before row {} column {} done", resumed->acc.bandRows, resumed->acc.bandCols)
+                           : std::string());
     } else if (args.resume && !args.quiet) {  // nothing to resume: start afresh
         fmt::print(stderr, "accretion: {}: starting from the beginning\n",
                    sharding.accumulating ? fmt::format("no checkpoint at {}", checkpoint.file().string())
@@ -339,7 +342,9 @@ void runRender(const RenderArgs& args) {
     auto interrupt = [&](int signal, std::uint32_t frame, const Accumulation& acc) {
         fmt::print(stderr, "accretion: {}: checkpoint {} (frame {}, chunk {}{}); continue with --resume\n",
                    StopSignal::name(signal), checkpoint.file().string(), frame, acc.nextChunk,
-                   acc.bandRows ? fmt::format(", rows 0..{} done", acc.bandRows - 1) : std::string());
+                   acc.bandRows || acc.bandCols
+                       ? fmt::format(", pixels before row {} column {} done", acc.bandRows, acc.bandCols)
+                       : std::string());
         throw Interrupted{signal};
     };
     // restir keeps reservoir history across frames: no checkpoint, the frames done are kept.

@@ -57,6 +57,7 @@ void writeAccumulationFile(const std::filesystem::path& file, const Accumulation
     header["height"] = a.height;
     header["next_chunk"] = a.nextChunk;
     header["band_rows"] = a.bandRows;
+    header["band_cols"] = a.bandCols;
     const std::string h = header.dump();
     std::string out;
     const std::size_t px = a.pixels();
@@ -103,9 +104,10 @@ AccumulationFile parseAccumulationFile(const std::string& bytes, const std::file
         a.height = f.header.at("height").get<std::uint32_t>();
         a.nextChunk = f.header.at("next_chunk").get<std::uint64_t>();
         a.bandRows = f.header.value("band_rows", 0u);  // files before band-major sweeps: 0
-        if (a.bandRows >= std::max(a.height, 1u))
-            throw InputError(fmt::format("{}: corrupted accumulation header: band_rows {} of {} rows", file.string(),
-                                         a.bandRows, a.height));
+        a.bandCols = f.header.value("band_cols", 0u);
+        if (a.bandRows >= std::max(a.height, 1u) || a.bandCols >= std::max(a.width, 1u))
+            throw InputError(fmt::format("{}: corrupted accumulation header: band at row {} column {} of {}x{}", file.string(),
+                                         a.bandRows, a.bandCols, a.width, a.height));
     } catch (const nlohmann::json::exception& e) {
         throw InputError(fmt::format("{}: corrupted accumulation header: {}", file.string(), e.what()));
     }

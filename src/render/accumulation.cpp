@@ -46,7 +46,7 @@ void Accumulation::reset(std::uint32_t w, std::uint32_t h, std::uint64_t firstCh
     done.assign(count, 0);
     rejected.assign(count, 0);
     nextChunk = firstChunk;
-    bandRows = 0;
+    bandRows = bandCols = 0;
 }
 
 void Accumulation::merge(const Accumulation& o) {

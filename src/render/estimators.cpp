@@ -1,6 +1,7 @@
 #include "accretion/render/estimators.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <optional>
 #include <ranges>
@@ -10,6 +11,7 @@
 #include <tbb/blocked_range2d.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include "accretion/core/error.h"
 #include "accretion/core/rng.h"
@@ -285,27 +287,28 @@ void prepareNearField(const LightingInputs& in, const LightArrays& L, const Visi
                           : sumTerms<M, P>(in.bvh, L, p.sp, lights, vis, shadows, p.sums.c, rc);
 }
 
-/// Runs chunks [c0, c1) over every pixel of rows [band0, band1) (Monte
-/// Carlo; exact's chunks are its rows) in one parallel sweep, each pixel's
-/// sums in registers: loaded from and stored to `acc`, or (acc null: the
-/// whole frame in one sweep) resolved straight into `out`. Pixels run in
+/// Runs chunks [c0, c1) over every pixel of `area` (exact: of its rows that
+/// the chunks are) in one parallel sweep, each pixel's sums in registers:
+/// loaded from and stored to `acc`, or (acc null: the whole frame in one
+/// sweep) resolved straight into `out`. Pixels run in
 /// groups of a tile row (runChunk). Counters (counting mode): per pixel, its
 /// key, the light terms as loop trips, the shadow rays with their traversal
 /// counts, and bytes.
 template <ShadingModel M, Primitive P, bool Count>
 LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const LightingPlan& plan, Accumulation* acc,
                        LightingImage* out, std::uint64_t c0, std::uint64_t c1, Progress* progress,
-                       std::uint32_t band0 = 0, std::uint32_t band1 = ~0u) {
+                       const PixelWindow& area) {
     const GBuffer& gb = in.gbuffer;
     const VisibilityOptions vis = VisibilityOptions::from(in.render);
     const EstimatorKind kind = in.render.estimator;
     const bool shadows = in.shading.visibility;  // off: V = 1, no shadow rays
     tbb::enumerable_thread_specific<LightingCounters> counters;
     // exact: chunks are row bands; Monte Carlo: every row, chunks are samples.
-    const std::uint32_t row0 = plan.exact ? static_cast<std::uint32_t>(std::min<std::uint64_t>(c0 * LightingPlan::kChunkRows, gb.height))
-                                          : std::min(band0, gb.height);
-    const std::uint32_t row1 = plan.exact ? static_cast<std::uint32_t>(std::min<std::uint64_t>(c1 * LightingPlan::kChunkRows, gb.height))
-                                          : std::min(band1, gb.height);
+    const std::uint32_t row0 = plan.exact ? static_cast<std::uint32_t>(std::clamp<std::uint64_t>(c0 * LightingPlan::kChunkRows, area.y0, area.y1))
+                                          : area.y0;
+    const std::uint32_t row1 = plan.exact ? static_cast<std::uint32_t>(std::clamp<std::uint64_t>(c1 * LightingPlan::kChunkRows, area.y0, area.y1))
+                                          : area.y1;
+    if (row0 >= row1 || area.x0 >= area.x1) return {};
 
     // Counting mode: pixel px's thread, with its work (hit pixels: `p`).
     const auto record = [&](std::size_t px, const GroupPixel* p) {
@@ -321,7 +324,7 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
         }
     };
 
-    tbb::parallel_for(tbb::blocked_range2d<std::uint32_t>(row0, row1, 8, 0, gb.width, 8), [&](const auto& r) {
+    tbb::parallel_for(tbb::blocked_range2d<std::uint32_t>(row0, row1, 8, area.x0, area.x1, 8), [&](const auto& r) {
         LightingCounters& c = counters.local();
         GroupPixel pix[kGroupPixels];
         std::uint64_t hitPixels = 0;
@@ -404,35 +407,72 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
     return total;
 }
 
+/// The pixels a frame's lighting covers: render.crop's window, else the whole image.
+PixelWindow litWindow(const LightingInputs& in) {
+    const std::vector<double>& c = in.render.crop;
+    if (c.size() != 4) return PixelWindow::whole(in.gbuffer.width, in.gbuffer.height);
+    return {std::uint32_t(c[0]), std::uint32_t(c[1]), std::uint32_t(c[2]), std::uint32_t(c[3])};
+}
+
+/// How long a band of a Monte Carlo sweep should take: what a stop request
+/// or a due checkpoint waits for. A band is sized from the slowest pixel
+/// seen so far, so a band of disk after sky rarely overshoots it.
+constexpr double kBandSeconds = 2.0;
+
 /// All chunks of acc.nextChunk.. plan.end, calling afterChunk between
-/// sweeps. Monte Carlo: band-major, every remaining chunk of a band of
-/// kBandRows rows in one sweep (acc.bandRows: the rows already done), so a
-/// pixel's per-sweep work (split's near field) is done once per frame and a
-/// crop's empty rows are passed once, not once per chunk; the sums are those
-/// of chunk-major sweeps, in the same order. exact: one sweep per chunk (its
-/// chunks are row bands). Counting mode: one sweep.
+/// sweeps. Monte Carlo: every remaining chunk of a band of pixels in one
+/// sweep, bands in raster order (whole rows, or a run of one row when a row
+/// would take longer than kBandSeconds: at 65536 spp a band is a few dozen
+/// pixels), each sized by the time the slowest pixel took so far. So a
+/// pixel's per-sweep work (split's near field) is done once per frame and
+/// nothing is kept between sweeps, a crop's empty rows are passed once, and
+/// a stop waits about kBandSeconds. The sums are those of chunk-major
+/// sweeps, in the same order: the image does not depend on the bands.
+/// exact: one sweep per chunk (a row). Counting mode: one sweep.
 template <ShadingModel M, Primitive P, bool Count>
 LightingCounters run(const LightingInputs& in, const LightArrays& L, const LightingPlan& plan, Accumulation& acc,
                      const ChunkHook& afterChunk, Progress* progress) {
     LightingCounters total;
-    if (Count) {
-        total += sweep<M, P, Count>(in, L, plan, &acc, nullptr, acc.nextChunk, plan.end, progress);
+    const PixelWindow whole = PixelWindow::whole(acc.width, acc.height);
+    if (Count) {  // the GPU's dispatch: the whole frame, whatever the crop
+        total += sweep<M, P, Count>(in, L, plan, &acc, nullptr, acc.nextChunk, plan.end, progress, whole);
         acc.nextChunk = plan.end;
         if (afterChunk) afterChunk(acc);
         return total;
     }
+    double pixelChunkSeconds = 0.0;  // measured: the slowest pixel-chunk of a band so far
     while (acc.nextChunk < plan.end) {
         const std::uint64_t c = acc.nextChunk;
+        const PixelWindow w = litWindow(in);  // a crop lights its window alone
         if (plan.exact) {
-            total += sweep<M, P, Count>(in, L, plan, &acc, nullptr, c, c + 1, progress);
+            total += sweep<M, P, Count>(in, L, plan, &acc, nullptr, c, c + 1, progress, w);
             acc.nextChunk = c + 1;
         } else {
-            const std::uint32_t band0 = acc.bandRows, band1 = std::min(acc.height, band0 + LightingPlan::kBandRows);
-            total += sweep<M, P, Count>(in, L, plan, &acc, nullptr, c, plan.end, progress, band0, band1);
-            acc.bandRows = band1;
-            if (band1 >= acc.height) {
+            const std::uint64_t span = plan.end - c;
+            // Pixels a band takes in kBandSeconds; at least enough for every core to have groups.
+            const double fit = pixelChunkSeconds > 0.0 ? kBandSeconds / (pixelChunkSeconds * double(span)) : 0.0;
+            const std::uint32_t least = 16u * kGroupPixels * std::uint32_t(tbb::this_task_arena::max_concurrency());
+            const std::uint32_t pixels = std::max(least, std::uint32_t(std::min(fit, 1e9)));
+            const std::uint32_t row = std::max(acc.bandRows, w.y0), x0 = std::max(acc.bandCols, w.x0);
+            PixelWindow band;
+            if (x0 == w.x0 && pixels >= w.width())  // whole rows
+                band = {w.x0, w.x1, row, std::min(w.y1, row + std::clamp(pixels / w.width(), 1u, LightingPlan::kBandRows))};
+            else  // a run of this row
+                band = {x0, std::min(w.x1, x0 + pixels), row, row + 1};
+            const auto start = std::chrono::steady_clock::now();
+            total += sweep<M, P, Count>(in, L, plan, &acc, nullptr, c, plan.end, progress, band);
+            const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            pixelChunkSeconds = std::max(pixelChunkSeconds, seconds / (double(band.pixels()) * double(span)));
+            if (band.x1 == w.x1) {
+                acc.bandRows = band.y1;
+                acc.bandCols = 0;
+            } else {
+                acc.bandRows = band.y0;
+                acc.bandCols = band.x1;
+            }
+            if (acc.bandRows >= w.y1) {
                 acc.nextChunk = plan.end;
-                acc.bandRows = 0;
+                acc.bandRows = acc.bandCols = 0;
             }
         }
         if (afterChunk && !afterChunk(acc)) break;
@@ -500,13 +540,16 @@ void allocate(LightingImage& out, std::size_t pixels) {
     out.rejected.resize(pixels);
 }
 
-void resolveLighting(const Accumulation& acc, bool exact, LightingImage& out, std::uint64_t* nonFinite) {
+void resolveLighting(const Accumulation& acc, bool exact, LightingImage& out, std::uint64_t* nonFinite,
+                     const PixelWindow* window) {
     allocate(out, acc.pixels());
+    const PixelWindow w = window ? *window : PixelWindow::whole(acc.width, acc.height);
     tbb::enumerable_thread_specific<std::uint64_t> zeroed(0);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, acc.pixels(), 4096), [&](const auto& r) {
+    tbb::parallel_for(tbb::blocked_range<std::uint32_t>(w.y0, w.y1), [&](const auto& r) {
         std::uint64_t& z = zeroed.local();
-        for (std::size_t px = r.begin(); px != r.end(); ++px)
-            z += resolvePixel(acc.sum[px], acc.sumSq[px], acc.n[px], acc.rejected[px], exact, out, px);
+        for (std::uint32_t y = r.begin(); y != r.end(); ++y)
+            for (std::size_t px = std::size_t(y) * acc.width + w.x0; px != std::size_t(y) * acc.width + w.x1; ++px)
+                z += resolvePixel(acc.sum[px], acc.sumSq[px], acc.n[px], acc.rejected[px], exact, out, px);
     });
     if (nonFinite)
         for (const std::uint64_t z : zeroed) *nonFinite += z;
@@ -519,11 +562,12 @@ LightingCounters directPrimitive(const LightingInputs& in, const LightArrays& L,
                                  LightingImage& out, Progress* p) {
     const bool spheres = in.bvh.settings().primitive == Primitive::sphere;
     const std::uint64_t c0 = plan.begin, c1 = plan.end;
+    const PixelWindow whole = PixelWindow::whole(in.gbuffer.width, in.gbuffer.height), w = litWindow(in);
     if (in.counters)
-        return spheres ? sweep<M, Primitive::sphere, true>(in, L, plan, nullptr, &out, c0, c1, p)
-                       : sweep<M, Primitive::billboard, true>(in, L, plan, nullptr, &out, c0, c1, p);
-    return spheres ? sweep<M, Primitive::sphere, false>(in, L, plan, nullptr, &out, c0, c1, p)
-                   : sweep<M, Primitive::billboard, false>(in, L, plan, nullptr, &out, c0, c1, p);
+        return spheres ? sweep<M, Primitive::sphere, true>(in, L, plan, nullptr, &out, c0, c1, p, whole)
+                       : sweep<M, Primitive::billboard, true>(in, L, plan, nullptr, &out, c0, c1, p, whole);
+    return spheres ? sweep<M, Primitive::sphere, false>(in, L, plan, nullptr, &out, c0, c1, p, w)
+                   : sweep<M, Primitive::billboard, false>(in, L, plan, nullptr, &out, c0, c1, p, w);
 }
 
 LightingCounters estimateLighting(const LightingInputs& in, LightingImage& out, Progress* progress) {

@@ -75,41 +75,37 @@ void recordCompose(const GBuffer& gbuffer, const Particles& particles, const Par
 
 /// composeImage: L = Le + Lr on hits (background on misses), depth, normal
 /// and particle AOVs, and the frame's spp statistics.
-void composeImage(const GBuffer& gbuffer, const Particles& particles, const ShadingSettings& shading, FrameImage& img,
-                  FrameStats& stats) {
+/// The image's layers from the G-buffer and the lighting over `traced` (the
+/// pixels traced: a crop's window, or the whole image); outside it, what a
+/// miss gives (background, no particle), filled at memory speed.
+void composeImage(const GBuffer& gbuffer, const Particles& particles, const ShadingSettings& shading, const PixelWindow& traced,
+                  FrameImage& img, FrameStats& stats) {
     const std::size_t pixels = std::size_t(img.width) * img.height;
-    img.L.resize(pixels);
+    img.L.assign(pixels, shading.background);
     img.Le.assign(pixels, Vec3(0.0f));
-    img.depth.resize(pixels);
-    img.normal.resize(pixels);
-    img.particle.resize(pixels);
+    img.depth.assign(pixels, std::numeric_limits<float>::infinity());
+    img.normal.assign(pixels, Vec3(0.0f));
+    img.particle.assign(pixels, kNoParticle);
     const float se = static_cast<float>(shading.self_emission);
     std::size_t hits = 0;
-    for (std::size_t px = 0; px < pixels; ++px) {
-        const GBufferTexel& g = gbuffer.texels[px];
-        img.particle[px] = g.particle;
-        if (!g.hit()) {
-            img.L[px] = shading.background;
-            img.depth[px] = std::numeric_limits<float>::infinity();
-            img.normal[px] = Vec3(0.0f);
-            continue;
-        }
-        ++hits;
-        if (!composeHit(se, particles.emission[g.particle], img.lighting.Lr[px], img.Le[px], img.L[px])) {
-            img.lighting.Lr_stderr[px] = Vec3(0.0f);
-            img.lighting.rejected[px] += 1.0f;
-            ++stats.nonFinite[std::string(pass::composeImage)];
-        }
-        img.depth[px] = g.depth;
-        img.normal[px] = g.normal;
-    }
-    stats.hitPixels = hits;
     double sppSum = 0.0;
-    for (std::size_t px = 0; px < pixels; ++px)
-        if (gbuffer.texels[px].hit()) {
+    for (std::uint32_t y = traced.y0; y < traced.y1; ++y)
+        for (std::size_t px = std::size_t(y) * img.width + traced.x0; px < std::size_t(y) * img.width + traced.x1; ++px) {
+            const GBufferTexel& g = gbuffer.texels[px];
+            if (!g.hit()) continue;  // as filled: background, no particle
+            ++hits;
+            img.particle[px] = g.particle;
+            if (!composeHit(se, particles.emission[g.particle], img.lighting.Lr[px], img.Le[px], img.L[px])) {
+                img.lighting.Lr_stderr[px] = Vec3(0.0f);
+                img.lighting.rejected[px] += 1.0f;
+                ++stats.nonFinite[std::string(pass::composeImage)];
+            }
+            img.depth[px] = g.depth;
+            img.normal[px] = g.normal;
             sppSum += img.lighting.spp[px];
             stats.maxSpp = std::max(stats.maxSpp, double(img.lighting.spp[px]));
         }
+    stats.hitPixels = hits;
     stats.meanSpp = hits ? sppSum / double(hits) : 0.0;
 }
 
@@ -185,13 +181,16 @@ void FrameRenderer::lightFrame(std::uint32_t frame, const Camera& camera, const 
     const LightingPlan lp = planLighting(settings_.render, camera.height, session ? session->shard : Shard{});
     // Progress by work: the hit pixels of the rows (exact) or the chunks
     // (samples) still to run, as the sweep counts them.
-    const std::uint64_t firstChunk = session && session->resume ? session->resume->nextChunk : lp.begin;
-    const std::uint32_t firstRow = session && session->resume ? session->resume->bandRows : 0;  // band-major: rows done
+    const Accumulation* resume = session ? session->resume : nullptr;
+    const std::uint64_t firstChunk = resume ? resume->nextChunk : lp.begin;
     std::uint64_t work = 0;
     for (std::uint32_t y = 0; y < gbuffer.height; ++y) {
         if (lp.exact && (y / LightingPlan::kChunkRows < firstChunk || y / LightingPlan::kChunkRows >= lp.end)) continue;
-        if (!lp.exact && y < firstRow) continue;
-        for (std::uint32_t x = 0; x < gbuffer.width; ++x) work += gbuffer.texels[std::size_t(y) * gbuffer.width + x].hit();
+        for (std::uint32_t x = 0; x < gbuffer.width; ++x) {
+            // Monte Carlo: the pixels before the band cursor are done (Accumulation::bandRows, bandCols).
+            if (!lp.exact && resume && (y < resume->bandRows || (y == resume->bandRows && x < resume->bandCols))) continue;
+            work += gbuffer.texels[std::size_t(y) * gbuffer.width + x].hit();
+        }
     }
     if (!lp.exact) work *= lp.end > firstChunk ? lp.end - firstChunk : 0;
     Progress progress(fmt::format("frame {} {}", frame, pass::estimateLighting), work, options_.quiet);
@@ -203,7 +202,7 @@ void FrameRenderer::lightFrame(std::uint32_t frame, const Camera& camera, const 
         if (session->resume) acc = *session->resume;
         else acc.reset(camera.width, camera.height, lp.begin);
         stats.lighting = accumulateLighting(in, lp, acc, session->afterChunk, &progress);
-        resolveLighting(acc, lp.exact, img.lighting, &stats.lighting.nonFinite);
+        resolveLighting(acc, lp.exact, img.lighting, &stats.lighting.nonFinite, plan_.counting ? nullptr : &img.window);
     }
     if (stats.lighting.nonFinite) stats.nonFinite[std::string(pass::estimateLighting)] = stats.lighting.nonFinite;
 }
@@ -259,7 +258,7 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const L
                plan.sampler == LightSamplerKind::tree ? &lightTree : nullptr, session, trace, img, stats);
     {
         auto t = timer.scope(pass::composeImage);
-        composeImage(gbuffer, particles, settings_.shading, img, stats);
+        composeImage(gbuffer, particles, settings_.shading, traced, img, stats);
         if (plan.counting) recordCompose(gbuffer, particles, *bvh_, img.counters.add(pass::composeImage, img.width, img.height));
     }
     if (plan.counting) {

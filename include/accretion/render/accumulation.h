@@ -56,10 +56,11 @@ struct Accumulation {
     std::vector<std::uint8_t> done;       ///< adaptive: target reached or capped
     std::vector<std::uint32_t> rejected;  ///< non-finite samples rejected (render.nonfinite)
     std::uint64_t nextChunk = 0;          ///< the RNG position: first chunk not yet added
-    /// Monte Carlo sweeps go band by band, every remaining chunk of a band of
-    /// rows at once: rows [0, bandRows) have all their chunks to the plan's
-    /// end, the others from nextChunk (0 between frames and in a finished run).
-    std::uint32_t bandRows = 0;
+    /// Monte Carlo sweeps run every remaining chunk of a band of pixels at
+    /// once, bands in raster order: rows [0, bandRows) are done to the plan's
+    /// end, and in row bandRows the columns [0, bandCols); every other pixel
+    /// is at nextChunk. Both 0 between frames and in a finished run.
+    std::uint32_t bandRows = 0, bandCols = 0;
 
     void reset(std::uint32_t w, std::uint32_t h, std::uint64_t firstChunk);
     std::size_t pixels() const { return std::size_t(width) * height; }

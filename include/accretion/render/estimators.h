@@ -11,6 +11,7 @@
 #include "accretion/counters/thread_counters.h"
 #include "accretion/lighting/light_sampler.h"
 #include "accretion/render/accumulation.h"
+#include "accretion/render/pixel_window.h"
 #include "accretion/render/gbuffer.h"
 #include "accretion/render/pixel_trace.h"
 #include "accretion/scene/settings.h"
@@ -73,7 +74,9 @@ LightingCounters accumulateLighting(const LightingInputs& in, const LightingPlan
 
 /// The estimate, its standard error, spp and rejected counts from the sums.
 /// A value that is not finite in float is zeroed and counted in `rejected`.
-void resolveLighting(const Accumulation& acc, bool exact, LightingImage& out, std::uint64_t* nonFinite = nullptr);
+/// (`window`: only its pixels; the others stay 0. Null: every pixel.)
+void resolveLighting(const Accumulation& acc, bool exact, LightingImage& out, std::uint64_t* nonFinite = nullptr,
+                     const PixelWindow* window = nullptr);
 
 /// The lights summed exactly per receiver by `split`: render.near_lights,
 /// or when 0 the automatic choice (docs/MODEL.md section 4).
