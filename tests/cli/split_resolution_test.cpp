@@ -17,7 +17,7 @@ namespace {
 using namespace accretion::test;
 
 /// The named channels of an EXR, pixel-interleaved.
-std::vector<float> readChannels(const std::filesystem::path& file, const std::vector<std::string>& names) {
+std::vector<float> exrChannels(const std::filesystem::path& file, const std::vector<std::string>& names) {
     auto in = OIIO::ImageInput::open(file.string());
     REQUIRE(in);
     const auto& spec = in->spec();
@@ -49,8 +49,8 @@ TEST_CASE("split at a resolution the old near-field cache overflowed: exact when
     // k = 16: most light is far, sampled.
     REQUIRE(runCommand(scene + "--estimator split --spp 64 -D render.near_lights=16 -o " + (dir / "some.exr").string(), out) == 0);
     const std::vector<std::string> rgb = {"Lr.R", "Lr.G", "Lr.B"}, sd = {"Lr_stderr.R", "Lr_stderr.G", "Lr_stderr.B"};
-    const auto exact = readChannels(dir / "exact.exr", rgb), all = readChannels(dir / "all.exr", rgb);
-    const auto some = readChannels(dir / "some.exr", rgb), someSd = readChannels(dir / "some.exr", sd);
+    const auto exact = exrChannels(dir / "exact.exr", rgb), all = exrChannels(dir / "all.exr", rgb);
+    const auto some = exrChannels(dir / "some.exr", rgb), someSd = exrChannels(dir / "some.exr", sd);
     REQUIRE(exact.size() == std::size_t(256 * 256 * 3));
     double worst = 0.0, sumExact = 0.0, sumSome = 0.0, var = 0.0;
     std::size_t lit = 0;
