@@ -7,6 +7,7 @@
 #include <fmt/ranges.h>
 
 #include "accretion/core/error.h"
+#include "accretion/scene/scene_parser.h"
 
 namespace accretion {
 
@@ -53,6 +54,14 @@ ViewCheck checkView(const std::map<std::string, std::string>& x, const std::map<
         }
     }
     return out;
+}
+
+void requireSceneView(const std::map<std::string, std::string>& attributes, const std::string& file, const Settings& scene,
+                      std::uint32_t frame, bool strict) {
+    const std::map<std::string, std::string> render = {{"accretion:frame", std::to_string(frame)},
+                                                       {"accretion:settings", settingsToToml(scene)}};
+    reportViewCheck(checkView(render, attributes, ViewKeys::frameAndSettings),
+                    fmt::format("frame {} of {}", frame, scene.scenePath), file, strict, true);
 }
 
 void reportViewCheck(const ViewCheck& check, const std::string& image, const std::string& reference, bool strict,

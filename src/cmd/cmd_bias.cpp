@@ -138,15 +138,10 @@ ExperimentRender readGpuRender(const std::string& file, const Settings& s, std::
         throw InputError(fmt::format("{}: seed {}, expected {}", file, meta("seed"), s.render.seed));
     if (meta("estimator") != enumName(s.render.estimator))
         throw InputError(fmt::format("{}: estimator {}, expected {}", file, meta("estimator"), enumName(s.render.estimator)));
-    if (g.metadata.count("settings")) {
-        // The scene the frame was rendered from: its scene-defining sections, as the reference's.
-        reportViewCheck(checkView({{"accretion:frame", std::to_string(g.frame)}, {"accretion:settings", meta("settings")}},
-                                  {{"accretion:frame", std::to_string(frame)}, {"accretion:settings", settingsToToml(s)}},
-                                  ViewKeys::frameAndSettings),
-                        file, "the scene", false, true);
-    } else {
-        reportViewCheck({{}, {"scene settings"}}, file, "the scene", strict);
-    }
+    // The scene the frame was rendered from (its metadata, as the EXR's attributes name it).
+    std::map<std::string, std::string> attributes;
+    for (const auto& [key, value] : g.metadata) attributes["accretion:" + key] = value;
+    requireSceneView(attributes, file, s, frame, strict);
     requireFinitePixels(g.Lr, file, "Lr", g.width);
     ExperimentRender r;
     r.image.lighting.Lr = std::move(g.Lr);
@@ -246,9 +241,7 @@ void runBias(const BiasArgs& a) {
 
     const BiasReference ref = loadBiasReference(a.reference, scene);
     // The reference must be of the view measured: its frame and scene-defining settings.
-    reportViewCheck(checkView({{"accretion:frame", std::to_string(frame)}, {"accretion:settings", settingsToToml(scene)}},
-                              readExrAttributes(a.reference), ViewKeys::frameAndSettings),
-                    fmt::format("frame {} of {}", frame, scene.scenePath), a.reference, a.strict, true);
+    requireSceneView(readExrAttributes(a.reference), a.reference, scene, frame, a.strict);
     const ParticleSource source(scene);
     std::vector<BiasRow> rows;
     for (const EstimatorSpec& spec : specs) rows.push_back(measureBias(a, spec, base, source, frame, ref, prefix));

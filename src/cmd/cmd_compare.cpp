@@ -7,7 +7,6 @@
 #include <functional>
 #include <limits>
 #include <memory>
-#include <sstream>
 
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
@@ -191,8 +190,11 @@ void writeErrorMaps(const CompareArgs& a, const Pair& p, const Comparison& cmp) 
 }
 
 /// Metadata differences: a warning each, or (--strict) an error.
-void checkMetadata(const CompareArgs& a, const std::string& image, const std::string& reference) {
-    reportViewCheck(checkView(readExrAttributes(image), readExrAttributes(reference)), image, reference, a.strict);
+/// The view check of the pair; returns the reference's attributes (read once).
+std::map<std::string, std::string> checkMetadata(const CompareArgs& a, const std::string& image, const std::string& reference) {
+    std::map<std::string, std::string> attributes = readExrAttributes(reference);
+    reportViewCheck(checkView(readExrAttributes(image), attributes), image, reference, a.strict);
+    return attributes;
 }
 
 void checkFlipOption(const CompareArgs& a) {
@@ -213,7 +215,7 @@ std::vector<std::string> parseChannels(const CompareArgs& a) {
 /// error summed over channels, as relMSE weighs them), each with the command
 /// that explains it light by light: `render --pixel` on the reference's own
 /// settings (its .settings.toml beside it, else its scene and estimator).
-void printWorstPixels(const Pair& p, std::size_t count) {
+void printWorstPixels(const Pair& p, const std::map<std::string, std::string>& attrs, std::size_t count) {
     std::vector<std::pair<double, std::size_t>> worst;
     for (std::size_t q = 0; q < p.xs.size(); ++q) {
         double e = 0.0;
@@ -226,7 +228,6 @@ void printWorstPixels(const Pair& p, std::size_t count) {
     count = std::min(count, worst.size());
     std::partial_sort(worst.begin(), worst.begin() + std::ptrdiff_t(count), worst.end(), std::greater<>());
     if (count == 0) return;
-    const auto attrs = readExrAttributes(p.reference);
     auto attr = [&](const char* key) { return attrs.count(key) ? attrs.at(key) : std::string(); };
     // The settings file of the run that wrote the reference: "ref.exr" ->
     // "ref.settings.toml", "ref.0003.exr" (a {frame} run) -> "ref.settings.toml".
@@ -263,7 +264,7 @@ void runCompareOne(const CompareArgs& a) {
             guard.check(out, "--error-map");
     }
     const Pair p = loadPair(a, a.image, a.reference, parseChannels(a));
-    checkMetadata(a, a.image, a.reference);
+    const auto referenceAttributes = checkMetadata(a, a.image, a.reference);
     if (p.partial())
         fmt::print(stderr, "accretion: compared the {}x{} pixels at ({}, {}) that both data windows hold (of {}x{})\n", p.w, p.h,
                    p.x0, p.y0, p.x.width, p.x.height);
@@ -282,7 +283,7 @@ void runCompareOne(const CompareArgs& a) {
            fraction(c.m.withinTolerance, c.m.lit), a.tolerance});
     if (!a.errorMap.empty()) writeErrorMaps(a, p, c);
     fmt::print("{}", a.json ? t.json()[0].dump(2) + "\n" : t.keyValues());
-    if (!a.json) printWorstPixels(p, 5);
+    if (!a.json) printWorstPixels(p, referenceAttributes, 5);
     if (a.flip == "hdr" && !a.json)
         fmt::print("HDR-FLIP exposures: {} from {:.4f} to {:.4f} stops (ACES)\n", c.hdr.exposures, c.hdr.startExposure,
                    c.hdr.stopExposure);

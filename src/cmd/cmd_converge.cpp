@@ -93,9 +93,7 @@ Reference loadReference(const std::string& pattern, const Settings& scene, std::
         throw InputError(fmt::format("{}: reference is {}x{}, the scene renders {}x{}", file, L.width, L.height,
                                      scene.camera.width, scene.camera.height));
     // Of the frame measured and the scene's settings; finite.
-    reportViewCheck(checkView({{"accretion:frame", std::to_string(frame)}, {"accretion:settings", settingsToToml(scene)}},
-                              readExrAttributes(file), ViewKeys::frameAndSettings),
-                    fmt::format("frame {} of {}", frame, scene.scenePath), file, false, true);
+    requireSceneView(readExrAttributes(file), file, scene, frame, false);
     Reference r;
     r.Lr = L.rgb;
     requireFinitePixels(r.Lr, file, "Lr", L.width);

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <optional>
 #include <ranges>
 #include <span>
 
@@ -274,9 +273,9 @@ void runChunks(const LightingInputs& in, const LightArrays& L, const LightingPla
 }
 
 /// split: the receiver's near field and the exact sum of its terms, found
-/// once per pixel per sweep; a sweep runs all of a pixel's chunks (a band of
-/// rows at a time), so nothing is kept between sweeps and k is bounded by
-/// NearField::kMaxNear alone, whatever the resolution.
+/// once per pixel per sweep; a sweep runs all of a pixel's remaining chunks
+/// (run(): a band of pixels at a time), so nothing is kept between sweeps
+/// and k is bounded by NearField::kMaxNear alone, whatever the resolution.
 template <ShadingModel M, Primitive P, bool Count>
 void prepareNearField(const LightingInputs& in, const LightArrays& L, const VisibilityOptions& vis, bool shadows,
                       GroupPixel& p) {
@@ -408,11 +407,7 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
 }
 
 /// The pixels a frame's lighting covers: render.crop's window, else the whole image.
-PixelWindow litWindow(const LightingInputs& in) {
-    const std::vector<double>& c = in.render.crop;
-    if (c.size() != 4) return PixelWindow::whole(in.gbuffer.width, in.gbuffer.height);
-    return {std::uint32_t(c[0]), std::uint32_t(c[1]), std::uint32_t(c[2]), std::uint32_t(c[3])};
-}
+PixelWindow litWindow(const LightingInputs& in) { return PixelWindow::of(in.render, in.gbuffer.width, in.gbuffer.height); }
 
 /// How long a band of a Monte Carlo sweep should take: what a stop request
 /// or a due checkpoint waits for. A band is sized from the slowest pixel
@@ -440,10 +435,10 @@ LightingCounters run(const LightingInputs& in, const LightArrays& L, const Light
         if (afterChunk) afterChunk(acc);
         return total;
     }
-    double pixelChunkSeconds = 0.0;  // measured: the slowest pixel-chunk of a band so far
+    const PixelWindow w = litWindow(in);  // a crop lights its window alone
+    double pixelChunkSeconds = 0.0;        // measured: the slowest pixel-chunk of a band so far
     while (acc.nextChunk < plan.end) {
         const std::uint64_t c = acc.nextChunk;
-        const PixelWindow w = litWindow(in);  // a crop lights its window alone
         if (plan.exact) {
             total += sweep<M, P, Count>(in, L, plan, &acc, nullptr, c, c + 1, progress, w);
             acc.nextChunk = c + 1;

@@ -3,6 +3,8 @@
 #include <string>
 #include <vector>
 
+#include "accretion/scene/settings.h"
+
 namespace accretion {
 
 /// Whether two renders show the same view: what their metadata (EXR
@@ -23,6 +25,13 @@ struct ViewCheck {
 enum class ViewKeys { all, frameAndSettings };
 ViewCheck checkView(const std::map<std::string, std::string>& image, const std::map<std::string, std::string>& reference,
                     ViewKeys keys = ViewKeys::all);
+
+/// `file` (its metadata `attributes`: a reference, a GPU frame) must be a
+/// render of frame `frame` of `scene`: the frame and the scene-defining
+/// settings, a difference an error; what it does not record a warning, an
+/// error when `strict`.
+void requireSceneView(const std::map<std::string, std::string>& attributes, const std::string& file, const Settings& scene,
+                      std::uint32_t frame, bool strict);
 
 /// The scene-defining sections of a settings TOML (what two renders of the
 /// same view share whatever their estimators): particles, camera, geometry, shading.

@@ -15,9 +15,10 @@ struct PixelWindow {
 
     static PixelWindow whole(std::uint32_t width, std::uint32_t height) { return {0, width, 0, height}; }
     /// render.crop of the settings, or the whole image when it is empty.
-    static PixelWindow of(const Settings& s) {
-        const std::vector<double>& c = s.render.crop;
-        if (c.size() != 4) return whole(s.camera.width, s.camera.height);
+    static PixelWindow of(const Settings& s) { return of(s.render, s.camera.width, s.camera.height); }
+    static PixelWindow of(const RenderSettings& render, std::uint32_t width, std::uint32_t height) {
+        const std::vector<double>& c = render.crop;
+        if (c.size() != 4) return whole(width, height);
         return {std::uint32_t(c[0]), std::uint32_t(c[1]), std::uint32_t(c[2]), std::uint32_t(c[3])};
     }
 
