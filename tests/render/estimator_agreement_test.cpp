@@ -5,6 +5,9 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <map>
+#include <string>
+#include <utility>
 
 #include "support/oracle.h"
 #include "support/statistics.h"
@@ -99,11 +102,21 @@ TEST_CASE("uniform, power, tree, split and ris (every source) agree with the ora
     s.shading.model = config.model;
     const Particles particles = ParticleSource(s).frame(0);
 
-    const Reference oracle = reference(test::oracleRender(s, particles));
-    const Reference exact = reference(renderParticles(s, particles));
+    // The references depend on the configuration alone: computed once for
+    // its seven estimators.
+    static std::map<std::string, std::pair<Reference, Reference>> references;
+    auto cached = references.find(config.name);
+    if (cached == references.end())
+        cached = references.emplace(config.name, std::pair{reference(test::oracleRender(s, particles)),
+                                                           reference(renderParticles(s, particles))}).first;
+    const Reference& oracle = cached->second.first;
+    const Reference& exact = cached->second.second;
     s.render.estimator = est.kind;
     s.render.source = est.source;
-    s.render.samples = est.samples;
+    // Under the sanitizers (ACCRETION_TEST_SEED_DIVISOR > 1) a quarter of the
+    // samples: the same confidence, less power; the bias meta-test below
+    // needs the full count and runs in the Release stage.
+    s.render.samples = test::statisticalSeeds(est.samples, est.samples / 4);
     s.render.candidates = est.candidates;
     s.render.near_lights = est.nearLights;
     s.render.seed = 11;
@@ -111,7 +124,7 @@ TEST_CASE("uniform, power, tree, split and ris (every source) agree with the ora
     FrameStats stats;
     const FrameImage mc = renderer.render(0, stats);
     if (est.kind == EstimatorKind::ris) {  // M target evaluations and at most one shadow ray per reservoir
-        const std::uint64_t reservoirs = std::uint64_t(est.samples) * stats.hitPixels;
+        const std::uint64_t reservoirs = std::uint64_t(s.render.samples) * stats.hitPixels;
         REQUIRE(stats.lighting.lightTerms == reservoirs * est.candidates);
         REQUIRE(stats.lighting.shadowRays <= reservoirs);
     }
@@ -133,9 +146,11 @@ TEST_CASE("uniform, power, tree, split and ris (every source) agree with the ora
 
     // Meta-test: the same harness rejects the estimate scaled by 1.03 (a 1%
     // bias shifts z by ~6.4, too close to kZ to be caught every time).
-    const EstimatorAgreement biased = compare(mc, oracle, 1.03f);
-    INFO("biased global z " << biased.globalZ);
-    CHECK(std::fabs(biased.globalZ) > kZ);
+    if (test::fullStatisticalPower()) {
+        const EstimatorAgreement biased = compare(mc, oracle, 1.03f);
+        INFO("biased global z " << biased.globalZ);
+        CHECK(std::fabs(biased.globalZ) > kZ);
+    }
 }
 
 TEST_CASE("split with every light in the near field is exact, and splits at any k agree with each other", "[estimators]") {
