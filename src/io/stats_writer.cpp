@@ -7,7 +7,7 @@ nlohmann::json frameStatsJson(const FrameStats& s) {
     for (const auto& [name, seconds] : s.timer.all()) passes[name] = seconds;
     const double lightingSeconds = s.timer.seconds(pass::estimateLighting);
 
-    return {
+    nlohmann::json j = {
         {"frame", s.frame},
         {"origin", {s.origin.x, s.origin.y, s.origin.z}},  // world position of the frame coordinates' origin
         {"seconds", s.seconds},
@@ -23,6 +23,7 @@ nlohmann::json frameStatsJson(const FrameStats& s) {
           {"reuse_rejected", s.lighting.reuseRejected},
           {"nonfinite_rejected", s.nonFinite},
           {"light_tree_nodes", s.lightTreeNodes},
+          {"near_lights", s.nearLights.k},
           {"reservoir_bytes", s.reservoirBytes},
           {"mean_spp", s.meanSpp},
           {"max_spp", s.maxSpp}}},
@@ -43,6 +44,14 @@ nlohmann::json frameStatsJson(const FrameStats& s) {
           {"tlas_seconds", s.bvh.tlasSeconds},
           {"embree_bytes", s.bvh.embreeBytes}}},
     };
+    if (!s.nearLights.candidates.empty()) {  // split, k automatic: the pilot's table (docs/MODEL.md section 4)
+        nlohmann::json rows = nlohmann::json::array();
+        for (const NearLightChoice::Candidate& c : s.nearLights.candidates)
+            rows.push_back({{"k", c.k}, {"rel_variance", c.relVariance}, {"cost", c.cost}, {"rel_variance_x_cost", c.relVariance * c.cost}});
+        j["near_light_pilot"] = {{"k", s.nearLights.k}, {"pixels", s.nearLights.pixels},
+                                 {"far_sample_cost", NearLightChoice::kFarSampleCost}, {"candidates", rows}};
+    }
+    return j;
 }
 
 }  // namespace accretion

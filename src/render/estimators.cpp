@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <memory>
 #include <ranges>
 #include <span>
 
@@ -198,8 +200,8 @@ struct GroupPixel {
     PixelSums sums;
     RayCounters rays;       ///< counting mode: its shadow rays' traversal
     LightSample xs[LightingPlan::kChunkSamples];  ///< a chunk's lights (chunkSamples() <= kChunkSamples)
-    NearField field;        ///< split: the near lights
-    DVec3 near{0.0};        ///< split: their exact sum
+    const NearField* field = nullptr;  ///< split: the near lights of its particle (NearFieldCache)
+    DVec3 near{0.0};                   ///< split: their exact sum at this pixel's point
 };
 
 /// Pixels shaded together: up to this many of a tile row.
@@ -240,7 +242,7 @@ void runChunk(const LightingInputs& in, const LightArrays& L, const VisibilityOp
         for (std::uint32_t k = 0; k < n; ++k) {
             if (pix[k].sums.done) continue;
             Rng rng = stream(pix[k]);
-            drawLights<K>(in, L, pix[k].sp, pix[k].field, rng, count, pix[k].xs);
+            drawLights<K>(in, L, pix[k].sp, *pix[k].field, rng, count, pix[k].xs);
         }
         for (std::uint32_t k = 0; k < n; ++k) {
             GroupPixel& p = pix[k];
@@ -272,15 +274,56 @@ void runChunks(const LightingInputs& in, const LightArrays& L, const LightingPla
     }
 }
 
-/// split: the receiver's near field and the exact sum of its terms, found
-/// once per pixel per sweep; a sweep runs all of a pixel's remaining chunks
-/// (run(): a band of pixels at a time), so nothing is kept between sweeps
-/// and k is bounded by NearField::kMaxNear alone, whatever the resolution.
+/// split: the near fields of one thread's recent particles. A near field is
+/// the k lights nearest to a particle's centre (not to the pixel's point on
+/// it), so every pixel of a particle shares one search: at 1080p a particle
+/// of disk_100k covers several pixels of a tile. What a pixel gets depends
+/// on its particle alone, never on the cache, the tiles or the threads.
+/// Direct-mapped; a particle whose slot an earlier pixel of the same group
+/// still uses gets the group's spare field instead.
+struct NearFieldCache {
+    static constexpr std::uint32_t kSlots = 64;
+    std::uint32_t particle[kSlots];
+    NearField field[kSlots];
+    NearField spare[kGroupPixels];
+    NearFieldCache() { std::fill(std::begin(particle), std::end(particle), kNoParticle); }
+};
+
+/// The near field of particle j (found on the light tree from its centre).
+const NearField& nearFieldOf(const LightingInputs& in, std::uint32_t j, NearFieldCache& cache, std::uint64_t& pinned,
+                             std::uint32_t& spares) {
+    static_assert(NearFieldCache::kSlots == 64);
+    const std::uint32_t s = (j * 0x9e3779b1u) >> 26;  // Fibonacci hashing onto 64 slots
+    const std::uint64_t bit = std::uint64_t(1) << s;
+    if (cache.particle[s] == j) {
+        pinned |= bit;
+        return cache.field[s];
+    }
+    NearField* out = &cache.spare[spares];
+    if (pinned & bit) {
+        ++spares;  // at most one per pixel of the group
+    } else {
+        out = &cache.field[s];
+        cache.particle[s] = j;
+        pinned |= bit;
+    }
+    ShadingPoint centre{};
+    centre.x = in.particles.position[j];
+    centre.self = j;
+    in.lightTree->nearest(centre, nearLightCount(in.render, in.nearLights), *out);
+    return *out;
+}
+
+/// split: a pixel's near field (its particle's, from the cache) and the
+/// exact sum of its terms at the pixel's point, once per pixel per sweep;
+/// a sweep runs all of a pixel's remaining chunks (run(): a band of pixels
+/// at a time), so nothing is kept between sweeps and k is bounded by
+/// NearField::kMaxNear alone, whatever the resolution.
 template <ShadingModel M, Primitive P, bool Count>
 void prepareNearField(const LightingInputs& in, const LightArrays& L, const VisibilityOptions& vis, bool shadows,
-                      GroupPixel& p) {
-    in.lightTree->nearest(p.sp, nearLightCount(in.render), p.field);
-    const std::span<const std::uint32_t> lights(p.field.light, p.field.count);
+                      GroupPixel& p, NearFieldCache& cache, std::uint64_t& pinned, std::uint32_t& spares) {
+    p.field = &nearFieldOf(in, p.sp.self, cache, pinned, spares);
+    const std::span<const std::uint32_t> lights(p.field->light, p.field->count);
     RayCounters* rc = Count ? &p.rays : nullptr;
     p.near = p.sums.trace ? sumTerms<M, P, true>(in.bvh, L, p.sp, lights, vis, shadows, p.sums.c, rc, p.sums.trace)
                           : sumTerms<M, P>(in.bvh, L, p.sp, lights, vis, shadows, p.sums.c, rc);
@@ -302,6 +345,7 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
     const EstimatorKind kind = in.render.estimator;
     const bool shadows = in.shading.visibility;  // off: V = 1, no shadow rays
     tbb::enumerable_thread_specific<LightingCounters> counters;
+    tbb::enumerable_thread_specific<std::unique_ptr<NearFieldCache>> nearCaches;
     // exact: chunks are row bands; Monte Carlo: every row, chunks are samples.
     const std::uint32_t row0 = plan.exact ? static_cast<std::uint32_t>(std::clamp<std::uint64_t>(c0 * LightingPlan::kChunkRows, area.y0, area.y1))
                                           : area.y0;
@@ -381,8 +425,12 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
                 } else if (kind == EstimatorKind::tree) {
                     runChunks<M, P, Count, EstimatorKind::tree>(in, L, plan, vis, shadows, c0, c1, pix, n);
                 } else if (kind == EstimatorKind::split) {
+                    std::unique_ptr<NearFieldCache>& cache = nearCaches.local();
+                    if (!cache) cache = std::make_unique<NearFieldCache>();
+                    std::uint64_t pinned = 0;  // the slots this group's pixels use
+                    std::uint32_t spares = 0;
                     for (std::uint32_t k = 0; k < n; ++k)
-                        if (!pix[k].sums.done) prepareNearField<M, P, Count>(in, L, vis, shadows, pix[k]);
+                        if (!pix[k].sums.done) prepareNearField<M, P, Count>(in, L, vis, shadows, pix[k], *cache, pinned, spares);
                     runChunks<M, P, Count, EstimatorKind::split>(in, L, plan, vis, shadows, c0, c1, pix, n);
                 } else {
                     runChunks<M, P, Count, EstimatorKind::uniform>(in, L, plan, vis, shadows, c0, c1, pix, n);
@@ -488,14 +536,119 @@ LightingCounters dispatchPrimitive(const LightingInputs& in, const LightArrays& 
 
 }  // namespace
 
-std::uint32_t nearLightCount(const RenderSettings& render) {
+std::uint32_t nearLightCount(const RenderSettings& render, std::uint32_t chosen) {
     if (render.near_lights > 0) return render.near_lights;
-    // Automatic: 16 near lights per sample of a round, 16 to 1024. On
-    // disk_100k at 320x180 the error x time of split is flat in k at 16 S
-    // (32 spp: k = 256 / 512 / 1024 all 0.17) and falls with k below it
-    // (docs/MODEL.md section 4); a preview of a few samples keeps its near
-    // field as cheap as its samples, a long render sums 1024 neighbours.
-    return std::clamp<std::uint32_t>(16u * std::min(render.samples, NearField::kMaxNear / 16u), 16u, NearField::kMaxNear);
+    return chosen > 0 ? chosen : 16u;
+}
+
+namespace {
+
+constexpr std::uint32_t kPilotPixels = 256, kPilotSamples = 16;
+constexpr double kPilotEpsilon = 1e-2;  ///< relMSE's (analysis/image_metrics.h: kRelMseEpsilon)
+
+/// One pilot pixel at every candidate k: per-channel far-sample variance,
+/// and the estimate (near sum + far mean) at the largest k.
+template <ShadingModel M, Primitive P>
+void pilotPixel(const LightingInputs& in, const LightArrays& L, const VisibilityOptions& vis, std::size_t px,
+                const std::vector<std::uint32_t>& ks, NearField& field, double* variance, DVec3& value) {
+    const GBufferTexel& g = in.gbuffer.texels[px];
+    const ShadingPoint sp = shadingPoint(g, in.particles);
+    ShadingPoint centre{};
+    centre.x = in.particles.position[g.particle];
+    centre.self = g.particle;
+    const bool shadows = in.shading.visibility;
+    for (std::size_t c = 0; c < ks.size(); ++c) {
+        in.lightTree->nearest(centre, ks[c], field);
+        LightingCounters counted;
+        const DVec3 near = sumTerms<M, P>(in.bvh, L, sp, std::span<const std::uint32_t>(field.light, field.count), vis,
+                                          shadows, counted, nullptr);
+        // The same stream at every k: the candidates differ by their near field alone.
+        Rng rng(px, in.frame, RngPass::nearLightPilot, in.render.seed);
+        DVec3 sum(0.0), sumSq(0.0);
+        for (std::uint32_t s = 0; s < kPilotSamples; ++s) {
+            const LightSample x = in.lightTree->sampleFar(sp, field, rng);
+            LightTerm t;
+            if (x.i >= L.count || !L.term<M>(sp, x.i, t) || !seen<P>(in.bvh, L, sp, x.i, t, vis, shadows, counted, nullptr))
+                continue;
+            const DVec3 f = DVec3(t.value) / double(x.pdf);
+            sum += f;
+            sumSq += f * f;
+        }
+        const double n = kPilotSamples;
+        const DVec3 var = glm::max(DVec3(0.0), (sumSq - sum * sum / n) / (n - 1.0));
+        for (int ch = 0; ch < 3; ++ch) variance[c * 3 + ch] = var[ch];
+        value = near + sum / n;  // the last (largest) k's
+    }
+}
+
+template <ShadingModel M, Primitive P>
+NearLightChoice choosePilot(const LightingInputs& in, const LightArrays& L) {
+    NearLightChoice choice;
+    std::vector<std::size_t> lit;
+    for (std::size_t px = 0; px < in.gbuffer.texels.size(); ++px)
+        if (in.gbuffer.texels[px].hit()) lit.push_back(px);
+    std::vector<std::size_t> pixels;
+    for (std::size_t i = 0; i < std::min<std::size_t>(lit.size(), kPilotPixels); ++i)
+        pixels.push_back(lit[i * lit.size() / std::min<std::size_t>(lit.size(), kPilotPixels)]);
+    std::vector<std::uint32_t> ks;
+    const std::uint32_t most = in.particles.size() > 1 ? std::uint32_t(in.particles.size() - 1) : 0u;
+    for (std::uint32_t k = 16; k <= NearField::kMaxNear; k *= 2) {
+        ks.push_back(std::min(k, most));
+        if (k >= most) break;
+    }
+    choice.pixels = static_cast<std::uint32_t>(pixels.size());
+    if (pixels.empty() || most == 0) {
+        choice.k = 16;
+        return choice;
+    }
+    std::vector<double> variance(pixels.size() * ks.size() * 3);
+    std::vector<DVec3> value(pixels.size());
+    const VisibilityOptions vis = VisibilityOptions::from(in.render);
+    tbb::enumerable_thread_specific<std::unique_ptr<NearField>> fields;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pixels.size(), 4), [&](const auto& r) {
+        std::unique_ptr<NearField>& field = fields.local();
+        if (!field) field = std::make_unique<NearField>();
+        for (std::size_t i = r.begin(); i != r.end(); ++i)
+            pilotPixel<M, P>(in, L, vis, pixels[i], ks, *field, &variance[i * ks.size() * 3], value[i]);
+    });
+    // V(k), summed in pixel order (the same whatever the threads).
+    const double samples = double(in.render.samples) * NearLightChoice::kFarSampleCost;
+    double best = std::numeric_limits<double>::infinity();
+    for (std::size_t c = 0; c < ks.size(); ++c) {
+        double v = 0.0;
+        for (std::size_t i = 0; i < pixels.size(); ++i)
+            for (int ch = 0; ch < 3; ++ch)
+                v += variance[(i * ks.size() + c) * 3 + ch] / (value[i][ch] * value[i][ch] + kPilotEpsilon);
+        v /= 3.0 * double(pixels.size());
+        const double cost = double(ks[c]) + samples;
+        choice.candidates.push_back({ks[c], v, cost});
+        // Ties (every far sample zero, or no far light left) go to the smaller k.
+        if (v * cost < best) {
+            best = v * cost;
+            choice.k = ks[c];
+        }
+    }
+    return choice;
+}
+
+}  // namespace
+
+NearLightChoice chooseNearLights(const LightingInputs& pilot) {
+    ACC_CHECK(pilot.lightTree);
+    const LightArrays L(pilot.particles, pilot.shading);
+    const bool spheres = pilot.bvh.settings().primitive == Primitive::sphere;
+    switch (pilot.shading.model) {
+    case ShadingModel::lambert:
+        return spheres ? choosePilot<ShadingModel::lambert, Primitive::sphere>(pilot, L)
+                       : choosePilot<ShadingModel::lambert, Primitive::billboard>(pilot, L);
+    case ShadingModel::sphere:
+        return spheres ? choosePilot<ShadingModel::sphere, Primitive::sphere>(pilot, L)
+                       : choosePilot<ShadingModel::sphere, Primitive::billboard>(pilot, L);
+    case ShadingModel::isotropic:
+        return spheres ? choosePilot<ShadingModel::isotropic, Primitive::sphere>(pilot, L)
+                       : choosePilot<ShadingModel::isotropic, Primitive::billboard>(pilot, L);
+    }
+    return {};
 }
 
 namespace {

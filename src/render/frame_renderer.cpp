@@ -167,6 +167,9 @@ void FrameRenderer::lightFrame(std::uint32_t frame, const Camera& camera, const 
         img.lighting.rejected.assign(pixels, 0.0f);
         return;
     }
+    const std::uint32_t nearLights = settings_.render.estimator == EstimatorKind::split && settings_.render.near_lights == 0
+                                         ? chooseFrameNearLights(frame, img.camera, particles, lightTree, stats)
+                                         : 0u;
     auto t = stats.timer.scope(pass::estimateLighting);
     if (plan.restir) {
         RestirInputs in{*bvh_, particles, gbuffer, camera, settings_, plan, frame, powerTable, lightTree,
@@ -178,6 +181,7 @@ void FrameRenderer::lightFrame(std::uint32_t frame, const Camera& camera, const 
     }
     LightingInputs in{*bvh_, particles, gbuffer, settings_.shading, settings_.render, frame, powerTable, lightTree,
                       plan.counting ? &img.counters.add(pass::estimateLighting, camera.width, camera.height) : nullptr, trace};
+    in.nearLights = nearLights;
     const LightingPlan lp = planLighting(settings_.render, camera.height, session ? session->shard : Shard{});
     // Progress by work: the hit pixels of the rows (exact) or the chunks
     // (samples) still to run, as the sweep counts them.
@@ -205,6 +209,22 @@ void FrameRenderer::lightFrame(std::uint32_t frame, const Camera& camera, const 
         resolveLighting(acc, lp.exact, img.lighting, &stats.lighting.nonFinite, plan_.counting ? nullptr : &img.window);
     }
     if (stats.lighting.nonFinite) stats.nonFinite[std::string(pass::estimateLighting)] = stats.lighting.nonFinite;
+}
+
+std::uint32_t FrameRenderer::chooseFrameNearLights(std::uint32_t frame, const CameraPose& pose, const Particles& particles,
+                                                   const LightTree* lightTree, FrameStats& stats) {
+    auto t = stats.timer.scope(pass::chooseNearLights);
+    // The pilot's image: the frame's view at 64 pixels across, whatever the
+    // resolution or crop, so that every part of one image gets one k.
+    constexpr std::uint32_t kWidth = 64;
+    const std::uint32_t height = std::max(1u, static_cast<std::uint32_t>(std::lround(
+        double(kWidth) * settings_.camera.height / settings_.camera.width)));
+    const Camera camera = Camera::fromPose(pose, kWidth, height).rebased(origin_);
+    GBuffer gbuffer;
+    traceGBuffer(*bvh_, particles, camera, settings_.shading.model, gbuffer);
+    const LightingInputs pilot{*bvh_, particles, gbuffer, settings_.shading, settings_.render, frame, nullptr, lightTree};
+    stats.nearLights = chooseNearLights(pilot);
+    return stats.nearLights.k;
 }
 
 FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const LightingSession* session, PixelTrace* trace) {

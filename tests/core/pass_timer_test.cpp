@@ -25,6 +25,7 @@ TEST_CASE("each pass has its own name, spelled as the stats files and the GPU ti
     // Written out here, not taken from the table: a reordered enum or name list fails.
     const std::pair<Pass, const char*> spelled[] = {
         {Pass::loadParticles, "loadParticles"},           {Pass::buildLightSampler, "buildLightSampler"},
+        {Pass::chooseNearLights, "chooseNearLights"},
         {Pass::buildClusters, "buildClusters"},           {Pass::traceGBuffer, "traceGBuffer"},
         {Pass::estimateLighting, "estimateLighting"},     {Pass::presampleLightTiles, "presampleLightTiles"},
         {Pass::presampleRegirGrid, "presampleRegirGrid"}, {Pass::generateCandidates, "generateCandidates"},

@@ -16,6 +16,7 @@ namespace accretion {
 enum class Pass : std::uint8_t {
     loadParticles,
     buildLightSampler,
+    chooseNearLights,
     buildClusters,
     traceGBuffer,
     estimateLighting,
@@ -30,9 +31,10 @@ enum class Pass : std::uint8_t {
     writeOutputs,
 };
 
-inline constexpr std::array<std::string_view, 14> kPassNames = {
+inline constexpr std::array<std::string_view, 15> kPassNames = {
     "loadParticles",
     "buildLightSampler",
+    "chooseNearLights",
     "buildClusters",
     "traceGBuffer",
     "estimateLighting",
@@ -59,6 +61,7 @@ std::optional<Pass> parsePass(std::string_view name);
 namespace pass {
 inline constexpr std::string_view loadParticles = passName(Pass::loadParticles);
 inline constexpr std::string_view buildLightSampler = passName(Pass::buildLightSampler);
+inline constexpr std::string_view chooseNearLights = passName(Pass::chooseNearLights);
 inline constexpr std::string_view buildClusters = passName(Pass::buildClusters);
 inline constexpr std::string_view traceGBuffer = passName(Pass::traceGBuffer);
 inline constexpr std::string_view estimateLighting = passName(Pass::estimateLighting);

@@ -60,6 +60,7 @@ struct LightingInputs {
     const LightTree* lightTree = nullptr;    ///< required by `tree`, and by ris with render.source = tree
     PassCounters* counters = nullptr;        ///< counting mode: one thread record per pixel (the BVH must count)
     PixelTrace* trace = nullptr;             ///< render --pixel: record the terms or samples of trace->px
+    std::uint32_t nearLights = 0;            ///< split with render.near_lights = 0: the frame's chooseNearLights k
 };
 
 /// Called after each chunk with the sums so far; returning false stops the
@@ -78,9 +79,37 @@ LightingCounters accumulateLighting(const LightingInputs& in, const LightingPlan
 void resolveLighting(const Accumulation& acc, bool exact, LightingImage& out, std::uint64_t* nonFinite = nullptr,
                      const PixelWindow* window = nullptr);
 
+/// split with render.near_lights = 0: the frame's k, from a pilot on a
+/// low-resolution image of the frame's view (docs/MODEL.md section 4).
+struct NearLightChoice {
+    struct Candidate {
+        std::uint32_t k = 0;        ///< near lights (at most N - 1)
+        double relVariance = 0.0;   ///< V(k): one far sample's variance over the estimate squared (+ 1e-2), mean over pilot pixels and RGB
+        double cost = 0.0;          ///< per pixel, in near lights: k + rho S (rho: kFarSampleCost)
+    };
+    /// A far sample (descent, term, a long shadow ray) costs as much as this
+    /// many near lights (their search shared by a particle's pixels, a term
+    /// and a short ray each): measured on disk_100k at 1920x1080, k = 1024,
+    /// on the 2-core EPYC VM: 0.84 us per far sample, 0.098 us per near
+    /// light, per lit pixel on both cores (bench/README.md, "split at 1080p").
+    static constexpr double kFarSampleCost = 8.6;
+    std::uint32_t k = 0;            ///< the choice: least relVariance x cost
+    std::uint32_t pixels = 0;       ///< pilot pixels (lit)
+    std::vector<Candidate> candidates;
+};
+
+/// The pilot: each lit pixel of `pilot.gbuffer` (at most 256, evenly
+/// spaced), for k = 16, 32, ..., NearField::kMaxNear: its particle's near
+/// field, the exact near sum at its point and 16 far samples on fixed
+/// streams (RngPass::nearLightPilot). Picks the k of least V(k) x (k +
+/// rho S) for S = render.samples: the error x time of a render of S samples.
+/// Deterministic: the same k for any crop, shard, resume or thread count.
+NearLightChoice chooseNearLights(const LightingInputs& pilot);
+
 /// The lights summed exactly per receiver by `split`: render.near_lights,
-/// or when 0 the automatic choice (docs/MODEL.md section 4).
-std::uint32_t nearLightCount(const RenderSettings& render);
+/// or when 0 `chosen` (the frame's chooseNearLights; 0: none yet, the
+/// smallest candidate).
+std::uint32_t nearLightCount(const RenderSettings& render, std::uint32_t chosen = 0);
 
 /// estimateLighting (docs/MODEL.md sections 3-4): `exact` sums every light i != j
 /// with one shadow ray each; `uniform` / `power` / `tree` average one-sample

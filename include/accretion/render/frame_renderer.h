@@ -46,6 +46,7 @@ struct FrameStats {
     std::uint64_t primaryRays = 0;
     LightingCounters lighting;
     std::size_t lightTreeNodes = 0;   ///< tree: nodes of the light tree
+    NearLightChoice nearLights;       ///< split with render.near_lights = 0: the pilot's choice of k
     std::size_t reservoirBytes = 0;   ///< restir: bytes per stored reservoir
     double meanSpp = 0.0;             ///< light samples per hit pixel, mean (adaptive sampling varies it)
     double maxSpp = 0.0;              ///< and maximum
@@ -93,6 +94,10 @@ private:
     /// loadParticles and buildClusters as this frame's plan says; plans the
     /// frame (the plan needs to know whether the particles emit).
     const Particles& prepareGeometry(std::uint32_t frame, const Camera& camera, FrameStats& stats, Particles& loaded);
+    /// chooseNearLights: split's k for this frame (render.near_lights = 0),
+    /// from a pilot on the frame's view at 64 pixels across.
+    std::uint32_t chooseFrameNearLights(std::uint32_t frame, const CameraPose& pose, const Particles& particles,
+                                        const LightTree* lightTree, FrameStats& stats);
     /// estimateLighting (the restir passes for restir) into img.lighting, or Lr = 0 unlit.
     void lightFrame(std::uint32_t frame, const Camera& camera, const Particles& particles, const GBuffer& gbuffer,
                     const AliasTable* powerTable, const LightTree* lightTree, const LightingSession* session,
