@@ -124,10 +124,13 @@ namespace {
 
 /// The first of the near lights [lo, hi) (one node's, in tree order) that
 /// lies right of the node's split at `depth`.
+/// The keys of [lo, hi) share their first `depth` steps (they lie below one
+/// node) and are sorted, so those going left come first: a binary search,
+/// not a scan (at k = 1024 a scan was most of a far sample's cost).
 std::uint32_t splitNear(const NearField& near, std::uint32_t lo, std::uint32_t hi, std::uint32_t depth) {
     const std::uint64_t bit = std::uint64_t(1) << (63 - depth);
-    while (lo < hi && !(near.key[lo] & bit)) ++lo;
-    return lo;
+    const std::uint64_t* first = std::partition_point(near.key + lo, near.key + hi, [bit](std::uint64_t k) { return !(k & bit); });
+    return static_cast<std::uint32_t>(first - near.key);
 }
 
 }  // namespace
