@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
 
+#include "accretion/core/atomic_file.h"
 #include "accretion/core/error.h"
 #include "accretion/core/version.h"
 #include "accretion/io/accumulation_file.h"
@@ -121,8 +122,12 @@ void runMerge(const MergeArgs& args) {
         guard.addInput(std::filesystem::path(s.exr).replace_extension(".acc"));
         guard.addInput(std::filesystem::path(s.exr).replace_extension(".png"));
     }
+    // The shards' settings beside the image, as a render writes them: what
+    // compare's worst-pixel commands render the reference's pixels with.
+    const std::filesystem::path settingsFile = std::filesystem::path(output).replace_extension(".settings.toml");
     guard.check(output, "-o");
     guard.check(png, "-o (its preview)");
+    guard.check(settingsFile, "-o (its settings)");
     const OutputLock lock(std::filesystem::path(output).replace_extension(".lock"));
     const nlohmann::json& first = in.front().acc.header;
     const std::uint32_t count = in.front().shard.count;
@@ -149,6 +154,7 @@ void runMerge(const MergeArgs& args) {
     writeRawExr(output, exr);
     const std::filesystem::path base = std::filesystem::path(output).replace_extension();
     writePreviewPng(png, preview, exr.width, exr.height, tone);
+    writeFileAtomic(settingsFile, first.at("settings").get<std::string>());
     double meanSpp = 0.0;
     std::size_t sampled = 0;
     for (const std::uint32_t n : merged.n) {

@@ -235,6 +235,12 @@ TEST_CASE("shards run with GNU parallel merge into the image of one run", "[cli]
         REQUIRE(runCommand(std::string(ACCRETION_BINARY) + " merge " + shard(2) + " " + shard(0) + " " + shard(1) + " -o " + merged.string(), out) == 0);
         INFO(out);
         CHECK(sameImage(one, merged));
+        // Beside it, the settings the shards were rendered with (what compare's
+        // worst-pixel commands render with).
+        const fs::path mergedSettings = fs::path(merged).replace_extension(".settings.toml");
+        REQUIRE(fs::exists(mergedSettings));
+        CHECK(accretion::test::readFile(mergedSettings) ==
+              accretion::test::readFile(dir / (std::string(estimator) + ".shard0of3.settings.toml")));
 
         // A missing or repeated shard is refused.
         CHECK(runCommand(std::string(ACCRETION_BINARY) + " merge " + shard(0) + " " + shard(1) + " -o " + (dir / "x.exr").string(), out) == 1);

@@ -4,6 +4,7 @@
 // (docs/MODEL.md section 4).
 #include <catch2/catch.hpp>
 
+#include <bit>
 #include <cstring>
 #include <limits>
 
@@ -47,8 +48,9 @@ TEST_CASE("split's automatic k: one pilot per view, k grows with the samples ask
     const NearLightChoice& first = choices.front();
     REQUIRE(first.pixels == 256);  // the pilot's 64x36 image holds more lit pixels: 256 evenly spaced
     // The candidates: 16, 32, ..., kMaxNear near lights.
-    REQUIRE(first.candidates.size() == 7);
+    REQUIRE(first.candidates.size() == std::size_t(std::countr_zero(NearField::kMaxNear / 16u)) + 1);
     for (std::size_t c = 0; c < first.candidates.size(); ++c) CHECK(first.candidates[c].k == (16u << c));
+    CHECK(first.candidates.back().k == NearField::kMaxNear);
     for (std::size_t i = 0; i < choices.size(); ++i) {
         INFO("samples choice " << i << ": k = " << choices[i].k);
         CHECK(choices[i].k == argmin(choices[i]));

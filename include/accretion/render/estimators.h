@@ -90,9 +90,10 @@ struct NearLightChoice {
     /// A far sample (descent, term, a long shadow ray) costs as much as this
     /// many near lights (their search shared by a particle's pixels, a term
     /// and a short ray each): measured on disk_100k at 1920x1080, k = 1024,
-    /// on the 2-core EPYC VM: 0.84 us per far sample, 0.098 us per near
-    /// light, per lit pixel on both cores (bench/README.md, "split at 1080p").
-    static constexpr double kFarSampleCost = 8.6;
+    /// on the 2-core EPYC VM: 0.83 us per far sample, 0.088 us per near
+    /// light, per lit pixel on both cores (bench/split_1080p.sh: 0.524 s per
+    /// spp and 56 s of near field over 634K lit pixels).
+    static constexpr double kFarSampleCost = 9.4;
     std::uint32_t k = 0;            ///< the choice: least relVariance x cost
     std::uint32_t pixels = 0;       ///< pilot pixels (lit)
     std::vector<Candidate> candidates;
