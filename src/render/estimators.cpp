@@ -104,14 +104,15 @@ std::uint32_t resolvePixel(const DVec3& sum, const DVec3& sumSq, std::uint32_t n
 }
 
 /// The lights of one chunk of uniform / power / tree / split (far) samples,
-/// in stream order, their records prefetched (a random light is a cache miss).
+/// in stream order, their records prefetched (a random light is a cache miss);
+/// `near`: split's near field (null for the others).
 template <EstimatorKind K>
-void drawLights(const LightingInputs& in, const LightArrays& L, const ShadingPoint& sp, const NearField& near, Rng& rng,
+void drawLights(const LightingInputs& in, const LightArrays& L, const ShadingPoint& sp, const NearField* near, Rng& rng,
                 std::uint32_t count, LightSample* xs) {
     for (std::uint32_t k = 0; k < count; ++k) {
         if constexpr (K == EstimatorKind::power) xs[k] = sampleSource<true>(L, in.powerTable, rng);
         else if constexpr (K == EstimatorKind::tree) xs[k] = in.lightTree->sample(sp, rng);
-        else if constexpr (K == EstimatorKind::split) xs[k] = in.lightTree->sampleFar(sp, near, rng);
+        else if constexpr (K == EstimatorKind::split) xs[k] = in.lightTree->sampleFar(sp, *near, rng);
         else xs[k] = sampleSource<false>(L, nullptr, rng);
         if (xs[k].i < L.count) {
             __builtin_prefetch(&L.packed[xs[k].i]);
@@ -242,7 +243,7 @@ void runChunk(const LightingInputs& in, const LightArrays& L, const VisibilityOp
         for (std::uint32_t k = 0; k < n; ++k) {
             if (pix[k].sums.done) continue;
             Rng rng = stream(pix[k]);
-            drawLights<K>(in, L, pix[k].sp, *pix[k].field, rng, count, pix[k].xs);
+            drawLights<K>(in, L, pix[k].sp, pix[k].field, rng, count, pix[k].xs);  // (field: split's alone)
         }
         for (std::uint32_t k = 0; k < n; ++k) {
             GroupPixel& p = pix[k];
