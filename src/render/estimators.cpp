@@ -243,7 +243,7 @@ void runChunk(const LightingInputs& in, const LightArrays& L, const VisibilityOp
         for (std::uint32_t k = 0; k < n; ++k) {
             if (pix[k].sums.done) continue;
             Rng rng = stream(pix[k]);
-            drawLights<K>(in, L, pix[k].sp, pix[k].field, rng, count, pix[k].xs);  // (field: split's alone)
+            drawLights<K>(in, L, pix[k].sp, pix[k].field, rng, count, pix[k].xs);
         }
         for (std::uint32_t k = 0; k < n; ++k) {
             GroupPixel& p = pix[k];
@@ -290,7 +290,16 @@ struct NearFieldCache {
     NearFieldCache() { std::fill(std::begin(particle), std::end(particle), kNoParticle); }
 };
 
-/// The near field of particle j (found on the light tree from its centre).
+/// The k lights nearest to particle j's centre, other than j: the near
+/// field of every pixel on j (and of the pilot's pixels).
+void nearestToParticle(const LightingInputs& in, std::uint32_t j, std::uint32_t k, NearField& out) {
+    ShadingPoint centre{};
+    centre.x = in.particles.position[j];
+    centre.self = j;
+    in.lightTree->nearest(centre, k, out);
+}
+
+/// The near field of particle j, from the cache or found.
 const NearField& nearFieldOf(const LightingInputs& in, std::uint32_t j, NearFieldCache& cache, std::uint64_t& pinned,
                              std::uint32_t& spares) {
     static_assert(NearFieldCache::kSlots == 64);
@@ -308,10 +317,7 @@ const NearField& nearFieldOf(const LightingInputs& in, std::uint32_t j, NearFiel
         cache.particle[s] = j;
         pinned |= bit;
     }
-    ShadingPoint centre{};
-    centre.x = in.particles.position[j];
-    centre.self = j;
-    in.lightTree->nearest(centre, nearLightCount(in.render, in.nearLights), *out);
+    nearestToParticle(in, j, nearLightCount(in.render, in.nearLights), *out);
     return *out;
 }
 
@@ -539,7 +545,8 @@ LightingCounters dispatchPrimitive(const LightingInputs& in, const LightArrays& 
 
 std::uint32_t nearLightCount(const RenderSettings& render, std::uint32_t chosen) {
     if (render.near_lights > 0) return render.near_lights;
-    return chosen > 0 ? chosen : 16u;
+    ACC_CHECK(chosen > 0);  // automatic k: the frame's pilot (FrameRenderer::chooseFrameNearLights) ran
+    return chosen;
 }
 
 namespace {
@@ -554,31 +561,25 @@ void pilotPixel(const LightingInputs& in, const LightArrays& L, const Visibility
                 const std::vector<std::uint32_t>& ks, NearField& field, double* variance, DVec3& value) {
     const GBufferTexel& g = in.gbuffer.texels[px];
     const ShadingPoint sp = shadingPoint(g, in.particles);
-    ShadingPoint centre{};
-    centre.x = in.particles.position[g.particle];
-    centre.self = g.particle;
     const bool shadows = in.shading.visibility;
+    static_assert(kPilotSamples % LightingPlan::kChunkSamples == 0);
     for (std::size_t c = 0; c < ks.size(); ++c) {
-        in.lightTree->nearest(centre, ks[c], field);
-        LightingCounters counted;
+        nearestToParticle(in, g.particle, ks[c], field);
+        PixelSums far;  // the far samples alone, drawn and shaded as the render's are
+        far.discardNonFinite = in.render.nonfinite == NonFinitePolicy::discard;
         const DVec3 near = sumTerms<M, P>(in.bvh, L, sp, std::span<const std::uint32_t>(field.light, field.count), vis,
-                                          shadows, counted, nullptr);
+                                          shadows, far.c, nullptr);
         // The same stream at every k: the candidates differ by their near field alone.
         Rng rng(px, in.frame, RngPass::nearLightPilot, in.render.seed);
-        DVec3 sum(0.0), sumSq(0.0);
-        for (std::uint32_t s = 0; s < kPilotSamples; ++s) {
-            const LightSample x = in.lightTree->sampleFar(sp, field, rng);
-            LightTerm t;
-            if (x.i >= L.count || !L.term<M>(sp, x.i, t) || !seen<P>(in.bvh, L, sp, x.i, t, vis, shadows, counted, nullptr))
-                continue;
-            const DVec3 f = DVec3(t.value) / double(x.pdf);
-            sum += f;
-            sumSq += f * f;
+        LightSample xs[LightingPlan::kChunkSamples];
+        for (std::uint32_t s = 0; s < kPilotSamples; s += LightingPlan::kChunkSamples) {
+            drawLights<EstimatorKind::split>(in, L, sp, &field, rng, LightingPlan::kChunkSamples, xs);
+            shadeSamples<M, P>(in.bvh, L, sp, xs, LightingPlan::kChunkSamples, DVec3(0.0), vis, shadows, far, nullptr);
         }
-        const double n = kPilotSamples;
-        const DVec3 var = glm::max(DVec3(0.0), (sumSq - sum * sum / n) / (n - 1.0));
+        const double n = std::max(far.n, 2u);
+        const DVec3 var = glm::max(DVec3(0.0), (far.sumSq - far.sum * far.sum / n) / (n - 1.0));
         for (int ch = 0; ch < 3; ++ch) variance[c * 3 + ch] = var[ch];
-        value = near + sum / n;  // the last (largest) k's
+        value = near + far.sum / n;  // the last (largest) k's
     }
 }
 

@@ -2,13 +2,16 @@
 // hold (256x256 at k = 1024 needed 269 MB of 256 MiB; here 1000 particles): band-major sweeps
 // keep nothing between sweeps, and the estimator stays the sum it must be.
 // Checked against exact (itself checked against the brute-force oracle),
-// read back with OpenImageIO.
+// read back with OpenImageIO. And the pilot that picks k: its variance per
+// sample against the one renders of its view measure.
 #include <catch2/catch.hpp>
 
 #include <cmath>
 #include <filesystem>
+#include <map>
 
 #include <OpenImageIO/imageio.h>
+#include <nlohmann/json.hpp>
 
 #include "support/cli.h"
 
@@ -68,4 +71,42 @@ TEST_CASE("split at a resolution the old near-field cache overflowed: exact when
     // The image sums: |z| < 4.4 (two-sided 1e-5: this test fails by chance once in 100,000 runs).
     CHECK(std::fabs(sumSome - sumExact) < 4.4 * std::sqrt(var));
     CHECK(std::sqrt(var) < 0.01 * sumExact);  // and the check has power: the error bar is under 1% of the sum
+}
+
+TEST_CASE("split's pilot predicts the variance per sample that a render of its view measures", "[cli][split]") {
+    // The pilot's V(k) (16 far samples at up to 256 pixels of a 64-pixel-wide
+    // view) against the mean over the lit pixels of S x stderr^2 / (Lr^2 +
+    // 1e-2) of renders of that same view at fixed k, S = 256 (the render's
+    // own standard errors: independent samples on other streams).
+    const auto dir = scratchDir("split_pilot_variance");
+    const std::string scene = kBin + " render " + kScenes + "/quickstart.toml --quiet -D camera.width=64 -D camera.height=36 "
+                              "--frames 0 --estimator split --spp 256 ";
+    std::string out;
+    REQUIRE(runCommand(scene + "-o " + (dir / "auto.exr").string(), out) == 0);
+    const nlohmann::json pilot = nlohmann::json::parse(readFile(dir / "auto.stats.json"))["frames"][0]["near_light_pilot"];
+    std::map<std::uint32_t, double> predicted;
+    for (const auto& c : pilot["candidates"]) predicted[c["k"].get<std::uint32_t>()] = c["rel_variance"].get<double>();
+    std::map<std::uint32_t, double> measured;
+    for (const std::uint32_t k : {16u, 1024u}) {
+        const auto file = dir / ("k" + std::to_string(k) + ".exr");
+        REQUIRE(runCommand(scene + "-D render.near_lights=" + std::to_string(k) + " -o " + file.string(), out) == 0);
+        const auto lr = exrChannels(file, {"Lr.R", "Lr.G", "Lr.B"}), sd = exrChannels(file, {"Lr_stderr.R", "Lr_stderr.G", "Lr_stderr.B"});
+        double v = 0.0;
+        std::size_t lit = 0;
+        for (std::size_t p = 0; p + 2 < lr.size(); p += 3) {
+            if (lr[p] + lr[p + 1] + lr[p + 2] <= 0.0f) continue;
+            ++lit;
+            for (int c = 0; c < 3; ++c) v += 256.0 * double(sd[p + c]) * sd[p + c] / (double(lr[p + c]) * lr[p + c] + 1e-2) / 3.0;
+        }
+        REQUIRE(lit > 200);
+        measured[k] = v / double(lit);
+        INFO("k = " << k << ": pilot " << predicted[k] << ", render " << measured[k]);
+        REQUIRE(predicted.count(k));
+        // Heavy-tailed 1/d^2 terms: within a factor 2 (measured: within 25%).
+        CHECK(predicted[k] > 0.5 * measured[k]);
+        CHECK(predicted[k] < 2.0 * measured[k]);
+    }
+    // And the order that decides k: a near field of 1024 leaves far less to sample than one of 16.
+    CHECK(measured[1024] < 0.2 * measured[16]);
+    CHECK(predicted[1024] < 0.2 * predicted[16]);
 }

@@ -108,9 +108,8 @@ struct NearLightChoice {
 NearLightChoice chooseNearLights(const LightingInputs& pilot);
 
 /// The lights summed exactly per receiver by `split`: render.near_lights,
-/// or when 0 `chosen` (the frame's chooseNearLights; 0: none yet, the
-/// smallest candidate).
-std::uint32_t nearLightCount(const RenderSettings& render, std::uint32_t chosen = 0);
+/// or when 0 `chosen`, the frame's chooseNearLights (which must have run).
+std::uint32_t nearLightCount(const RenderSettings& render, std::uint32_t chosen);
 
 /// estimateLighting (docs/MODEL.md sections 3-4): `exact` sums every light i != j
 /// with one shadow ray each; `uniform` / `power` / `tree` average one-sample
