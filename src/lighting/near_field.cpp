@@ -22,7 +22,7 @@ float LightTree::farPower(const Node& node, std::uint32_t nearCount, double near
     return std::max(static_cast<float>(double(node.power) - nearPower), node.power * 1e-6f);
 }
 
-void LightTree::nearest(const ShadingPoint& sp, std::uint32_t k, NearField& out) const {
+void LightTree::nearest(const ShadingPoint& sp, std::uint32_t k, NearField& out, std::uint32_t cutNodes) const {
     constexpr std::uint32_t kNoSeed = 0xffffffffu;
     out.count = 0;
     out.power[0] = 0.0;
@@ -98,10 +98,11 @@ void LightTree::nearest(const ShadingPoint& sp, std::uint32_t k, NearField& out)
     std::uint32_t lights[NearField::kMaxLights];
     for (std::uint32_t j = 0; j < found; ++j) lights[j] = best[j].light;
     if (sp.self < trail_.size()) lights[found++] = sp.self;
-    nearField(sp, lights, found, out);
+    nearField(sp, lights, found, out, cutNodes);
 }
 
-void LightTree::nearField(const ShadingPoint& sp, const std::uint32_t* lights, std::uint32_t count, NearField& out) const {
+void LightTree::nearField(const ShadingPoint& sp, const std::uint32_t* lights, std::uint32_t count, NearField& out,
+                          std::uint32_t cutNodes) const {
     ACC_CHECK(count <= NearField::kMaxLights);
     // Tree order, with the prefix sums of the powers.
     std::pair<std::uint64_t, std::uint32_t> order[NearField::kMaxLights];
@@ -118,6 +119,7 @@ void LightTree::nearField(const ShadingPoint& sp, const std::uint32_t* lights, s
         const Vec3 delta = leaf.center - sp.x;
         out.radius2 = std::max(out.radius2, glm::dot(delta, delta));
     }
+    buildFarCut(sp, cutNodes, out);
 }
 
 namespace {
@@ -143,27 +145,123 @@ std::pair<float, float> LightTree::farChildren(std::uint32_t c, const NearField&
                               near.light + mid, hi - mid)};
 }
 
+float LightTree::cutWeight(std::uint32_t n, const NearField& near, std::uint32_t lo, std::uint32_t hi,
+                           const ShadingPoint& sp) const {
+    const Node& node = nodes_[n];
+    const float far = farPower(node, hi - lo, near.power[hi] - near.power[lo]);
+    if (!(far > 0.0f)) return 0.0f;
+    LightTreeView flat = view();
+    flat.model = ShadingModel::isotropic;
+    const float bound = flat.importance(node, far, sp, near.radius2);
+    if (model_ != ShadingModel::lambert) return bound;  // a normal per pixel: no cosine shared by the particle
+    return view().importance(node, far, sp, near.radius2) + 1e-3f * bound;
+}
+
+void LightTree::buildFarCut(const ShadingPoint& sp, std::uint32_t cutNodes, NearField& out) const {
+    ACC_CHECK(cutNodes >= 1 && cutNodes <= NearField::kMaxCut);
+    out.cutCount = 0;
+    out.cutTotal = 0.0f;
+    if (nodes_.empty()) return;
+    struct Open {
+        float weight;
+        std::uint32_t node, lo, hi, depth;
+        bool operator<(const Open& o) const { return weight < o.weight || (weight == o.weight && node > o.node); }
+    };
+    Open open[NearField::kMaxCut];
+    std::uint32_t count = 0;
+    const auto offer = [&](std::uint32_t n, std::uint32_t lo, std::uint32_t hi, std::uint32_t depth) {
+        const float w = cutWeight(n, out, lo, hi, sp);
+        if (!(w > 0.0f)) return;
+        open[count++] = {w, n, lo, hi, depth};
+        std::push_heap(open, open + count);
+    };
+    const auto keep = [&](const Open& o) {
+        const std::uint32_t c = out.cutCount++;
+        out.cutNode[c] = o.node;
+        out.cutWeight[c] = o.weight;
+        out.cutLo[c] = static_cast<std::uint16_t>(o.lo);
+        out.cutHi[c] = static_cast<std::uint16_t>(o.hi);
+        out.cutDepth[c] = static_cast<std::uint8_t>(o.depth);
+    };
+    offer(0, 0, out.count, 0);
+    // Refine where the weight is largest: each split adds at most one node.
+    while (count > 0 && count + out.cutCount < cutNodes) {
+        std::pop_heap(open, open + count);
+        const Open o = open[--count];
+        const Node& node = nodes_[o.node];
+        if (node.count == 1) {
+            keep(o);
+            continue;
+        }
+        const std::uint32_t mid = splitNear(out, o.lo, o.hi, o.depth);
+        offer(node.child, o.lo, mid, o.depth + 1);
+        offer(node.child + 1, mid, o.hi, o.depth + 1);
+    }
+    for (std::uint32_t k = 0; k < count; ++k) keep(open[k]);
+    float run = 0.0f;
+    for (std::uint32_t c = 0; c < out.cutCount; ++c) out.cutCdf[c] = run += out.cutWeight[c];
+    out.cutTotal = run;
+}
+
+void LightTree::farLeaves(std::uint32_t n, const NearField& near, std::uint32_t lo, std::uint32_t hi, const ShadingPoint& sp,
+                          FarLeaves& out) const {
+    std::uint32_t stack[2 * kGatherBelow], top = 0;
+    stack[top++] = n;
+    out.total = 0.0f;
+    out.count = 0;
+    while (top > 0) {
+        const std::uint32_t k = stack[--top];
+        const Node& m = nodes_[k];
+        if (m.count > 1) {
+            stack[top++] = m.child;
+            stack[top++] = m.child + 1;
+            continue;
+        }
+        if (std::find(near.light + lo, near.light + hi, m.child) != near.light + hi) continue;
+        out.leaf[out.count] = k;
+        out.importance[out.count] = view().importance(m, m.power, sp);
+        out.total += out.importance[out.count];
+        ++out.count;
+    }
+}
+
 LightSample LightTree::sampleFar(const ShadingPoint& sp, const NearField& near, Rng& rng) const {
-    if (nodes_.empty() || near.count >= nodes_[0].count) return {kNoLightSample, 0.0f};
-    std::uint32_t n = 0, lo = 0, hi = near.count, depth = 0;
-    float pdf = 1.0f;
-    while (nodes_[n].count > 1) {
-        const std::uint32_t c = nodes_[n].child;
+    if (near.cutCount == 0) return {kNoLightSample, 0.0f};
+    const float target = rng.uniform() * near.cutTotal;
+    const std::uint32_t c = std::min<std::uint32_t>(
+        static_cast<std::uint32_t>(std::upper_bound(near.cutCdf, near.cutCdf + near.cutCount, target) - near.cutCdf),
+        near.cutCount - 1);
+    float pdf = near.cutWeight[c] / near.cutTotal;
+    std::uint32_t n = near.cutNode[c], lo = near.cutLo[c], hi = near.cutHi[c], depth = near.cutDepth[c];
+    while (nodes_[n].count > kGatherBelow) {
+        const std::uint32_t child = nodes_[n].child;
         const std::uint32_t mid = splitNear(near, lo, hi, depth);
-        const auto [a, b] = farChildren(c, near, lo, mid, hi, sp);
+        const auto [a, b] = farChildren(child, near, lo, mid, hi, sp);
         const float u = rng.uniform();
         if (!(a + b > 0.0f)) return {kNoLightSample, 0.0f};
         const float pa = a / (a + b);
         if (u < pa) {
-            n = c;
+            n = child;
             hi = mid;
             pdf *= pa;
         } else {
-            n = c + 1;
+            n = child + 1;
             lo = mid;
             pdf *= 1.0f - pa;
         }
         ++depth;
+    }
+    if (nodes_[n].count > 1) {
+        FarLeaves leaves;
+        farLeaves(n, near, lo, hi, sp, leaves);
+        if (!(leaves.total > 0.0f)) return {kNoLightSample, 0.0f};
+        const float t = rng.uniform() * leaves.total;
+        std::uint32_t k = 0;
+        float run = leaves.importance[0];
+        while (k + 1 < leaves.count && (run <= t || leaves.importance[k] == 0.0f)) run += leaves.importance[++k];
+        while (leaves.importance[k] == 0.0f && k > 0) --k;  // rounding at the top end: the last leaf with a term
+        pdf *= leaves.importance[k] / leaves.total;
+        n = leaves.leaf[k];
     }
     if (!(pdf > 0.0f)) return {kNoLightSample, 0.0f};
     return {nodes_[n].child, pdf};
@@ -172,19 +270,41 @@ LightSample LightTree::sampleFar(const ShadingPoint& sp, const NearField& near, 
 float LightTree::pdfFar(const ShadingPoint& sp, const NearField& near, std::uint32_t i) const {
     if (i >= trail_.size() || near.contains(i)) return 0.0f;
     const Trail t = trail_[i];
-    std::uint32_t n = 0, lo = 0, hi = near.count;
-    float pdf = 1.0f;
-    for (std::uint32_t k = 0; k < t.depth; ++k) {
-        const std::uint32_t c = nodes_[n].child;
+    std::uint32_t n = 0, lo = 0, hi = near.count, k = 0;
+    // Down the light's path to the cut node above it.
+    const auto cutIndex = [&](std::uint32_t node) {
+        return static_cast<std::uint32_t>(std::find(near.cutNode, near.cutNode + near.cutCount, node) - near.cutNode);
+    };
+    std::uint32_t c = cutIndex(n);
+    for (; c == near.cutCount; c = cutIndex(n)) {
+        if (k == t.depth) return 0.0f;  // no cut node above it: no far power there
         const std::uint32_t mid = splitNear(near, lo, hi, k);
-        const auto [a, b] = farChildren(c, near, lo, mid, hi, sp);
+        const bool right = (t.bits >> k) & 1u;
+        n = nodes_[n].child + (right ? 1 : 0);
+        if (right) lo = mid;
+        else hi = mid;
+        ++k;
+    }
+    float pdf = near.cutWeight[c] / near.cutTotal;
+    for (; nodes_[n].count > kGatherBelow; ++k) {
+        const std::uint32_t child = nodes_[n].child;
+        const std::uint32_t mid = splitNear(near, lo, hi, k);
+        const auto [a, b] = farChildren(child, near, lo, mid, hi, sp);
         if (!(a + b > 0.0f)) return 0.0f;
         const bool right = (t.bits >> k) & 1u;
         const float pa = a / (a + b);
         pdf *= right ? 1.0f - pa : pa;
-        n = right ? c + 1 : c;
+        n = right ? child + 1 : child;
         if (right) lo = mid;
         else hi = mid;
+    }
+    if (nodes_[n].count > 1) {
+        FarLeaves leaves;
+        farLeaves(n, near, lo, hi, sp, leaves);
+        if (!(leaves.total > 0.0f)) return 0.0f;
+        for (std::uint32_t m = 0; m < leaves.count; ++m)
+            if (leaves.leaf[m] == t.leaf) return pdf * (leaves.importance[m] / leaves.total);
+        return 0.0f;
     }
     return pdf;
 }

@@ -136,6 +136,59 @@ TEST_CASE("every light sampler draws in proportion to its pdf (one chi-square ha
                  N, emits);
 }
 
+TEST_CASE("split's far cut, found at a particle's centre, draws in proportion to pdfFar at every pixel on it",
+          "[lighting][sampler][statistical]") {
+    // The renderer finds a particle's near field and far cut once, at its
+    // centre with its billboard normal, and draws far lights for each of its
+    // pixels at the pixel's own point (and, for sphere impostors, normal).
+    Settings s = accretion::test::smallDiskSettings();
+    s.particles.count = 4000;  // enough lights for cut nodes above the gather size
+    const Particles particles = ParticleSource(s).frame(0);
+    const auto N = static_cast<std::uint32_t>(particles.size());
+    const LightArrays L{particles, s.shading};
+    const LightTree tree(particles, s.shading);
+    const std::uint32_t j = 1234;
+    const Vec3 n = glm::normalize(Vec3(0.3f, 1.0f, 0.2f));
+    const ShadingPoint centre{particles.position[j], n, n, Vec3(0.8f), j, particles.position[j], Vec3(0.0f)};
+    // A point on the billboard's plane half a radius from the centre, seen
+    // with the billboard's normal and with a tilted (impostor) one.
+    const Vec3 along = glm::normalize(glm::cross(n, Vec3(1, 0, 0)));
+    const Vec3 local = 0.5f * particles.radius[j] * along;
+    ShadingPoint flat = centre;
+    flat.x += local;
+    flat.local = local;
+    ShadingPoint tilted = flat;
+    tilted.n = glm::normalize(n + 0.8f * along);
+    NearField near;
+    for (const std::uint32_t k : {16u, 256u}) {
+        INFO("k " << k);
+        tree.nearest(centre, k, near);
+        // The cut is refined down to single lights, and holds nodes that the
+        // draws descend below and gather from.
+        std::uint32_t leaves = 0, gathered = 0, descended = 0;
+        for (std::uint32_t c = 0; c < near.cutCount; ++c) {
+            const std::uint32_t count = tree.nodes()[near.cutNode[c]].count;
+            leaves += count == 1;
+            gathered += count > 1 && count <= 16;
+            descended += count > 16;
+        }
+        CHECK(leaves > 0);
+        CHECK(gathered > 0);
+        CHECK(descended > 0);
+        for (const ShadingPoint* sp : {&flat, &tilted}) {
+            std::vector<bool> lit(N);
+            for (std::uint32_t i = 0; i < N; ++i) {
+                LightTerm t;
+                lit[i] = !near.contains(i) && L.term<ShadingModel::lambert>(*sp, i, t);
+            }
+            checkSampler({sp == &flat ? "split: a pixel on the billboard" : "split: a pixel with a tilted normal",
+                          [&](Rng& rng) { return tree.sampleFar(*sp, near, rng); },
+                          [&](std::uint32_t i) { return tree.pdfFar(*sp, near, i); }},
+                         N, lit);
+        }
+    }
+}
+
 TEST_CASE("ReGIR cell reservoirs: W is an unbiased estimate of 1 / p_src for every light", "[lighting][sampler][statistical]") {
     // A regir candidate carries its slot's W in place of 1 / p_src. RIS then
     // stays unbiased iff E[W 1{y = i}] = 1 for every light i that can light a

@@ -38,14 +38,21 @@ public:
 
     /// The min(k, N - 1) lights nearest to the receiver other than its own
     /// particle (depth-first, the nearer child first, pruned by the k-th
-    /// distance on the nodes' spheres), in tree order with their powers.
-    void nearest(const ShadingPoint& sp, std::uint32_t k, NearField& out) const;
-    /// The near field of these lights (nearest()'s out.light, in any order:
-    /// what a cache keeps of it).
-    void nearField(const ShadingPoint& sp, const std::uint32_t* lights, std::uint32_t count, NearField& out) const;
-    /// Draw a far light (not in `near`): sample()'s descent with each node's
-    /// power less the power of its near lights (a node of near lights only
-    /// has none), so the pdf is renormalised over the far lights exactly.
+    /// distance on the nodes' spheres), in tree order with their powers, and
+    /// the far cut seen from the receiver (NearField). The renderer finds it
+    /// at a particle's centre with the particle's normal, for all its pixels.
+    /// The cut has at most `cutNodes` nodes (1..NearField::kMaxCut).
+    void nearest(const ShadingPoint& sp, std::uint32_t k, NearField& out, std::uint32_t cutNodes = NearField::kMaxCut) const;
+    /// The near field of these lights (nearest()'s out.light, in any order)
+    /// and its far cut of at most `cutNodes` nodes, seen from sp.
+    void nearField(const ShadingPoint& sp, const std::uint32_t* lights, std::uint32_t count, NearField& out,
+                   std::uint32_t cutNodes = NearField::kMaxCut) const;
+    /// Draw a far light (not in `near`): a node of near's cut in proportion
+    /// to its weight, then sample()'s descent below it with each node's power
+    /// less the power of its near lights (a node of near lights only has
+    /// none), ending with one draw among the far leaves of a node of at most
+    /// kGatherBelow lights, so the pdf is renormalised over the far lights
+    /// exactly. sp may be another point than the one near was found for.
     LightSample sampleFar(const ShadingPoint& sp, const NearField& near, Rng& rng) const;
     /// Probability that sampleFar() returns light i (0 for a near light).
     float pdfFar(const ShadingPoint& sp, const NearField& near, std::uint32_t i) const;
@@ -81,6 +88,22 @@ private:
     /// near.light[lo, mid) and [mid, hi): one step of sampleFar / pdfFar.
     std::pair<float, float> farChildren(std::uint32_t c, const NearField& near, std::uint32_t lo, std::uint32_t mid,
                                         std::uint32_t hi, const ShadingPoint& sp) const;
+    /// The far cut of `out` (its near lights found), seen from sp.
+    void buildFarCut(const ShadingPoint& sp, std::uint32_t cutNodes, NearField& out) const;
+    /// A cut node's weight: its far importance at sp, plus 1e-3 of the bound
+    /// without the cosine (never 0 where the node has far power).
+    float cutWeight(std::uint32_t n, const NearField& near, std::uint32_t lo, std::uint32_t hi, const ShadingPoint& sp) const;
+    /// The far leaves of node n (at most kGatherBelow lights; its near
+    /// lights are near.light[lo, hi)) with their importances at sp.
+    struct FarLeaves {
+        std::uint32_t leaf[16];
+        float importance[16];
+        float total;
+        std::uint32_t count;
+    };
+    static constexpr std::uint32_t kGatherBelow = 16;
+    void farLeaves(std::uint32_t n, const NearField& near, std::uint32_t lo, std::uint32_t hi, const ShadingPoint& sp,
+                   FarLeaves& out) const;
     /// The power of a node's far lights (`nearCount` of its lights are near, with `nearPower`).
     static float farPower(const Node& node, std::uint32_t nearCount, double nearPower);
     /// A light's path from the root as a tree-order key (the first step in bit 63).

@@ -111,6 +111,13 @@ NearLightChoice chooseNearLights(const LightingInputs& pilot);
 /// or when 0 `chosen`, the frame's chooseNearLights (which must have run).
 std::uint32_t nearLightCount(const RenderSettings& render, std::uint32_t chosen);
 
+/// The most nodes in `split`'s far cut (NearField): twice render.samples,
+/// a power of 2 in [16, NearField::kMaxCut]. A cut of M nodes costs about
+/// M importance bounds once per near field and saves about log2(M) levels
+/// of the descent on every far sample of the particle's pixels; measured
+/// on disk_100k at 1080p, 1024 nodes was the best at 512 spp (bench/README.md).
+std::uint32_t farCutSize(const RenderSettings& render);
+
 /// estimateLighting (docs/MODEL.md sections 3-4): `exact` sums every light i != j
 /// with one shadow ray each; `uniform` / `power` / `tree` average one-sample
 /// estimates f I G V / p(i) (S per round, more rounds until target_stderr);
