@@ -87,13 +87,14 @@ struct NearLightChoice {
         double relVariance = 0.0;   ///< V(k): one far sample's variance over the estimate squared (+ 1e-2), mean over pilot pixels and RGB
         double cost = 0.0;          ///< per pixel, in near lights: k + rho S (rho: kFarSampleCost)
     };
-    /// A far sample (descent, term, a long shadow ray) costs as much as this
-    /// many near lights (their search shared by a particle's pixels, a term
-    /// and a short ray each): measured on disk_100k at 1920x1080, k = 1024,
-    /// on the 2-core EPYC VM: 0.83 us per far sample, 0.088 us per near
-    /// light, per lit pixel on both cores (bench/split_1080p.sh: 0.524 s per
-    /// spp and 56 s of near field over 634K lit pixels).
-    static constexpr double kFarSampleCost = 9.4;
+    /// A far sample (a cut node, a short descent, a term, a long shadow ray)
+    /// costs as much as this many near lights (their search and far cut
+    /// shared by a particle's pixels, a term and a short ray each): measured
+    /// on disk_100k at 1920x1080, k = 1024, on the 2-core EPYC VM at 3e803b0:
+    /// 0.40 us per far sample, 0.094 us per near light, per lit pixel on both
+    /// cores (bench/split_1080p.sh: 0.253 s per spp and 61 s of near field
+    /// over 634K lit pixels).
+    static constexpr double kFarSampleCost = 4.3;
     std::uint32_t k = 0;            ///< the choice: least relVariance x cost
     std::uint32_t pixels = 0;       ///< pilot pixels (lit)
     std::vector<Candidate> candidates;
