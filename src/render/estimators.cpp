@@ -560,16 +560,16 @@ std::uint32_t nearLightCount(const RenderSettings& render, std::uint32_t chosen)
 
 std::uint32_t farCutSize(const RenderSettings& render) {
     const std::uint32_t twice = render.samples >= NearField::kMaxCut / 2 ? NearField::kMaxCut : 2 * render.samples;
-    return std::clamp<std::uint32_t>(std::bit_ceil(twice), 16, NearField::kMaxCut);
+    return std::clamp<std::uint32_t>(std::bit_ceil(twice), kMinFarCut, NearField::kMaxCut);
 }
 
 namespace {
 
 constexpr std::uint32_t kPilotPixels = 256, kPilotSamples = 16;
 /// The pilot's far cut: one size whatever S, so that V(k) does not depend on
-/// S (the render's cut, farCutSize, grows with S; on disk_100k's 1080p crop
-/// relMSE x S moved by under 5% from 64 to 1024 nodes).
-constexpr std::uint32_t kPilotCutNodes = 256;
+/// S: the smallest a render uses (farCutSize); a larger one has about the
+/// same variance (disk_100k at 1080p, k = 1024: within 5% from 256 to 1024 nodes).
+constexpr std::uint32_t kPilotCutNodes = kMinFarCut;
 constexpr double kPilotEpsilon = 1e-2;  ///< relMSE's (analysis/image_metrics.h: kRelMseEpsilon)
 
 /// One pilot pixel at every candidate k: per-channel far-sample variance,
