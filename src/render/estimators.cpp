@@ -565,7 +565,12 @@ std::uint32_t farCutSize(const RenderSettings& render) {
 
 namespace {
 
-constexpr std::uint32_t kPilotPixels = 256, kPilotSamples = 16;
+/// 64 far samples a pixel: with 16, V(k) came out noisy and low where the
+/// far field's rare bright draws dominate (disk_100k at 1080p, frames 0-2:
+/// V(1024) 0.32-0.36 and V(16) 1.6-2.6 against 0.55 and 1.34 measured by
+/// renders, so k jumped between 32 and 1024 from frame to frame); with 64,
+/// 0.46-0.54 and 1.6-1.7 for 0.2 s a frame instead of 0.15.
+constexpr std::uint32_t kPilotPixels = 256, kPilotSamples = 64;
 /// The pilot's far cut: one size whatever S, so that V(k) does not depend on
 /// S: the smallest a render uses (farCutSize); a larger one has about the
 /// same variance (disk_100k at 1080p, k = 1024: within 5% from 256 to 1024 nodes).

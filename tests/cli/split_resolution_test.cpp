@@ -74,7 +74,7 @@ TEST_CASE("split at a resolution the old near-field cache overflowed: exact when
 }
 
 TEST_CASE("split's pilot predicts the variance per sample that a render of its view measures", "[cli][split]") {
-    // The pilot's V(k) (16 far samples at up to 256 pixels of a 64-pixel-wide
+    // The pilot's V(k) (64 far samples at up to 256 pixels of a 64-pixel-wide
     // view) against the mean over the lit pixels of S x stderr^2 / (Lr^2 +
     // 1e-2) of renders of that same view at fixed k, S = 256 (the render's
     // own standard errors: independent samples on other streams).

@@ -102,7 +102,7 @@ struct NearLightChoice {
 
 /// The pilot: each lit pixel of `pilot.gbuffer` (at most 256, evenly
 /// spaced), for k = 16, 32, ..., NearField::kMaxNear: its particle's near
-/// field, the exact near sum at its point and 16 far samples on fixed
+/// field, the exact near sum at its point and 64 far samples on fixed
 /// streams (RngPass::nearLightPilot). Picks the k of least V(k) x (k +
 /// rho S) for S = render.samples: the error x time of a render of S samples.
 /// Deterministic: the same k for any crop, shard, resume or thread count.
