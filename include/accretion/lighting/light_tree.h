@@ -95,13 +95,13 @@ private:
     float cutWeight(std::uint32_t n, const NearField& near, std::uint32_t lo, std::uint32_t hi, const ShadingPoint& sp) const;
     /// The far leaves of node n (at most kGatherBelow lights; its near
     /// lights are near.light[lo, hi)) with their importances at sp.
+    static constexpr std::uint32_t kGatherBelow = 16;
     struct FarLeaves {
-        std::uint32_t leaf[16];
-        float importance[16];
+        std::uint32_t leaf[kGatherBelow];
+        float importance[kGatherBelow];
         float total;
         std::uint32_t count;
     };
-    static constexpr std::uint32_t kGatherBelow = 16;
     void farLeaves(std::uint32_t n, const NearField& near, std::uint32_t lo, std::uint32_t hi, const ShadingPoint& sp,
                    FarLeaves& out) const;
     /// The power of a node's far lights (`nearCount` of its lights are near, with `nearPower`).
