@@ -162,7 +162,7 @@ TEST_CASE("split's far cut, found at a particle's centre, draws in proportion to
     NearField near;
     for (const std::uint32_t k : {16u, 256u}) {
         INFO("k " << k);
-        tree.nearest(centre, k, near);
+        tree.nearest(centre, k, near, 256);  // the renderer's smallest cut (kMinFarCut)
         // The cut is refined down to single lights, and holds nodes that the
         // draws descend below and gather from.
         std::uint32_t leaves = 0, gathered = 0, descended = 0;
