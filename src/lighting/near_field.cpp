@@ -255,11 +255,7 @@ LightSample LightTree::sampleFar(const ShadingPoint& sp, const NearField& near, 
         FarLeaves leaves;
         farLeaves(n, near, lo, hi, sp, leaves);
         if (!(leaves.total > 0.0f)) return {kNoLightSample, 0.0f};
-        const float t = rng.uniform() * leaves.total;
-        std::uint32_t k = 0;
-        float run = leaves.importance[0];
-        while (k + 1 < leaves.count && (run <= t || leaves.importance[k] == 0.0f)) run += leaves.importance[++k];
-        while (leaves.importance[k] == 0.0f && k > 0) --k;  // rounding at the top end: the last leaf with a term
+        const std::uint32_t k = pickLeaf(leaves.importance, leaves.count, rng.uniform() * leaves.total);
         pdf *= leaves.importance[k] / leaves.total;
         n = leaves.leaf[k];
     }

@@ -32,6 +32,18 @@ struct LightTreeSmallNode {
     float total;
 };
 
+/// The entry of `importance[0, count)` (their sum > 0) that `target`, a
+/// uniform times that sum, falls on: each with probability in proportion
+/// to its importance; where rounding at the top end lands past the last
+/// non-zero one, that one (an entry of importance 0 is never picked).
+ACC_HD inline std::uint32_t pickLeaf(const float* importance, std::uint32_t count, float target) {
+    std::uint32_t k = 0;
+    float run = importance[0];
+    while (k + 1 < count && (run <= target || importance[k] == 0.0f)) run += importance[++k];
+    while (importance[k] == 0.0f && k > 0) --k;
+    return k;
+}
+
 struct LightTreeView {
     static constexpr std::uint32_t kExactBelow = LightTreeSmallNode::kCapacity;
     const LightTreeNode* nodes = nullptr;
@@ -162,11 +174,7 @@ struct LightTreeView {
             LightTreeSmallNode leaves;
             const std::uint32_t count = smallNodeLeaves(n, sp, leaves);
             if (!(leaves.total > 0.0f)) return {kNoLightSample, 0.0f};
-            const float target = rng.uniform() * leaves.total;
-            std::uint32_t k = 0;
-            float run = leaves.importance[0];
-            while (k + 1 < count && (run <= target || leaves.importance[k] == 0.0f)) run += leaves.importance[++k];
-            while (leaves.importance[k] == 0.0f && k > 0) --k;  // rounding at the top end: the last leaf with a term
+            const std::uint32_t k = pickLeaf(leaves.importance, count, rng.uniform() * leaves.total);
             pdf *= leaves.importance[k] / leaves.total;
             n = leaves.leaf[k];
         }
