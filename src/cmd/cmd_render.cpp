@@ -217,7 +217,8 @@ nlohmann::json writeFrameOutputs(const RenderRun& run, std::uint32_t frame, cons
     for (const Heatmap& h : image.heatmaps) run.guard.check(base + "." + h.name + ".png", "output");
     // The previews show the rendered window; their tone is stated in the EXR.
     const PixelWindow& w = image.window;
-    const std::vector<Vec3> L = cropPixels(image.L, image.width, w), Lr = cropPixels(image.lighting.Lr, image.width, w);
+    const std::vector<Vec3>& L = image.L;
+    const std::vector<Vec3>& Lr = image.lighting.Lr;
     const RenderSettings& rs = settings.render;
     const PreviewTone tone = previewTone(L, rs.tonemap, rs.auto_exposure, rs.exposure);
     const PreviewTone lrTone = previewTone(Lr, rs.tonemap, rs.auto_exposure, rs.exposure);
@@ -246,7 +247,7 @@ nlohmann::json writeFrameOutputs(const RenderRun& run, std::uint32_t frame, cons
         fj["gpu"] = toJson(makeGpuReport(image.counters, settings, fs.reservoirBytes));
         for (const Heatmap& h : image.heatmaps) {
             const std::string png = base + "." + h.name + ".png";
-            writeHeatmapPng(png, cropPixels(h.values, image.width, image.window), image.window.width(), image.window.height(),
+            writeHeatmapPng(png, h.values, image.window.width(), image.window.height(),
                             h.name + ": " + h.unit);
             fj["outputs"][h.name + "_png"] = png;
         }
@@ -315,6 +316,14 @@ void runRender(const RenderArgs& args) {
     std::uint32_t firstFrame = sharding.first;
     std::optional<AccumulationFile> resumed = checkpoint.load(args.resume, firstFrame, sharding.end);
     if (resumed) {
+        // The same settings hold the same pixels; a file that says otherwise was not written by this run.
+        const Accumulation& acc = resumed->acc;
+        const PixelWindow traced = planFrame(settings, FrameFacts{}).traced;
+        if (acc.width != settings.camera.width || acc.height != settings.camera.height || acc.window != traced)
+            throw InputError(fmt::format("{}: checkpoint of pixels [{}, {}) x [{}, {}) of {}x{}; this run lights [{}, {}) x [{}, {}) of {}x{}",
+                                         checkpoint.file().string(), acc.window.x0, acc.window.x1, acc.window.y0,
+                                         acc.window.y1, acc.width, acc.height, traced.x0, traced.x1, traced.y0, traced.y1,
+                                         settings.camera.width, settings.camera.height));
         for (const auto& f : resumed->header.at("finished_frames")) stats["frames"].push_back(f);
         firstFrame = resumed->header.at("frame").get<std::uint32_t>();
         if (!args.quiet)
@@ -388,7 +397,8 @@ void runRender(const RenderArgs& args) {
             if (!sharding.accumulating) stopBetweenFrames(signal, frame + 1);
             Accumulation next;
             next.reset(settings.camera.width, settings.camera.height,
-                       sharding.bySamples ? planLighting(settings.render, settings.camera.height, shard).begin : 0);
+                       sharding.bySamples ? planLighting(settings.render, settings.camera.height, shard).begin : 0,
+                       &renderer.plan().traced);
             saveCheckpoint(frame + 1, next);
             interrupt(signal, frame + 1, next);
         }

@@ -116,7 +116,7 @@ void explainPixel(const Settings& settings, std::uint32_t x, std::uint32_t y, bo
         stats = FrameStats{};
         img = renderer.render(frame, stats, nullptr, frame == last ? &trace : nullptr);
     }
-    const std::size_t px = trace.px;
+    const std::size_t px = img.window.index(x, y);  // the layers hold the window's pixels
     fmt::print("pixel ({}, {}) of frame {}, {} estimator, seed {}\n", x, y, last, enumName(settings.render.estimator),
                settings.render.seed);
     if (img.particle[px] == kNoParticle) {

@@ -55,6 +55,7 @@ void writeAccumulationFile(const std::filesystem::path& file, const Accumulation
     nlohmann::json header = content.header;
     header["width"] = a.width;
     header["height"] = a.height;
+    header["window"] = {a.window.x0, a.window.x1, a.window.y0, a.window.y1};
     header["next_chunk"] = a.nextChunk;
     header["band_rows"] = a.bandRows;
     header["band_cols"] = a.bandCols;
@@ -102,6 +103,12 @@ AccumulationFile parseAccumulationFile(const std::string& bytes, const std::file
         Accumulation& a = f.acc;
         a.width = f.header.at("width").get<std::uint32_t>();
         a.height = f.header.at("height").get<std::uint32_t>();
+        // The pixels held: files before windowed sums hold the whole image.
+        const std::vector<std::uint32_t> w = f.header.value("window", std::vector<std::uint32_t>{0, a.width, 0, a.height});
+        if (w.size() != 4 || w[0] >= w[1] || w[2] >= w[3] || w[1] > a.width || w[3] > a.height)
+            throw InputError(fmt::format("{}: corrupted accumulation header: window {} of a {}x{} image", file.string(),
+                                         f.header.at("window").dump(), a.width, a.height));
+        a.window = {w[0], w[1], w[2], w[3]};
         a.nextChunk = f.header.at("next_chunk").get<std::uint64_t>();
         a.bandRows = f.header.value("band_rows", 0u);  // files before band-major sweeps: 0
         a.bandCols = f.header.value("band_cols", 0u);

@@ -91,14 +91,13 @@ void writeFrameExr(const std::filesystem::path& file, const FrameImage& img, boo
     const int nch = static_cast<int>(channels.size());
 
     // The data window is the rendered window (render.crop), inside the
-    // display window of the whole image.
-    const PixelWindow w = img.window.pixels() ? img.window : PixelWindow::whole(img.width, img.height);
+    // display window of the whole image; the layers hold its pixels.
+    const PixelWindow& w = img.window;
+    ACC_CHECK(img.L.size() == w.pixels());
     // Interleaved pixels in the native per-channel formats (all 4 bytes).
     std::vector<std::uint32_t> buf(w.pixels() * nch);
-    std::size_t k = 0;
-    for (std::uint32_t y = w.y0; y < w.y1; ++y)
-        for (std::uint32_t x = w.x0; x < w.x1; ++x, ++k)
-            for (int ch = 0; ch < nch; ++ch) buf[k * nch + ch] = channels[ch].bits(std::size_t(y) * img.width + x);
+    for (std::size_t k = 0; k < w.pixels(); ++k)
+        for (int ch = 0; ch < nch; ++ch) buf[k * nch + ch] = channels[ch].bits(k);
 
     ExrImage exr;
     exr.fullWidth = img.width;

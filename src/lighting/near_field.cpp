@@ -23,11 +23,21 @@ float LightTree::farPower(const Node& node, std::uint32_t nearCount, double near
 }
 
 void LightTree::nearest(const ShadingPoint& sp, std::uint32_t k, NearField& out, std::uint32_t cutNodes) const {
-    constexpr std::uint32_t kNoSeed = 0xffffffffu;
     out.count = 0;
     out.power[0] = 0.0;
-    k = std::min(k, NearField::kMaxNear);
     if (nodes_.empty()) return;
+    // The receiver's own particle joins them: it gives no term, and the far
+    // sampler must not spend draws on it.
+    std::uint32_t lights[NearField::kMaxLights];
+    std::uint32_t found = nearestLights(sp, k, lights);
+    if (sp.self < trail_.size()) lights[found++] = sp.self;
+    nearField(sp, lights, found, out, cutNodes);
+}
+
+std::uint32_t LightTree::nearestLights(const ShadingPoint& sp, std::uint32_t k, std::uint32_t* lights) const {
+    constexpr std::uint32_t kNoSeed = 0xffffffffu;
+    k = std::min(k, NearField::kMaxNear);
+    if (nodes_.empty()) return 0;
     // The best so far as a max-heap on squared distance (ties: the larger
     // index is dropped first).
     struct Found {
@@ -93,12 +103,9 @@ void LightTree::nearest(const ShadingPoint& sp, std::uint32_t k, NearField& out,
         search(seed, kNoSeed);
         if (seed != 0) search(0, seed);
     }
-    // The receiver's own particle joins them: it gives no term, and the far
-    // sampler must not spend draws on it.
-    std::uint32_t lights[NearField::kMaxLights];
+    std::sort_heap(best, best + found);  // nearest first, in the heap's order
     for (std::uint32_t j = 0; j < found; ++j) lights[j] = best[j].light;
-    if (sp.self < trail_.size()) lights[found++] = sp.self;
-    nearField(sp, lights, found, out, cutNodes);
+    return found;
 }
 
 void LightTree::nearField(const ShadingPoint& sp, const std::uint32_t* lights, std::uint32_t count, NearField& out,

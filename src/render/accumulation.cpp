@@ -36,9 +36,11 @@ LightingPlan planLighting(const RenderSettings& render, std::uint32_t height, Sh
     return plan;
 }
 
-void Accumulation::reset(std::uint32_t w, std::uint32_t h, std::uint64_t firstChunk) {
+void Accumulation::reset(std::uint32_t w, std::uint32_t h, std::uint64_t firstChunk, const PixelWindow* lit) {
     width = w;
     height = h;
+    window = lit ? *lit : PixelWindow::whole(w, h);
+    ACC_CHECK(PixelWindow::whole(w, h).contains(window));
     const std::size_t count = pixels();
     sum.assign(count, DVec3(0.0));
     sumSq.assign(count, DVec3(0.0));
@@ -50,7 +52,7 @@ void Accumulation::reset(std::uint32_t w, std::uint32_t h, std::uint64_t firstCh
 }
 
 void Accumulation::merge(const Accumulation& o) {
-    ACC_CHECK(o.width == width && o.height == height);
+    ACC_CHECK(o.width == width && o.height == height && o.window == window);
     for (std::size_t px = 0; px < pixels(); ++px) {
         sum[px] += o.sum[px];
         sumSq[px] += o.sumSq[px];

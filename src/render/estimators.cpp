@@ -197,7 +197,8 @@ void risChunk(const ParticleBvh& bvh, const LightArrays& L, const AliasTable* ta
 
 /// One hit pixel of a group while its chunks run.
 struct GroupPixel {
-    std::size_t px = 0;
+    std::size_t px = 0;     ///< y * width + x in the whole image: its streams, its trace
+    std::size_t slot = 0;   ///< in the window's buffers (G-buffer, sums, image)
     ShadingPoint sp;
     PixelSums sums;
     RayCounters rays;       ///< counting mode: its shadow rays' traversal
@@ -346,7 +347,8 @@ void prepareNearField(const LightingInputs& in, const LightArrays& L, const Visi
 }
 
 /// Runs chunks [c0, c1) over every pixel of `area` (exact: of its rows that
-/// the chunks are) in one parallel sweep, each pixel's sums in registers:
+/// the chunks are; a part of the G-buffer's window, whose layout `acc` and
+/// `out` share) in one parallel sweep, each pixel's sums in registers:
 /// loaded from and stored to `acc`, or (acc null: the whole frame in one
 /// sweep) resolved straight into `out`. Pixels run in
 /// groups of a tile row (runChunk). Counters (counting mode): per pixel, its
@@ -357,6 +359,7 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
                        LightingImage* out, std::uint64_t c0, std::uint64_t c1, Progress* progress,
                        const PixelWindow& area) {
     const GBuffer& gb = in.gbuffer;
+    ACC_CHECK(gb.window.contains(area) && (!acc || acc->window == gb.window) && (acc || out->Lr.size() == gb.texels.size()));
     const VisibilityOptions vis = VisibilityOptions::from(in.render);
     const EstimatorKind kind = in.render.estimator;
     const bool shadows = in.shading.visibility;  // off: V = 1, no shadow rays
@@ -369,7 +372,7 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
                                           : area.y1;
     if (row0 >= row1 || area.x0 >= area.x1) return {};
 
-    // Counting mode: pixel px's thread, with its work (hit pixels: `p`).
+    // Counting mode (the whole image: slot = px): pixel px's thread, with its work (hit pixels: `p`).
     const auto record = [&](std::size_t px, const GroupPixel* p) {
         if constexpr (Count) {
             const GBufferTexel& g = gb.texels[px];
@@ -390,39 +393,40 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
         for (std::uint32_t y = r.rows().begin(); y != r.rows().end(); ++y) {
             for (std::uint32_t x0 = r.cols().begin(); x0 < r.cols().end(); x0 += kGroupPixels) {
                 const std::uint32_t x1 = std::min(r.cols().end(), x0 + kGroupPixels);
-                const std::size_t row = std::size_t(y) * gb.width;
+                const std::size_t row = std::size_t(y) * gb.width, rowSlot = gb.window.index(x0, y) - x0;
                 // The next group's texels (the next row's at a row's end) are
                 // read soon: a range's rows are short runs of the G-buffer.
-                const std::size_t next = x1 < r.cols().end() ? row + x1 : row + gb.width + r.cols().begin();
+                const std::size_t next = x1 < r.cols().end() ? rowSlot + x1 : rowSlot + gb.window.width() + r.cols().begin();
                 if (next + kGroupPixels <= gb.texels.size())
                     for (std::size_t b = 0; b < kGroupPixels * sizeof(GBufferTexel); b += 64)
                         __builtin_prefetch(reinterpret_cast<const char*>(&gb.texels[next]) + b);
                 // The group's hits first, their particles' records prefetched.
                 std::uint32_t n = 0;
                 for (std::uint32_t x = x0; x != x1; ++x) {
-                    const std::size_t px = row + x;
-                    const std::uint32_t j = gb.texels[px].particle;
+                    const std::size_t slot = rowSlot + x;
+                    const std::uint32_t j = gb.texels[slot].particle;
                     if (j == kNoParticle) {  // nothing to add: sums stay 0
-                        record(px, nullptr);
+                        record(row + x, nullptr);
                         if (!acc) {
-                            out->Lr[px] = out->Lr_stderr[px] = Vec3(0.0f);
-                            out->spp[px] = out->rejected[px] = 0.0f;
+                            out->Lr[slot] = out->Lr_stderr[slot] = Vec3(0.0f);
+                            out->spp[slot] = out->rejected[slot] = 0.0f;
                         }
                         continue;
                     }
                     __builtin_prefetch(&in.particles.position[j]);
                     __builtin_prefetch(&in.particles.albedo[j]);
-                    pix[n++].px = px;
+                    pix[n].px = row + x;
+                    pix[n++].slot = slot;
                 }
                 if (n == 0) continue;
                 hitPixels += n;
                 for (std::uint32_t k = 0; k < n; ++k) {
                     GroupPixel& p = pix[k];
-                    p.sp = shadingPoint(gb.texels[p.px], in.particles);
+                    p.sp = shadingPoint(gb.texels[p.slot], in.particles);
                     p.sums = PixelSums{};
                     p.sums.discardNonFinite = in.render.nonfinite == NonFinitePolicy::discard;
                     p.rays = RayCounters{};
-                    if (acc) p.sums.load(*acc, p.px);
+                    if (acc) p.sums.load(*acc, p.slot);
                     if (in.trace && in.trace->px == p.px) [[unlikely]] p.sums.trace = in.trace;
                 }
                 if (kind == EstimatorKind::exact) {
@@ -454,8 +458,8 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
                 for (std::uint32_t k = 0; k < n; ++k) {
                     GroupPixel& p = pix[k];
                     record(p.px, &p);
-                    if (acc) p.sums.store(*acc, p.px);
-                    else p.sums.c.nonFinite += resolvePixel(p.sums.sum, p.sums.sumSq, p.sums.n, p.sums.rejected, plan.exact, *out, p.px);
+                    if (acc) p.sums.store(*acc, p.slot);
+                    else p.sums.c.nonFinite += resolvePixel(p.sums.sum, p.sums.sumSq, p.sums.n, p.sums.rejected, plan.exact, *out, p.slot);
                     p.sums.c.nonFinite += p.sums.rejected - p.sums.rejectedBefore;
                     c += p.sums.c;
                 }
@@ -469,9 +473,6 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
     for (const auto& c : counters) total += c;
     return total;
 }
-
-/// The pixels a frame's lighting covers: render.crop's window, else the whole image.
-PixelWindow litWindow(const LightingInputs& in) { return PixelWindow::of(in.render, in.gbuffer.width, in.gbuffer.height); }
 
 /// How long a band of a Monte Carlo sweep should take: what a stop request
 /// or a due checkpoint waits for. A band is sized from the slowest pixel
@@ -492,14 +493,13 @@ template <ShadingModel M, Primitive P, bool Count>
 LightingCounters run(const LightingInputs& in, const LightArrays& L, const LightingPlan& plan, Accumulation& acc,
                      const ChunkHook& afterChunk, Progress* progress) {
     LightingCounters total;
-    const PixelWindow whole = PixelWindow::whole(acc.width, acc.height);
-    if (Count) {  // the GPU's dispatch: the whole frame, whatever the crop
-        total += sweep<M, P, Count>(in, L, plan, &acc, nullptr, acc.nextChunk, plan.end, progress, whole);
+    const PixelWindow w = in.gbuffer.window;  // a crop lights its window alone
+    if (Count) {  // the GPU's dispatch: the whole frame, in one sweep
+        total += sweep<M, P, Count>(in, L, plan, &acc, nullptr, acc.nextChunk, plan.end, progress, w);
         acc.nextChunk = plan.end;
         if (afterChunk) afterChunk(acc);
         return total;
     }
-    const PixelWindow w = litWindow(in);  // a crop lights its window alone
     double pixelChunkSeconds = 0.0;        // measured: the slowest pixel-chunk of a band so far
     while (acc.nextChunk < plan.end) {
         const std::uint64_t c = acc.nextChunk;
@@ -578,7 +578,9 @@ constexpr std::uint32_t kPilotCutNodes = kMinFarCut;
 constexpr double kPilotEpsilon = 1e-2;  ///< relMSE's (analysis/image_metrics.h: kRelMseEpsilon)
 
 /// One pilot pixel at every candidate k: per-channel far-sample variance,
-/// and the estimate (near sum + far mean) at the largest k.
+/// and the estimate (near sum + far mean) at the largest k. The near fields
+/// are nearestToParticle's: one search for the largest k, whose first k
+/// lights are the search's for each smaller k.
 template <ShadingModel M, Primitive P>
 void pilotPixel(const LightingInputs& in, const LightArrays& L, const VisibilityOptions& vis, std::size_t px,
                 const std::vector<std::uint32_t>& ks, NearField& field, double* variance, DVec3& value) {
@@ -586,12 +588,20 @@ void pilotPixel(const LightingInputs& in, const LightArrays& L, const Visibility
     const ShadingPoint sp = shadingPoint(g, in.particles);
     const bool shadows = in.shading.visibility;
     static_assert(kPilotSamples % LightingPlan::kChunkSamples == 0);
+    ShadingPoint centre{};
+    centre.x = in.particles.position[g.particle];
+    centre.n = sp.n;
+    centre.self = g.particle;
+    std::uint32_t nearest[NearField::kMaxLights];
+    const std::uint32_t found = in.lightTree->nearestLights(centre, ks.back(), nearest);
     for (std::size_t c = 0; c < ks.size(); ++c) {
-        nearestToParticle(in, g.particle, ks[c], sp.n, kPilotCutNodes, field);
+        std::uint32_t lights[NearField::kMaxLights];
+        const std::uint32_t count = std::min(ks[c], found);
+        std::copy(nearest, nearest + count, lights);
+        lights[count] = g.particle;  // as nearest() adds it
+        in.lightTree->nearField(centre, lights, count + 1, field, kPilotCutNodes);
         PixelSums far;  // the far samples alone, drawn and shaded as the render's are
         far.discardNonFinite = in.render.nonfinite == NonFinitePolicy::discard;
-        const DVec3 near = sumTerms<M, P>(in.bvh, L, sp, std::span<const std::uint32_t>(field.light, field.count), vis,
-                                          shadows, far.c, nullptr);
         // The same stream at every k: the candidates differ by their near field alone.
         Rng rng(px, in.frame, RngPass::nearLightPilot, in.render.seed);
         LightSample xs[LightingPlan::kChunkSamples];
@@ -602,7 +612,9 @@ void pilotPixel(const LightingInputs& in, const LightArrays& L, const Visibility
         const double n = std::max(far.n, 2u);
         const DVec3 var = glm::max(DVec3(0.0), (far.sumSq - far.sum * far.sum / n) / (n - 1.0));
         for (int ch = 0; ch < 3; ++ch) variance[c * 3 + ch] = var[ch];
-        value = near + far.sum / n;  // the last (largest) k's
+        if (c + 1 == ks.size())  // the pixel's value: the largest k's near sum and far mean
+            value = sumTerms<M, P>(in.bvh, L, sp, std::span<const std::uint32_t>(field.light, field.count), vis, shadows,
+                                   far.c, nullptr) + far.sum / n;
     }
 }
 
@@ -694,7 +706,7 @@ void checkSamplerInputs(const LightingInputs& in) {
 
 LightingCounters accumulateLighting(const LightingInputs& in, const LightingPlan& plan, Accumulation& acc,
                                     const ChunkHook& afterChunk, Progress* progress) {
-    ACC_CHECK(acc.width == in.gbuffer.width && acc.height == in.gbuffer.height);
+    ACC_CHECK(acc.width == in.gbuffer.width && acc.height == in.gbuffer.height && acc.window == in.gbuffer.window);
     if (in.particles.empty() || acc.nextChunk >= plan.end) return {};
     checkSamplerInputs(in);
     const LightArrays L(in.particles, in.shading);
@@ -713,16 +725,13 @@ void allocate(LightingImage& out, std::size_t pixels) {
     out.rejected.resize(pixels);
 }
 
-void resolveLighting(const Accumulation& acc, bool exact, LightingImage& out, std::uint64_t* nonFinite,
-                     const PixelWindow* window) {
+void resolveLighting(const Accumulation& acc, bool exact, LightingImage& out, std::uint64_t* nonFinite) {
     allocate(out, acc.pixels());
-    const PixelWindow w = window ? *window : PixelWindow::whole(acc.width, acc.height);
     tbb::enumerable_thread_specific<std::uint64_t> zeroed(0);
-    tbb::parallel_for(tbb::blocked_range<std::uint32_t>(w.y0, w.y1), [&](const auto& r) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, acc.pixels(), 4096), [&](const auto& r) {
         std::uint64_t& z = zeroed.local();
-        for (std::uint32_t y = r.begin(); y != r.end(); ++y)
-            for (std::size_t px = std::size_t(y) * acc.width + w.x0; px != std::size_t(y) * acc.width + w.x1; ++px)
-                z += resolvePixel(acc.sum[px], acc.sumSq[px], acc.n[px], acc.rejected[px], exact, out, px);
+        for (std::size_t px = r.begin(); px != r.end(); ++px)
+            z += resolvePixel(acc.sum[px], acc.sumSq[px], acc.n[px], acc.rejected[px], exact, out, px);
     });
     if (nonFinite)
         for (const std::uint64_t z : zeroed) *nonFinite += z;
@@ -735,16 +744,16 @@ LightingCounters directPrimitive(const LightingInputs& in, const LightArrays& L,
                                  LightingImage& out, Progress* p) {
     const bool spheres = in.bvh.settings().primitive == Primitive::sphere;
     const std::uint64_t c0 = plan.begin, c1 = plan.end;
-    const PixelWindow whole = PixelWindow::whole(in.gbuffer.width, in.gbuffer.height), w = litWindow(in);
+    const PixelWindow& w = in.gbuffer.window;  // a crop lights its window alone
     if (in.counters)
-        return spheres ? sweep<M, Primitive::sphere, true>(in, L, plan, nullptr, &out, c0, c1, p, whole)
-                       : sweep<M, Primitive::billboard, true>(in, L, plan, nullptr, &out, c0, c1, p, whole);
+        return spheres ? sweep<M, Primitive::sphere, true>(in, L, plan, nullptr, &out, c0, c1, p, w)
+                       : sweep<M, Primitive::billboard, true>(in, L, plan, nullptr, &out, c0, c1, p, w);
     return spheres ? sweep<M, Primitive::sphere, false>(in, L, plan, nullptr, &out, c0, c1, p, w)
                    : sweep<M, Primitive::billboard, false>(in, L, plan, nullptr, &out, c0, c1, p, w);
 }
 
 LightingCounters estimateLighting(const LightingInputs& in, LightingImage& out, Progress* progress) {
-    const std::size_t pixels = std::size_t(in.gbuffer.width) * in.gbuffer.height;
+    const std::size_t pixels = in.gbuffer.texels.size();
     if (in.particles.empty()) {
         out.Lr.assign(pixels, Vec3(0.0f));
         out.Lr_stderr.assign(pixels, Vec3(0.0f));

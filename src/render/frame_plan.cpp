@@ -20,6 +20,7 @@ void planRun(const Settings& s, FramePlan& plan) {
     // A static scene's one BVH is also last frame's.
     plan.previousBvh = plan.keepHistory && s.shading.visibility && !plan.staticGeometry && needsPreviousBvh(s);
     plan.counting = s.gpu.counters;
+    plan.traced = restir || plan.counting ? PixelWindow::whole(s.camera.width, s.camera.height) : PixelWindow::of(s);
 }
 
 /// This frame's passes.
@@ -68,7 +69,10 @@ void describe(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
          plan.sampler == LightSamplerKind::tree    ? "light tree"
          : plan.sampler == LightSamplerKind::power ? "alias table over light power"
          : dark ? noLight : fmt::format("{} samples lights uniformly", enumName(est)));
-    step(pass::traceGBuffer, true, "one primary ray per pixel");
+    step(pass::traceGBuffer, true,
+         plan.traced.isWhole(s.camera.width, s.camera.height)
+             ? std::string("one primary ray per pixel")
+             : fmt::format("one primary ray per pixel of render.crop's {}x{} window", plan.traced.width(), plan.traced.height()));
     step(pass::estimateLighting, plan.lighting,
          dark ? noLight : restir ? "the restir passes below" : std::string(enumName(est)));
     if (restir) {

@@ -74,39 +74,65 @@ void recordCompose(const GBuffer& gbuffer, const Particles& particles, const Par
 }
 
 /// composeImage: L = Le + Lr on hits (background on misses), depth, normal
-/// and particle AOVs, and the frame's spp statistics.
-/// The image's layers from the G-buffer and the lighting over `traced` (the
-/// pixels traced: a crop's window, or the whole image); outside it, what a
-/// miss gives (background, no particle), filled at memory speed.
-void composeImage(const GBuffer& gbuffer, const Particles& particles, const ShadingSettings& shading, const PixelWindow& traced,
-                  FrameImage& img, FrameStats& stats) {
-    const std::size_t pixels = std::size_t(img.width) * img.height;
-    img.L.assign(pixels, shading.background);
-    img.Le.assign(pixels, Vec3(0.0f));
-    img.depth.assign(pixels, std::numeric_limits<float>::infinity());
-    img.normal.assign(pixels, Vec3(0.0f));
-    img.particle.assign(pixels, kNoParticle);
+/// and particle AOVs of the G-buffer's window, and the frame's spp statistics.
+void composeImage(const GBuffer& gbuffer, const Particles& particles, const ShadingSettings& shading, FrameImage& img,
+                  FrameStats& stats) {
+    const std::size_t pixels = gbuffer.texels.size();
+    img.L.resize(pixels);
+    img.Le.resize(pixels);
+    img.depth.resize(pixels);
+    img.normal.resize(pixels);
+    img.particle.resize(pixels);
     const float se = static_cast<float>(shading.self_emission);
     std::size_t hits = 0;
     double sppSum = 0.0;
-    for (std::uint32_t y = traced.y0; y < traced.y1; ++y)
-        for (std::size_t px = std::size_t(y) * img.width + traced.x0; px < std::size_t(y) * img.width + traced.x1; ++px) {
-            const GBufferTexel& g = gbuffer.texels[px];
-            if (!g.hit()) continue;  // as filled: background, no particle
-            ++hits;
-            img.particle[px] = g.particle;
-            if (!composeHit(se, particles.emission[g.particle], img.lighting.Lr[px], img.Le[px], img.L[px])) {
-                img.lighting.Lr_stderr[px] = Vec3(0.0f);
-                img.lighting.rejected[px] += 1.0f;
-                ++stats.nonFinite[std::string(pass::composeImage)];
-            }
-            img.depth[px] = g.depth;
-            img.normal[px] = g.normal;
-            sppSum += img.lighting.spp[px];
-            stats.maxSpp = std::max(stats.maxSpp, double(img.lighting.spp[px]));
+    for (std::size_t px = 0; px < pixels; ++px) {
+        const GBufferTexel& g = gbuffer.texels[px];
+        if (!g.hit()) {
+            img.L[px] = shading.background;
+            img.Le[px] = img.normal[px] = Vec3(0.0f);
+            img.depth[px] = std::numeric_limits<float>::infinity();
+            img.particle[px] = kNoParticle;
+            continue;
         }
+        ++hits;
+        img.particle[px] = g.particle;
+        if (!composeHit(se, particles.emission[g.particle], img.lighting.Lr[px], img.Le[px], img.L[px])) {
+            img.lighting.Lr_stderr[px] = Vec3(0.0f);
+            img.lighting.rejected[px] += 1.0f;
+            ++stats.nonFinite[std::string(pass::composeImage)];
+        }
+        img.depth[px] = g.depth;
+        img.normal[px] = g.normal;
+        sppSum += img.lighting.spp[px];
+        stats.maxSpp = std::max(stats.maxSpp, double(img.lighting.spp[px]));
+    }
     stats.hitPixels = hits;
     stats.meanSpp = hits ? sppSum / double(hits) : 0.0;
+}
+
+/// Cut every per-pixel layer of `img` (of the whole image) to its window:
+/// restir and counting mode render the whole frame and keep render.crop's
+/// pixels. The counters stay the whole dispatch's.
+void cropLayers(FrameImage& img) {
+    const PixelWindow& w = img.window;
+    auto cut = [&](auto& layer) {
+        if (!layer.empty()) layer = cropPixels(layer, img.width, w);
+    };
+    cut(img.L);
+    cut(img.Le);
+    cut(img.lighting.Lr);
+    cut(img.lighting.Lr_stderr);
+    cut(img.lighting.spp);
+    cut(img.lighting.rejected);
+    cut(img.depth);
+    cut(img.normal);
+    cut(img.particle);
+    cut(img.reservoirs.W);
+    cut(img.reservoirs.M);
+    cut(img.reservoirs.light);
+    cut(img.reservoirs.p_hat);
+    for (Heatmap& h : img.heatmaps) cut(h.values);
 }
 
 }  // namespace
@@ -159,7 +185,7 @@ void FrameRenderer::lightFrame(std::uint32_t frame, const Camera& camera, const 
                                const AliasTable* powerTable, const LightTree* lightTree, const LightingSession* session,
                                PixelTrace* trace, FrameImage& img, FrameStats& stats) {
     const FramePlan& plan = plan_;
-    const std::size_t pixels = std::size_t(camera.width) * camera.height;
+    const std::size_t pixels = gbuffer.texels.size();
     if (!plan.lighting) {  // nothing lights the scene: Lr = 0
         img.lighting.Lr.assign(pixels, Vec3(0.0f));
         img.lighting.Lr_stderr.assign(pixels, Vec3(0.0f));
@@ -188,12 +214,13 @@ void FrameRenderer::lightFrame(std::uint32_t frame, const Camera& camera, const 
     const Accumulation* resume = session ? session->resume : nullptr;
     const std::uint64_t firstChunk = resume ? resume->nextChunk : lp.begin;
     std::uint64_t work = 0;
-    for (std::uint32_t y = 0; y < gbuffer.height; ++y) {
+    const PixelWindow& w = gbuffer.window;
+    for (std::uint32_t y = w.y0; y < w.y1; ++y) {
         if (lp.exact && (y / LightingPlan::kChunkRows < firstChunk || y / LightingPlan::kChunkRows >= lp.end)) continue;
-        for (std::uint32_t x = 0; x < gbuffer.width; ++x) {
+        for (std::uint32_t x = w.x0; x < w.x1; ++x) {
             // Monte Carlo: the pixels before the band cursor are done (Accumulation::bandRows, bandCols).
             if (!lp.exact && resume && (y < resume->bandRows || (y == resume->bandRows && x < resume->bandCols))) continue;
-            work += gbuffer.texels[std::size_t(y) * gbuffer.width + x].hit();
+            work += gbuffer.at(x, y).hit();
         }
     }
     if (!lp.exact) work *= lp.end > firstChunk ? lp.end - firstChunk : 0;
@@ -204,9 +231,9 @@ void FrameRenderer::lightFrame(std::uint32_t frame, const Camera& camera, const 
         Accumulation local;
         Accumulation& acc = session->result ? *session->result : local;
         if (session->resume) acc = *session->resume;
-        else acc.reset(camera.width, camera.height, lp.begin);
+        else acc.reset(camera.width, camera.height, lp.begin, &gbuffer.window);
         stats.lighting = accumulateLighting(in, lp, acc, session->afterChunk, &progress);
-        resolveLighting(acc, lp.exact, img.lighting, &stats.lighting.nonFinite, plan_.counting ? nullptr : &img.window);
+        resolveLighting(acc, lp.exact, img.lighting, &stats.lighting.nonFinite);
     }
     if (stats.lighting.nonFinite) stats.nonFinite[std::string(pass::estimateLighting)] = stats.lighting.nonFinite;
 }
@@ -259,13 +286,11 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const L
         stats.lightTreeNodes = lightTree.nodeCount();
     }
 
-    // A crop renders only its window, each pixel as in the whole image:
-    // every estimator but restir lights a pixel from its own streams alone.
-    // restir (spatial reuse reads the neighbours; history is the whole
-    // frame's) and counting mode (the GPU's dispatch is the whole frame)
-    // render everything and keep the window.
+    // A crop traces, lights and holds only its window, each pixel as in the
+    // whole image: every estimator but restir lights a pixel from its own
+    // streams alone. restir and counting mode render everything (FramePlan::traced).
     img.window = PixelWindow::of(settings_);
-    const PixelWindow traced = plan.restir || plan.counting ? PixelWindow::whole(camera.width, camera.height) : img.window;
+    const PixelWindow& traced = plan.traced;
     GBuffer gbuffer;
     {
         auto t = timer.scope(pass::traceGBuffer);
@@ -278,13 +303,14 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const L
                plan.sampler == LightSamplerKind::tree ? &lightTree : nullptr, session, trace, img, stats);
     {
         auto t = timer.scope(pass::composeImage);
-        composeImage(gbuffer, particles, settings_.shading, traced, img, stats);
+        composeImage(gbuffer, particles, settings_.shading, img, stats);
         if (plan.counting) recordCompose(gbuffer, particles, *bvh_, img.counters.add(pass::composeImage, img.width, img.height));
     }
     if (plan.counting) {
         img.counters.accel = bvh_->accelCounters();
         img.heatmaps = counterHeatmaps(img.counters, img.width, img.height);
     }
+    if (traced != img.window) cropLayers(img);
     stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return img;
 }

@@ -17,9 +17,9 @@ void trace(const ParticleBvh& bvh, const Particles& particles, const Camera& cam
     const bool spheres = bvh.settings().primitive == Primitive::sphere;
 
     // One G-buffer texel from a primary hit (gbuffer_texel.h: shared with the OptiX twin).
-    auto fill = [&](std::size_t px, std::uint32_t x, std::uint32_t y, const Vec3& dir, const SurfaceHit& hit) {
+    auto fill = [&](std::size_t slot, std::uint32_t x, std::uint32_t y, const Vec3& dir, const SurfaceHit& hit) {
         const std::uint32_t j = hit.particle;
-        gbuffer.texels[px] = spheres ? sphereTexel(camera, x, y, dir, j, particles.position[j], particles.radius[j], hit.t)
+        gbuffer.texels[slot] = spheres ? sphereTexel(camera, x, y, dir, j, particles.position[j], particles.radius[j], hit.t)
                                      : billboardTexel(camera, x, y, dir, j, particles.position[j], particles.radius[j],
                                                       bvh.frame(j), hit.uv, model);
     };
@@ -44,13 +44,13 @@ void trace(const ParticleBvh& bvh, const Particles& particles, const Camera& cam
                 bvh.intersect8(camera.position, dirs, n, hits, found);
                 for (int k = 0; k < n; ++k) {
                     if (!window.contains(x0 + k, y)) continue;
-                    const std::size_t px = std::size_t(y) * camera.width + x0 + k;
-                    if (found[k]) fill(px, x0 + k, y, dirs[k], hits[k]);
-                    else gbuffer.texels[px] = GBufferTexel{};
+                    const std::size_t slot = window.index(x0 + k, y);
+                    if (found[k]) fill(slot, x0 + k, y, dirs[k], hits[k]);
+                    else gbuffer.texels[slot] = GBufferTexel{};
                     if constexpr (Count) {
                         // The counters come from the ray a GPU thread traces: one
                         // ray through the counting TLAS (its hit is the same).
-                        Recorder<true> rec(&counters->threads[px]);
+                        Recorder<true> rec(&counters->threads[std::size_t(y) * camera.width + x0 + k]);
                         RayCounters rc;
                         SurfaceHit single;
                         bvh.intersect(camera.position, dirs[k], std::numeric_limits<float>::infinity(), single, &rc);
@@ -75,10 +75,9 @@ std::uint64_t traceGBuffer(const ParticleBvh& bvh, const Particles& particles, c
     gbuffer.height = camera.height;
     const PixelWindow w = window ? *window : PixelWindow::whole(camera.width, camera.height);
     ACC_CHECK(w.x0 < w.x1 && w.x1 <= camera.width && w.y0 < w.y1 && w.y1 <= camera.height);
-    if (w.isWhole(camera.width, camera.height))
-        gbuffer.texels.resize(std::size_t(camera.width) * camera.height);  // every texel is written by the trace
-    else
-        gbuffer.texels.assign(std::size_t(camera.width) * camera.height, GBufferTexel{});  // outside the window: misses
+    ACC_CHECK(!counters || w.isWhole(camera.width, camera.height));  // the GPU's dispatch is the whole frame
+    gbuffer.window = w;
+    gbuffer.texels.resize(w.pixels());  // every texel is written by the trace
     if (counters) trace<true>(bvh, particles, camera, model, w, gbuffer, counters);
     else trace<false>(bvh, particles, camera, model, w, gbuffer, nullptr);
     return w.pixels();

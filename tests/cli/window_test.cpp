@@ -40,10 +40,14 @@ std::string scene() {
 }
 
 /// Extra options per estimator: restir over three frames (temporal and
-/// spatial reuse, its history the whole frame's); tree adaptive.
+/// spatial reuse, its history the whole frame's); tree adaptive; split with
+/// the pilot's k; "counting": power with the GPU counters (the whole frame's
+/// dispatch, its heatmap layers cut to the window).
 std::string options(const std::string& estimator) {
     if (estimator == "restir") return " --estimator restir --frames 0:3 -D restir.bias_correction=\"pairwise\"";
     if (estimator == "tree") return " --estimator tree --frames 0:1 --spp 4 --target-stderr 5% -D render.max_samples=32";
+    if (estimator == "split") return " --estimator split --frames 0:1 --spp 6 -D render.near_lights=0";
+    if (estimator == "counting") return " --estimator power --frames 0:1 --spp 4 -D gpu.counters=true";
     return " --estimator " + estimator + " --frames 0:1 --spp 6";
 }
 
@@ -60,7 +64,7 @@ std::string lastFrame(const std::string& estimator) { return estimator == "resti
 
 TEST_CASE("render --crop writes the window of the full render as the EXR's data window", "[cli][window]") {
     const auto dir = scratchDir("crop");
-    const std::string estimator = GENERATE("exact", "power", "uniform", "ris", "tree", "restir");
+    const std::string estimator = GENERATE("exact", "power", "uniform", "ris", "tree", "split", "restir", "counting");
     std::string out;
     const std::string base = scene() + options(estimator);
     REQUIRE(runCommand(base + " -o " + (dir / "full.{frame}.exr").string(), out) == 0);
@@ -95,7 +99,7 @@ TEST_CASE("render --crop writes the window of the full render as the EXR's data 
 
 TEST_CASE("render --pixel prints the full render's pixel bit for bit", "[cli][window]") {
     const auto dir = scratchDir("pixel");
-    const std::string estimator = GENERATE("exact", "power", "ris", "restir");
+    const std::string estimator = GENERATE("exact", "power", "ris", "split", "restir");
     std::string out;
     const std::string base = scene() + options(estimator);
     REQUIRE(runCommand(base + " -o " + (dir / "full.{frame}.exr").string(), out) == 0);
@@ -134,6 +138,7 @@ TEST_CASE("render --pixel prints the full render's pixel bit for bit", "[cli][wi
         CHECK_THAT(out, Contains("hit: particle " + std::to_string(full.at(x, y, "particle.id"))));
         if (estimator == std::string("exact")) CHECK_THAT(out, Contains("(the pixel's Lr: bit-equal)"));
         if (estimator == std::string("power")) CHECK_THAT(out, Contains("6 light samples"));
+        if (estimator == std::string("split")) CHECK_THAT(out, Contains("nearest lights summed exactly"));
         if (estimator == std::string("ris")) CHECK_THAT(out, Contains("6 reservoirs (RIS)"));
         if (estimator == std::string("restir")) CHECK_THAT(out, Contains("spatialResampling"));
     }

@@ -36,9 +36,23 @@ TEST_CASE("nearest: the k nearest lights but the receiver's own, against a brute
         for (std::uint32_t i = 0; i < N; ++i)
             if (i != j) all.push_back({glm::distance(glm::dvec3(particles.position[i]), glm::dvec3(sp.x)), i});
         std::sort(all.begin(), all.end());
+        // nearestLights: one search, nearest first; the split pilot takes its
+        // first k as nearest(k)'s lights for every candidate k.
+        std::uint32_t order[NearField::kMaxLights];
+        const std::uint32_t found = tree.nearestLights(sp, 256, order);
+        REQUIRE(found == std::min(256u, N - 1));
+        for (std::uint32_t m = 1; m < found; ++m)
+            CHECK(glm::distance(glm::dvec3(particles.position[order[m - 1]]), glm::dvec3(sp.x)) <=
+                  glm::distance(glm::dvec3(particles.position[order[m]]), glm::dvec3(sp.x)) * (1.0 + 1e-6));
         for (const std::uint32_t k : {1u, 5u, 32u, 256u}) {
             INFO("receiver " << j << ", k " << k);
             tree.nearest(sp, k, near);
+            std::vector<std::uint32_t> prefix(order, order + std::min(k, found)), search;
+            for (std::uint32_t m = 0; m < near.count; ++m)
+                if (near.light[m] != j) search.push_back(near.light[m]);
+            std::sort(prefix.begin(), prefix.end());
+            std::sort(search.begin(), search.end());
+            CHECK(prefix == search);
             const std::uint32_t want = std::min(k, N - 1);
             REQUIRE(near.count == want + 1);  // and the receiver's own particle
             CHECK(near.contains(j));

@@ -43,6 +43,11 @@ public:
     /// at a particle's centre with the particle's normal, for all its pixels.
     /// The cut has at most `cutNodes` nodes (1..NearField::kMaxCut).
     void nearest(const ShadingPoint& sp, std::uint32_t k, NearField& out, std::uint32_t cutNodes = NearField::kMaxCut) const;
+    /// nearest()'s search alone: the min(k, N - 1, NearField::kMaxNear)
+    /// lights nearest to sp.x other than sp.self into `lights`, nearest first
+    /// (ties: the smaller index first); returns how many. Its first k' are
+    /// the search's for any k' <= k, so one search serves every smaller k.
+    std::uint32_t nearestLights(const ShadingPoint& sp, std::uint32_t k, std::uint32_t* lights) const;
     /// The near field of these lights (nearest()'s out.light, in any order)
     /// and its far cut of at most `cutNodes` nodes, seen from sp.
     void nearField(const ShadingPoint& sp, const std::uint32_t* lights, std::uint32_t count, NearField& out,

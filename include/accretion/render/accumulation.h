@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "accretion/core/math.h"
+#include "accretion/render/pixel_window.h"
 #include "accretion/render/shard.h"
 #include "accretion/scene/settings.h"
 
@@ -48,23 +49,26 @@ LightingPlan planLighting(const RenderSettings& render, std::uint32_t height, Sh
 
 /// Per-pixel running sums of the lighting estimate: everything a restart or
 /// a merge needs. The estimate is sum / n, its standard error comes from
-/// sumSq; `exact` stores its value with n = 1.
+/// sumSq; `exact` stores its value with n = 1. The sums are those of the
+/// window lit (render.crop's, or the whole image), row by row.
 struct Accumulation {
-    std::uint32_t width = 0, height = 0;
+    std::uint32_t width = 0, height = 0;  ///< the image's
+    PixelWindow window;                   ///< the pixels held
     std::vector<DVec3> sum, sumSq;
     std::vector<std::uint32_t> n;         ///< samples taken
     std::vector<std::uint8_t> done;       ///< adaptive: target reached or capped
     std::vector<std::uint32_t> rejected;  ///< non-finite samples rejected (render.nonfinite)
     std::uint64_t nextChunk = 0;          ///< the RNG position: first chunk not yet added
     /// Monte Carlo sweeps run every remaining chunk of a band of pixels at
-    /// once, bands in raster order: rows [0, bandRows) are done to the plan's
-    /// end, and in row bandRows the columns [0, bandCols); every other pixel
-    /// is at nextChunk. Both 0 between frames and in a finished run.
+    /// once, bands in raster order over the window: rows [window.y0,
+    /// bandRows) are done to the plan's end, and in row bandRows the columns
+    /// [window.x0, bandCols); every other pixel is at nextChunk (image
+    /// coordinates). Both 0 between frames and in a finished run.
     std::uint32_t bandRows = 0, bandCols = 0;
 
-    void reset(std::uint32_t w, std::uint32_t h, std::uint64_t firstChunk);
-    std::size_t pixels() const { return std::size_t(width) * height; }
-    /// Add a disjoint part of the same work (another shard): sums, counts.
+    /// Empty sums of `window` (the whole image when not given) of a w x h image.
+    void reset(std::uint32_t w, std::uint32_t h, std::uint64_t firstChunk, const PixelWindow* window = nullptr);
+    std::size_t pixels() const { return window.pixels(); }
     void merge(const Accumulation& other);
 };
 

@@ -18,7 +18,7 @@
 
 namespace accretion {
 
-/// Per-pixel estimate of the reflected light Lr.
+/// Per-pixel estimate of the reflected light Lr, of the G-buffer's window (row by row).
 struct LightingImage {
     std::vector<Vec3> Lr;        ///< estimate
     std::vector<Vec3> Lr_stderr; ///< standard error of the estimate (0 for exact)
@@ -73,11 +73,10 @@ using ChunkHook = std::function<bool(const Accumulation&)>;
 LightingCounters accumulateLighting(const LightingInputs& in, const LightingPlan& plan, Accumulation& acc,
                                     const ChunkHook& afterChunk = {}, Progress* progress = nullptr);
 
-/// The estimate, its standard error, spp and rejected counts from the sums.
-/// A value that is not finite in float is zeroed and counted in `rejected`.
-/// (`window`: only its pixels; the others stay 0. Null: every pixel.)
-void resolveLighting(const Accumulation& acc, bool exact, LightingImage& out, std::uint64_t* nonFinite = nullptr,
-                     const PixelWindow* window = nullptr);
+/// The estimate, its standard error, spp and rejected counts from the sums
+/// (of acc.window's pixels, as they are held). A value that is not finite in
+/// float is zeroed and counted in `rejected`.
+void resolveLighting(const Accumulation& acc, bool exact, LightingImage& out, std::uint64_t* nonFinite = nullptr);
 
 /// split with render.near_lights = 0: the frame's k, from a pilot on a
 /// low-resolution image of the frame's view (docs/MODEL.md section 4).

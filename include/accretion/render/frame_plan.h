@@ -6,6 +6,7 @@
 
 #include "accretion/particles/particles.h"
 #include "accretion/render/estimator_table.h"
+#include "accretion/render/pixel_window.h"
 #include "accretion/scene/settings.h"
 
 namespace accretion {
@@ -39,6 +40,12 @@ struct FramePlan {
     bool keepHistory = false;     ///< restir temporal reuse over several frames: history buffers and motion kept
     bool previousBvh = false;     ///< a second BVH kept for basic_visibility
     bool counting = false;        ///< counter code compiled into the loops
+    /// The pixels traced and lit, and the size of every per-pixel buffer:
+    /// render.crop's window (each pixel as in the whole image), or the whole
+    /// image for restir (spatial reuse reads the neighbours, history is the
+    /// whole frame's) and counting mode (the GPU's dispatch is the whole
+    /// frame), whose layers are cut to the crop after the frame.
+    PixelWindow traced;
     // This frame.
     bool loadParticles = true;    ///< load (or generate) the particles
     bool buildClusters = true;    ///< build (or refit) the BVH

@@ -21,9 +21,10 @@
 
 namespace accretion {
 
-/// Every per-pixel output of one frame (the EXR layers).
+/// Every per-pixel output of one frame (the EXR layers), each of the pixels
+/// of `window` row by row (window.index(x, y)).
 struct FrameImage {
-    std::uint32_t width = 0, height = 0;
+    std::uint32_t width = 0, height = 0;  ///< the image's
     PixelWindow window;               ///< the pixels rendered (render.crop; the whole image by default)
     CameraPose camera;                ///< the frame's camera in world space (its jitter included)
     std::vector<Vec3> L;              ///< pixel value: Le + Lr, or the background

@@ -13,10 +13,15 @@
 
 namespace accretion {
 
+/// The primary hits of a window of the image (traceGBuffer's: a crop's, or
+/// the whole image), row by row: a crop holds and touches its own pixels
+/// alone. A pixel's streams are still keyed by its index in the whole image.
 struct GBuffer {
-    std::uint32_t width = 0, height = 0;
-    std::vector<GBufferTexel> texels;
-    const GBufferTexel& at(std::uint32_t x, std::uint32_t y) const { return texels[std::size_t(y) * width + x]; }
+    std::uint32_t width = 0, height = 0;  ///< the image's
+    PixelWindow window;                   ///< the pixels held
+    std::vector<GBufferTexel> texels;     ///< window.pixels() texels
+    const GBufferTexel& at(std::uint32_t x, std::uint32_t y) const { return texels[window.index(x, y)]; }
+    bool whole() const { return window.isWhole(width, height); }
 };
 
 /// The shading point of a hit texel.
@@ -40,8 +45,7 @@ inline void recordTexel(ThreadCounters& t, const GBufferTexel& g, const Particle
 /// traceGBuffer: one primary ray per pixel through its centre (docs/MODEL.md
 /// section 3). Returns the number of rays traced. With counters (counting
 /// mode), records each pixel's thread: hit key, the ray, bytes. With a
-/// window, only its pixels are traced (each as in the whole image; the rest
-/// are misses).
+/// window, only its pixels are traced and held (each as in the whole image).
 std::uint64_t traceGBuffer(const ParticleBvh& bvh, const Particles& particles, const Camera& camera,
                            ShadingModel model, GBuffer& gbuffer, PassCounters* counters = nullptr,
                            const PixelWindow* window = nullptr);

@@ -26,6 +26,9 @@ struct PixelWindow {
     std::uint32_t height() const { return y1 - y0; }
     std::size_t pixels() const { return std::size_t(width()) * height(); }
     bool contains(std::uint32_t x, std::uint32_t y) const { return x >= x0 && x < x1 && y >= y0 && y < y1; }
+    bool contains(const PixelWindow& w) const { return w.x0 >= x0 && w.x1 <= x1 && w.y0 >= y0 && w.y1 <= y1; }
+    /// Where pixel (x, y) of the image lies in a buffer of the window's pixels, row by row.
+    std::size_t index(std::uint32_t x, std::uint32_t y) const { return std::size_t(y - y0) * width() + (x - x0); }
     bool isWhole(std::uint32_t w, std::uint32_t h) const { return x0 == 0 && y0 == 0 && x1 == w && y1 == h; }
     bool operator==(const PixelWindow&) const = default;
 };

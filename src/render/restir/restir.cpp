@@ -69,6 +69,7 @@ Restir::Restir(const Settings& settings, bool keepHistory)
 LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, ReservoirImage& aov, PassTimer& timer,
                                 PassRejections& rejected) {
     const GBuffer& full = in.gbuffer;
+    ACC_CHECK(full.whole());  // spatial reuse reads the neighbours, history is the whole frame's
     const std::size_t pixels = std::size_t(full.width) * full.height;
     out.Lr.assign(pixels, Vec3(0.0f));
     out.Lr_stderr.assign(pixels, Vec3(0.0f));
@@ -83,6 +84,7 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
     if (in.plan.upsample) {
         reduced.width = lightingGridExtent(full.width, scale);
         reduced.height = lightingGridExtent(full.height, scale);
+        reduced.window = PixelWindow::whole(reduced.width, reduced.height);
         reduced.texels.resize(std::size_t(reduced.width) * reduced.height);
         for (std::uint32_t y = 0; y < reduced.height; ++y)
             for (std::uint32_t x = 0; x < reduced.width; ++x) {
