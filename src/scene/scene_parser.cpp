@@ -302,21 +302,28 @@ void validate(const Settings& s, const std::map<std::string, std::string>& loc, 
         // Peak resident estimate from bench/results.json: ~300 B per particle
         // (particles, clusters, BVH) and ~330 B per pixel (G-buffer, images,
         // AOVs; reservoirs and history for restir), plus ~60 MB of libraries.
-        // Refused above render.memory_limit_mb, or else above the machine's
-        // physical memory (a run that cannot fit ends in an allocation failure).
+        // A crop holds its window's pixels alone, but for restir and counting
+        // mode (the whole frame: FramePlan::traced). Refused above
+        // render.memory_limit_mb, or else above the machine's physical memory
+        // (a run that cannot fit ends in an allocation failure).
         const double particles = s.particles.file.empty() ? double(s.particles.count) : 0.0;
-        const double pixels = double(s.camera.width) * s.camera.height;
+        const std::vector<double>& crop = s.render.crop;
+        const bool window = crop.size() == 4 && s.render.estimator != EstimatorKind::restir && !s.gpu.counters;
+        const double pixels = window ? (crop[1] - crop[0]) * (crop[3] - crop[2]) : double(s.camera.width) * s.camera.height;
         const double perPixel = s.render.estimator == EstimatorKind::restir ? 480.0 : 330.0;
         const double mb = (300.0 * particles + perPixel * pixels) / 1e6 + 60.0;
+        const std::string image = window ? fmt::format("a {}x{} crop of {}x{}", crop[1] - crop[0], crop[3] - crop[2],
+                                                       s.camera.width, s.camera.height)
+                                         : fmt::format("{}x{}", s.camera.width, s.camera.height);
         const double physicalMb = double(physicalMemoryBytes()) / 1e6;
         if (s.render.memory_limit_mb > 0.0 && mb > s.render.memory_limit_mb)
             fail("render.memory_limit_mb",
-                 fmt::format("{} particles at {}x{} need about {:.0f} MB, more than the limit of {:.0f} MB", particles,
-                             s.camera.width, s.camera.height, mb, s.render.memory_limit_mb));
+                 fmt::format("{} particles at {} need about {:.0f} MB, more than the limit of {:.0f} MB", particles, image,
+                             mb, s.render.memory_limit_mb));
         if (s.render.memory_limit_mb <= 0.0 && physicalMb > 0.0 && mb > physicalMb)
             fail(300.0 * particles > perPixel * pixels ? "particles.count" : "camera.width",
-                 fmt::format("{} particles at {}x{} need about {:.0f} MB, more than this machine's {:.0f} MB of physical "
-                             "memory", particles, s.camera.width, s.camera.height, mb, physicalMb));
+                 fmt::format("{} particles at {} need about {:.0f} MB, more than this machine's {:.0f} MB of physical "
+                             "memory", particles, image, mb, physicalMb));
     }
     if (s.render.estimator == EstimatorKind::ris && (s.render.source == LightSource::tiles || s.render.source == LightSource::regir))
         fail("render.source", fmt::format("\"{}\" is a restir source: its presampled lights are drawn once per frame, and ris "

@@ -7,6 +7,7 @@
 #include <regex>
 
 #include <OpenImageIO/imageio.h>
+#include <nlohmann/json.hpp>
 
 #include "support/cli.h"
 
@@ -143,4 +144,23 @@ TEST_CASE("render --pixel prints the full render's pixel bit for bit", "[cli][wi
         if (estimator == std::string("restir")) CHECK_THAT(out, Contains("spatialResampling"));
     }
     CHECK(listing(dir) == before);  // --pixel writes nothing
+}
+
+TEST_CASE("a crop of a 16384x16384 image holds its window alone: it fits where the whole image is refused", "[cli][window]") {
+    const auto dir = scratchDir("crop_huge");
+    const std::string base = kBin + " render " + kScenes + "/quickstart.toml --quiet -D particles.count=1500 --frames 0:1 "
+                             "--estimator split --spp 4 -D camera.width=16384 -D camera.height=16384 -D render.memory_limit_mb=2000";
+    std::string out;
+    // The whole image: about 330 B a pixel, 88 GB, over the limit (on any machine).
+    REQUIRE(runCommand(base + " -o " + (dir / "whole.{frame}.exr").string(), out) == 1);
+    CHECK_THAT(out, Contains("at 16384x16384 need about") && Contains("more than the limit of 2000 MB"));
+    REQUIRE(runCommand(base + " --crop 8000,8064,8000,8032 -o " + (dir / "crop.{frame}.exr").string(), out) == 0);
+    const Exr win = readExr(dir / "crop.0000.exr");
+    CHECK(win.fullWidth == 16384);
+    CHECK(win.fullHeight == 16384);
+    CHECK(win.width == 64);
+    CHECK(win.height == 32);
+    // Its memory is the particles' and libraries', not the image's (a whole-image G-buffer alone is 11.8 GB).
+    const auto stats = nlohmann::json::parse(readFile(dir / "crop.stats.json"));
+    CHECK(stats.at("peak_rss_bytes").get<double>() < 300e6);
 }
