@@ -69,6 +69,7 @@ struct Accumulation {
     /// Empty sums of `window` (the whole image when not given) of a w x h image.
     void reset(std::uint32_t w, std::uint32_t h, std::uint64_t firstChunk, const PixelWindow* window = nullptr);
     std::size_t pixels() const { return window.pixels(); }
+    /// Add a disjoint part of the same work (another shard of the same window): sums, counts.
     void merge(const Accumulation& other);
 };
 

@@ -68,7 +68,8 @@ struct LightingInputs {
 using ChunkHook = std::function<bool(const Accumulation&)>;
 
 /// Add the chunks [acc.nextChunk, plan.end) of the frame to `acc` (which
-/// must be reset() for the frame or restored from a checkpoint). Counting
+/// must be reset() for the frame and the G-buffer's window, or restored from
+/// a checkpoint). Counting
 /// mode runs them in one sweep. Returns the counters of the chunks run.
 LightingCounters accumulateLighting(const LightingInputs& in, const LightingPlan& plan, Accumulation& acc,
                                     const ChunkHook& afterChunk = {}, Progress* progress = nullptr);
