@@ -293,17 +293,23 @@ struct NearFieldCache {
     NearFieldCache() { std::fill(std::begin(particle), std::end(particle), kNoParticle); }
 };
 
-/// The k lights nearest to particle j's centre, other than j, and the far
-/// cut of at most `cutNodes` nodes seen from the centre with normal n: the near field of every pixel on
-/// j (and of the pilot's pixels). Lambert: n is the billboard's, the same
-/// for every pixel of j; the other models' cuts do not use it.
-void nearestToParticle(const LightingInputs& in, std::uint32_t j, std::uint32_t k, const Vec3& n, std::uint32_t cutNodes,
-                       NearField& out) {
+/// Particle j's centre with normal n, where its near field is found for
+/// all its pixels. Lambert: n is the billboard's, the same for every pixel
+/// of j; the other models' cuts do not use it.
+ShadingPoint particleCentre(const LightingInputs& in, std::uint32_t j, const Vec3& n) {
     ShadingPoint centre{};
     centre.x = in.particles.position[j];
     centre.n = n;
     centre.self = j;
-    in.lightTree->nearest(centre, k, out, cutNodes);
+    return centre;
+}
+
+/// The k lights nearest to particle j's centre, other than j, and the far
+/// cut of at most `cutNodes` nodes seen from there: the near field of every
+/// pixel on j.
+void nearestToParticle(const LightingInputs& in, std::uint32_t j, std::uint32_t k, const Vec3& n, std::uint32_t cutNodes,
+                       NearField& out) {
+    in.lightTree->nearest(particleCentre(in, j, n), k, out, cutNodes);
 }
 
 /// The near field of particle j (a pixel on it has normal n), from the cache or found.
@@ -588,10 +594,7 @@ void pilotPixel(const LightingInputs& in, const LightArrays& L, const Visibility
     const ShadingPoint sp = shadingPoint(g, in.particles);
     const bool shadows = in.shading.visibility;
     static_assert(kPilotSamples % LightingPlan::kChunkSamples == 0);
-    ShadingPoint centre{};
-    centre.x = in.particles.position[g.particle];
-    centre.n = sp.n;
-    centre.self = g.particle;
+    const ShadingPoint centre = particleCentre(in, g.particle, sp.n);
     std::uint32_t nearest[NearField::kMaxLights];
     const std::uint32_t found = in.lightTree->nearestLights(centre, ks.back(), nearest);
     for (std::size_t c = 0; c < ks.size(); ++c) {

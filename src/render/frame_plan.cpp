@@ -20,7 +20,8 @@ void planRun(const Settings& s, FramePlan& plan) {
     // A static scene's one BVH is also last frame's.
     plan.previousBvh = plan.keepHistory && s.shading.visibility && !plan.staticGeometry && needsPreviousBvh(s);
     plan.counting = s.gpu.counters;
-    plan.traced = restir || plan.counting ? PixelWindow::whole(s.camera.width, s.camera.height) : PixelWindow::of(s);
+    ACC_CHECK(!restir || !cropRendersAlone(s));  // reuse reads the neighbours: the whole frame
+    plan.traced = cropRendersAlone(s) ? PixelWindow::of(s) : PixelWindow::whole(s.camera.width, s.camera.height);
 }
 
 /// This frame's passes.

@@ -302,13 +302,13 @@ void validate(const Settings& s, const std::map<std::string, std::string>& loc, 
         // Peak resident estimate from bench/results.json: ~300 B per particle
         // (particles, clusters, BVH) and ~330 B per pixel (G-buffer, images,
         // AOVs; reservoirs and history for restir), plus ~60 MB of libraries.
-        // A crop holds its window's pixels alone, but for restir and counting
-        // mode (the whole frame: FramePlan::traced). Refused above
+        // A crop holds its window's pixels alone where cropRendersAlone
+        // (FramePlan::traced). Refused above
         // render.memory_limit_mb, or else above the machine's physical memory
         // (a run that cannot fit ends in an allocation failure).
         const double particles = s.particles.file.empty() ? double(s.particles.count) : 0.0;
         const std::vector<double>& crop = s.render.crop;
-        const bool window = crop.size() == 4 && s.render.estimator != EstimatorKind::restir && !s.gpu.counters;
+        const bool window = crop.size() == 4 && cropRendersAlone(s);
         const double pixels = window ? (crop[1] - crop[0]) * (crop[3] - crop[2]) : double(s.camera.width) * s.camera.height;
         const double perPixel = s.render.estimator == EstimatorKind::restir ? 480.0 : 330.0;
         const double mb = (300.0 * particles + perPixel * pixels) / 1e6 + 60.0;

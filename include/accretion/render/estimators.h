@@ -68,9 +68,8 @@ struct LightingInputs {
 using ChunkHook = std::function<bool(const Accumulation&)>;
 
 /// Add the chunks [acc.nextChunk, plan.end) of the frame to `acc` (which
-/// must be reset() for the frame and the G-buffer's window, or restored from
-/// a checkpoint). Counting
-/// mode runs them in one sweep. Returns the counters of the chunks run.
+/// must be reset() for the frame and the G-buffer's window, or restored
+/// from a checkpoint). Counting mode runs them in one sweep. Returns the counters of the chunks run.
 LightingCounters accumulateLighting(const LightingInputs& in, const LightingPlan& plan, Accumulation& acc,
                                     const ChunkHook& afterChunk = {}, Progress* progress = nullptr);
 
@@ -102,8 +101,8 @@ struct NearLightChoice {
 
 /// The pilot: each lit pixel of `pilot.gbuffer` (at most 256, evenly
 /// spaced), for k = 16, 32, ..., NearField::kMaxNear: its particle's near
-/// field, the exact near sum at its point and 64 far samples on fixed
-/// streams (RngPass::nearLightPilot). Picks the k of least V(k) x (k +
+/// field and 64 far samples on fixed streams (RngPass::nearLightPilot);
+/// the exact near sum at its point for the largest k (the estimate). Picks the k of least V(k) x (k +
 /// rho S) for S = render.samples: the error x time of a render of S samples.
 /// Deterministic: the same k for any crop, shard, resume or thread count.
 NearLightChoice chooseNearLights(const LightingInputs& pilot);

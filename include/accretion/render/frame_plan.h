@@ -41,10 +41,8 @@ struct FramePlan {
     bool previousBvh = false;     ///< a second BVH kept for basic_visibility
     bool counting = false;        ///< counter code compiled into the loops
     /// The pixels traced and lit, and the size of every per-pixel buffer:
-    /// render.crop's window (each pixel as in the whole image), or the whole
-    /// image for restir (spatial reuse reads the neighbours, history is the
-    /// whole frame's) and counting mode (the GPU's dispatch is the whole
-    /// frame), whose layers are cut to the crop after the frame.
+    /// render.crop's window where cropRendersAlone (settings.h), else the
+    /// whole image, whose layers are cut to the crop after the frame.
     PixelWindow traced;
     // This frame.
     bool loadParticles = true;    ///< load (or generate) the particles
