@@ -13,7 +13,8 @@ ref=${1:?usage: bench/split_1080p.sh REFERENCE.exr [SPP ...]}
 shift
 levels=("$@")
 [ ${#levels[@]} -eq 0 ] && levels=(16 24 40 128 192 256)
-bin=./build/accretion
+bin=${ACCRETION:-./build/accretion}
+export ACCRETION=$bin  # scripts/pass_names.py asks it for the pass table
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 csv=bench/split_1080p.csv
@@ -26,11 +27,13 @@ for spp in "${levels[@]}"; do
   rel=$("$bin" compare "$out/s$spp.exr" "$ref" --layer Lr --flip none --json 2>/dev/null | python3 -c 'import json,sys; print(json.load(sys.stdin)["relMSE"])')
   python3 - "$out/s$spp.stats.json" "$spp" "$start" "$end" "$rel" >> "$csv" <<'PY'
 import json, sys
+sys.path.insert(0, "scripts")
+from pass_names import PASS
 stats, spp, start, end, rel = sys.argv[1], int(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4]), float(sys.argv[5])
 f = json.load(open(stats))["frames"][0]
 p = f["passes"]
-near = p.get("chooseNearLights", 0.0)
-light = p.get("estimateLighting", 0.0)
+near = p.get(PASS.chooseNearLights, 0.0)
+light = p.get(PASS.estimateLighting, 0.0)
 print(f"{spp},{end - start:.2f},{rel:.6g},{f['counts']['near_lights']},{near:.3f},{light:.2f},{end - start - near - light:.2f}")
 PY
   tail -1 "$csv" >&2

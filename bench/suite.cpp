@@ -303,12 +303,12 @@ std::size_t bareIntersect(RTCScene scene, const Camera& cam, bool packets) {
 
 struct FrameTiming {
     double frameSeconds = 0.0;
-    std::map<std::string, double, std::less<>> passes;
+    std::map<Pass, double> passes;
     std::uint64_t shadowRays = 0, hitPixels = 0;
     /// A pass's seconds; the pass must have run.
-    double seconds(std::string_view pass) const {
+    double seconds(Pass pass) const {
         const auto it = passes.find(pass);
-        if (it == passes.end()) throw std::runtime_error(fmt::format("bench: no pass {} in the frame", pass));
+        if (it == passes.end()) throw std::runtime_error(fmt::format("bench: no pass {} in the frame", passName(pass)));
         return it->second;
     }
 };
@@ -330,7 +330,7 @@ FrameTiming timeFrames(const Settings& s, const ParticleSource& source, std::uin
     const FrameStats& m = stats[stats.size() / 2];
     FrameTiming t;
     t.frameSeconds = m.seconds;
-    for (const auto& [name, sec] : m.timer.all()) t.passes[name] = sec;
+    for (const auto& [pass, sec] : m.timer.all()) t.passes[pass] = sec;
     t.shadowRays = m.lighting.shadowRays;
     t.hitPixels = m.hitPixels;
     return t;
@@ -617,15 +617,15 @@ void Suite::benchRestirFrame() {
         const FrameTiming t = timeFrames(restir, diskSource, 4, 4, 3);
         double lighting = 0.0;
         nlohmann::json passes;
-        for (const auto& [name, sec] : t.passes) passes[name] = sec;
-        for (const std::string_view name : {pass::generateCandidates, pass::temporalResampling, pass::spatialResampling})
-            if (const auto it = t.passes.find(name); it != t.passes.end()) lighting += it->second;
+        for (const auto& [pass, sec] : t.passes) passes[std::string(passName(pass))] = sec;
+        for (const Pass pass : {Pass::generateCandidates, Pass::temporalResampling, Pass::spatialResampling})
+            if (const auto it = t.passes.find(pass); it != t.passes.end()) lighting += it->second;
         const double candidates = double(t.hitPixels) * restir.render.candidates;
         figures["restir_frame_100k_720p"] = {
             {"seconds", t.frameSeconds},
             {"passes_s", passes},
             {"resampling_share", lighting / t.frameSeconds},
-            {"candidates_per_s_per_core", candidates / t.seconds(pass::generateCandidates) / cores},
+            {"candidates_per_s_per_core", candidates / t.seconds(Pass::generateCandidates) / cores},
             {"shadow_rays", t.shadowRays}};
     }
 }
@@ -753,8 +753,8 @@ void Suite::benchScaling() {
         s.particles.count = n;
         const ParticleSource src(s);
         const FrameTiming t = timeFrames(s, src, 2, 2, 1);
-        csvP += fmt::format("{},{:.6f},{:.6f},{:.6f},{}\n", n, t.seconds(pass::buildClusters), t.frameSeconds,
-                            t.seconds(pass::traceShadowRays), t.shadowRays);
+        csvP += fmt::format("{},{:.6f},{:.6f},{:.6f},{}\n", n, t.seconds(Pass::buildClusters), t.frameSeconds,
+                            t.seconds(Pass::traceShadowRays), t.shadowRays);
     }
     writeFileAtomic(outDir + "/scaling_particles.csv", csvP);
     std::string csvR = "width,height,pixels,restir_frame_s,trace_gbuffer_s\n";
@@ -764,7 +764,7 @@ void Suite::benchScaling() {
         s.camera.width = w;
         s.camera.height = h;
         const FrameTiming t = timeFrames(s, diskSource, 2, 2, 1);
-        csvR += fmt::format("{},{},{},{:.6f},{:.6f}\n", w, h, std::uint64_t(w) * h, t.frameSeconds, t.seconds(pass::traceGBuffer));
+        csvR += fmt::format("{},{},{},{:.6f},{:.6f}\n", w, h, std::uint64_t(w) * h, t.frameSeconds, t.seconds(Pass::traceGBuffer));
     }
     writeFileAtomic(outDir + "/scaling_resolution.csv", csvR);
     try {
@@ -821,7 +821,7 @@ void Suite::benchPlanSkips() {
         };
         auto primaryPass = [&](const Settings& s) {
             const ParticleSource src(s);
-            return timeFrames(s, src, 2, 1, 3).seconds(pass::traceGBuffer);
+            return timeFrames(s, src, 2, 1, 3).seconds(Pass::traceGBuffer);
         };
         auto pair = [&](const std::string& name, double with, double without) {
             skips[name] = {{"with_work_s", with}, {"skipped_s", without}, {"saved_s", with - without}};

@@ -17,7 +17,7 @@ uniform Monte Carlo as the baseline, measured by `accretion bias` over
   the whole frame, and its lighting passes alone (presampling, candidates,
   reuse, shadow rays: what the configuration changes). The presampling
   passes have no timings of their own and are priced with
-  generateCandidates' coefficients (cost_model.h, costProxy).
+  generateCandidates' coefficients (the costProxy column of `accretion passes`).
 
 References: quickstart, exact; disk_100k, split with k = 256 at 1024 spp.
 Writes out/restir_table/<scene>.{md,json} and, with --update-docs, the

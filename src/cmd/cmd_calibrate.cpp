@@ -38,7 +38,7 @@ nlohmann::json reportHoldout(const std::vector<CostRow>& rows, double fraction, 
                               fmt::format("{} worst", costModelFormName(f)));
     fmt::print("{}\n", header);
     for (std::size_t k = 0; k < h[0].passes.size(); ++k) {
-        std::string line = fmt::format("{:<22} {:>5}", h[0].passes[k].pass, h[0].passes[k].rows);
+        std::string line = fmt::format("{:<22} {:>5}", h[0].passes[k].label(), h[0].passes[k].rows);
         for (const Holdout& x : h)
             if (k < x.passes.size()) line += fmt::format("  {:>14.1f}% {:>14.1f}%", 100 * x.passes[k].median, 100 * x.passes[k].worst);
         fmt::print("{}\n", line);
@@ -73,11 +73,11 @@ void runCalibrate(const CalibrateArgs& args) {
         std::string line;
         for (std::size_t k = 0; k < kCostFeatures.size(); ++k)
             if (ns[k] > 0.0) line += fmt::format(" {} {:.4g}", kCostFeatures[k], ns[k]);
-        fmt::print("  {:<22} ns:{}\n", pass, line);
+        fmt::print("  {:<22} ns:{}\n", passName(pass), line);
     }
     fmt::print("{:<14} {:<22} {:>12} {:>12} {:>12}\n", "config", "pass", "measured ms", "predicted", "residual");
     for (std::size_t i = 0; i < c.rows.size(); ++i)
-        fmt::print("{:<14} {:<22} {:>12.4f} {:>12.4f} {:>+12.4f}\n", c.rows[i].config, c.rows[i].pass, c.rows[i].measuredMs,
+        fmt::print("{:<14} {:<22} {:>12.4f} {:>12.4f} {:>+12.4f}\n", c.rows[i].config, c.rows[i].pass.label(), c.rows[i].measuredMs,
                    c.predictedMs[i], c.predictedMs[i] - c.rows[i].measuredMs);
     fmt::print("rms residual {:.4g} ms, R^2 {:.4f}, max relative error {:.1f}%\n", c.rmsMs, c.r2, 100.0 * c.maxRelativeError);
     nlohmann::json doc = c.toJson();

@@ -103,9 +103,9 @@ Table passTable(const GpuReport& r, const CostCoefficients& coef, const std::str
     totalMs = 0.0;
     for (const PassReport& p : r.passes) {
         const CostFeatures f = costFeatures(p, coef.cacheBytes);
-        const double ms = coef.predictMs(p.pass, f);
+        const double ms = coef.predictMs(p.pass.pass, f);
         totalMs += ms;
-        std::vector<Cell> row{config, p.pass, p.threads, p.trips, p.rays, p.perRay(p.blasEntries), p.perRay(p.anyHits),
+        std::vector<Cell> row{config, p.pass.label(), p.threads, p.trips, p.rays, p.perRay(p.blasEntries), p.perRay(p.anyHits),
                               p.perRay(p.proceeds), 1e-6 * double(p.bytesRead), 1e-6 * double(p.bytesWritten),
                               100.0 * p.ser.branchBefore.efficiency, 100.0 * p.ser.loopBefore.efficiency,
                               p.ser.predictedSpeedup, p.rayModel};
@@ -124,16 +124,16 @@ nlohmann::json reportSerSweep(const CostRun& run, const CountedFrame& main) {
     fmt::print("\nSER (window {} threads, reorder cost {} lane-steps per thread): branch SIMT efficiency before -> after, "
                "distinct keys per warp, predicted speed-up\n", settings.gpu.ser_window, settings.gpu.ser_reorder_cost);
     for (const PassCounters& pc : main.image.counters.passes) {
-        if (pc.pass == pass::buildClusters) continue;
+        if (pc.pass == Pass::buildClusters) continue;
         std::string best;
         double bestGain = 0.0;
         for (const SerKey& k : run.serKeys) {
             const SerReport s = serOf(pc, settings.gpu, k);
             fmt::print("  {:<20} {:<26} {:5.1f}% -> {:5.1f}%  keys {:5.2f} -> {:5.2f}  loop {:5.1f}% -> {:5.1f}%  {:5.2f}x\n",
-                       pc.pass, s.key, 100.0 * s.branchBefore.efficiency, 100.0 * s.branchAfter.efficiency,
+                       passName(pc.pass), s.key, 100.0 * s.branchBefore.efficiency, 100.0 * s.branchAfter.efficiency,
                        s.distinctSortKeysBefore, s.distinctSortKeysAfter, 100.0 * s.loopBefore.efficiency,
                        100.0 * s.loopAfter.efficiency, s.predictedSpeedup);
-            serSweep.push_back({{"pass", pc.pass},
+            serSweep.push_back({{"pass", passName(pc.pass)},
                                 {"key", s.key},
                                 {"branch_efficiency_before", s.branchBefore.efficiency},
                                 {"branch_efficiency_after", s.branchAfter.efficiency},
@@ -147,7 +147,7 @@ nlohmann::json reportSerSweep(const CostRun& run, const CountedFrame& main) {
                 best = s.key;
             }
         }
-        fmt::print("  {:<20} best key: {} ({:.2f}x)\n", pc.pass, best, bestGain);
+        fmt::print("  {:<20} best key: {} ({:.2f}x)\n", passName(pc.pass), best, bestGain);
     }
 
     return serSweep;
@@ -165,7 +165,7 @@ nlohmann::json reportOmm(const CostRun& run, const CountedFrame& main) {
         auto anyHits = [](const GpuReport& g, bool shadow) {
             std::uint64_t ah = 0, rays = 0;
             for (const PassReport& p : g.passes) {
-                const bool isPrimary = p.pass == pass::traceGBuffer;
+                const bool isPrimary = p.pass.pass == Pass::traceGBuffer;
                 if (p.rays == 0 || isPrimary == shadow) continue;
                 ah += p.anyHits;
                 rays += p.rays;
@@ -336,11 +336,11 @@ void runCost(const CostArgs& a) {
     else
         fmt::print("{:<20} {:.3f} UNCALIBRATED ms per frame (an order-of-magnitude guess, not a measurement)\n", "total", totalMs);
     for (const PassReport& p : r.passes)
-        if (p.rays > 0) fmt::print("  {}: {} ({})\n", p.pass, p.rayModel, p.reason);
+        if (p.rays > 0) fmt::print("  {}: {} ({})\n", p.pass.label(), p.rayModel, p.reason);
 
     nlohmann::json doc = toJson(r);
     for (std::size_t k = 0; k < r.passes.size(); ++k) doc["passes"][k]["predicted_ms"] =
-        coef.predictMs(r.passes[k].pass, costFeatures(r.passes[k], coef.cacheBytes));
+        coef.predictMs(r.passes[k].pass.pass, costFeatures(r.passes[k], coef.cacheBytes));
     doc["ser_sweep"] = reportSerSweep(run, main);
     doc["any_hit_omm"] = reportOmm(run, main);
     doc["blas_memory_by_cluster_size"] = reportBlasMemory(run);

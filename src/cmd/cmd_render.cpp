@@ -226,7 +226,7 @@ nlohmann::json writeFrameOutputs(const RenderRun& run, std::uint32_t frame, cons
     meta["preview"] = tone.describe();
     nlohmann::json outputs;
     {
-        auto t = fs.timer.scope(pass::writeOutputs);
+        auto t = fs.timer.scope(Pass::writeOutputs);
         writeFrameExr(exr, image, !estimatorInfo(settings.render.estimator).sums, meta);
         writePreviewPng(base + ".png", L, w.width(), w.height(), tone);
         writePreviewPng(base + ".Lr.png", Lr, w.width(), w.height(), lrTone);
@@ -259,9 +259,9 @@ nlohmann::json writeFrameOutputs(const RenderRun& run, std::uint32_t frame, cons
 void printFrame(const Settings& settings, std::uint32_t frame, const nlohmann::json& fj, const FrameStats& fs) {
     if (settings.render.target_stderr > 0.0)
         fmt::print("  adaptive: mean {:.1f}, max {:.0f} samples per hit pixel\n", fs.meanSpp, fs.maxSpp);
-    for (const auto& [name, count] : fs.nonFinite)
-        fmt::print("  {}: {} non-finite values rejected ({})\n", name, count, enumName(settings.render.nonfinite));
-    const double lighting = fs.timer.seconds(pass::estimateLighting);
+    for (const auto& [pass, count] : fs.nonFinite)
+        fmt::print("  {}: {} non-finite values rejected ({})\n", passName(pass), count, enumName(settings.render.nonfinite));
+    const double lighting = fs.timer.seconds(Pass::estimateLighting);
     fmt::print("frame {}: {} ({:.2f} s, {} particles, CPU traces {}, build {:.1f} ms, {:.2f} M shadow rays/s)\n", frame,
                fj["outputs"]["exr"].get<std::string>(), fs.seconds, fs.particles, fs.bvh.layout,
                1e3 * (fs.bvh.clusterSeconds + fs.bvh.blasSeconds + fs.bvh.tlasSeconds),
@@ -390,7 +390,7 @@ void runRender(const RenderArgs& args) {
         const nlohmann::json fj = writeFrameOutputs(run, frame, image, fs, sums);
         stats["frames"].push_back(fj);
         shadowRays += fs.lighting.shadowRays;
-        lightingSeconds += fs.timer.seconds(pass::estimateLighting);
+        lightingSeconds += fs.timer.seconds(Pass::estimateLighting);
         printFrame(settings, frame, fj, fs);
         // Stopped between frames: the next frame starts from its first chunk.
         if (const int signal = stop.pending(); signal && frame + 1 < sharding.end) {

@@ -183,7 +183,7 @@ std::vector<std::string> sceneArgv(const TuneContext& t, const std::string& comm
 
 /// Predicted GPU ms per pass of one configuration at the scene's
 /// resolution: its counters (`accretion cost`, cached) priced with the calibration.
-std::map<std::string, double> predictMs(TuneContext& t, const std::vector<std::string>& defines, const std::string& what) {
+std::map<Pass, double> predictMs(TuneContext& t, const std::vector<std::string>& defines, const std::string& what) {
     std::string key = t.sceneText + "\ncost frame " + std::to_string(t.args.frame);
     for (const std::string& d : defines) key += "\n" + d;
     const std::filesystem::path prefix = t.cache / (cacheKey(key) + ".cost");
@@ -191,15 +191,15 @@ std::map<std::string, double> predictMs(TuneContext& t, const std::vector<std::s
     argv.insert(argv.end(), {"--frames", fmt::format("{}:{}", t.args.frame, t.args.frame + 1), "--history", "1", "--overhead", "0",
                              "--cluster-sizes", "", "--omm-levels", "", "--ser-keys", "hit", "-q", "-o", prefix.string() + ".json"});
     measure(t, argv, prefix.string() + ".csv", "GPU time of " + what);
-    std::map<std::string, double> ms;
+    std::map<Pass, double> ms;  // a pass's runs summed
     for (CostRow& r : readCounterCsv(prefix.string() + ".csv")) {
         r.features[kColdWork] = coldWork(r.features[2], r.features[5], r.workingSetBytes, t.coefficients.cacheBytes);
-        ms[r.pass] += t.coefficients.predictMs(r.pass, r.features);
+        ms[r.pass.pass] += t.coefficients.predictMs(r.pass.pass, r.features);
     }
     return ms;
 }
 
-double total(const std::map<std::string, double>& ms) {
+double total(const std::map<Pass, double>& ms) {
     double s = 0.0;
     for (const auto& [pass, v] : ms) s += v;
     return s;
@@ -313,7 +313,7 @@ void runTune(const TuneArgs& a) {
 
     // Geometry: the same image whatever it is; the fastest predicted frame.
     Option base{"the scene's lighting", {}};
-    std::vector<std::pair<Option, std::map<std::string, double>>> geometryMs;
+    std::vector<std::pair<Option, std::map<Pass, double>>> geometryMs;
     for (const Option& g : geometry) geometryMs.emplace_back(g, predictMs(t, g.defines, g.label));
     const auto fastest = std::min_element(geometryMs.begin(), geometryMs.end(),
                                           [](const auto& p, const auto& q) { return total(p.second) < total(q.second); });
@@ -321,9 +321,9 @@ void runTune(const TuneArgs& a) {
     Table gt({{"geometry", "geometry (the image does not depend on it)", -44}, {"build_ms", "build ms", 9, "{:.3f}", "{:.6g}"},
               {"gbuffer_ms", "G-buffer", 9, "{:.3f}", "{:.6g}"}, {"shadow_ms", "shadow", 9, "{:.3f}", "{:.6g}"},
               {"frame_ms", "frame ms", 9, "{:.3f}", "{:.6g}"}});
+    const auto of = [](const std::map<Pass, double>& ms, Pass p) { return ms.count(p) ? ms.at(p) : 0.0; };
     for (const auto& [g, ms] : geometryMs)
-        gt.add({g.label, ms.count("buildClusters") ? ms.at("buildClusters") : 0.0, ms.count("traceGBuffer") ? ms.at("traceGBuffer") : 0.0,
-                ms.count("traceShadowRays") ? ms.at("traceShadowRays") : 0.0, total(ms)});
+        gt.add({g.label, of(ms, Pass::buildClusters), of(ms, Pass::traceGBuffer), of(ms, Pass::traceShadowRays), total(ms)});
 
     // Lighting: error on the CPU, GPU time on the chosen geometry.
     std::vector<ParetoPoint> points;

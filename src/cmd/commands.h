@@ -81,6 +81,7 @@ void addCostCommand(CLI::App& app);
 void addCalibrateCommand(CLI::App& app);
 void addPlanCommand(CLI::App& app);
 void addEstimatorsCommand(CLI::App& app);
+void addPassesCommand(CLI::App& app);
 void addMergeCommand(CLI::App& app);
 void addBatchCommand(CLI::App& app);
 void addCamerasCommand(CLI::App& app);

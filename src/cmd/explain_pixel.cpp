@@ -92,7 +92,7 @@ void printRestir(const PixelTrace& t, const Settings& s) {
     fmt::print("restir: the pixel's reservoir after each pass\n");
     fmt::print("  {:<20} {:>9} {:>8} {:>14} {:>14}\n", "pass", "y", "M", "p_hat(y)", "W");
     for (const auto& p : t.passes)
-        fmt::print("  {:<20} {:>9} {:>8} {:>14.8g} {:>14.8g}\n", p.pass, light(p.reservoir.y), p.reservoir.M, p.reservoir.p_hat,
+        fmt::print("  {:<20} {:>9} {:>8} {:>14.8g} {:>14.8g}\n", p.pass.label(), light(p.reservoir.y), p.reservoir.M, p.reservoir.p_hat,
                    p.reservoir.W);
     // Why M stops growing over frames: the temporal pass caps the history's M.
     const double cap = std::floor(s.restir.m_cap * double(std::max(1u, s.render.candidates)));

@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
     accretion::cmd::addCalibrateCommand(app);
     accretion::cmd::addPlanCommand(app);
     accretion::cmd::addEstimatorsCommand(app);
+    accretion::cmd::addPassesCommand(app);
     accretion::cmd::addMergeCommand(app);
     accretion::cmd::addBatchCommand(app);
     accretion::cmd::addCamerasCommand(app);

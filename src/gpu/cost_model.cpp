@@ -18,13 +18,13 @@
 #include "accretion/core/json_text.h"
 #include "accretion/core/median.h"
 #include "accretion/core/parse.h"
-#include "accretion/core/pass_timer.h"
+#include "accretion/core/pass.h"
 
 namespace accretion {
 
 namespace {
 /// The pass names, for errors that name an unknown one.
-std::string knownPasses() { return fmt::format("passes: {}", fmt::join(kPassNames, ", ")); }
+std::string knownPasses() { return "passes: " + passNameList(); }
 }  // namespace
 
 double coldWork(double rays, double bytes, double workingSetBytes, double cacheBytes) {
@@ -113,11 +113,12 @@ CostCoefficients CostCoefficients::fromJson(const nlohmann::json& j, const std::
     }
     if (j.contains("per_pass_ns")) {
         if (!j["per_pass_ns"].is_object()) throw InputError(fmt::format("{}: per_pass_ns is not an object", path));
-        for (const auto& [pass, obj] : j["per_pass_ns"].items()) {
-            if (!obj.is_object()) throw InputError(fmt::format("{}: per_pass_ns.{} is not an object", path, pass));
-            if (!parsePass(pass) || pass.find('[') != std::string::npos)
-                throw InputError(fmt::format("{}: per_pass_ns.{}: not a pass ({})", path, pass, knownPasses()));
-            read(obj, "per_pass_ns." + pass, out.perPass[pass]);
+        for (const auto& [name, obj] : j["per_pass_ns"].items()) {
+            if (!obj.is_object()) throw InputError(fmt::format("{}: per_pass_ns.{} is not an object", path, name));
+            const std::optional<PassRun> run = parsePassRun(name);
+            if (!run || run->run != 1)
+                throw InputError(fmt::format("{}: per_pass_ns.{}: not a pass ({})", path, name, knownPasses()));
+            read(obj, "per_pass_ns." + name, out.perPass[run->pass]);
         }
     }
     return out;
@@ -130,7 +131,8 @@ nlohmann::json CostCoefficients::toJson() const {
     if (!gpu.empty()) j["gpu"] = gpu;
     if (!measuredAt.empty()) j["measured_at"] = measuredAt;
     for (const auto& [pass, f] : perPass)
-        for (std::size_t k = 0; k < kCostFeatures.size(); ++k) j["per_pass_ns"][pass][std::string(kCostFeatures[k])] = f[k];
+        for (std::size_t k = 0; k < kCostFeatures.size(); ++k)
+            j["per_pass_ns"][std::string(passName(pass))][std::string(kCostFeatures[k])] = f[k];
     return j;
 }
 
@@ -147,21 +149,9 @@ double dotMs(const CostFeatures& ns, const CostFeatures& f) {
 
 double CostCoefficients::predictMs(const CostFeatures& f) const { return dotMs(ns, f); }
 
-std::string passFamily(const std::string& pass) {
-    const auto bracket = pass.find('[');
-    return bracket == std::string::npos ? pass : pass.substr(0, bracket);
-}
-
-std::string costProxy(const std::string& family) {
-    // RTXDI's presampling passes are generateCandidates' kind of work: one
-    // thread per entry, a RIS loop over random light records, no rays.
-    if (family == pass::presampleLightTiles || family == pass::presampleRegirGrid) return std::string(pass::generateCandidates);
-    return family;
-}
-
-double CostCoefficients::predictMs(const std::string& pass, const CostFeatures& f) const {
-    auto it = perPass.find(passFamily(pass));
-    if (it == perPass.end()) it = perPass.find(costProxy(passFamily(pass)));
+double CostCoefficients::predictMs(Pass pass, const CostFeatures& f) const {
+    auto it = perPass.find(pass);
+    if (it == perPass.end()) it = perPass.find(passInfo(pass).costProxy);
     return dotMs(it == perPass.end() ? ns : it->second, f);
 }
 
@@ -285,9 +275,9 @@ std::vector<CostRow> readCounterCsv(const std::string& path) {
     for (std::size_t k = 0; k < kBaseCostFeatures; ++k) required.emplace_back(kCostFeatures[k]);
     std::vector<CostRow> rows;
     for (auto& [lineNo, r] : readCsv(path, required)) {
-        CostRow row{r["config"], r["pass"], {}, 0.0};
-        if (!parsePass(row.pass))
-            throw InputError(fmt::format("{}:{}: pass '{}' is not a pass ({})", path, lineNo, row.pass, knownPasses()));
+        const std::optional<PassRun> pass = parsePassRun(r["pass"]);
+        if (!pass) throw InputError(fmt::format("{}:{}: pass '{}' is not a pass ({})", path, lineNo, r["pass"], knownPasses()));
+        CostRow row{r["config"], *pass, {}, 0.0};
         for (std::size_t k = 0; k < kCostFeatures.size(); ++k) {
             const auto cell = r.find(std::string(kCostFeatures[k]));
             if (cell == r.end()) continue;  // a later counter, absent from a CSV of the first form: 0
@@ -302,13 +292,13 @@ std::vector<CostRow> readCounterCsv(const std::string& path) {
 }
 
 void joinTimings(const std::string& path, std::vector<CostRow>& rows) {
-    std::map<std::pair<std::string, std::string>, double> ms;
+    std::map<std::pair<std::string, PassRun>, double> ms;
     for (auto& [lineNo, r] : readCsv(path, {"config", "pass", "ms"})) {
-        const auto key = std::make_pair(r["config"], r["pass"]);
-        if (!parsePass(key.second))
-            throw InputError(fmt::format("{}:{}: pass '{}' is not a pass ({})", path, lineNo, key.second, knownPasses()));
+        const std::optional<PassRun> pass = parsePassRun(r["pass"]);
+        if (!pass) throw InputError(fmt::format("{}:{}: pass '{}' is not a pass ({})", path, lineNo, r["pass"], knownPasses()));
+        const auto key = std::make_pair(r["config"], *pass);
         if (ms.count(key))
-            throw InputError(fmt::format("{}:{}: a second timing for config '{}' pass '{}'", path, lineNo, key.first, key.second));
+            throw InputError(fmt::format("{}:{}: a second timing for config '{}' pass '{}'", path, lineNo, key.first, r["pass"]));
         ms[key] = parseNumber(r["ms"], fmt::format("{}:{}: ms", path, lineNo));
     }
     std::vector<CostRow> joined;
@@ -321,7 +311,7 @@ void joinTimings(const std::string& path, std::vector<CostRow>& rows) {
     }
     if (!ms.empty())
         throw InputError(fmt::format("{}: no counters for config '{}' pass '{}'", path, ms.begin()->first.first,
-                                     ms.begin()->first.second));
+                                     ms.begin()->first.second.label()));
     rows = std::move(joined);
 }
 
@@ -341,8 +331,8 @@ std::size_t featureIndex(std::string_view name) {
 
 /// The counters a pass family is fitted on: buildClusters its builds and
 /// dispatches, every other pass all but the builds (isBuildFeature).
-FeatureMask passFeatures(const std::string& family) {
-    const bool build = family == pass::buildClusters;
+FeatureMask passFeatures(Pass pass) {
+    const bool build = pass == Pass::buildClusters;
     FeatureMask m{};
     for (std::size_t k = 0; k < m.size(); ++k) m[k] = isBuildFeature(k) == build;
     m[featureIndex("dispatches")] = true;
@@ -447,9 +437,9 @@ std::vector<CostRow> withCache(std::vector<CostRow> rows, double cacheBytes) {
     return rows;
 }
 
-std::map<std::string, std::vector<const CostRow*>> rowsByPass(const std::vector<CostRow>& rows) {
-    std::map<std::string, std::vector<const CostRow*>> byPass;
-    for (const CostRow& r : rows) byPass[passFamily(r.pass)].push_back(&r);
+std::map<Pass, std::vector<const CostRow*>> rowsByPass(const std::vector<CostRow>& rows) {
+    std::map<Pass, std::vector<const CostRow*>> byPass;
+    for (const CostRow& r : rows) byPass[r.pass.pass].push_back(&r);
     return byPass;
 }
 
@@ -508,7 +498,7 @@ Calibration calibrate(const std::vector<CostRow>& rows, CostModelForm form) {
     double mean = 0.0, ssTot = 0.0, ssRes = 0.0;
     for (const CostRow& r : c.rows) mean += r.measuredMs / double(rows.size());
     for (const CostRow& r : c.rows) {
-        const double p = c.coefficients.predictMs(r.pass, r.features);
+        const double p = c.coefficients.predictMs(r.pass.pass, r.features);
         c.predictedMs.push_back(p);
         ssRes += (p - r.measuredMs) * (p - r.measuredMs);
         ssTot += (r.measuredMs - mean) * (r.measuredMs - mean);
@@ -542,18 +532,18 @@ Holdout holdout(const std::vector<CostRow>& rows, CostModelForm form, double fra
     const CostCoefficients c = fit(train, form);
     const std::vector<CostRow> priced = withCache(rows, c.cacheBytes);
     using Errors = std::vector<std::pair<double, std::string>>;  // relative error, configuration
-    std::map<std::string, Errors> byPass;
+    std::map<Pass, Errors> byPass;
     Errors all;
     for (const CostRow& r : priced) {
         if (!in(h.predicted, r.config) || !(r.measuredMs > 0.0)) continue;
-        const double predicted = c.predictMs(r.pass, r.features);
+        const double predicted = c.predictMs(r.pass.pass, r.features);
         h.rows.push_back(r);
         h.predictedMs.push_back(predicted);
         const double e = std::abs(predicted - r.measuredMs) / r.measuredMs;
-        byPass[passFamily(r.pass)].push_back({e, r.config});
+        byPass[r.pass.pass].push_back({e, r.config});
         all.push_back({e, r.config});
     }
-    auto summary = [](const std::string& pass, const Errors& es) {
+    auto summary = [](std::optional<Pass> pass, const Errors& es) {
         HoldoutError he{pass, es.size(), 0.0, 0.0, ""};
         std::vector<double> v;
         for (const auto& [e, config] : es) {
@@ -567,18 +557,18 @@ Holdout holdout(const std::vector<CostRow>& rows, CostModelForm form, double fra
         return he;
     };
     for (const auto& [pass, es] : byPass) h.passes.push_back(summary(pass, es));
-    if (!all.empty()) h.passes.push_back(summary("all passes", all));
+    if (!all.empty()) h.passes.push_back(summary(std::nullopt, all));
     return h;
 }
 
 nlohmann::json Holdout::toJson() const {
     nlohmann::json p = nlohmann::json::array();
     for (const HoldoutError& e : passes)
-        p.push_back({{"pass", e.pass}, {"rows", e.rows}, {"median_relative_error", e.median},
+        p.push_back({{"pass", e.label()}, {"rows", e.rows}, {"median_relative_error", e.median},
                      {"worst_relative_error", e.worst}, {"worst_config", e.worstConfig}});
     nlohmann::json rs = nlohmann::json::array();
     for (std::size_t i = 0; i < rows.size(); ++i)
-        rs.push_back({{"config", rows[i].config}, {"pass", rows[i].pass}, {"measured_ms", rows[i].measuredMs},
+        rs.push_back({{"config", rows[i].config}, {"pass", rows[i].pass.label()}, {"measured_ms", rows[i].measuredMs},
                       {"predicted_ms", predictedMs[i]}});
     return {{"form", costModelFormName(form)}, {"fitted", fitted}, {"predicted", predicted},
             {"passes", p}, {"rows", rs}};
@@ -589,7 +579,7 @@ nlohmann::json Calibration::toJson() const {
     nlohmann::json res = nlohmann::json::array();
     for (std::size_t i = 0; i < rows.size(); ++i)
         res.push_back({{"config", rows[i].config},
-                       {"pass", rows[i].pass},
+                       {"pass", rows[i].pass.label()},
                        {"measured_ms", rows[i].measuredMs},
                        {"predicted_ms", predictedMs[i]},
                        {"residual_ms", predictedMs[i] - rows[i].measuredMs}});

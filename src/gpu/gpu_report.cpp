@@ -6,7 +6,7 @@
 
 #include <fmt/format.h>
 
-#include "accretion/core/pass_timer.h"
+#include "accretion/core/pass.h"
 #include "accretion/counters/gpu_layouts.h"
 #include "accretion/gpu/cost_model.h"
 
@@ -47,7 +47,7 @@ void adviseRayModel(PassReport& p) {
 
 PassReport summarise(const PassCounters& pc, const GpuSettings& gpu, const SerKey& key) {
     PassReport p;
-    p.pass = pc.label();
+    p.pass = pc.id();
     p.width = pc.width;
     p.height = pc.height;
     p.dispatches = pc.dispatches;
@@ -115,8 +115,7 @@ GpuReport makeGpuReport(const FrameCounters& counters, const Settings& settings,
     for (PassReport& p : r.passes) {
         p.tlasLevels = p.rays * tlasDepth;
         if (p.rays > 0) p.workingSetBytes = double(r.blas.gpuBytes) + double(accel.tlasInstances) * gpu_layout::kTlasInstanceBytes;
-        else if (p.pass == pass::generateCandidates || p.pass == pass::presampleLightTiles || p.pass == pass::presampleRegirGrid || p.pass == pass::temporalResampling || passFamily(p.pass) == pass::spatialResampling)
-            p.workingSetBytes = lightBytes;
+        else if (passInfo(p.pass.pass).readsLights) p.workingSetBytes = lightBytes;
     }
 
     const std::uint64_t pixels = std::uint64_t(settings.camera.width) * settings.camera.height;
@@ -145,7 +144,7 @@ nlohmann::json simtJson(const SimtStats& s) {
 }  // namespace
 
 nlohmann::json toJson(const PassReport& p) {
-    return {{"pass", p.pass},
+    return {{"pass", p.pass.label()},
             {"width", p.width},
             {"height", p.height},
             {"threads", p.threads},
@@ -234,13 +233,13 @@ std::vector<Heatmap> counterHeatmaps(const FrameCounters& counters, std::uint32_
                               {"gpu.trips", std::vector<float>(pixels, 0.0f), "light-loop trips per pixel, all passes"},
                               {"gpu.bytes", std::vector<float>(pixels, 0.0f), "bytes read + written per pixel, all passes"}};
     for (const PassCounters& pc : counters.passes) {
-        if (pc.pass == pass::buildClusters || pc.width == 0 || pc.height == 0) continue;
+        if (pc.pass == Pass::buildClusters || pc.width == 0 || pc.height == 0) continue;
         // A pass that traces also gets its own map: the BLAS entries of its rays.
         bool traces = false;
         for (const ThreadCounters& t : pc.threads) traces = traces || t.rays > 0;
         if (traces)
-            maps.push_back({fmt::format("gpu.{}.blas_entries", pc.pass), std::vector<float>(pixels, 0.0f),
-                            fmt::format("BLAS entries per pixel, {}", pc.pass)});
+            maps.push_back({fmt::format("gpu.{}.blas_entries", passName(pc.pass)), std::vector<float>(pixels, 0.0f),
+                            fmt::format("BLAS entries per pixel, {}", passName(pc.pass))});
         Heatmap* own = traces ? &maps.back() : nullptr;
         for (std::uint32_t y = 0; y < height; ++y)
             for (std::uint32_t x = 0; x < width; ++x) {

@@ -4,8 +4,10 @@ namespace accretion {
 
 nlohmann::json frameStatsJson(const FrameStats& s) {
     nlohmann::json passes = nlohmann::json::object();
-    for (const auto& [name, seconds] : s.timer.all()) passes[name] = seconds;
-    const double lightingSeconds = s.timer.seconds(pass::estimateLighting);
+    for (const auto& [pass, seconds] : s.timer.all()) passes[std::string(passName(pass))] = seconds;
+    nlohmann::json nonFinite = nlohmann::json::object();
+    for (const auto& [pass, count] : s.nonFinite) nonFinite[std::string(passName(pass))] = count;
+    const double lightingSeconds = s.timer.seconds(Pass::estimateLighting);
 
     nlohmann::json j = {
         {"frame", s.frame},
@@ -21,7 +23,7 @@ nlohmann::json frameStatsJson(const FrameStats& s) {
           {"light_terms", s.lighting.lightTerms},
           {"reuse_accepted", s.lighting.reuseAccepted},
           {"reuse_rejected", s.lighting.reuseRejected},
-          {"nonfinite_rejected", s.nonFinite},
+          {"nonfinite_rejected", nonFinite},
           {"light_tree_nodes", s.lightTreeNodes},
           {"near_lights", s.nearLights.k},
           {"reservoir_bytes", s.reservoirBytes},

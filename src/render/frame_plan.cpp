@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include "accretion/core/math.h"
-#include "accretion/core/pass_timer.h"
 #include "accretion/lighting/reservoir_codec.h"
 
 namespace accretion {
@@ -45,72 +44,73 @@ void describe(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
     const EstimatorKind est = s.render.estimator;
     const bool restir = estimatorInfo(est).reuse;
     const bool manyFrames = s.render.frames > 1;
-    auto step = [&](std::string_view name, bool runs, std::string why, bool isPass = true, bool nested = false) {
-        plan.steps.push_back({std::string(name), runs, std::move(why), isPass, nested});
+    auto step = [&](Pass pass, bool runs, std::string why) { plan.steps.push_back({pass, {}, runs, std::move(why)}); };
+    auto work = [&](std::string name, bool runs, std::string why) {
+        plan.steps.push_back({std::nullopt, std::move(name), runs, std::move(why)});
     };
     const std::string once = "static particles and camera: built at the first frame";
-    step(pass::loadParticles, plan.loadParticles,
+    step(Pass::loadParticles, plan.loadParticles,
          !plan.loadParticles ? once : plan.staticGeometry && manyFrames ? "once: the particles do not move" : "every frame");
-    step(pass::buildClusters, plan.buildClusters,
+    step(Pass::buildClusters, plan.buildClusters,
          !plan.buildClusters ? once
          : plan.staticGeometry ? (manyFrames ? "once for all frames: static particles and camera" : "one frame")
                                : fmt::format("every frame ({})", enumName(s.geometry.build)));
-    step("alpha filter callbacks", plan.alphaFilter,
+    work("alpha filter callbacks", plan.alphaFilter,
          plan.alphaFilter ? (s.gpu.omm == OmmMode::off ? "disc alpha: any-hit on every candidate"
                                                        : fmt::format("disc alpha with {} OMM level {}", enumName(s.gpu.omm), s.gpu.omm_level))
-                          : "no alpha test (opaque quads or spheres)", false);
-    step("previous-frame BVH", plan.previousBvh,
+                          : "no alpha test (opaque quads or spheres)");
+    work("previous-frame BVH", plan.previousBvh,
          plan.previousBvh ? "basic_visibility tests history samples against last frame's geometry"
-                          : "not needed (no basic_visibility with history and visibility reuse)", false);
+                          : "not needed (no basic_visibility with history and visibility reuse)");
     const bool dark = !plan.lighting;
     const std::string noLight = facts.lightingSkipped ? "no lighting passes: skipped by the command (geometry timed alone)"
                                 : !facts.emissive ? "no lighting passes: no particle emits"
                                                   : "no lighting passes: albedo 0";
-    step(pass::buildLightSampler, plan.sampler != LightSamplerKind::none,
+    step(Pass::buildLightSampler, plan.sampler != LightSamplerKind::none,
          plan.sampler == LightSamplerKind::tree    ? "light tree"
          : plan.sampler == LightSamplerKind::power ? "alias table over light power"
          : dark ? noLight : fmt::format("{} samples lights uniformly", enumName(est)));
-    step(pass::traceGBuffer, true,
+    step(Pass::traceGBuffer, true,
          plan.traced.isWhole(s.camera.width, s.camera.height)
              ? std::string("one primary ray per pixel")
              : fmt::format("one primary ray per pixel of render.crop's {}x{} window", plan.traced.width(), plan.traced.height()));
-    step(pass::estimateLighting, plan.lighting,
+    step(Pass::estimateLighting, plan.lighting,
          dark ? noLight : restir ? "the restir passes below" : std::string(enumName(est)));
     if (restir) {
         const RestirSettings& r = s.restir;
-        step(pass::presampleLightTiles, plan.presampleTiles,
+        step(Pass::presampleLightTiles, plan.presampleTiles,
              plan.presampleTiles ? fmt::format("{} tiles x {} lights by power", r.tile_count, r.tile_size)
-             : dark ? noLight : fmt::format("source {}: no light tiles", enumName(s.render.source)), true, true);
-        step(pass::presampleRegirGrid, plan.presampleRegir,
+             : dark ? noLight : fmt::format("source {}: no light tiles", enumName(s.render.source)));
+        step(Pass::presampleRegirGrid, plan.presampleRegir,
              plan.presampleRegir ? fmt::format("{}^3 cells x {} reservoirs of {} tile candidates", r.regir_cells,
                                                r.regir_lights_per_cell, r.regir_build_samples)
-             : dark ? noLight : fmt::format("source {}: no ReGIR grid", enumName(s.render.source)), true, true);
-        step(pass::generateCandidates, plan.restir,
-             dark ? noLight : fmt::format("{} candidates from {}", s.render.candidates, enumName(s.render.source)), true, true);
-        step(pass::temporalResampling, plan.temporal,
+             : dark ? noLight : fmt::format("source {}: no ReGIR grid", enumName(s.render.source)));
+        step(Pass::generateCandidates, plan.restir,
+             dark ? noLight : fmt::format("{} candidates from {}", s.render.candidates, enumName(s.render.source)));
+        step(Pass::temporalResampling, plan.temporal,
              plan.temporal ? "reprojection through particle motion"
              : dark ? noLight : !s.restir.temporal ? "temporal off: no history buffers or motion"
-             : !manyFrames ? "one frame: no history buffers or motion" : "first frame: no history yet", true, true);
-        step(pass::spatialResampling, plan.spatialIterations > 0,
+             : !manyFrames ? "one frame: no history buffers or motion" : "first frame: no history yet");
+        step(Pass::spatialResampling, plan.spatialIterations > 0,
              plan.spatialIterations ? fmt::format("{} neighbours x {}", s.restir.spatial_neighbours, s.restir.spatial_iterations)
-                                    : (dark ? noLight : "no neighbours"), true, true);
-        step(pass::traceShadowRays, plan.restir,
+                                    : (dark ? noLight : "no neighbours"));
+        step(Pass::traceShadowRays, plan.restir,
              plan.shadowRays ? "one shadow ray per pixel"
-             : dark ? noLight : "visibility off: the kept sample shaded with V = 1, no shadow rays", true, true);
-        step(pass::upsampleLighting, plan.upsample,
-             plan.upsample ? fmt::format("lighting at scale {}", s.restir.resolution_scale) : "full-resolution lighting", true, true);
+             : dark ? noLight : "visibility off: the kept sample shaded with V = 1, no shadow rays");
+        step(Pass::upsampleLighting, plan.upsample,
+             plan.upsample ? fmt::format("lighting at scale {}", s.restir.resolution_scale) : "full-resolution lighting");
     } else {
-        step("shadow rays", plan.shadowRays,
-             plan.shadowRays ? "V by occlusion queries" : (dark ? noLight : "visibility off: no shadow rays"), false);
+        work("shadow rays", plan.shadowRays,
+             plan.shadowRays ? "V by occlusion queries" : (dark ? noLight : "visibility off: no shadow rays"));
     }
     const bool reservoirs = plan.lighting && estimatorInfo(est).resampling;
-    step("reservoirs", reservoirs,
+    work("reservoirs", reservoirs,
          reservoirs ? fmt::format("{} B each", restir ? ReservoirCodec(s.restir).bytes() : 16)
-                    : fmt::format("estimator {}: no reservoirs", enumName(est)), false);
-    step("counters", plan.counting,
-         plan.counting ? "counting variants of every pass" : "counters off: no counting code in the loops", false);
-    step(pass::composeImage, true, "Le + Lr");
-    step(pass::writeOutputs, true, "EXR, PNG previews, stats (by the command)");
+                    : fmt::format("estimator {}: no reservoirs", enumName(est)));
+    work("counters", plan.counting,
+         plan.counting ? "counting variants of every pass" : "counters off: no counting code in the loops");
+    step(Pass::composeImage, true, "Le + Lr");
+    step(Pass::writeOutputs, true, "EXR, PNG previews, stats (by the command)");
 }
 
 }  // namespace
@@ -141,24 +141,26 @@ FramePlan planFrame(const Settings& settings, const FrameFacts& facts) {
     return plan;
 }
 
-std::vector<std::string> FramePlan::passes() const {
-    std::vector<std::string> out;
+std::vector<Pass> FramePlan::passes() const {
+    std::vector<Pass> out;
     for (const PlannedStep& s : steps)
-        if (s.isPass && s.runs && s.name != pass::writeOutputs) out.push_back(s.name);
+        if (s.pass && s.runs && *s.pass != Pass::writeOutputs) out.push_back(*s.pass);
     return out;
 }
 
-const PlannedStep* FramePlan::find(std::string_view name) const {
+const PlannedStep* FramePlan::find(Pass pass) const {
     for (const PlannedStep& s : steps)
-        if (s.name == name) return &s;
+        if (s.pass == pass) return &s;
     return nullptr;
 }
 
 std::string formatPlan(const FramePlan& plan) {
     std::string out;
-    for (const PlannedStep& s : plan.steps)
-        out += fmt::format("  {}{:<{}} {:<8} {}\n", s.nested ? "  " : "", s.name, s.nested ? 22 : 24,
+    for (const PlannedStep& s : plan.steps) {
+        const bool nested = s.pass && isNested(*s.pass);
+        out += fmt::format("  {}{:<{}} {:<8} {}\n", nested ? "  " : "", s.name(), nested ? 22 : 24,
                            s.runs ? "runs" : "skipped", s.why);
+    }
     return out;
 }
 

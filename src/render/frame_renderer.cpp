@@ -26,7 +26,7 @@ void recordClusterBuild(const ParticleBvh& bvh, const Particles& particles, Fram
     const GeometrySettings& g = bvh.settings();
     if (g.layout == AccelLayout::instances) {
         const auto n = static_cast<std::uint32_t>(particles.size());
-        PassCounters& pc = counters.add(pass::buildClusters, n, 1);
+        PassCounters& pc = counters.add(Pass::buildClusters, n, 1);
         pc.dispatches = 1;  // the instance records
         pc.build.addTlas(n, s.refitted);
         for (ThreadCounters& t : pc.threads) {
@@ -37,7 +37,7 @@ void recordClusterBuild(const ParticleBvh& bvh, const Particles& particles, Fram
         }
         return;
     }
-    PassCounters& pc = counters.add(pass::buildClusters, static_cast<std::uint32_t>(clusters.count()), 1);
+    PassCounters& pc = counters.add(Pass::buildClusters, static_cast<std::uint32_t>(clusters.count()), 1);
     pc.dispatches = 1;  // the primitive expansion; the builds are counted apart
     const bool triangles = g.primitive == Primitive::billboard && g.layout == AccelLayout::clusters;
     const bool custom = !triangles;  // boxes or spheres
@@ -100,7 +100,7 @@ void composeImage(const GBuffer& gbuffer, const Particles& particles, const Shad
         if (!composeHit(se, particles.emission[g.particle], img.lighting.Lr[px], img.Le[px], img.L[px])) {
             img.lighting.Lr_stderr[px] = Vec3(0.0f);
             img.lighting.rejected[px] += 1.0f;
-            ++stats.nonFinite[std::string(pass::composeImage)];
+            ++stats.nonFinite[Pass::composeImage];
         }
         img.depth[px] = g.depth;
         img.normal[px] = g.normal;
@@ -154,7 +154,7 @@ const Particles& FrameRenderer::prepareGeometry(std::uint32_t frame, const Camer
     facts.geometryBuilt = built_ && !options_.rebuildStatic;
     facts.historyAvailable = restir_ && restir_->hasHistory();
     if (planFrame(settings_, facts).loadParticles) {
-        auto t = stats.timer.scope(pass::loadParticles);
+        auto t = stats.timer.scope(Pass::loadParticles);
         loaded = source_.frame(frame);
         for (Vec3& p : loaded.position) p -= origin_;
         if (plan_.staticGeometry) staticParticles_ = std::move(loaded);
@@ -164,7 +164,7 @@ const Particles& FrameRenderer::prepareGeometry(std::uint32_t frame, const Camer
     plan_ = planFrame(settings_, facts);
     stats.particles = particles.size();
     if (plan_.buildClusters) {
-        auto t = stats.timer.scope(pass::buildClusters);
+        auto t = stats.timer.scope(Pass::buildClusters);
         if (plan_.previousBvh) {  // double buffer: last frame's BVH stays valid
             std::swap(bvh_, previousBvh_);
             if (!bvh_) bvh_ = newBvh(*device_, settings_);
@@ -196,7 +196,7 @@ void FrameRenderer::lightFrame(std::uint32_t frame, const Camera& camera, const 
     const std::uint32_t nearLights = settings_.render.estimator == EstimatorKind::split && settings_.render.near_lights == 0
                                          ? chooseFrameNearLights(frame, img.camera, particles, lightTree, stats)
                                          : 0u;
-    auto t = stats.timer.scope(pass::estimateLighting);
+    auto t = stats.timer.scope(Pass::estimateLighting);
     if (plan.restir) {
         RestirInputs in{*bvh_, particles, gbuffer, camera, settings_, plan, frame, powerTable, lightTree,
                         plan.previousBvh ? previousBvh_.get() : nullptr, plan.counting ? &img.counters : nullptr, trace};
@@ -206,7 +206,7 @@ void FrameRenderer::lightFrame(std::uint32_t frame, const Camera& camera, const 
         return;
     }
     LightingInputs in{*bvh_, particles, gbuffer, settings_.shading, settings_.render, frame, powerTable, lightTree,
-                      plan.counting ? &img.counters.add(pass::estimateLighting, camera.width, camera.height) : nullptr, trace};
+                      plan.counting ? &img.counters.add(Pass::estimateLighting, camera.width, camera.height) : nullptr, trace};
     in.nearLights = nearLights;
     const LightingPlan lp = planLighting(settings_.render, camera.height, session ? session->shard : Shard{});
     // Progress by work: the hit pixels of the rows (exact) or the chunks
@@ -224,7 +224,7 @@ void FrameRenderer::lightFrame(std::uint32_t frame, const Camera& camera, const 
         }
     }
     if (!lp.exact) work *= lp.end > firstChunk ? lp.end - firstChunk : 0;
-    Progress progress(fmt::format("frame {} {}", frame, pass::estimateLighting), work, options_.quiet);
+    Progress progress(fmt::format("frame {} {}", frame, passName(Pass::estimateLighting)), work, options_.quiet);
     if (!session) {
         stats.lighting = estimateLighting(in, img.lighting, &progress);
     } else {  // in chunks, from a checkpoint, into the session's sums
@@ -235,12 +235,12 @@ void FrameRenderer::lightFrame(std::uint32_t frame, const Camera& camera, const 
         stats.lighting = accumulateLighting(in, lp, acc, session->afterChunk, &progress);
         resolveLighting(acc, lp.exact, img.lighting, &stats.lighting.nonFinite);
     }
-    if (stats.lighting.nonFinite) stats.nonFinite[std::string(pass::estimateLighting)] = stats.lighting.nonFinite;
+    if (stats.lighting.nonFinite) stats.nonFinite[Pass::estimateLighting] = stats.lighting.nonFinite;
 }
 
 std::uint32_t FrameRenderer::chooseFrameNearLights(std::uint32_t frame, const CameraPose& pose, const Particles& particles,
                                                    const LightTree* lightTree, FrameStats& stats) {
-    auto t = stats.timer.scope(pass::chooseNearLights);
+    auto t = stats.timer.scope(Pass::chooseNearLights);
     // The pilot's image: the frame's view at 64 pixels across, whatever the
     // resolution or crop, so that every part of one image gets one k.
     constexpr std::uint32_t kWidth = 64;
@@ -280,7 +280,7 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const L
     AliasTable powerTable;
     LightTree lightTree;
     if (plan.sampler != LightSamplerKind::none) {
-        auto t = timer.scope(pass::buildLightSampler);
+        auto t = timer.scope(Pass::buildLightSampler);
         if (plan.sampler == LightSamplerKind::power) powerTable = buildPowerTable(particles);
         if (plan.sampler == LightSamplerKind::tree) lightTree = LightTree(particles, settings_.shading);
         stats.lightTreeNodes = lightTree.nodeCount();
@@ -293,8 +293,8 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const L
     const PixelWindow& traced = plan.traced;
     GBuffer gbuffer;
     {
-        auto t = timer.scope(pass::traceGBuffer);
-        PassCounters* pc = plan.counting ? &img.counters.add(pass::traceGBuffer, camera.width, camera.height) : nullptr;
+        auto t = timer.scope(Pass::traceGBuffer);
+        PassCounters* pc = plan.counting ? &img.counters.add(Pass::traceGBuffer, camera.width, camera.height) : nullptr;
         stats.primaryRays = traceGBuffer(*bvh_, particles, camera, settings_.shading.model, gbuffer, pc, &traced);
     }
     img.width = camera.width;
@@ -302,9 +302,9 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const L
     lightFrame(frame, camera, particles, gbuffer, plan.sampler == LightSamplerKind::power ? &powerTable : nullptr,
                plan.sampler == LightSamplerKind::tree ? &lightTree : nullptr, session, trace, img, stats);
     {
-        auto t = timer.scope(pass::composeImage);
+        auto t = timer.scope(Pass::composeImage);
         composeImage(gbuffer, particles, settings_.shading, img, stats);
-        if (plan.counting) recordCompose(gbuffer, particles, *bvh_, img.counters.add(pass::composeImage, img.width, img.height));
+        if (plan.counting) recordCompose(gbuffer, particles, *bvh_, img.counters.add(Pass::composeImage, img.width, img.height));
     }
     if (plan.counting) {
         img.counters.accel = bvh_->accelCounters();

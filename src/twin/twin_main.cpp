@@ -599,7 +599,9 @@ void TwinRun::renderFrame(std::uint32_t frame, std::uint64_t seed) {
     if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
     writeGpuFrame(file, out);
     const AccelStats& as = accel_->stats();
-    stats_["frames"].push_back({{"frame", frame}, {"output", file.string()}, {"passes", plan.passes()}, {"particles", n},
+    std::vector<std::string> passes;
+    for (const Pass pass : plan.passes()) passes.emplace_back(passName(pass));
+    stats_["frames"].push_back({{"frame", frame}, {"output", file.string()}, {"passes", passes}, {"particles", n},
                                 {"hit_pixels", hits}, {"blases", as.blases}, {"instances", as.instances},
                                 {"primitives", as.primitives}, {"largest_blas_primitives", as.largestBlas},
                                 {"rebuilt_blases", as.rebuiltBlases}, {"refitted", as.refitted}, {"partial", as.partial},

@@ -149,7 +149,7 @@ TEST_CASE("calibrate recovers the coefficients that made the timings of real cos
     std::string timings = "config,pass,ms\n";
     for (const std::string& csv : csvs)
         for (const CostRow& r : readCounterCsv(csv))
-            timings += r.config + "," + r.pass + "," + std::to_string(truth.predictMs(r.features)) + "\n";
+            timings += r.config + "," + r.pass.label() + "," + std::to_string(truth.predictMs(r.features)) + "\n";
     {
         std::ofstream(dir / "timings.csv") << timings;
     }

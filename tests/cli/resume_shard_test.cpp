@@ -1,14 +1,18 @@
 // Batch-render robustness with real processes: checkpoints and --resume
 // (bit-identical to an uninterrupted run), refusal of foreign or corrupted
-// checkpoints, kill -9 at random moments (never a broken output), and shards
+// checkpoints, kill -9 mid-write and after each write (never a broken output), and shards
 // run with GNU parallel merged into the image of one run.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <set>
+#include <optional>
 #include <random>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -50,17 +54,33 @@ public:
     void signal(int s) const { ::kill(pid_, s); }
     /// Exit status, or 128 + signal when killed.
     int wait() {
-        int status = 0;
-        ::waitpid(pid_, &status, 0);
-        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        if (!status_) reap(0);
+        return *status_;
     }
-    bool running() const {
+    bool running() { return !status_ && !reap(WNOHANG); }
+    /// Freezes the process where it is (SIGSTOP): true when it was still
+    /// running, so that a signal sent now lands mid-run; false when it had
+    /// already exited.
+    bool freeze() {
+        if (status_) return false;
+        ::kill(pid_, SIGSTOP);
         int status = 0;
-        return ::waitpid(pid_, &status, WNOHANG) == 0;
+        ::waitpid(pid_, &status, WUNTRACED);
+        if (WIFSTOPPED(status)) return true;
+        status_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        return false;
     }
 
 private:
+    /// Waits (flags 0) or polls (WNOHANG) for the exit; true once it has exited.
+    bool reap(int flags) {
+        int status = 0;
+        if (::waitpid(pid_, &status, flags) != pid_) return false;
+        status_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        return true;
+    }
     pid_t pid_ = 0;
+    std::optional<int> status_;
 };
 
 /// Every pixel of every channel, bit for bit.
@@ -173,7 +193,52 @@ TEST_CASE("a checkpoint of other settings, or a corrupted one, is refused with a
     CHECK(accretion::test::readFile(ckpt) == "not a checkpoint");
 }
 
-TEST_CASE("kill -9 at random moments never leaves a broken file, and resuming still gives the same image",
+/// What a run has written to `dir` so far: each output's size and time, and
+/// the writers' temporaries (named by their process: a killed run's stay).
+struct DirState {
+    std::map<std::string, std::pair<std::uintmax_t, fs::file_time_type>> outputs;
+    std::set<std::string> temporaries;
+};
+DirState dirState(const fs::path& dir) {
+    DirState state;
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(dir, ec)) {
+        const std::string name = e.path().filename().string();
+        if (name.front() == '.' && name.find(".tmp") != std::string::npos) {
+            state.temporaries.insert(name);
+            continue;
+        }
+        const auto size = fs::file_size(e.path(), ec);
+        const auto time = fs::last_write_time(e.path(), ec);
+        if (!ec) state.outputs[name] = {size, time};
+    }
+    return state;
+}
+
+/// The moments a run is killed at, in turn: while a file is being written
+/// (its temporary exists), and just after a checkpoint or output changed.
+enum class KillMoment { midWrite, afterWrite };
+
+/// Polls `dir` until the moment has come `n` times or the process exits;
+/// true if it came.
+bool awaitMoment(Process& p, const fs::path& dir, KillMoment moment, int n) {
+    DirState last = dirState(dir);
+    const std::set<std::string> stale = last.temporaries;  // of killed runs
+    bool wasWriting = false;
+    while (p.running()) {
+        const DirState now = dirState(dir);
+        const bool writing = std::any_of(now.temporaries.begin(), now.temporaries.end(),
+                                         [&](const std::string& t) { return !stale.count(t); });
+        const bool came = moment == KillMoment::midWrite ? writing && !wasWriting : now.outputs != last.outputs;
+        wasWriting = writing;
+        last = now;
+        if (came && --n == 0) return true;
+        std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+    return false;
+}
+
+TEST_CASE("kill -9 mid-write and after each write never leaves a broken file, and resuming still gives the same image",
           "[cli][resume][fault]") {
     const fs::path ref = accretion::test::scratchDir("kill_reference");
     const fs::path dir = accretion::test::scratchDir("kill_trials");
@@ -181,33 +246,36 @@ TEST_CASE("kill -9 at random moments never leaves a broken file, and resuming st
     constexpr int spp = 32768;  // about 6 s: room for many kills
     REQUIRE(runCommand(renderCommand(ref, "", spp), out) == 0);
 
+    // Longer campaigns: ACCRETION_KILL_TRIALS=N.
     const char* env = std::getenv("ACCRETION_KILL_TRIALS");
-    const int maxTrials = env ? std::atoi(env) : 25;
-    // Longer campaigns: ACCRETION_KILL_TRIALS=N ACCRETION_KILL_SEED=S.
-    const char* seedEnv = std::getenv("ACCRETION_KILL_SEED");
-    std::mt19937 rng(seedEnv ? unsigned(std::atoi(seedEnv)) : 2026u);
-    std::uniform_int_distribution<int> delayMs(20, 700);
-    int trials = 0, killed = 0;
+    const int maxTrials = env ? std::atoi(env) : 24;
+    int trials = 0, killedMidWrite = 0, killedAfterWrite = 0;
     std::size_t checked = 0;
     std::vector<std::string> broken;
     for (bool finished = false; !finished;) {
         Process p(renderCommand(dir, "--resume --checkpoint-every 0.03", spp));
         if (trials < maxTrials) {
-            std::this_thread::sleep_for(std::chrono::milliseconds(delayMs(rng)));
+            // Each kill comes at the 1st to 4th write of the run (so that
+            // later trials get further) and lands on a process frozen mid-run.
+            const KillMoment moment = trials % 2 ? KillMoment::afterWrite : KillMoment::midWrite;
+            REQUIRE(awaitMoment(p, dir, moment, 1 + (trials / 2) % 4));
+            REQUIRE(p.freeze());
             p.signal(SIGKILL);
+            p.signal(SIGCONT);
+            REQUIRE(p.wait() == 128 + SIGKILL);
+            ++(moment == KillMoment::midWrite ? killedMidWrite : killedAfterWrite);
             ++trials;
+        } else {
+            REQUIRE(p.wait() == 0);
+            finished = true;
         }
-        const int status = p.wait();
-        killed += status == 128 + SIGKILL;
-        finished = status == 0;
-        REQUIRE((finished || status == 128 + SIGKILL));
         for (const std::string& b : brokenFiles(dir, checked)) broken.push_back(b);
     }
-    INFO(trials << " trials, " << killed << " killed mid-run, " << checked << " files checked");
-    WARN("kill -9 trials: " << trials << ", killed mid-run " << killed << ", files checked " << checked
-                            << ", broken " << broken.size());
+    INFO(trials << " trials, " << checked << " files checked");
+    CHECK(killedMidWrite == maxTrials / 2);
+    CHECK(killedAfterWrite == maxTrials - maxTrials / 2);
+    for (const std::string& b : broken) UNSCOPED_INFO(b);
     CHECK(broken.empty());
-    CHECK(killed >= 5);
     for (const char* f : {"quickstart.0000.exr", "quickstart.0001.exr"}) {
         INFO(f);
         CHECK(sameImage(ref / f, dir / f));

@@ -21,7 +21,7 @@ std::vector<CostRow> syntheticRows(std::size_t n, std::uint32_t seed) {
     for (std::size_t i = 0; i < n; ++i) {
         CostRow r;
         r.config = "c" + std::to_string(i / 7);
-        r.pass = "p" + std::to_string(i % 7);
+        r.pass = {static_cast<Pass>(i % 7)};
         r.features = {1e6 * (0.2 + u(rng)), 5e4 * u(rng), 1e6 * u(rng), 4e6 * u(rng), 2e5 * u(rng), 8e7 * (0.1 + u(rng))};
         rows.push_back(r);
     }
@@ -98,31 +98,31 @@ TEST_CASE("the per-pass form predicts held-out configurations its form made exac
     // Two passes whose times the shared form cannot express: builds at a
     // constant per BLAS, traced rays whose cost grows with the BLAS depths.
     CostCoefficients truth;
-    truth.perPass["buildClusters"] = {};
-    truth.perPass["buildClusters"][8] = 5000.0;    // dispatches
-    truth.perPass["buildClusters"][9] = 75000.0;   // build_launches
-    truth.perPass["traceShadowRays"] = {};
-    truth.perPass["traceShadowRays"][2] = 1.5;     // rays
-    truth.perPass["traceShadowRays"][6] = 0.03;    // blas_levels
-    truth.perPass["traceShadowRays"][8] = 10000.0; // dispatches
+    truth.perPass[Pass::buildClusters] = {};
+    truth.perPass[Pass::buildClusters][8] = 5000.0;    // dispatches
+    truth.perPass[Pass::buildClusters][9] = 75000.0;   // build_launches
+    truth.perPass[Pass::traceShadowRays] = {};
+    truth.perPass[Pass::traceShadowRays][2] = 1.5;     // rays
+    truth.perPass[Pass::traceShadowRays][6] = 0.03;    // blas_levels
+    truth.perPass[Pass::traceShadowRays][8] = 10000.0; // dispatches
     std::mt19937 rng(7);
     std::uniform_real_distribution<double> u(0.0, 1.0);
     std::vector<CostRow> rows;
     for (int c = 0; c < 20; ++c) {
         const double builds = 100.0 + 5000.0 * u(rng), pixels = 2e5 + 2e6 * u(rng);
-        CostRow b{"c" + std::to_string(c), "buildClusters", {}, 0.0};
+        CostRow b{"c" + std::to_string(c), {Pass::buildClusters}, {}, 0.0};
         b.features[0] = builds;
         b.features[5] = 8000.0 * 1e5 / builds;  // bytes: the same particles in more or fewer clusters
         b.features[8] = 2.0;
         b.features[9] = builds;
-        CostRow t{b.config, "traceShadowRays", {}, 0.0};
+        CostRow t{b.config, {Pass::traceShadowRays}, {}, 0.0};
         t.features[0] = pixels;
         t.features[2] = pixels * (0.2 + 0.3 * u(rng));
         t.features[3] = t.features[2] * (2.0 + 6.0 * u(rng));
         t.features[6] = t.features[3] * (4.0 + 8.0 * u(rng));
         t.features[8] = 1.0;
         for (CostRow* r : {&b, &t}) {
-            r->measuredMs = truth.predictMs(r->pass, r->features);
+            r->measuredMs = truth.predictMs(r->pass.pass, r->features);
             rows.push_back(*r);
         }
     }
@@ -131,7 +131,7 @@ TEST_CASE("the per-pass form predicts held-out configurations its form made exac
     CHECK(perPass.fitted.size() == 10);
     CHECK(perPass.predicted.size() == 10);
     for (const HoldoutError& e : perPass.passes) {
-        INFO(e.pass);
+        INFO(e.label());
         CHECK(e.worst < 1e-6);
     }
     const Holdout shared = holdout(rows, CostModelForm::shared, 0.5, 1);
@@ -147,8 +147,8 @@ TEST_CASE("the per-pass form predicts held-out configurations its form made exac
     std::ofstream(file) << all.coefficients.toJson().dump();
     const CostCoefficients loaded = CostCoefficients::load(file.string());
     for (const CostRow& r : rows) {
-        CHECK(loaded.predictMs(r.pass, r.features) == Approx(r.measuredMs).epsilon(1e-6));
-        CHECK(loaded.predictMs(r.pass + "[2]", r.features) == Approx(r.measuredMs).epsilon(1e-6));
+        CHECK(loaded.predictMs(r.pass.pass, r.features) == Approx(r.measuredMs).epsilon(1e-6));
+        CHECK(loaded.predictMs(parsePassRun(r.pass.label() + "[2]")->pass, r.features) == Approx(r.measuredMs).epsilon(1e-6));
     }
 }
 
@@ -166,7 +166,7 @@ TEST_CASE("the selected form keeps the counters that made the timings and drops 
     std::normal_distribution<double> noise(0.0, 0.03);
     std::vector<CostRow> rows;
     for (int c = 0; c < 40; ++c) {
-        CostRow t{"c" + std::to_string(c), "traceShadowRays", {}, 0.0};
+        CostRow t{"c" + std::to_string(c), {Pass::traceShadowRays}, {}, 0.0};
         t.features[0] = 2e5 + 2e6 * u(rng);           // threads: unrelated here
         t.features[1] = 1e4 + 1e5 * u(rng);           // warp_steps: unrelated
         t.features[2] = 1e5 + 1e6 * u(rng);           // rays
@@ -181,7 +181,7 @@ TEST_CASE("the selected form keeps the counters that made the timings and drops 
         rows.push_back(t);
     }
     const Calibration c = calibrate(rows, CostModelForm::selected);
-    const CostFeatures& ns = c.coefficients.perPass.at("traceShadowRays");
+    const CostFeatures& ns = c.coefficients.perPass.at(Pass::traceShadowRays);
     for (std::size_t k : {2u, 6u, 8u}) {
         INFO(kCostFeatures[k]);
         CHECK(ns[k] == Approx(truth[k]).epsilon(0.15));
@@ -204,7 +204,7 @@ TEST_CASE("calibrate finds the cache of the working-set term that made the timin
     std::uniform_real_distribution<double> u(0.0, 1.0);
     std::vector<CostRow> rows;
     for (int c = 0; c < int(kCostFeatures.size()) + 2; ++c) {  // at least one row per coefficient
-        CostRow r{"c" + std::to_string(c), "traceGBuffer", {}, 0.0};
+        CostRow r{"c" + std::to_string(c), {Pass::traceGBuffer}, {}, 0.0};
         r.features[0] = r.features[2] = 2e5 + 2e6 * u(rng);  // threads = rays
         r.features[8] = 1.0;
         r.workingSetBytes = std::ldexp(0.5 * 1024 * 1024, c % 10);
@@ -216,7 +216,7 @@ TEST_CASE("calibrate finds the cache of the working-set term that made the timin
         INFO(costModelFormName(form));
         const Calibration cal = calibrate(rows, form);
         CHECK(cal.coefficients.cacheBytes == cache);
-        const CostFeatures& ns = cal.coefficients.perPass.at("traceGBuffer");
+        const CostFeatures& ns = cal.coefficients.perPass.at(Pass::traceGBuffer);
         CHECK(ns[kColdWork] == Approx(2.0).epsilon(1e-6));
         CHECK(ns[2] + ns[0] == Approx(0.5).epsilon(1e-6));  // threads and rays are the same column here
         CHECK(cal.maxRelativeError < 1e-6);
@@ -233,16 +233,16 @@ TEST_CASE("a presampling pass without timings is priced with generateCandidates'
     c.ns[0] = 1.0;  // shared: 1 ns per unit of the first feature
     CostFeatures candidates{};
     candidates[1] = 2.0;  // generateCandidates: 2 ns per unit of the second
-    c.perPass["generateCandidates"] = candidates;
+    c.perPass[Pass::generateCandidates] = candidates;
     CostFeatures f{};
     f[0] = 1e6;
     f[1] = 1e6;
     // 1e6 units x 2 ns = 2 ms by the proxy; the shared form would give 1 ms.
-    CHECK(c.predictMs("presampleLightTiles", f) == Approx(2.0));
-    CHECK(c.predictMs("presampleRegirGrid", f) == Approx(2.0));
-    CHECK(c.predictMs("traceShadowRays", f) == Approx(1.0));  // no proxy: shared
-    c.perPass["presampleRegirGrid"] = CostFeatures{};  // its own coefficients, once fitted, win
-    CHECK(c.predictMs("presampleRegirGrid", f) == Approx(0.0));
+    CHECK(c.predictMs(Pass::presampleLightTiles, f) == Approx(2.0));
+    CHECK(c.predictMs(Pass::presampleRegirGrid, f) == Approx(2.0));
+    CHECK(c.predictMs(Pass::traceShadowRays, f) == Approx(1.0));  // no proxy: shared
+    c.perPass[Pass::presampleRegirGrid] = CostFeatures{};  // its own coefficients, once fitted, win
+    CHECK(c.predictMs(Pass::presampleRegirGrid, f) == Approx(0.0));
 }
 
 TEST_CASE("a build's elements are counted whole and clamped at the knots, refits and the TLAS apart", "[gpu][cost]") {
@@ -290,7 +290,7 @@ TEST_CASE("the build pass is fitted on the build counters, the other passes on t
     std::vector<CostRow> rows;
     for (int c = 0; c < int(kCostFeatures.size()) + 2; ++c) {  // at least one row per coefficient
         const double clusters = 10.0 + 100.0 * c;
-        CostRow b{"c" + std::to_string(c), "buildClusters", {}, 0.0};
+        CostRow b{"c" + std::to_string(c), {Pass::buildClusters}, {}, 0.0};
         b.features[0] = clusters;  // threads
         b.features[8] = 1.0;       // dispatches
         b.features[9] = clusters;  // build_launches
@@ -298,14 +298,14 @@ TEST_CASE("the build pass is fitted on the build counters, the other passes on t
         rows.push_back(b);
     }
     const Calibration c = calibrate(rows, CostModelForm::per_pass);
-    const CostFeatures& ns = c.coefficients.perPass.at("buildClusters");
+    const CostFeatures& ns = c.coefficients.perPass.at(Pass::buildClusters);
     CHECK(ns[0] == 0.0);
     CHECK(ns[9] == Approx(75000.0).epsilon(1e-6));
     CostFeatures instances{};
     instances[0] = 1e6;  // a thread per particle, one launch
     instances[8] = 1.0;
     instances[9] = 1.0;
-    CHECK(c.coefficients.predictMs("buildClusters", instances) == Approx(0.085).epsilon(1e-6));
+    CHECK(c.coefficients.predictMs(Pass::buildClusters, instances) == Approx(0.085).epsilon(1e-6));
 }
 
 TEST_CASE("cost prices with the committed calibration, the uncalibrated guess only on request", "[gpu][cost]") {
@@ -315,11 +315,11 @@ TEST_CASE("cost prices with the committed calibration, the uncalibrated guess on
     REQUIRE_FALSE(committed.measuredAt.empty());
     REQUIRE_THAT(committed.source, Catch::Matchers::Contains(kDefaultCoefficientsFile));
     // The per-pass coefficients of the passes the GPU timed, the BLAS builds' launch cost among them.
-    for (const char* pass : {"buildClusters", "traceGBuffer", "traceShadowRays", "generateCandidates"})
+    for (const Pass pass : {Pass::buildClusters, Pass::traceGBuffer, Pass::traceShadowRays, Pass::generateCandidates})
         REQUIRE(committed.perPass.count(pass) == 1);
     // The file of the source tree, read as a file, is the same calibration.
     const CostCoefficients file = CostCoefficients::load(std::string(ACCRETION_SOURCE_DIR) + "/" + kDefaultCoefficientsFile);
-    REQUIRE(file.perPass.at("buildClusters") == committed.perPass.at("buildClusters"));
+    REQUIRE(file.perPass.at(Pass::buildClusters) == committed.perPass.at(Pass::buildClusters));
     const CostCoefficients guess = CostCoefficients::forSetting("uncalibrated");
     REQUIRE_FALSE(guess.calibrated);
     REQUIRE_THAT(guess.source, Catch::Matchers::Contains("uncalibrated"));

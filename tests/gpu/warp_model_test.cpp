@@ -12,7 +12,7 @@ namespace {
 
 /// One 32-wide warp-row dispatch: 32 x rows threads, groups 32 x 1.
 PassCounters rowPass(std::uint32_t rows) {
-    PassCounters p("test", 32, rows);
+    PassCounters p(Pass::traceShadowRays, 32, rows);
     for (auto& t : p.threads) t.active = 1;
     return p;
 }
@@ -81,7 +81,7 @@ TEST_CASE("SIMT efficiency of a loop runs as long as the longest lane", "[gpu][w
 }
 
 TEST_CASE("SER report on a pass: keys from hit and type, gain net of the reorder cost", "[gpu][warp]") {
-    PassCounters p("traceShadowRays", 32, 8);
+    PassCounters p(Pass::traceShadowRays, 32, 8);
     for (std::size_t i = 0; i < p.threads.size(); ++i) {
         ThreadCounters& t = p.threads[i];
         t.active = 1;

@@ -4,6 +4,8 @@
 #include <string_view>
 #include <vector>
 
+#include "accretion/core/pass.h"
+
 namespace accretion {
 
 /// What one ray query did, as a GPU would count it (docs/MODEL.md section 6).
@@ -126,7 +128,7 @@ private:
 /// One pass's dispatch: a width x height grid of threads (pixels; for
 /// buildClusters one thread per cluster, height 1).
 struct PassCounters {
-    std::string pass;
+    Pass pass = Pass::traceGBuffer;
     std::uint32_t run = 1;  ///< 1 for a pass's first run in the frame, 2 for its second (spatial iterations)...
     std::uint32_t width = 0, height = 0;
     std::vector<ThreadCounters> threads;
@@ -139,10 +141,8 @@ struct PassCounters {
     std::uint64_t footprintBytes = 0;
 
     PassCounters() = default;
-    PassCounters(std::string_view name, std::uint32_t w, std::uint32_t h)
-        : pass(name), width(w), height(h), threads(std::size_t(w) * h) {}
-    /// The pass name, with "[n]" for its n-th run when n > 1: spatialResampling[2].
-    std::string label() const { return run > 1 ? pass + "[" + std::to_string(run) + "]" : pass; }
+    PassCounters(Pass p, std::uint32_t w, std::uint32_t h) : pass(p), width(w), height(h), threads(std::size_t(w) * h) {}
+    PassRun id() const { return {pass, run}; }
 };
 
 /// The acceleration structures of a frame as the GPU memory model reads
@@ -171,10 +171,10 @@ struct FrameCounters {
     AccelCounters accel;  ///< the frame's BVH, for the memory model
 
     /// The record of a pass about to run.
-    PassCounters& add(std::string_view name, std::uint32_t w, std::uint32_t h) {
+    PassCounters& add(Pass pass, std::uint32_t w, std::uint32_t h) {
         std::uint32_t run = 1;
-        for (const PassCounters& p : passes) run += p.pass == name;
-        passes.emplace_back(name, w, h).run = run;
+        for (const PassCounters& p : passes) run += p.pass == pass;
+        passes.emplace_back(pass, w, h).run = run;
         return passes.back();
     }
     bool empty() const { return passes.empty(); }

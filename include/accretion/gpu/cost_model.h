@@ -2,12 +2,14 @@
 #include <array>
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "accretion/core/pass.h"
 #include "accretion/gpu/gpu_report.h"
 
 namespace accretion {
@@ -109,7 +111,7 @@ CostFeatures costFeatures(const PassReport& pass, double cacheBytes);
 /// Nanoseconds per unit of each feature: predicted time = sum coefficient x counter.
 struct CostCoefficients {
     CostFeatures ns{};
-    std::map<std::string, CostFeatures> perPass;  ///< per_pass form: by pass name (spatialResampling[2] uses spatialResampling's)
+    std::map<Pass, CostFeatures> perPass;  ///< per_pass form: by pass (spatialResampling[2] uses spatialResampling's)
     double cacheBytes = kDefaultCacheBytes;       ///< the cache of cold_work
     std::string source;      ///< where they came from, in words
     bool calibrated = true;  ///< false: defaults(), an order-of-magnitude guess
@@ -136,8 +138,8 @@ struct CostCoefficients {
     /// With the shared coefficients.
     double predictMs(const CostFeatures& f) const;
     /// With the pass's own coefficients when there are any, else those of
-    /// its proxy (costProxy), else the shared ones.
-    double predictMs(const std::string& pass, const CostFeatures& f) const;
+    /// its proxy (kPasses' costProxy), else the shared ones.
+    double predictMs(Pass pass, const CostFeatures& f) const;
 };
 
 /// Non-negative least squares, min |A x - b| subject to x >= 0 (Lawson &
@@ -146,7 +148,8 @@ std::vector<double> nonNegativeLeastSquares(const std::vector<CostFeatures>& A, 
 
 /// One pass of one configuration: its counters and, for calibration, the measured time.
 struct CostRow {
-    std::string config, pass;
+    std::string config;
+    PassRun pass;
     CostFeatures features{};
     double measuredMs = 0.0;
     double workingSetBytes = 0.0;  ///< PassReport::workingSetBytes (cold_work is recomputed from it for a cache)
@@ -173,7 +176,8 @@ Calibration calibrate(const std::vector<CostRow>& rows, CostModelForm form = Cos
 /// split at random (a seeded Fisher-Yates), `fraction` of them fitted, the
 /// rest predicted; per pass the median and worst relative error.
 struct HoldoutError {
-    std::string pass;
+    std::optional<Pass> pass;  ///< nullopt: all passes
+    std::string label() const { return pass ? std::string(passName(*pass)) : std::string("all passes"); }
     std::size_t rows = 0;
     double median = 0.0, worst = 0.0;
     std::string worstConfig;
@@ -187,13 +191,5 @@ struct Holdout {
     nlohmann::json toJson() const;
 };
 Holdout holdout(const std::vector<CostRow>& rows, CostModelForm form, double fraction, std::uint64_t seed);
-
-/// The pass whose per-pass coefficients price a pass that has none of its
-/// own: presampleLightTiles and presampleRegirGrid -> generateCandidates
-/// (one thread per entry, a RIS loop over random light records, no rays);
-/// any other pass is its own.
-std::string costProxy(const std::string& family);
-/// "spatialResampling[2]" -> "spatialResampling": the pass a run belongs to.
-std::string passFamily(const std::string& pass);
 
 }  // namespace accretion

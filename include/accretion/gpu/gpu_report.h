@@ -15,7 +15,7 @@ namespace accretion {
 /// One pass's counters, summed, with its SIMT/SER statistics and the
 /// inline-RayQuery vs pipeline-TraceRay advice (docs/MODEL.md section 6).
 struct PassReport {
-    std::string pass;
+    PassRun pass;
     std::uint32_t width = 0, height = 0;
     std::uint64_t threads = 0, hitThreads = 0;
     std::uint64_t trips = 0, rays = 0, proceeds = 0, blasEntries = 0, anyHits = 0;

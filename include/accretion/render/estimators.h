@@ -46,7 +46,7 @@ struct LightingCounters {
 };
 
 /// Non-finite values rejected, per pass name (render.nonfinite).
-using PassRejections = std::map<std::string, std::uint64_t>;
+using PassRejections = std::map<Pass, std::uint64_t>;
 
 /// Everything the lighting estimators read.
 struct LightingInputs {

@@ -1,9 +1,11 @@
 #pragma once
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "accretion/core/pass.h"
 #include "accretion/particles/particles.h"
 #include "accretion/render/estimator_table.h"
 #include "accretion/render/pixel_window.h"
@@ -14,11 +16,11 @@ namespace accretion {
 /// One line of a frame's plan: a pass (or the work inside one) and whether
 /// it runs, with what it does or why it is skipped.
 struct PlannedStep {
-    std::string name;
+    std::optional<Pass> pass;  ///< a timed pass (stats' "passes"), else work inside one, named by `work`
+    std::string work;
     bool runs = true;
     std::string why;
-    bool isPass = true;  ///< a timed pass (stats' "passes"), else work inside one
-    bool nested = false; ///< a restir pass, inside estimateLighting
+    std::string_view name() const { return pass ? passName(*pass) : std::string_view(work); }
 };
 
 /// What the frame renderer knows of a frame before it plans it.
@@ -58,9 +60,9 @@ struct FramePlan {
     bool upsample = false;        ///< upsampleLighting (restir at reduced resolution)
     std::vector<PlannedStep> steps;
 
-    /// Names of the passes that run, in order (restir's inside estimateLighting).
-    std::vector<std::string> passes() const;
-    const PlannedStep* find(std::string_view name) const;
+    /// The passes that run, in order (restir's inside estimateLighting), writeOutputs aside.
+    std::vector<Pass> passes() const;
+    const PlannedStep* find(Pass pass) const;
 };
 
 /// The plan of one frame.

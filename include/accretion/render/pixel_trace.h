@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "accretion/core/math.h"
+#include "accretion/core/pass.h"
 #include "accretion/lighting/reservoir.h"
 #include "accretion/lighting/reservoir_codec.h"
 
@@ -50,7 +51,7 @@ struct PixelTrace {
 
     /// restir: the pixel's reservoir after each pass (at its lighting texel).
     struct PassState {
-        std::string pass;
+        PassRun pass;
         StoredReservoir reservoir;
     };
     std::vector<PassState> passes;

@@ -9,7 +9,7 @@ namespace {
 template <ShadingModel SM, Primitive P, LightSource S, bool Count>
 LightingCounters generateCandidatesKernel(const FrameContext& f, std::vector<StoredReservoir>& out) {
     const std::uint32_t Mc = f.in.settings.render.candidates;
-    PassCounters* pc = passCounters<Count>(f, pass::generateCandidates);
+    PassCounters* pc = passCounters<Count>(f, Pass::generateCandidates);
     const std::uint32_t R = f.codec.bytes();
     const std::uint64_t seed = f.in.settings.render.seed;
     const float jitter = float(f.rs.regir_jitter);

@@ -8,7 +8,7 @@ namespace accretion::restir {
 RegirGrid presampleRegirGrid(const FrameContext& f) {
     const RestirSettings& r = f.rs;
     const std::uint32_t cells = r.regir_cells * r.regir_cells * r.regir_cells;
-    PassCounters* pc = f.counters ? &f.counters->add(pass::presampleRegirGrid, r.regir_lights_per_cell, cells) : nullptr;
+    PassCounters* pc = f.counters ? &f.counters->add(Pass::presampleRegirGrid, r.regir_lights_per_cell, cells) : nullptr;
     return accretion::presampleRegirGrid(f.L, *f.tiles, RegirPlacement{r.regir_cells, float(r.regir_cell_size)},
                                          r.regir_lights_per_cell, r.regir_build_samples, f.in.frame, f.in.settings.render.seed, pc);
 }

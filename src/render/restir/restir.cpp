@@ -16,47 +16,47 @@ LightingCounters runPasses(restir::FrameContext& f, std::vector<StoredReservoir>
                            std::vector<Vec3>& lowLr, PassTimer& timer, PassRejections& rejected, std::size_t traced) {
     const FramePlan& plan = f.in.plan;
     LightingCounters total;
-    auto add = [&](std::string_view name, const LightingCounters& c) {
+    auto add = [&](Pass pass, const LightingCounters& c) {
         total += c;
-        if (c.nonFinite) rejected[std::string(name)] += c.nonFinite;
+        if (c.nonFinite) rejected[pass] += c.nonFinite;
     };
-    auto snapshot = [&](std::string_view name, const std::vector<StoredReservoir>& r) {
-        if (f.in.trace) f.in.trace->passes.push_back({std::string(name), r[traced]});
+    auto snapshot = [&](PassRun run, const std::vector<StoredReservoir>& r) {
+        if (f.in.trace) f.in.trace->passes.push_back({run, r[traced]});
     };
     LightTiles tiles;
     RegirGrid grid;
     if (plan.presampleTiles) {
-        auto t = timer.scope(pass::presampleLightTiles);
+        auto t = timer.scope(Pass::presampleLightTiles);
         tiles = restir::presampleLightTiles(f);
         f.tiles = &tiles;
     }
     if (plan.presampleRegir) {
-        auto t = timer.scope(pass::presampleRegirGrid);
+        auto t = timer.scope(Pass::presampleRegirGrid);
         grid = restir::presampleRegirGrid(f);
         f.regir = &grid;
     }
     {
-        auto t = timer.scope(pass::generateCandidates);
-        add(pass::generateCandidates, restir::generateCandidates(f, a));
+        auto t = timer.scope(Pass::generateCandidates);
+        add(Pass::generateCandidates, restir::generateCandidates(f, a));
     }
-    snapshot(pass::generateCandidates, a);
+    snapshot({Pass::generateCandidates}, a);
     if (plan.temporal) {
-        auto t = timer.scope(pass::temporalResampling);
-        add(pass::temporalResampling, restir::temporalResampling(f, a, b));
+        auto t = timer.scope(Pass::temporalResampling);
+        add(Pass::temporalResampling, restir::temporalResampling(f, a, b));
         std::swap(a, b);
-        snapshot(pass::temporalResampling, a);
+        snapshot({Pass::temporalResampling}, a);
     }
     if (plan.spatialIterations > 0) {
-        auto t = timer.scope(pass::spatialResampling);
+        auto t = timer.scope(Pass::spatialResampling);
         for (std::uint32_t it = 0; it < plan.spatialIterations; ++it) {
-            add(pass::spatialResampling, restir::spatialResampling(f, it, a, b));
+            add(Pass::spatialResampling, restir::spatialResampling(f, it, a, b));
             std::swap(a, b);
-            snapshot(pass::spatialResampling, a);
+            snapshot({Pass::spatialResampling, it + 1}, a);
         }
     }
     {
-        auto t = timer.scope(pass::traceShadowRays);
-        add(pass::traceShadowRays, restir::traceShadowRays(f, a, lowLr));
+        auto t = timer.scope(Pass::traceShadowRays);
+        add(Pass::traceShadowRays, restir::traceShadowRays(f, a, lowLr));
     }
     return total;
 }
@@ -120,9 +120,9 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
     if (!plan.upsample) {
         out.Lr = lowLr;
     } else {
-        auto t = timer.scope(pass::upsampleLighting);
+        auto t = timer.scope(Pass::upsampleLighting);
         restir::upsampleLighting(full, *lg, in.particles, lowLr, f.scale, rs_, out.Lr);
-        if (in.counters) restir::recordUpsample(in, *lg, in.counters->add(pass::upsampleLighting, full.width, full.height));
+        if (in.counters) restir::recordUpsample(in, *lg, in.counters->add(Pass::upsampleLighting, full.width, full.height));
     }
     aov.W.assign(pixels, 0.0f);
     aov.M.assign(pixels, 0.0f);

@@ -111,8 +111,8 @@ struct FrameContext {
 
 /// The counters of a pass about to run (counting mode), else null.
 template <bool Count>
-PassCounters* passCounters(const FrameContext& f, std::string_view name) {
-    if constexpr (Count) return &f.counters->add(name, f.lg.width, f.lg.height);
+PassCounters* passCounters(const FrameContext& f, Pass pass) {
+    if constexpr (Count) return &f.counters->add(pass, f.lg.width, f.lg.height);
     return nullptr;
 }
 

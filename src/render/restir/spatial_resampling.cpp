@@ -11,7 +11,7 @@ LightingCounters spatialResamplingKernel(const FrameContext& f, std::uint32_t it
     const std::uint32_t W = f.lg.width, H = f.lg.height;
     const float radius = std::max(1.0f, float(f.rs.spatial_radius) * f.scale);
     const std::uint32_t k = f.rs.spatial_neighbours;
-    PassCounters* pc = passCounters<Count>(f, pass::spatialResampling);
+    PassCounters* pc = passCounters<Count>(f, Pass::spatialResampling);
     const std::uint32_t R = f.codec.bytes();
     return forEachPixel(W, H, [&](std::size_t px, std::uint32_t x, std::uint32_t y, LightingCounters& c, Scratch& scratch) {
         const GBufferTexel& g = f.lg.texels[px];

@@ -10,7 +10,7 @@ LightingCounters temporalResamplingKernel(const FrameContext& f, const std::vect
                                     std::vector<StoredReservoir>& out) {
     const Restir::History& h = *f.prev;
     const Particles& particles = f.in.particles;
-    PassCounters* pc = passCounters<Count>(f, pass::temporalResampling);
+    PassCounters* pc = passCounters<Count>(f, Pass::temporalResampling);
     const std::uint32_t R = f.codec.bytes();
     return forEachPixel(f.lg.width, f.lg.height, [&](std::size_t px, std::uint32_t, std::uint32_t, LightingCounters& c, Scratch& scratch) {
         const GBufferTexel& g = f.lg.texels[px];

@@ -7,7 +7,7 @@ namespace {
 
 template <ShadingModel SM, Primitive P, bool Count>
 LightingCounters traceShadowRaysKernel(const FrameContext& f, std::vector<StoredReservoir>& res, std::vector<Vec3>& Lr) {
-    PassCounters* pc = passCounters<Count>(f, pass::traceShadowRays);
+    PassCounters* pc = passCounters<Count>(f, Pass::traceShadowRays);
     const std::uint32_t R = f.codec.bytes();
     return forEachPixel(f.lg.width, f.lg.height, [&](std::size_t px, std::uint32_t, std::uint32_t, LightingCounters& c) {
         Lr[px] = Vec3(0.0f);
