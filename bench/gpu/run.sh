@@ -1,7 +1,7 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine, from the repository root:
 #   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
-#                                      layout_images layouts streams front identity
+#                                      layout_images layouts streams front identity shared_core
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -321,6 +321,20 @@ step_identity() {
 CONFIGS
     rm -f "$t"/*.gpuframe
     return $differ
+}
+
+# The ReSTIR steps the CPU and the twin share (restir_steps.h), run on this
+# GPU and on its host CPU on the same inputs (tests/twin/shared_core_check.cu):
+# bit for bit, neighbourPoint's cos and sin within CUDA's documented bound.
+step_shared_core() {
+    mkdir -p "$W/shared_core"
+    nvcc -std=c++20 -O3 -fmad=false --expt-relaxed-constexpr -diag-suppress=20012,20011,20014,20044 -arch=sm_90 \
+        -Iinclude -I"$S/include" tests/twin/shared_core_check.cu src/geometry/camera.cpp -o "$W/shared_core/check" &&
+        { echo "commit $(cat "$D/commit")"; nvidia-smi --query-gpu=name,driver_version --format=csv,noheader;
+          "$W/shared_core/check"; } | tee "$W/shared_core/result.txt"
+    local rc=${PIPESTATUS[0]}
+    rm -f "$W/shared_core/check"
+    return "$rc"
 }
 
 for s in "$@"; do

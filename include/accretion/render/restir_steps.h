@@ -5,6 +5,8 @@
 // the estimator reaches both or neither. Inputs are fixed-size; the frame is
 // reached through small adapters (the Domains of combineReservoirs), which on
 // the CPU also count what a GPU thread would do and on the GPU do nothing.
+// tests/twin/shared_core_check.cu runs every step on the GPU and on the CPU
+// on the same inputs: bit for bit, but for neighbourPoint's cos and sin.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -52,20 +54,37 @@ ACC_HD bool resampleCandidates(std::uint32_t count, RngT& rng, Draw&& draw, Targ
     return !discard;
 }
 
-/// Spatial reuse's neighbour of texel (x, y) on a W x H grid: uniform in the
-/// disc of `radius` texels (polar, sqrt for area), rounded to a texel q.
-/// Draws two numbers whatever the outcome; false when the point falls off
-/// the grid or on (x, y) itself.
+/// Spatial reuse's neighbour point of texel (x, y): uniform in the disc of
+/// `radius` texels (polar, sqrt for area), in continuous texel coordinates.
+/// Draws two numbers. cos and sin are the host's libm and the device's
+/// cosf/sinf (2 ulp, CUDA's documented bound): the point may differ by a few
+/// ulp between the hosts (tests/twin/shared_core_check.cu measures it).
 template <class RngT>
-ACC_HD bool drawNeighbour(RngT& rng, float radius, std::uint32_t x, std::uint32_t y, std::uint32_t W, std::uint32_t H,
-                          std::size_t& q) {
+ACC_HD void neighbourPoint(RngT& rng, float radius, std::uint32_t x, std::uint32_t y, float& fx, float& fy) {
     const float r = radius * std::sqrt(rng.uniform());
     const float phi = 6.28318530718f * rng.uniform();
-    const long nx = std::lround(float(x) + r * std::cos(phi));
-    const long ny = std::lround(float(y) + r * std::sin(phi));
+    fx = float(x) + r * std::cos(phi);
+    fy = float(y) + r * std::sin(phi);
+}
+
+/// The texel q of a neighbour point (rounded to nearest); false when it
+/// falls off the W x H grid or on (x, y) itself.
+ACC_HD inline bool neighbourTexel(float fx, float fy, std::uint32_t x, std::uint32_t y, std::uint32_t W, std::uint32_t H,
+                                  std::size_t& q) {
+    const long nx = std::lround(fx), ny = std::lround(fy);
     if (nx < 0 || ny < 0 || nx >= long(W) || ny >= long(H) || (nx == long(x) && ny == long(y))) return false;
     q = std::size_t(ny) * W + std::size_t(nx);
     return true;
+}
+
+/// Spatial reuse's neighbour of texel (x, y) on a W x H grid: neighbourPoint
+/// rounded by neighbourTexel. Draws two numbers whatever the outcome.
+template <class RngT>
+ACC_HD bool drawNeighbour(RngT& rng, float radius, std::uint32_t x, std::uint32_t y, std::uint32_t W, std::uint32_t H,
+                          std::size_t& q) {
+    float fx, fy;
+    neighbourPoint(rng, radius, x, y, fx, fy);
+    return neighbourTexel(fx, fy, x, y, W, H, q);
 }
 
 /// Temporal reuse's reprojection: the surface point where it was last frame

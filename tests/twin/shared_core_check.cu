@@ -1,0 +1,304 @@
+// The shared ReSTIR steps (accretion/render/restir_steps.h) run where they
+// run: each step on the GPU, in a CUDA kernel (one thread per case), and on
+// the CPU (this program's host code, compiled by the host compiler), on the
+// same inputs. Every result must agree bit for bit, except neighbourPoint,
+// whose cos and sin are the device's cosf/sinf on one side and libm on the
+// other: its points must agree within the bound CUDA documents for them
+// (2 ulp of cos and sin, scaled by the radius, plus one ulp of the sum), and
+// its texels wherever the host's point is not within that bound of a
+// rounding boundary. Prints one line per step and "shared_core_check: PASS"
+// or the first disagreements and "FAIL" (exit 1). Without a GPU: exit 2.
+//   nvcc -std=c++20 -fmad=false ... tests/twin/shared_core_check.cu src/geometry/camera.cpp
+// scripts/compile_twin.sh compiles it on every CI run; bench/gpu/run.sh's
+// shared_core step runs it on the lent GPU (results in bench/gpu/results).
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <vector>
+
+#include <cuda_runtime.h>
+
+#include "accretion/core/rng.h"
+#include "accretion/render/restir_steps.h"
+
+namespace {
+
+using namespace accretion;
+
+/// One case's results as raw 32-bit words (floats by their bits).
+struct Out {
+    std::uint32_t w[8];
+};
+
+ACC_HD std::uint32_t bits(float v) {
+    std::uint32_t u;
+    std::memcpy(&u, &v, sizeof u);
+    return u;
+}
+
+// ---------------------------------------------------------------- the cases
+// Each case is one ACC_HD function of its index and its inputs: the kernel
+// and the host loop call the same function.
+
+constexpr int kNeighbours = 4096, kReprojections = 4096, kCaps = 512, kCandidates = 1024, kCombines = 3000, kShades = 600;
+
+ACC_HD void neighbourCase(int k, Out& o) {
+    PortableRng rng(std::uint64_t(k), 1, RngPass::restirSpatial, 5);
+    const std::uint32_t W = 64 + k % 7, H = 36 + k % 5, x = k % W, y = (k / 3) % H;
+    const float radius = 1.0f + float(k % 40);
+    float fx, fy;
+    restir::neighbourPoint(rng, radius, x, y, fx, fy);
+    std::size_t q = 0;
+    const bool ok = restir::neighbourTexel(fx, fy, x, y, W, H, q);
+    PortableRng again(std::uint64_t(k), 1, RngPass::restirSpatial, 5);
+    std::size_t q2 = 0;
+    const bool ok2 = restir::drawNeighbour(again, radius, x, y, W, H, q2);  // the composition the passes call
+    o = Out{{bits(fx), bits(fy), std::uint32_t(ok), ok ? std::uint32_t(q) : 0u, std::uint32_t(ok2), ok2 ? std::uint32_t(q2) : 0u,
+             bits(radius), 0u}};
+}
+
+ACC_HD void reprojectCase(int k, const Camera& cam, const Vec3* points, Out& o) {
+    std::size_t q = 0;
+    float depth = 0.0f;
+    const bool half = k % 2;
+    const bool ok = restir::reprojectPoint(cam, points[k], half ? 0.5f : 1.0f, half ? 160 : 320, half ? 90 : 180, q, depth);
+    o = Out{{std::uint32_t(ok), ok ? std::uint32_t(q) : 0u, ok ? bits(depth) : 0u, 0u, 0u, 0u, 0u, 0u}};
+}
+
+ACC_HD void capCase(int k, Out& o) {
+    const std::uint32_t m = restir::capHistoryM(std::uint32_t(k) * 37u, std::uint32_t(k) % 9u, 0.5 + 0.25 * (k % 80));
+    o = Out{{m, 0u, 0u, 0u, 0u, 0u, 0u, 0u}};
+}
+
+/// Candidates of a fixed stream: the odd zero-pdf candidate, the odd
+/// non-finite weight (p_hat 1e38 over pdf 1e-3).
+struct CandidateDraw {
+    ACC_HD LightSample operator()(PortableRng& g) const {
+        const std::uint32_t i = static_cast<std::uint32_t>(g.uniform() * 1000.0f);
+        return LightSample{i, i % 97 == 0 ? 0.0f : 0.001f};
+    }
+};
+struct CandidateTarget {
+    ACC_HD float operator()(std::uint32_t i) const { return i % 211 == 0 ? 1e38f : float(i % 13) * 0.125f; }
+};
+
+ACC_HD void candidatesCase(int k, Out& o) {
+    PortableRng rng(std::uint64_t(k), 2, RngPass::restirCandidates, 3);
+    int rejects = 0;
+    Reservoir r;
+    const bool kept = restir::resampleCandidates(1 + k % 32, rng, CandidateDraw{}, CandidateTarget{},
+                                                 [&] { return ++rejects > 100; }, r);
+    o = Out{{std::uint32_t(kept), std::uint32_t(rejects), r.y, bits(r.w_sum), bits(r.p_hat), bits(r.W), r.M, 0u}};
+}
+
+/// Domains whose p_hat is a fixed function of (domain, light): zero for a
+/// few pairs, so basic's support and pairwise's zero branches are taken.
+struct TableDomains {
+    const StoredReservoir* r;
+    std::uint32_t n;
+    ACC_HD std::uint32_t count() const { return n; }
+    ACC_HD const StoredReservoir& reservoir(std::uint32_t i) const { return r[i]; }
+    ACC_HD static float pHat(std::uint32_t i, std::uint32_t y) {
+        const std::uint32_t h = (i * 2654435761u) ^ (y * 40503u);
+        return h % 7 == 0 ? 0.0f : float(h % 1000 + 1) * 0.001f;
+    }
+    ACC_HD float targetPdf(std::uint32_t i, std::uint32_t y) const { return pHat(i, y); }
+    ACC_HD bool supports(std::uint32_t i, std::uint32_t y) const { return pHat(i, y) > 0.0f; }
+    ACC_HD void countTerm() const {}
+};
+
+ACC_HD void combineCase(int k, const StoredReservoir* offers, Out& o) {
+    const TableDomains d{offers + std::size_t(k) * restir::kMaxOffers, 1 + std::uint32_t(k % restir::kMaxOffers)};
+    const BiasCorrection bias = k % 3 == 0 ? BiasCorrection::none : k % 3 == 1 ? BiasCorrection::basic : BiasCorrection::pairwise;
+    PortableRng rng(std::uint64_t(k), 4, RngPass::restirTemporal, 9);
+    const StoredReservoir out = restir::combineReservoirs(d, bias, rng);
+    o = Out{{out.y, bits(out.W), out.M, bits(out.p_hat), 0u, 0u, 0u, 0u}};
+}
+
+ACC_HD void shadeCase(int k, const float* in, Out& o) {
+    const float* v = in + 4 * k;
+    const LightTerm t{Vec3(v[0], v[1], k % 50 == 0 ? 3e38f : v[2]), Vec3(0.0f, 0.0f, 1.0f), 1.0f};
+    Vec3 Lr(0.0f);
+    const restir::Shade s = restir::shadeSample(t, 100.0f * v[3], k % 4 != 0, Lr);
+    const StoredReservoir occ = restir::occludedReservoir(StoredReservoir{7u, 1.0f, std::uint32_t(k), 0.5f});
+    o = Out{{std::uint32_t(s), bits(Lr.x), bits(Lr.y), bits(Lr.z), occ.y, bits(occ.W), occ.M, bits(occ.p_hat)}};
+}
+
+// ---------------------------------------------------------------- the hosts
+
+struct Inputs {
+    Camera cam;
+    Vec3* points;
+    StoredReservoir* offers;
+    float* shades;
+};
+
+enum class Step { neighbours, reprojections, caps, candidates, combines, shades };
+constexpr Step kSteps[] = {Step::neighbours, Step::reprojections, Step::caps, Step::candidates, Step::combines, Step::shades};
+
+ACC_HD int caseCount(Step s) {
+    switch (s) {
+        case Step::neighbours: return kNeighbours;
+        case Step::reprojections: return kReprojections;
+        case Step::caps: return kCaps;
+        case Step::candidates: return kCandidates;
+        case Step::combines: return kCombines;
+        case Step::shades: return kShades;
+    }
+    return 0;
+}
+
+ACC_HD void runCase(Step s, int k, const Inputs& in, Out& o) {
+    switch (s) {
+        case Step::neighbours: neighbourCase(k, o); break;
+        case Step::reprojections: reprojectCase(k, in.cam, in.points, o); break;
+        case Step::caps: capCase(k, o); break;
+        case Step::candidates: candidatesCase(k, o); break;
+        case Step::combines: combineCase(k, in.offers, o); break;
+        case Step::shades: shadeCase(k, in.shades, o); break;
+    }
+}
+
+__global__ void runCases(Step s, Inputs in, Out* out) {
+    const int k = int(blockIdx.x * blockDim.x + threadIdx.x);
+    if (k < caseCount(s)) runCase(s, k, in, out[k]);
+}
+
+const char* stepName(Step s) {
+    switch (s) {
+        case Step::neighbours: return "neighbourPoint/neighbourTexel/drawNeighbour";
+        case Step::reprojections: return "reprojectPoint";
+        case Step::caps: return "capHistoryM";
+        case Step::candidates: return "resampleCandidates";
+        case Step::combines: return "combineReservoirs";
+        case Step::shades: return "shadeSample/occludedReservoir";
+    }
+    return "?";
+}
+
+#define CHECK_CUDA(x)                                                                            \
+    do {                                                                                         \
+        const cudaError_t e = (x);                                                               \
+        if (e != cudaSuccess) {                                                                  \
+            std::fprintf(stderr, "shared_core_check: %s: %s\n", #x, cudaGetErrorString(e));      \
+            std::exit(e == cudaErrorNoDevice || e == cudaErrorInsufficientDriver ? 2 : 1);       \
+        }                                                                                        \
+    } while (0)
+
+template <class T>
+T* toDevice(const std::vector<T>& v) {
+    T* d = nullptr;
+    CHECK_CUDA(cudaMalloc(&d, v.size() * sizeof(T)));
+    CHECK_CUDA(cudaMemcpy(d, v.data(), v.size() * sizeof(T), cudaMemcpyHostToDevice));
+    return d;
+}
+
+float asFloat(std::uint32_t u) {
+    float f;
+    std::memcpy(&f, &u, sizeof f);
+    return f;
+}
+
+/// One ulp at |v|.
+double ulpOf(float v) { return double(std::nextafter(std::abs(v), INFINITY)) - double(std::abs(v)); }
+
+/// Distance of t to the nearest rounding boundary of lround (k + 0.5).
+double toBoundary(float t) { return std::abs(double(t) - (std::floor(double(t)) + 0.5)); }
+
+/// The neighbour case's agreement: the points within the bound, the texels
+/// equal unless the host's point lies within the bound of a boundary, and
+/// drawNeighbour equal to its parts on each side. worstRatio: the largest
+/// |device - host| over its bound (<= 1 passes).
+bool neighbourAgrees(const Out& h, const Out& d, double& worstRatio, int& boundaryCases) {
+    const float radius = asFloat(h.w[6]);
+    bool ok = true;
+    for (int c = 0; c < 2; ++c) {
+        const float fh = asFloat(h.w[c]), fd = asFloat(d.w[c]);
+        // cosf/sinf: 2 ulp of a value in [-1, 1] (CUDA C Programming Guide,
+        // table of single-precision functions), times r <= radius; then the
+        // product (|r cos| <= radius) and the sum round once each: an ulp of
+        // each. r and phi are IEEE operations (sqrt, *), the same on both.
+        const double bound = double(radius) * 2.0 * 0x1p-24 + ulpOf(radius) + ulpOf(fh);
+        const double diff = std::abs(double(fh) - double(fd));
+        worstRatio = std::max(worstRatio, diff / bound);
+        ok = ok && diff <= bound;
+        if (toBoundary(fh) <= bound) ++boundaryCases;
+    }
+    const double near = double(radius) * 2.0 * 0x1p-24 + ulpOf(radius) + ulpOf(64.0f);  // the bound for any point under 64
+    const bool nearBoundary = toBoundary(asFloat(h.w[0])) <= near || toBoundary(asFloat(h.w[1])) <= near;
+    if (!nearBoundary) ok = ok && h.w[2] == d.w[2] && h.w[3] == d.w[3] && h.w[4] == d.w[4] && h.w[5] == d.w[5];
+    ok = ok && h.w[2] == h.w[4] && h.w[3] == h.w[5] && d.w[2] == d.w[4] && d.w[3] == d.w[5];  // drawNeighbour = its parts
+    return ok;
+}
+
+}  // namespace
+
+int main() {
+    int devices = 0;
+    if (cudaGetDeviceCount(&devices) != cudaSuccess || devices == 0) {
+        std::fprintf(stderr, "shared_core_check: no CUDA device\n");
+        return 2;
+    }
+    cudaDeviceProp prop{};
+    CHECK_CUDA(cudaGetDeviceProperties(&prop, 0));
+
+    // The inputs, drawn once on the host from a fixed stream.
+    PortableRng in(7, 3, RngPass::restirSpatial, 11);
+    std::vector<Vec3> points(kReprojections);
+    for (Vec3& p : points) p = Vec3(20.0f * in.uniform() - 10.0f, 2.0f * in.uniform() - 1.0f, 20.0f * in.uniform() - 10.0f);
+    std::vector<StoredReservoir> offers(std::size_t(kCombines) * restir::kMaxOffers);
+    for (int k = 0; k < kCombines; ++k)
+        for (std::uint32_t i = 0; i < 1 + std::uint32_t(k % restir::kMaxOffers); ++i) {
+            const std::uint32_t y = static_cast<std::uint32_t>(in.uniform() * 5000.0f);
+            const float W = in.uniform() < 0.1f ? 0.0f : 10.0f * in.uniform();
+            offers[std::size_t(k) * restir::kMaxOffers + i] =
+                StoredReservoir{y, W, 1u + static_cast<std::uint32_t>(in.uniform() * 40.0f), TableDomains::pHat(i, y)};
+        }
+    std::vector<float> shades(4 * kShades);
+    for (float& v : shades) v = in.uniform();
+    const Inputs host{Camera::lookAt(Vec3(0.0f, 7.0f, 17.0f), Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f), 45.0, 320, 180), points.data(),
+                      offers.data(), shades.data()};
+    const Inputs device{host.cam, toDevice(points), toDevice(offers), toDevice(shades)};
+
+    std::printf("shared_core_check: %s, CUDA %d.%d; host results from the host compiler, device results from sm_%d%d\n",
+                prop.name, CUDART_VERSION / 1000, (CUDART_VERSION % 1000) / 10, prop.major, prop.minor);
+    bool pass = true;
+    for (const Step s : kSteps) {
+        const int n = caseCount(s);
+        std::vector<Out> onHost(n), onDevice(n);
+        for (int k = 0; k < n; ++k) runCase(s, k, host, onHost[k]);
+        Out* d = nullptr;
+        CHECK_CUDA(cudaMalloc(&d, n * sizeof(Out)));
+        runCases<<<(n + 127) / 128, 128>>>(s, device, d);
+        CHECK_CUDA(cudaGetLastError());
+        CHECK_CUDA(cudaMemcpy(onDevice.data(), d, n * sizeof(Out), cudaMemcpyDeviceToHost));
+        CHECK_CUDA(cudaFree(d));
+        int differ = 0, bitDiffer = 0, boundary = 0, shown = 0;
+        double worst = 0.0;
+        for (int k = 0; k < n; ++k) {
+            const bool same = std::memcmp(&onHost[k], &onDevice[k], sizeof(Out)) == 0;
+            bitDiffer += !same;
+            const bool ok = s == Step::neighbours ? neighbourAgrees(onHost[k], onDevice[k], worst, boundary) : same;
+            if (ok) continue;
+            ++differ;
+            if (shown++ < 5) {
+                std::printf("  %s case %d: host", stepName(s), k);
+                for (std::uint32_t w : onHost[k].w) std::printf(" %08x", w);
+                std::printf(" / device");
+                for (std::uint32_t w : onDevice[k].w) std::printf(" %08x", w);
+                std::printf("\n");
+            }
+        }
+        if (s == Step::neighbours)
+            std::printf("%-44s %5d cases: %d outside the bound; %d differ in some bit, worst |device - host| = %.3f of the "
+                        "bound; %d coordinates within the bound of a rounding boundary\n",
+                        stepName(s), n, differ, bitDiffer, worst, boundary);
+        else
+            std::printf("%-44s %5d cases: %d differ in some bit\n", stepName(s), n, differ);
+        pass = pass && differ == 0;
+    }
+    std::printf("shared_core_check: %s\n", pass ? "PASS" : "FAIL");
+    return pass ? 0 : 1;
+}
