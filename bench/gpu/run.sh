@@ -323,18 +323,28 @@ CONFIGS
     return $differ
 }
 
-# The ReSTIR steps the CPU and the twin share (restir_steps.h), run on this
-# GPU and on its host CPU on the same inputs (tests/twin/shared_core_check.cu):
-# bit for bit, neighbourPoint's cos and sin within CUDA's documented bound.
+# The ReSTIR steps and pass bodies the CPU and the twin share (restir_steps.h,
+# restir_passes.h), run on this GPU and on its host CPU on the same inputs
+# (tests/twin/shared_core_check.cu): bit for bit, neighbourPoint's cos and sin
+# within CUDA's documented bound. Then the same check built with FMA
+# contraction on the device (-fmad=true, which the twin never uses), which it
+# must catch: a check that cannot fail proves nothing.
 step_shared_core() {
     mkdir -p "$W/shared_core"
-    nvcc -std=c++20 -O3 -fmad=false --expt-relaxed-constexpr -diag-suppress=20012,20011,20014,20044 -arch=sm_90 \
-        -Iinclude -I"$S/include" tests/twin/shared_core_check.cu src/geometry/camera.cpp -o "$W/shared_core/check" &&
-        { echo "commit $(cat "$D/commit")"; nvidia-smi --query-gpu=name,driver_version --format=csv,noheader;
-          "$W/shared_core/check"; } | tee "$W/shared_core/result.txt"
+    local flags=(-std=c++20 -O3 --expt-relaxed-constexpr -diag-suppress=20012,20011,20014,20044 -arch=sm_90 -Iinclude -I"$S/include")
+    local src=(tests/twin/shared_core_check.cu src/geometry/camera.cpp)
+    nvcc "${flags[@]}" -fmad=false "${src[@]}" -o "$W/shared_core/check" &&
+        nvcc "${flags[@]}" -fmad=true "${src[@]}" -o "$W/shared_core/check_fma" || return 1
+    { echo "commit $(cat "$D/commit")"; nvidia-smi --query-gpu=name,driver_version --format=csv,noheader
+      "$W/shared_core/check"; } | tee "$W/shared_core/result.txt"
     local rc=${PIPESTATUS[0]}
-    rm -f "$W/shared_core/check"
-    return "$rc"
+    "$W/shared_core/check_fma" > "$W/shared_core/result_fma.txt"
+    local fma=$?
+    echo "the same check with -fmad=true on the device: exit $fma ($(grep -c 'differ in some bit' "$W/shared_core/result_fma.txt") steps reported; $(tail -1 "$W/shared_core/result_fma.txt"))" |
+        tee -a "$W/shared_core/result.txt"
+    grep -v ': 0 differ' "$W/shared_core/result_fma.txt" | grep 'cases:' | tee -a "$W/shared_core/result.txt"
+    rm -f "$W/shared_core/check" "$W/shared_core/check_fma"
+    [ "$rc" -eq 0 ] && [ "$fma" -eq 1 ]
 }
 
 for s in "$@"; do

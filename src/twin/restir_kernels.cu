@@ -1,6 +1,7 @@
 #include "restir_kernels.h"
 
 #include "accretion/render/upsample_pixel.h"
+#include "device_bridge.h"
 #include "restir_device.h"
 
 namespace accretion::twin {
@@ -49,61 +50,26 @@ __global__ void generateCandidatesKernel(LaunchParams p) {
     });
 }
 
-/// temporalResampling: last frame's reservoir at the reprojected point.
+/// temporalResampling: restir_passes.h's body over the device bridge.
 template <ShadingModel SM>
 __global__ void temporalResamplingKernel(LaunchParams p) {
-    onTexel(p, [&](const Texel& t) {
-        const auto& [x, y, px, g] = t;
-        const RestirParams& rp = p.restir;
-        const StoredReservoir cur = rp.in[px];
-        rp.out[px] = cur;
-        if (!g.hit()) return;
-        const std::uint32_t j = g.particle;
-        if (j >= rp.prevLights.count) return;
-        const Vec3 xPrev = rp.prevLights.position[j] + g.local;
-        float depth;
-        std::size_t q = 0;
-        bool ok = restir::reprojectPoint(rp.prevCamera, xPrev, rp.scale, rp.width, rp.height, q, depth);
-        if (ok) {
-            const GBufferTexel gp = rp.prevGbuffer[q];
-            ok = gp.particle == j &&
-                 resampling::similarSurface(g.normal, depth, gp.normal, gp.depth, rp.normalThreshold, rp.depthThreshold);
-        }
-        if (!ok) return;
-        Offer offers[2];
-        offers[0] = {cur, shadingPointOf(g, p.lights), &p.lights};
-        StoredReservoir prev = rp.prevReservoirs[q];
-        prev.M = restir::capHistoryM(prev.M, cur.M, rp.mCap);
-        offers[1] = {prev, shadingPointOf(rp.prevGbuffer[q], rp.prevLights), &rp.prevLights};
-        PortableRng rng(px, rp.frame, RngPass::restirTemporal, rp.seed);
-        rp.out[px] = sanitize(rp, restir::combineReservoirs(DeviceDomains<SM>{offers, 2}, rp.bias, rng), px);
-    });
+    std::uint32_t x, y;
+    std::size_t px;
+    if (!pixelOf(p, x, y, px)) return;
+    const restir::ReuseParams params = reuseParams(p.restir);
+    DeviceBridge<SM> b(p, params);
+    restir::temporalResamplingTexel(b, px);
 }
 
-/// spatialResampling: k neighbours uniform in a disc of the radius.
+/// spatialResampling: restir_passes.h's body over the device bridge.
 template <ShadingModel SM>
 __global__ void spatialResamplingKernel(LaunchParams p, std::uint32_t iteration) {
-    onTexel(p, [&](const Texel& t) {
-        const auto& [x, y, px, g] = t;
-        const RestirParams& rp = p.restir;
-        rp.out[px] = rp.in[px];
-        if (!g.hit()) return;
-        const std::uint32_t W = rp.width, H = rp.height;
-        PortableRng rng(px ^ (std::uint64_t(iteration) << 40), rp.frame, RngPass::restirSpatial, rp.seed);
-        Offer offers[kMaxOffers];
-        std::uint32_t n = 0;
-        offers[n++] = {rp.in[px], shadingPointOf(g, p.lights), &p.lights};
-        for (std::uint32_t s = 0; s < rp.neighbours; ++s) {
-            std::size_t q;
-            if (!restir::drawNeighbour(rng, rp.radius, x, y, W, H, q)) continue;
-            const GBufferTexel gn = rp.gbuffer[q];
-            if (!gn.hit() ||
-                !resampling::similarSurface(g.normal, g.depth, gn.normal, gn.depth, rp.normalThreshold, rp.depthThreshold))
-                continue;
-            offers[n++] = {rp.in[q], shadingPointOf(gn, p.lights), &p.lights};
-        }
-        rp.out[px] = sanitize(rp, restir::combineReservoirs(DeviceDomains<SM>{offers, n}, rp.bias, rng), px);
-    });
+    std::uint32_t x, y;
+    std::size_t px;
+    if (!pixelOf(p, x, y, px)) return;
+    const restir::ReuseParams params = reuseParams(p.restir);
+    DeviceBridge<SM> b(p, params);
+    restir::spatialResamplingTexel(b, px, x, y, iteration);
 }
 
 dim3 blocks(const LaunchParams& p) { return dim3((p.restir.width + 7) / 8, (p.restir.height + 7) / 8); }

@@ -21,6 +21,7 @@
 #include <cuda_runtime.h>
 
 #include "accretion/core/rng.h"
+#include "accretion/render/restir_passes.h"
 #include "accretion/render/restir_steps.h"
 
 namespace {
@@ -126,6 +127,89 @@ ACC_HD void shadeCase(int k, const float* in, Out& o) {
     o = Out{{std::uint32_t(s), bits(Lr.x), bits(Lr.y), bits(Lr.z), occ.y, bits(occ.W), occ.M, bits(occ.p_hat)}};
 }
 
+// ---------------------------------------------------------------- the passes
+// The reuse passes' bodies (restir_passes.h) over a bridge of plain arrays,
+// the same on both sides: a W x H lighting grid whose texel px holds
+// particle px (most texels) at a point last frame's camera sees near texel
+// px, so that reprojection lands on, beside or off its texel; p_hat a fixed
+// function of (the domain's particle, the light), as TableDomains.
+
+constexpr std::uint32_t kGridW = 48, kGridH = 27;
+
+struct PassInputs {
+    restir::ReuseParams params;
+    BiasCorrection bias;
+    const GBufferTexel* texels;       ///< this frame's (and, here, last frame's) grid
+    const StoredReservoir* in;        ///< the pass's input
+    const StoredReservoir* history;   ///< last frame's reservoirs
+    const Vec3* historyPositions;     ///< last frame's particle centres
+    std::uint32_t particles;
+    Camera camera;                    ///< last frame's
+};
+
+/// Domains keyed by the particle of each offer's texel.
+struct KeyDomains {
+    const StoredReservoir* r;
+    const std::uint32_t* key;
+    std::uint32_t n;
+    ACC_HD std::uint32_t count() const { return n; }
+    ACC_HD const StoredReservoir& reservoir(std::uint32_t i) const { return r[i]; }
+    ACC_HD float targetPdf(std::uint32_t i, std::uint32_t y) const { return TableDomains::pHat(key[i], y); }
+    ACC_HD bool supports(std::uint32_t i, std::uint32_t y) const { return targetPdf(i, y) > 0.0f; }
+    ACC_HD void countTerm() const {}
+};
+
+struct CheckBridge {
+    using Rng = PortableRng;
+    template <std::uint32_t N>
+    struct Offers {
+        const CheckBridge& b;
+        StoredReservoir r[N];
+        std::uint32_t key[N];
+        std::uint32_t n = 0;
+        ACC_HD void addCurrent(const StoredReservoir& x, const GBufferTexel& g) { r[n] = x, key[n++] = g.particle; }
+        ACC_HD void addHistory(const StoredReservoir& x, std::size_t q) { r[n] = x, key[n++] = b.in.texels[q].particle ^ 0x55u; }
+        ACC_HD StoredReservoir combine(PortableRng& rng) const { return restir::combineReservoirs(KeyDomains{r, key, n}, b.in.bias, rng); }
+    };
+    const PassInputs& in;
+    StoredReservoir& out;   ///< the texel's output (a body writes its own texel alone)
+    std::uint32_t* reuses;  ///< accepted, rejected of this texel
+
+    ACC_HD const restir::ReuseParams& params() const { return in.params; }
+    ACC_HD GBufferTexel texel(std::size_t px) const { return in.texels[px]; }
+    ACC_HD StoredReservoir input(std::size_t px) const { return in.in[px]; }
+    ACC_HD void output(std::size_t, const StoredReservoir& r) const { out = r; }
+    ACC_HD void store(std::size_t, const StoredReservoir& r) const { out = r; }
+    ACC_HD restir::NoRecorder recorder(std::size_t, const GBufferTexel&) const { return {}; }
+    ACC_HD std::uint32_t reservoirBytes() const { return 16; }
+    ACC_HD void reuse(bool accepted) const { ++reuses[accepted ? 0 : 1]; }
+    template <std::uint32_t N>
+    ACC_HD Offers<N> offers() const { return Offers<N>{*this}; }
+    ACC_HD bool historyHas(std::uint32_t j) const { return j < in.particles; }
+    ACC_HD Vec3 historyPosition(std::uint32_t j) const { return in.historyPositions[j]; }
+    ACC_HD const Camera& historyCamera() const { return in.camera; }
+    ACC_HD GBufferTexel historyTexel(std::size_t q) const { return in.texels[q]; }
+    ACC_HD StoredReservoir historyReservoir(std::size_t q) const { return in.history[q]; }
+};
+
+/// Case k: texel k % (W H) of pass k / (W H): temporal then spatial (two
+/// iterations), under none, basic and pairwise.
+constexpr int kPassCases = 6 * int(kGridW * kGridH);
+
+ACC_HD void passCase(int k, const PassInputs* variants, Out& o) {
+    const std::uint32_t texels = kGridW * kGridH;
+    const std::size_t px = std::size_t(k) % texels;
+    const int variant = k / int(texels);  // bias x (temporal, spatial)
+    const PassInputs& in = variants[variant / 2];
+    StoredReservoir r;
+    std::uint32_t reuses[2] = {0, 0};
+    const CheckBridge b{in, r, reuses};
+    const std::uint32_t x = std::uint32_t(px % kGridW), y = std::uint32_t(px / kGridW);
+    if (variant % 2 == 0) restir::temporalResamplingTexel(b, px);
+    else restir::spatialResamplingTexel(b, px, x, y, 1 + variant % 4);
+    o = Out{{r.y, bits(r.W), r.M, bits(r.p_hat), reuses[0], reuses[1], 0u, 0u}};
+}
+
 // ---------------------------------------------------------------- the hosts
 
 struct Inputs {
@@ -133,10 +217,12 @@ struct Inputs {
     Vec3* points;
     StoredReservoir* offers;
     float* shades;
+    PassInputs* passes;  ///< none, basic, pairwise
 };
 
-enum class Step { neighbours, reprojections, caps, candidates, combines, shades };
-constexpr Step kSteps[] = {Step::neighbours, Step::reprojections, Step::caps, Step::candidates, Step::combines, Step::shades};
+enum class Step { neighbours, reprojections, caps, candidates, combines, shades, passes };
+constexpr Step kSteps[] = {Step::neighbours, Step::reprojections, Step::caps, Step::candidates, Step::combines, Step::shades,
+                           Step::passes};
 
 ACC_HD int caseCount(Step s) {
     switch (s) {
@@ -146,6 +232,7 @@ ACC_HD int caseCount(Step s) {
         case Step::candidates: return kCandidates;
         case Step::combines: return kCombines;
         case Step::shades: return kShades;
+        case Step::passes: return kPassCases;
     }
     return 0;
 }
@@ -158,6 +245,7 @@ ACC_HD void runCase(Step s, int k, const Inputs& in, Out& o) {
         case Step::candidates: candidatesCase(k, o); break;
         case Step::combines: combineCase(k, in.offers, o); break;
         case Step::shades: shadeCase(k, in.shades, o); break;
+        case Step::passes: passCase(k, in.passes, o); break;
     }
 }
 
@@ -174,6 +262,7 @@ const char* stepName(Step s) {
         case Step::candidates: return "resampleCandidates";
         case Step::combines: return "combineReservoirs";
         case Step::shades: return "shadeSample/occludedReservoir";
+        case Step::passes: return "temporal/spatialResamplingTexel";
     }
     return "?";
 }
@@ -258,9 +347,55 @@ int main() {
         }
     std::vector<float> shades(4 * kShades);
     for (float& v : shades) v = in.uniform();
+    // The passes' grid: particle px at a point near texel px's ray, seen by
+    // last frame's camera; a tenth of the texels empty.
+    const Camera gridCam = Camera::lookAt(Vec3(0.0f, 2.0f, 30.0f), Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f), 40.0, kGridW, kGridH);
+    const std::uint32_t texels = kGridW * kGridH;
+    std::vector<GBufferTexel> grid(texels);
+    std::vector<Vec3> centres(texels);
+    std::vector<StoredReservoir> current(texels), history(texels);
+    for (std::uint32_t px = 0; px < texels; ++px) {
+        const float depth = 20.0f + 10.0f * in.uniform();
+        const Vec3 point = gridCam.position + depth * gridCam.pixelDirection(px % kGridW, px / kGridW);
+        GBufferTexel& g = grid[px];
+        g.particle = in.uniform() < 0.1f ? kNoParticle : px;
+        g.local = Vec3(0.2f * in.uniform() - 0.1f, 0.2f * in.uniform() - 0.1f, 0.0f);
+        g.normal = glm::normalize(Vec3(0.3f * in.uniform() - 0.15f, 0.3f * in.uniform() - 0.15f, 1.0f));
+        g.geomNormal = g.normal;
+        float fx, fy;
+        gridCam.project(point, fx, fy, g.depth);
+        // Last frame the particle sat within about a texel of where it is now.
+        centres[px] = point - g.local + Vec3(0.06f * in.uniform() - 0.03f, 0.06f * in.uniform() - 0.03f, 0.0f);
+        const auto reservoir = [&] {
+            const std::uint32_t y = static_cast<std::uint32_t>(in.uniform() * 5000.0f);
+            return StoredReservoir{y, in.uniform() < 0.1f ? 0.0f : 10.0f * in.uniform(), 1u + static_cast<std::uint32_t>(in.uniform() * 40.0f),
+                                   TableDomains::pHat(px, y)};
+        };
+        current[px] = reservoir();
+        history[px] = reservoir();
+    }
+    GBufferTexel* dGrid = toDevice(grid);
+    StoredReservoir *dCurrent = toDevice(current), *dHistory = toDevice(history);
+    Vec3* dCentres = toDevice(centres);
+    std::vector<PassInputs> hostPasses, devicePasses;
+    for (const BiasCorrection bias : {BiasCorrection::none, BiasCorrection::basic, BiasCorrection::pairwise}) {
+        restir::ReuseParams params;
+        params.frame = 5;
+        params.seed = 9;
+        params.width = kGridW;
+        params.height = kGridH;
+        params.normalThreshold = 0.95f;
+        params.depthThreshold = 0.1f;
+        params.mCap = 20.0;
+        params.neighbours = 8;
+        params.radius = 6.0f;
+        hostPasses.push_back({params, bias, grid.data(), current.data(), history.data(), centres.data(), texels, gridCam});
+        devicePasses.push_back({params, bias, dGrid, dCurrent, dHistory, dCentres, texels, gridCam});
+    }
+
     const Inputs host{Camera::lookAt(Vec3(0.0f, 7.0f, 17.0f), Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f), 45.0, 320, 180), points.data(),
-                      offers.data(), shades.data()};
-    const Inputs device{host.cam, toDevice(points), toDevice(offers), toDevice(shades)};
+                      offers.data(), shades.data(), hostPasses.data()};
+    const Inputs device{host.cam, toDevice(points), toDevice(offers), toDevice(shades), toDevice(devicePasses)};
 
     std::printf("shared_core_check: %s, CUDA %d.%d; host results from the host compiler, device results from sm_%d%d\n",
                 prop.name, CUDART_VERSION / 1000, (CUDART_VERSION % 1000) / 10, prop.major, prop.minor);
@@ -291,7 +426,12 @@ int main() {
                 std::printf("\n");
             }
         }
-        if (s == Step::neighbours)
+        if (s == Step::passes) {
+            std::uint64_t accepted = 0, rejected = 0;
+            for (const Out& o : onHost) accepted += o.w[4], rejected += o.w[5];
+            std::printf("%-44s %5d cases: %d differ in some bit (reuse offers accepted %llu, rejected %llu)\n", stepName(s), n, differ,
+                        (unsigned long long)accepted, (unsigned long long)rejected);
+        } else if (s == Step::neighbours)
             std::printf("%-44s %5d cases: %d outside the bound; %d differ in some bit, worst |device - host| = %.3f of the "
                         "bound; %d coordinates within the bound of a rounding boundary\n",
                         stepName(s), n, differ, bitDiffer, worst, boundary);

@@ -1,0 +1,114 @@
+#pragma once
+// The CPU's bridge of the shared pass bodies (accretion/render/restir_passes.h):
+// the frame's buffers, Embree for basic_visibility's shadow rays, the
+// counters of counting mode, the reservoir codec.
+#include <algorithm>
+#include <optional>
+
+#include "accretion/core/error.h"
+#include "accretion/render/restir_passes.h"
+#include "combine_reservoirs.h"
+#include "restir_pass.h"
+
+namespace accretion::restir {
+
+/// The ReuseParams of a CPU frame.
+inline ReuseParams reuseParams(const FrameContext& f) {
+    ReuseParams p;
+    p.frame = f.in.frame;
+    p.seed = f.in.settings.render.seed;
+    p.width = f.lg.width;
+    p.height = f.lg.height;
+    p.scale = f.scale;
+    p.normalThreshold = float(f.rs.normal_threshold);
+    p.depthThreshold = float(f.rs.depth_threshold);
+    p.mCap = f.rs.m_cap;
+    p.neighbours = f.rs.spatial_neighbours;
+    p.radius = std::max(1.0f, float(f.rs.spatial_radius) * f.scale);
+    return p;
+}
+
+/// One CPU pass's bridge, made per texel on the thread that runs it.
+template <ShadingModel SM, Primitive P, bool Count>
+class CpuBridge {
+public:
+    using Rng = accretion::Rng;
+
+    /// A CPU pass's offers (scratch.offers, cleared): each with its domain
+    /// for basic_visibility, combined by combineOffers.
+    class Offers {
+    public:
+        explicit Offers(CpuBridge& b) : b_(b) { b_.scratch_.offers.clear(); }
+        void addCurrent(const StoredReservoir& r, const GBufferTexel& g) {
+            // With temporal reuse as well, a temporal output also holds samples
+            // that passed the previous frame's test, not this pixel's: treating
+            // it as tested here is then an approximation (measured by
+            // `accretion bias`); exact with temporal off.
+            const FrameContext& f = b_.f_;
+            b_.scratch_.offers.push_back({r, {shadingPoint(g, f.in.particles), &f.L, f.rs.candidate_visibility, &f.in.bvh}});
+        }
+        void addHistory(const StoredReservoir& r, std::size_t q) {
+            // The previous frame's visibility needs the previous frame's BVH
+            // (kept by the frame renderer when basic_visibility asks for it).
+            const FrameContext& f = b_.f_;
+            const Restir::History& h = *f.prev;
+            b_.scratch_.offers.push_back({r, {shadingPoint(h.gbuffer.texels[q], h.particles), &h.lights,
+                                              f.rs.candidate_visibility || f.rs.visibility_reuse,
+                                              f.in.previousBvh ? f.in.previousBvh : &f.in.bvh}});
+        }
+        StoredReservoir combine(Rng& rng) { return combineOffers<SM, P, Count>(b_.scratch_, b_.f_, rng, b_.c_, *b_.rec_); }
+
+    private:
+        CpuBridge& b_;
+    };
+
+    CpuBridge(const FrameContext& f, const ReuseParams& p, PassCounters* pc, const std::vector<StoredReservoir>& in,
+              std::vector<StoredReservoir>& out, LightingCounters& c, Scratch& scratch)
+        : f_(f), p_(p), pc_(pc), in_(in), out_(out), c_(c), scratch_(scratch) {}
+
+    const ReuseParams& params() const { return p_; }
+    const GBufferTexel& texel(std::size_t px) const { return f_.lg.texels[px]; }
+    const StoredReservoir& input(std::size_t px) const { return in_[px]; }
+    void output(std::size_t px, const StoredReservoir& r) { out_[px] = r; }
+    void store(std::size_t px, const StoredReservoir& r) { out_[px] = f_.codec.roundTrip(f_.sanitize(r, px, c_)); }
+    Recorder<Count>& recorder(std::size_t px, const GBufferTexel& g) {
+        rec_.emplace(restir::recorder<Count>(pc_, px));
+        recordHit(*rec_, f_, g);
+        return *rec_;
+    }
+    std::uint32_t reservoirBytes() const { return f_.codec.bytes(); }
+    void reuse(bool accepted) { ++(accepted ? c_.reuseAccepted : c_.reuseRejected); }
+    template <std::uint32_t N>
+    Offers offers() { return Offers(*this); }
+
+    bool historyHas(std::uint32_t j) const { return j < f_.prev->particles.size(); }
+    const Vec3& historyPosition(std::uint32_t j) const { return f_.prev->particles.position[j]; }
+    const Camera& historyCamera() const { return f_.prev->camera; }
+    const GBufferTexel& historyTexel(std::size_t q) const { return f_.prev->gbuffer.texels[q]; }
+    const StoredReservoir& historyReservoir(std::size_t q) const { return f_.prev->reservoirs[q]; }
+
+private:
+    const FrameContext& f_;
+    const ReuseParams& p_;
+    PassCounters* pc_;
+    const std::vector<StoredReservoir>& in_;
+    std::vector<StoredReservoir>& out_;
+    LightingCounters& c_;
+    Scratch& scratch_;
+    std::optional<Recorder<Count>> rec_;
+};
+
+/// Runs body(bridge, px, x, y) over the lighting grid (forEachPixel's tiles),
+/// each texel with a bridge of its thread's counters and scratch.
+template <ShadingModel SM, Primitive P, bool Count, class Body>
+LightingCounters forEachTexel(const FrameContext& f, Pass pass, const std::vector<StoredReservoir>& in,
+                              std::vector<StoredReservoir>& out, Body&& body) {
+    const ReuseParams p = reuseParams(f);
+    PassCounters* pc = passCounters<Count>(f, pass);
+    return forEachPixel(f.lg.width, f.lg.height, [&](std::size_t px, std::uint32_t x, std::uint32_t y, LightingCounters& c, Scratch& s) {
+        CpuBridge<SM, P, Count> b(f, p, pc, in, out, c, s);
+        body(b, px, x, y);
+    });
+}
+
+}  // namespace accretion::restir
