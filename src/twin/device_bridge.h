@@ -18,14 +18,38 @@ __device__ inline restir::ReuseParams reuseParams(const RestirParams& rp) {
     p.normalThreshold = rp.normalThreshold;
     p.depthThreshold = rp.depthThreshold;
     p.mCap = rp.mCap;
+    p.candidates = rp.candidates;
     p.neighbours = rp.neighbours;
     p.radius = rp.radius;
     return p;
 }
 
+/// The visibility of a bridge whose pass traces no shadow ray (the twin
+/// refuses restir.candidate_visibility: generateCandidates never asks).
+struct NoShadowRays {
+    __device__ bool operator()(const ShadingPoint&, std::uint32_t, const LightTerm&) const { return true; }
+};
+
+/// render.source on the twin: the light tree at the receiver, else the
+/// source pmf (uniform or power; the twin refuses tiles and regir). Nothing
+/// counted.
+struct DeviceSource {
+    const LaunchParams& p;
+    struct Drawer {
+        const LaunchParams& p;
+        const ShadingPoint& sp;
+        __device__ LightSample sample(PortableRng& g) const { return p.tree.nodes ? p.tree.sample(sp, g) : p.source.sample(g); }
+    };
+    __device__ std::uint32_t reads() const { return 0; }
+    __device__ std::uint32_t gathers() const { return 0; }
+    __device__ Drawer at(const ShadingPoint& sp, std::uint32_t, std::uint32_t, PortableRng&) const { return {p, sp}; }
+};
+
 /// One thread's bridge: the launch's lighting grid, its reservoirs in and
-/// out, and last frame's (prevLights, prevGbuffer, prevReservoirs).
-template <ShadingModel SM>
+/// out (restir.in and restir.out, or restir.out in place), last frame's
+/// (prevLights, prevGbuffer, prevReservoirs), and the pass's shadow rays
+/// (Visibility: sp, light, term -> seen, counted by the raygen).
+template <ShadingModel SM, class Visibility = NoShadowRays>
 class DeviceBridge {
 public:
     using Rng = PortableRng;
@@ -52,13 +76,17 @@ public:
         std::uint32_t n_ = 0;
     };
 
-    __device__ DeviceBridge(const LaunchParams& p, const restir::ReuseParams& params) : p_(p), params_(params) {}
+    __device__ DeviceBridge(const LaunchParams& p, const restir::ReuseParams& params, bool inPlace = false,
+                            Visibility visibility = {}, LaunchCounters* counters = nullptr)
+        : p_(p), params_(params), in_(inPlace ? p.restir.out : p.restir.in), visibility_(visibility), counters_(counters) {}
 
     __device__ const restir::ReuseParams& params() const { return params_; }
     __device__ GBufferTexel texel(std::size_t px) const { return p_.restir.gbuffer[px]; }
-    __device__ StoredReservoir input(std::size_t px) const { return p_.restir.in[px]; }
+    __device__ StoredReservoir input(std::size_t px) const { return in_[px]; }
     __device__ void output(std::size_t px, const StoredReservoir& r) const { p_.restir.out[px] = r; }
+    __device__ void keep(std::size_t px, const StoredReservoir& r) const { p_.restir.out[px] = r; }
     __device__ void store(std::size_t px, const StoredReservoir& r) const { p_.restir.out[px] = sanitize(p_.restir, r, px); }
+    __device__ bool reject(std::size_t px) const { return rejectAt(p_.restir, px); }
     __device__ restir::NoRecorder recorder(std::size_t, const GBufferTexel&) const { return {}; }
     __device__ std::uint32_t reservoirBytes() const { return sizeof(StoredReservoir); }
     __device__ void reuse(bool) const {}
@@ -71,9 +99,29 @@ public:
     __device__ GBufferTexel historyTexel(std::size_t q) const { return p_.restir.prevGbuffer[q]; }
     __device__ StoredReservoir historyReservoir(std::size_t q) const { return p_.restir.prevReservoirs[q]; }
 
+    __device__ ShadingPoint shadingPoint(const GBufferTexel& g) const { return shadingPointOf(g, p_.lights); }
+    __device__ float targetPdf(const ShadingPoint& sp, std::uint32_t i) const { return twin::targetPdf<SM>(p_.lights, sp, i); }
+    __device__ bool lightTerm(const ShadingPoint& sp, std::uint32_t i, LightTerm& t) const {
+        return twin::lightTerm<SM>(p_.lights, sp, i, t);
+    }
+    __device__ void countLightTerm() const {
+        if (counters_) ++counters_->lightTerms;
+    }
+    __device__ bool shadows() const { return p_.shadows; }
+    __device__ bool visible(const ShadingPoint& sp, std::uint32_t i, const LightTerm& t, restir::NoRecorder&) const {
+        return visibility_(sp, i, t);
+    }
+    __device__ void occluded() const {}  // the raygen's visibility counts its blocked rays
+    __device__ bool dropOccludedCandidates() const { return false; }
+    __device__ bool visibilityReuse() const { return p_.restir.visibilityReuse; }
+    __device__ void writeLr(std::size_t px, const Vec3& Lr) const { p_.restir.Lr[px] = Lr; }
+
 private:
     const LaunchParams& p_;
     const restir::ReuseParams& params_;
+    const StoredReservoir* in_;
+    Visibility visibility_;
+    LaunchCounters* counters_;
 };
 
 }  // namespace accretion::twin

@@ -16,6 +16,7 @@
 #include "accretion/render/sample_sums.h"
 #include "accretion/render/shadow_query.h"
 #include "launch_params.h"
+#include "device_bridge.h"
 #include "restir_device.h"
 
 using namespace accretion;
@@ -154,43 +155,33 @@ __device__ void samplePixel(const ShadingPoint& sp, std::size_t px, SampleSums& 
     }
 }
 
-/// traceShadowRays (src/render/restir/trace_shadow_rays.cpp): one shadow ray
-/// for the kept sample of restir.out, Lr = f I G V W; with visibility reuse an
-/// occluded sample's W is zeroed in the stored reservoir.
+/// traceShadowRays' shadow ray on the twin: optixTrace with any-hit, or
+/// optixTraverse with optionally optixReorder by the SER key (the light's
+/// cluster in serHintBits bits).
+template <bool Traverse>
+struct OptixShadowRays {
+    LaunchCounters* c;
+    __device__ bool operator()(const ShadingPoint& sp, std::uint32_t light, const LightTerm& t) const {
+        const RestirParams& rp = params.restir;
+        if constexpr (Traverse) {
+            const unsigned mask = rp.serHintBits >= 32 ? 0xffffffffu : (1u << rp.serHintBits) - 1u;
+            return visible<false>(sp, light, t, *c, rp.reorder, rp.particleCluster[light] & mask, rp.serHintBits);
+        } else {
+            return visible<true>(sp, light, t, *c);
+        }
+    }
+};
+
+/// traceShadowRays: restir_passes.h's body over the device bridge, in place
+/// on restir.out, with OptiX's shadow rays.
 template <ShadingModel SM, bool Traverse>
 __device__ void shadePixel() {
     const uint3 idx = optixGetLaunchIndex();
-    const RestirParams& rp = params.restir;
-    const std::size_t px = std::size_t(idx.y) * rp.width + idx.x;  // the lighting grid's texel
-    rp.Lr[px] = Vec3(0.0f);
-    const GBufferTexel g = rp.gbuffer[px];
-    if (!g.hit()) return;
-    const StoredReservoir r = rp.out[px];
-    if (!(r.W > 0.0f)) return;
-    const ShadingPoint sp = shadingPointOf(g, params.lights);
-    LightTerm t;
+    const std::size_t px = std::size_t(idx.y) * params.restir.width + idx.x;  // the lighting grid's texel
     LaunchCounters c;
-    ++c.lightTerms;
-    bool seen = true;
-    if (lightTerm<SM>(params.lights, sp, r.y, t)) {
-        if (params.shadows) {
-            if constexpr (Traverse) {
-                const unsigned mask = rp.serHintBits >= 32 ? 0xffffffffu : (1u << rp.serHintBits) - 1u;
-                seen = visible<false>(sp, r.y, t, c, rp.reorder, rp.particleCluster[r.y] & mask, rp.serHintBits);
-            } else {
-                seen = visible<true>(sp, r.y, t, c);
-            }
-        }
-        switch (restir::shadeSample(t, r.W, seen, rp.Lr[px])) {
-        case restir::Shade::lit: break;
-        case restir::Shade::occluded:
-            if (rp.visibilityReuse) rp.out[px] = restir::occludedReservoir(r);
-            break;
-        case restir::Shade::overflow:
-            if (rejectAt(rp, px)) rp.out[px] = StoredReservoir{};
-            break;
-        }
-    }
+    const restir::ReuseParams reuse = reuseParams(params.restir);
+    DeviceBridge<SM, OptixShadowRays<Traverse>> b(params, reuse, true, OptixShadowRays<Traverse>{&c}, &c);
+    restir::traceShadowRayTexel(b, px);
     addCounters(c);
 }
 

@@ -15,39 +15,15 @@ __device__ inline bool pixelOf(const LaunchParams& p, std::uint32_t& x, std::uin
     return x < p.restir.width && y < p.restir.height;
 }
 
-/// A texel of the lighting grid as a restir kernel sees it: its
-/// coordinates, index and G-buffer texel.
-struct Texel {
-    std::uint32_t x, y;
-    std::size_t px;
-    GBufferTexel g;
-};
-
-/// step(texel) on the thread's texel of the lighting grid, if it has one.
-template <class Step>
-__device__ inline void onTexel(const LaunchParams& p, Step&& step) {
-    Texel t;
-    if (!pixelOf(p, t.x, t.y, t.px)) return;
-    t.g = p.restir.gbuffer[t.px];
-    step(t);
-}
-
-/// generateCandidates: RIS of `candidates` lights from the source pmf or the light tree (render.source) with target p_hat.
+/// generateCandidates: restir_passes.h's body over the device bridge and its source.
 template <ShadingModel SM>
 __global__ void generateCandidatesKernel(LaunchParams p) {
-    onTexel(p, [&](const Texel& t) {
-        const auto& [x, y, px, g] = t;
-        const RestirParams& rp = p.restir;
-        rp.out[px] = StoredReservoir{};
-        if (!g.hit()) return;
-        const ShadingPoint sp = shadingPointOf(g, p.lights);
-        PortableRng rng(px, rp.frame, RngPass::restirCandidates, rp.seed);
-        const auto draw = [&](PortableRng& g) { return p.tree.nodes ? p.tree.sample(sp, g) : p.source.sample(g); };
-        const auto target = [&](std::uint32_t i) { return targetPdf<SM>(p.lights, sp, i); };
-        Reservoir r;
-        if (!restir::resampleCandidates(rp.candidates, rng, draw, target, [&] { return rejectAt(rp, px); }, r)) return;
-        rp.out[px] = StoredReservoir::of(r);
-    });
+    std::uint32_t x, y;
+    std::size_t px;
+    if (!pixelOf(p, x, y, px)) return;
+    const restir::ReuseParams params = reuseParams(p.restir);
+    DeviceBridge<SM> b(p, params);
+    restir::generateCandidatesTexel(b, DeviceSource{p}, px, x, y);
 }
 
 /// temporalResampling: restir_passes.h's body over the device bridge.

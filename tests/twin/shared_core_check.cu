@@ -142,9 +142,10 @@ struct PassInputs {
     const GBufferTexel* texels;       ///< this frame's (and, here, last frame's) grid
     const StoredReservoir* in;        ///< the pass's input
     const StoredReservoir* history;   ///< last frame's reservoirs
-    const Vec3* historyPositions;     ///< last frame's particle centres
+    const Vec3* historyPositions;     ///< last frame's particle centres (and, here, this frame's lights)
     std::uint32_t particles;
     Camera camera;                    ///< last frame's
+    const Vec3* emission;             ///< the lights' I (particle px: light px)
 };
 
 /// Domains keyed by the particle of each offer's texel.
@@ -190,24 +191,73 @@ struct CheckBridge {
     ACC_HD const Camera& historyCamera() const { return in.camera; }
     ACC_HD GBufferTexel historyTexel(std::size_t q) const { return in.texels[q]; }
     ACC_HD StoredReservoir historyReservoir(std::size_t q) const { return in.history[q]; }
+    // The lights: particle j at historyPositions[j] with emission[j], lambert
+    // (the real evalLight, on both sides); visibility a fixed function of the
+    // pair, so both branches of every test are taken.
+    Vec3* Lr = nullptr;
+    ACC_HD ShadingPoint shadingPoint(const GBufferTexel& g) const {
+        const Vec3 c = in.historyPositions[g.particle];
+        return {c + g.local, g.normal, g.geomNormal, Vec3(0.7f), g.particle, c, g.local};
+    }
+    ACC_HD bool lightTerm(const ShadingPoint& sp, std::uint32_t i, LightTerm& t) const {
+        if (i == sp.self || i >= in.particles) return false;
+        return evalLight<ShadingModel::lambert>(sp, in.historyPositions[i], in.emission[i], 0.01f, t);
+    }
+    ACC_HD float targetPdf(const ShadingPoint& sp, std::uint32_t i) const {
+        LightTerm t;
+        return lightTerm(sp, i, t) ? luminance(t.value) : 0.0f;
+    }
+    ACC_HD void countLightTerm() const {}
+    ACC_HD std::uint32_t clusterOf(std::uint32_t i) const { return i / 64; }
+    ACC_HD bool shadows() const { return true; }
+    ACC_HD bool visible(const ShadingPoint& sp, std::uint32_t i, const LightTerm&, restir::NoRecorder&) const {
+        return (sp.self * 31u + i) % 5u != 0u;
+    }
+    ACC_HD void occluded() const { ++reuses[1]; }
+    ACC_HD bool dropOccludedCandidates() const { return in.bias != BiasCorrection::none; }
+    ACC_HD bool visibilityReuse() const { return in.bias == BiasCorrection::pairwise; }
+    ACC_HD void writeLr(std::size_t, const Vec3& v) const { *Lr = v; }
+    ACC_HD void keep(std::size_t, const StoredReservoir& r) const { out = r; }
+    ACC_HD bool reject(std::size_t) const { return ++reuses[0] % 2 == 0; }
 };
 
-/// Case k: texel k % (W H) of pass k / (W H): temporal then spatial (two
-/// iterations), under none, basic and pairwise.
-constexpr int kPassCases = 6 * int(kGridW * kGridH);
+/// render.source uniform over the particles, as the check draws it.
+struct UniformSource {
+    std::uint32_t lights;
+    struct Drawer {
+        std::uint32_t lights;
+        ACC_HD LightSample sample(PortableRng& g) const { return {g.uniformInt(lights), 1.0f / float(lights)}; }
+    };
+    ACC_HD std::uint32_t reads() const { return 0; }
+    ACC_HD std::uint32_t gathers() const { return 0; }
+    ACC_HD Drawer at(const ShadingPoint&, std::uint32_t, std::uint32_t, PortableRng&) const { return {lights}; }
+};
+
+/// Case k: texel k % (W H) of pass k / (W H): under none, basic and
+/// pairwise, generateCandidates, temporal, spatial (iterations 1 and 3) and
+/// traceShadowRays (candidate visibility and visibility reuse with the bias).
+constexpr int kPassKinds = 5;
+constexpr int kPassCases = 3 * kPassKinds * int(kGridW * kGridH);
 
 ACC_HD void passCase(int k, const PassInputs* variants, Out& o) {
     const std::uint32_t texels = kGridW * kGridH;
     const std::size_t px = std::size_t(k) % texels;
-    const int variant = k / int(texels);  // bias x (temporal, spatial)
-    const PassInputs& in = variants[variant / 2];
+    const int variant = k / int(texels);  // bias x kind
+    const PassInputs& in = variants[variant / kPassKinds];
     StoredReservoir r;
+    Vec3 Lr(-1.0f);
     std::uint32_t reuses[2] = {0, 0};
-    const CheckBridge b{in, r, reuses};
+    CheckBridge b{in, r, reuses};
+    b.Lr = &Lr;
     const std::uint32_t x = std::uint32_t(px % kGridW), y = std::uint32_t(px / kGridW);
-    if (variant % 2 == 0) restir::temporalResamplingTexel(b, px);
-    else restir::spatialResamplingTexel(b, px, x, y, 1 + variant % 4);
-    o = Out{{r.y, bits(r.W), r.M, bits(r.p_hat), reuses[0], reuses[1], 0u, 0u}};
+    switch (variant % kPassKinds) {
+    case 0: restir::generateCandidatesTexel(b, UniformSource{in.particles}, px, x, y); break;
+    case 1: restir::temporalResamplingTexel(b, px); break;
+    case 2: restir::spatialResamplingTexel(b, px, x, y, 1); break;
+    case 3: restir::spatialResamplingTexel(b, px, x, y, 3); break;
+    case 4: restir::traceShadowRayTexel(b, px); break;
+    }
+    o = Out{{r.y, bits(r.W), r.M, bits(r.p_hat), reuses[0], reuses[1], bits(Lr.x), bits(Lr.y) ^ bits(Lr.z)}};
 }
 
 // ---------------------------------------------------------------- the hosts
@@ -262,7 +312,7 @@ const char* stepName(Step s) {
         case Step::candidates: return "resampleCandidates";
         case Step::combines: return "combineReservoirs";
         case Step::shades: return "shadeSample/occludedReservoir";
-        case Step::passes: return "temporal/spatialResamplingTexel";
+        case Step::passes: return "the pass bodies (restir_passes.h)";
     }
     return "?";
 }
@@ -377,6 +427,9 @@ int main() {
     GBufferTexel* dGrid = toDevice(grid);
     StoredReservoir *dCurrent = toDevice(current), *dHistory = toDevice(history);
     Vec3* dCentres = toDevice(centres);
+    std::vector<Vec3> emission(texels);
+    for (Vec3& I : emission) I = in.uniform() < 0.05f ? Vec3(0.0f) : Vec3(in.uniform(), in.uniform(), in.uniform()) * 50.0f;
+    Vec3* dEmission = toDevice(emission);
     std::vector<PassInputs> hostPasses, devicePasses;
     for (const BiasCorrection bias : {BiasCorrection::none, BiasCorrection::basic, BiasCorrection::pairwise}) {
         restir::ReuseParams params;
@@ -389,8 +442,9 @@ int main() {
         params.mCap = 20.0;
         params.neighbours = 8;
         params.radius = 6.0f;
-        hostPasses.push_back({params, bias, grid.data(), current.data(), history.data(), centres.data(), texels, gridCam});
-        devicePasses.push_back({params, bias, dGrid, dCurrent, dHistory, dCentres, texels, gridCam});
+        params.candidates = 12;
+        hostPasses.push_back({params, bias, grid.data(), current.data(), history.data(), centres.data(), texels, gridCam, emission.data()});
+        devicePasses.push_back({params, bias, dGrid, dCurrent, dHistory, dCentres, texels, gridCam, dEmission});
     }
 
     const Inputs host{Camera::lookAt(Vec3(0.0f, 7.0f, 17.0f), Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f), 45.0, 320, 180), points.data(),
@@ -429,7 +483,7 @@ int main() {
         if (s == Step::passes) {
             std::uint64_t accepted = 0, rejected = 0;
             for (const Out& o : onHost) accepted += o.w[4], rejected += o.w[5];
-            std::printf("%-44s %5d cases: %d differ in some bit (reuse offers accepted %llu, rejected %llu)\n", stepName(s), n, differ,
+            std::printf("%-44s %5d cases: %d differ in some bit (offers accepted and values rejected %llu; offers rejected and samples occluded %llu)\n", stepName(s), n, differ,
                         (unsigned long long)accepted, (unsigned long long)rejected);
         } else if (s == Step::neighbours)
             std::printf("%-44s %5d cases: %d outside the bound; %d differ in some bit, worst |device - host| = %.3f of the "

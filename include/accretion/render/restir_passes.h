@@ -10,8 +10,11 @@
 //   GBufferTexel texel(px)                   this frame's lighting-grid texel
 //   StoredReservoir input(px)                the pass's input reservoir
 //   void output(px, r)                       the pass's output, as it is
+//   void keep(px, r)                         the output as the frame keeps reservoirs (the codec)
 //   void store(px, r)                        a combined reservoir: sanitized (render.nonfinite)
-//                                            and stored as the frame keeps reservoirs
+//                                            and kept
+//   bool reject(px)                          a non-finite value at px counted; true when
+//                                            render.nonfinite discards the reservoir
 //   Rec recorder(px, g)                      the thread's counters (Recorder<Count> on the CPU,
 //                                            NoRecorder on the GPU), its branch key recorded
 //   std::uint32_t reservoirBytes()           a stored reservoir's bytes (the codec's)
@@ -22,6 +25,16 @@
 //                                              combine(rng)      restir_steps.h's combineReservoirs
 //   history: bool historyHas(j), Vec3 historyPosition(j), const Camera& historyCamera(),
 //            GBufferTexel historyTexel(q), StoredReservoir historyReservoir(q)
+//   lights:  ShadingPoint shadingPoint(g); float targetPdf(sp, i) (a light term counted);
+//            bool lightTerm(sp, i, t) (not counted); void countLightTerm();
+//            std::uint32_t clusterOf(i) (counting mode's SER hint)
+//   shadows: bool shadows() (plan.shadowRays); bool visible(sp, i, t, rec) (a shadow ray traced
+//            and counted); void occluded() (one found blocked); bool dropOccludedCandidates()
+//            (restir.candidate_visibility); bool visibilityReuse(); void writeLr(px, Lr)
+//
+// generateCandidates also takes a candidate source S: reads(), gathers()
+// per candidate (its records and table entries), and at(sp, x, y, rng) the
+// receiver's drawer, whose sample(rng) gives a LightSample.
 //
 // The CPU's bridge is src/render/restir/cpu_bridge.h (Embree, counters, the
 // reservoir codec), the twin's src/twin/device_bridge.h (OptiX, nothing
@@ -29,9 +42,11 @@
 // on the CPU through one bridge of its own and compares them bit for bit.
 #include <cstddef>
 #include <cstdint>
+#include <type_traits>
 
 #include "accretion/core/rng.h"
 #include "accretion/counters/gpu_layouts.h"
+#include "accretion/lighting/shading.h"
 #include "accretion/render/gbuffer_texel.h"
 #include "accretion/render/restir_steps.h"
 
@@ -45,17 +60,54 @@ struct ReuseParams {
     float scale = 1.0f;                   ///< lighting / image resolution
     float normalThreshold = 0.9f, depthThreshold = 0.1f;
     double mCap = 20.0;                   ///< restir.m_cap
+    std::uint32_t candidates = 16;        ///< render.candidates
     std::uint32_t neighbours = 0;         ///< restir.spatial_neighbours
     float radius = 1.0f;                  ///< spatial disc radius in lighting texels (>= 1)
 };
 
 /// The counters of a thread that counts nothing (the GPU's bridge).
 struct NoRecorder {
+    static constexpr bool on = false;
+    ACC_HD void hint(std::uint32_t) {}
     ACC_HD void trip(std::uint32_t = 1) {}
     ACC_HD void read(std::uint32_t) {}
     ACC_HD void gather(std::uint32_t) {}
     ACC_HD void write(std::uint32_t) {}
 };
+
+/// generateCandidates at texel (x, y) = px: RIS of `candidates` lights from
+/// the source with target p_hat (no visibility), resampleCandidates of
+/// restir_steps.h; with candidate_visibility an occluded winner is dropped
+/// before reuse (Bitterli et al. 2020, Alg. 5).
+template <class B, class Source>
+ACC_HD void generateCandidatesTexel(B& b, const Source& source, std::size_t px, std::uint32_t x, std::uint32_t y) {
+    const ReuseParams& p = b.params();
+    const GBufferTexel g = b.texel(px);
+    auto&& rec = b.recorder(px, g);
+    b.output(px, StoredReservoir{});
+    if (!g.hit()) return;
+    const std::uint32_t M = p.candidates;
+    rec.trip(M);
+    rec.read(M * source.reads());  // per candidate its light's record and the source's entries
+    rec.gather(M * source.gathers());
+    rec.write(b.reservoirBytes());
+    const ShadingPoint sp = b.shadingPoint(g);
+    typename B::Rng rng(px, p.frame, RngPass::restirCandidates, p.seed);
+    const auto drawer = source.at(sp, x, y, rng);
+    Reservoir r;
+    if (!resampleCandidates(
+            M, rng, [&](typename B::Rng& u) { return drawer.sample(u); }, [&](std::uint32_t i) { return b.targetPdf(sp, i); },
+            [&] { return b.reject(px); }, r))
+        return;  // the output stays empty
+    if (b.dropOccludedCandidates() && r.W > 0.0f) {
+        LightTerm t;
+        if (b.lightTerm(sp, r.y, t) && !b.visible(sp, r.y, t, rec)) {
+            b.occluded();
+            r.W = 0.0f;
+        }
+    }
+    b.keep(px, StoredReservoir::of(r));
+}
 
 /// temporalResampling at texel px: the surface point where it was last frame
 /// (moved back by its particle's motion), projected with the previous camera
@@ -66,7 +118,7 @@ template <class B>
 ACC_HD void temporalResamplingTexel(B& b, std::size_t px) {
     const ReuseParams& p = b.params();
     const GBufferTexel g = b.texel(px);
-    auto rec = b.recorder(px, g);
+    auto&& rec = b.recorder(px, g);
     const StoredReservoir cur = b.input(px);
     b.output(px, cur);
     if (!g.hit()) return;
@@ -113,7 +165,7 @@ template <class B>
 ACC_HD void spatialResamplingTexel(B& b, std::size_t px, std::uint32_t x, std::uint32_t y, std::uint32_t iteration) {
     const ReuseParams& p = b.params();
     const GBufferTexel g = b.texel(px);
-    auto rec = b.recorder(px, g);
+    auto&& rec = b.recorder(px, g);
     b.output(px, b.input(px));
     if (!g.hit()) return;
     const std::uint32_t R = b.reservoirBytes();
@@ -142,6 +194,54 @@ ACC_HD void spatialResamplingTexel(B& b, std::size_t px, std::uint32_t x, std::u
         offers.addCurrent(b.input(q), gn);
     }
     b.store(px, offers.combine(rng));
+}
+
+}  // namespace accretion::restir
+
+namespace accretion::restir {
+
+/// traceShadowRays at texel px: one shadow ray for the kept sample, Lr =
+/// f I G V W (shadeSample); with visibility reuse an occluded sample's
+/// reservoir keeps its M alone; an overflowing one is a zero sample
+/// (render.nonfinite decides on the reservoir). Reads and writes the
+/// bridge's output reservoir in place.
+template <class B>
+ACC_HD void traceShadowRayTexel(B& b, std::size_t px) {
+    b.writeLr(px, Vec3(0.0f));
+    const GBufferTexel g = b.texel(px);
+    auto&& rec = b.recorder(px, g);
+    rec.write(gpu_layout::kRadiance);
+    if (!g.hit()) return;
+    const StoredReservoir r = b.input(px);
+    const std::uint32_t R = b.reservoirBytes();
+    rec.read(R);
+    if (!(r.W > 0.0f)) return;
+    rec.read(gpu_layout::kParticleRecord);
+    rec.gather(1);
+    if constexpr (std::decay_t<decltype(rec)>::on) rec.hint(b.clusterOf(r.y));
+    const ShadingPoint sp = b.shadingPoint(g);
+    LightTerm t;
+    b.countLightTerm();
+    if (!b.lightTerm(sp, r.y, t)) return;
+    bool seen = true;
+    if (b.shadows()) {
+        rec.trip();
+        seen = b.visible(sp, r.y, t, rec);
+    }
+    Vec3 Lr(0.0f);
+    switch (shadeSample(t, r.W, seen, Lr)) {
+    case Shade::lit: b.writeLr(px, Lr); break;
+    case Shade::occluded:
+        b.occluded();
+        if (b.visibilityReuse()) {
+            b.keep(px, occludedReservoir(r));
+            rec.write(R);
+        }
+        break;
+    case Shade::overflow:  // a zero sample (discard: and no reservoir for reuse)
+        if (b.reject(px)) b.keep(px, StoredReservoir{});
+        break;
+    }
 }
 
 }  // namespace accretion::restir

@@ -1,11 +1,12 @@
 #pragma once
 // The CPU's bridge of the shared pass bodies (accretion/render/restir_passes.h):
-// the frame's buffers, Embree for basic_visibility's shadow rays, the
-// counters of counting mode, the reservoir codec.
+// the frame's buffers, Embree for shadow rays, the counters of counting
+// mode, the reservoir codec.
 #include <algorithm>
 #include <optional>
 
 #include "accretion/core/error.h"
+#include "accretion/lighting/light_sampler.h"
 #include "accretion/render/restir_passes.h"
 #include "combine_reservoirs.h"
 #include "restir_pass.h"
@@ -23,10 +24,19 @@ inline ReuseParams reuseParams(const FrameContext& f) {
     p.normalThreshold = float(f.rs.normal_threshold);
     p.depthThreshold = float(f.rs.depth_threshold);
     p.mCap = f.rs.m_cap;
+    p.candidates = f.in.settings.render.candidates;
     p.neighbours = f.rs.spatial_neighbours;
     p.radius = std::max(1.0f, float(f.rs.spatial_radius) * f.scale);
     return p;
 }
+
+/// What a CPU pass reads and writes: its input reservoirs, its output (the
+/// same vector for a pass that works in place) and, for traceShadowRays, Lr.
+struct CpuBuffers {
+    const std::vector<StoredReservoir>* in = nullptr;
+    std::vector<StoredReservoir>* out = nullptr;
+    std::vector<Vec3>* Lr = nullptr;
+};
 
 /// One CPU pass's bridge, made per texel on the thread that runs it.
 template <ShadingModel SM, Primitive P, bool Count>
@@ -45,14 +55,14 @@ public:
             // it as tested here is then an approximation (measured by
             // `accretion bias`); exact with temporal off.
             const FrameContext& f = b_.f_;
-            b_.scratch_.offers.push_back({r, {shadingPoint(g, f.in.particles), &f.L, f.rs.candidate_visibility, &f.in.bvh}});
+            b_.scratch_.offers.push_back({r, {accretion::shadingPoint(g, f.in.particles), &f.L, f.rs.candidate_visibility, &f.in.bvh}});
         }
         void addHistory(const StoredReservoir& r, std::size_t q) {
             // The previous frame's visibility needs the previous frame's BVH
             // (kept by the frame renderer when basic_visibility asks for it).
             const FrameContext& f = b_.f_;
             const Restir::History& h = *f.prev;
-            b_.scratch_.offers.push_back({r, {shadingPoint(h.gbuffer.texels[q], h.particles), &h.lights,
+            b_.scratch_.offers.push_back({r, {accretion::shadingPoint(h.gbuffer.texels[q], h.particles), &h.lights,
                                               f.rs.candidate_visibility || f.rs.visibility_reuse,
                                               f.in.previousBvh ? f.in.previousBvh : &f.in.bvh}});
         }
@@ -62,15 +72,17 @@ public:
         CpuBridge& b_;
     };
 
-    CpuBridge(const FrameContext& f, const ReuseParams& p, PassCounters* pc, const std::vector<StoredReservoir>& in,
-              std::vector<StoredReservoir>& out, LightingCounters& c, Scratch& scratch)
-        : f_(f), p_(p), pc_(pc), in_(in), out_(out), c_(c), scratch_(scratch) {}
+    CpuBridge(const FrameContext& f, const ReuseParams& p, PassCounters* pc, const CpuBuffers& io, LightingCounters& c,
+              Scratch& scratch)
+        : f_(f), p_(p), pc_(pc), io_(io), c_(c), scratch_(scratch) {}
 
     const ReuseParams& params() const { return p_; }
     const GBufferTexel& texel(std::size_t px) const { return f_.lg.texels[px]; }
-    const StoredReservoir& input(std::size_t px) const { return in_[px]; }
-    void output(std::size_t px, const StoredReservoir& r) { out_[px] = r; }
-    void store(std::size_t px, const StoredReservoir& r) { out_[px] = f_.codec.roundTrip(f_.sanitize(r, px, c_)); }
+    const StoredReservoir& input(std::size_t px) const { return (*io_.in)[px]; }
+    void output(std::size_t px, const StoredReservoir& r) { (*io_.out)[px] = r; }
+    void keep(std::size_t px, const StoredReservoir& r) { (*io_.out)[px] = f_.codec.roundTrip(r); }
+    void store(std::size_t px, const StoredReservoir& r) { keep(px, f_.sanitize(r, px, c_)); }
+    bool reject(std::size_t px) { return f_.reject(px, c_); }
     Recorder<Count>& recorder(std::size_t px, const GBufferTexel& g) {
         rec_.emplace(restir::recorder<Count>(pc_, px));
         recordHit(*rec_, f_, g);
@@ -87,12 +99,33 @@ public:
     const GBufferTexel& historyTexel(std::size_t q) const { return f_.prev->gbuffer.texels[q]; }
     const StoredReservoir& historyReservoir(std::size_t q) const { return f_.prev->reservoirs[q]; }
 
+    ShadingPoint shadingPoint(const GBufferTexel& g) const { return accretion::shadingPoint(g, f_.in.particles); }
+    float targetPdf(const ShadingPoint& sp, std::uint32_t i) {
+        ++c_.lightTerms;
+        return f_.L.template targetPdf<SM>(sp, i);
+    }
+    bool lightTerm(const ShadingPoint& sp, std::uint32_t i, LightTerm& t) const { return f_.L.template term<SM>(sp, i, t); }
+    void countLightTerm() { ++c_.lightTerms; }
+    std::uint32_t clusterOf(std::uint32_t i) const { return f_.in.bvh.clusterOf(i); }
+    bool shadows() const { return f_.shadows; }
+    bool visible(const ShadingPoint& sp, std::uint32_t i, const LightTerm& t, Recorder<Count>& rec) {
+        ++c_.shadowRays;
+        RayCounters rc;
+        const PackedLight& l = f_.L.packed[i];
+        const bool seen = accretion::visible<P>(f_.in.bvh, f_.vis, sp, i, l.position, l.radius, t, rec.rayCounters(rc));
+        rec.ray(rc);
+        return seen;
+    }
+    void occluded() { ++c_.shadowOccluded; }
+    bool dropOccludedCandidates() const { return f_.rs.candidate_visibility && f_.shadows; }
+    bool visibilityReuse() const { return f_.rs.visibility_reuse; }
+    void writeLr(std::size_t px, const Vec3& Lr) { (*io_.Lr)[px] = Lr; }
+
 private:
     const FrameContext& f_;
     const ReuseParams& p_;
     PassCounters* pc_;
-    const std::vector<StoredReservoir>& in_;
-    std::vector<StoredReservoir>& out_;
+    const CpuBuffers& io_;
     LightingCounters& c_;
     Scratch& scratch_;
     std::optional<Recorder<Count>> rec_;
@@ -101,12 +134,11 @@ private:
 /// Runs body(bridge, px, x, y) over the lighting grid (forEachPixel's tiles),
 /// each texel with a bridge of its thread's counters and scratch.
 template <ShadingModel SM, Primitive P, bool Count, class Body>
-LightingCounters forEachTexel(const FrameContext& f, Pass pass, const std::vector<StoredReservoir>& in,
-                              std::vector<StoredReservoir>& out, Body&& body) {
+LightingCounters forEachTexel(const FrameContext& f, Pass pass, const CpuBuffers& io, Body&& body) {
     const ReuseParams p = reuseParams(f);
     PassCounters* pc = passCounters<Count>(f, pass);
     return forEachPixel(f.lg.width, f.lg.height, [&](std::size_t px, std::uint32_t x, std::uint32_t y, LightingCounters& c, Scratch& s) {
-        CpuBridge<SM, P, Count> b(f, p, pc, in, out, c, s);
+        CpuBridge<SM, P, Count> b(f, p, pc, io, c, s);
         body(b, px, x, y);
     });
 }

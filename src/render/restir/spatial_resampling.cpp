@@ -9,7 +9,7 @@ namespace accretion::restir {
 LightingCounters spatialResampling(const FrameContext& f, std::uint32_t iteration, const std::vector<StoredReservoir>& cur,
                                    std::vector<StoredReservoir>& out) {
     return dispatchKernel(f, [&]<ShadingModel SM, Primitive P, bool Count>() {
-        return forEachTexel<SM, P, Count>(f, Pass::spatialResampling, cur, out,
+        return forEachTexel<SM, P, Count>(f, Pass::spatialResampling, CpuBuffers{&cur, &out},
                                           [&](auto& b, std::size_t px, std::uint32_t x, std::uint32_t y) {
                                               spatialResamplingTexel(b, px, x, y, iteration);
                                           });

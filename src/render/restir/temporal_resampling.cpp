@@ -9,7 +9,7 @@ namespace accretion::restir {
 LightingCounters temporalResampling(const FrameContext& f, const std::vector<StoredReservoir>& cur, std::vector<StoredReservoir>& out) {
     ACC_CHECK(f.prev && f.prev->gbuffer.width == f.lg.width && f.prev->gbuffer.height == f.lg.height);
     return dispatchKernel(f, [&]<ShadingModel SM, Primitive P, bool Count>() {
-        return forEachTexel<SM, P, Count>(f, Pass::temporalResampling, cur, out,
+        return forEachTexel<SM, P, Count>(f, Pass::temporalResampling, CpuBuffers{&cur, &out},
                                           [](auto& b, std::size_t px, std::uint32_t, std::uint32_t) { temporalResamplingTexel(b, px); });
     });
 }
