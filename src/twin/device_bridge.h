@@ -85,7 +85,6 @@ public:
     __device__ StoredReservoir input(std::size_t px) const { return in_[px]; }
     __device__ void output(std::size_t px, const StoredReservoir& r) const { p_.restir.out[px] = r; }
     __device__ void keep(std::size_t px, const StoredReservoir& r) const { p_.restir.out[px] = r; }
-    __device__ void store(std::size_t px, const StoredReservoir& r) const { p_.restir.out[px] = sanitize(p_.restir, r, px); }
     __device__ bool reject(std::size_t px) const { return rejectAt(p_.restir, px); }
     __device__ restir::NoRecorder recorder(std::size_t, const GBufferTexel&) const { return {}; }
     __device__ std::uint32_t reservoirBytes() const { return sizeof(StoredReservoir); }

@@ -35,20 +35,12 @@ __device__ inline float targetPdf(const LightView& L, const ShadingPoint& sp, st
     return lightTerm<SM>(L, sp, i, t) ? luminance(t.value) : 0.0f;
 }
 
-__device__ inline bool finiteF(float v) { return isfinite(v); }
-
 /// FrameContext::reject: count a non-finite value at px; true if the policy discards.
 __device__ inline bool rejectAt(const RestirParams& p, std::size_t px) {
     ++p.rejected[px];
     return p.discardNonFinite;
 }
 
-/// FrameContext::sanitize.
-__device__ inline StoredReservoir sanitize(const RestirParams& p, StoredReservoir r, std::size_t px) {
-    if (finiteF(r.W) && finiteF(r.p_hat)) return r;
-    if (rejectAt(p, px)) return StoredReservoir{};
-    return StoredReservoir{kNoLight, 0.0f, r.M, 0.0f};
-}
 
 struct Offer {
     StoredReservoir r;

@@ -180,7 +180,6 @@ struct CheckBridge {
     ACC_HD GBufferTexel texel(std::size_t px) const { return in.texels[px]; }
     ACC_HD StoredReservoir input(std::size_t px) const { return in.in[px]; }
     ACC_HD void output(std::size_t, const StoredReservoir& r) const { out = r; }
-    ACC_HD void store(std::size_t, const StoredReservoir& r) const { out = r; }
     ACC_HD restir::NoRecorder recorder(std::size_t, const GBufferTexel&) const { return {}; }
     ACC_HD std::uint32_t reservoirBytes() const { return 16; }
     ACC_HD void reuse(bool accepted) const { ++reuses[accepted ? 0 : 1]; }
@@ -208,7 +207,6 @@ struct CheckBridge {
         return lightTerm(sp, i, t) ? luminance(t.value) : 0.0f;
     }
     ACC_HD void countLightTerm() const {}
-    ACC_HD std::uint32_t clusterOf(std::uint32_t i) const { return i / 64; }
     ACC_HD bool shadows() const { return true; }
     ACC_HD bool visible(const ShadingPoint& sp, std::uint32_t i, const LightTerm&, restir::NoRecorder&) const {
         return (sp.self * 31u + i) % 5u != 0u;

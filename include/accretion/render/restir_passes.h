@@ -11,8 +11,6 @@
 //   StoredReservoir input(px)                the pass's input reservoir
 //   void output(px, r)                       the pass's output, as it is
 //   void keep(px, r)                         the output as the frame keeps reservoirs (the codec)
-//   void store(px, r)                        a combined reservoir: sanitized (render.nonfinite)
-//                                            and kept
 //   bool reject(px)                          a non-finite value at px counted; true when
 //                                            render.nonfinite discards the reservoir
 //   Rec recorder(px, g)                      the thread's counters (Recorder<Count> on the CPU,
@@ -154,7 +152,7 @@ ACC_HD void temporalResamplingTexel(B& b, std::size_t px) {
     prev.M = capHistoryM(prev.M, cur.M, p.mCap);
     offers.addHistory(prev, q);
     typename B::Rng rng(px, p.frame, RngPass::restirTemporal, p.seed);
-    b.store(px, offers.combine(rng));
+    b.keep(px, sanitizeReservoir(offers.combine(rng), [&] { return b.reject(px); }));
 }
 
 /// spatialResampling at texel (x, y) = px, iteration `iteration`: k
@@ -193,7 +191,7 @@ ACC_HD void spatialResamplingTexel(B& b, std::size_t px, std::uint32_t x, std::u
         rec.gather(1);
         offers.addCurrent(b.input(q), gn);
     }
-    b.store(px, offers.combine(rng));
+    b.keep(px, sanitizeReservoir(offers.combine(rng), [&] { return b.reject(px); }));
 }
 
 }  // namespace accretion::restir

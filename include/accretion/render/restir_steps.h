@@ -54,6 +54,16 @@ ACC_HD bool resampleCandidates(std::uint32_t count, RngT& rng, Draw&& draw, Targ
     return !discard;
 }
 
+/// A combined reservoir whose weights overflowed or went NaN: reject() counts
+/// it and says whether render.nonfinite discards it (an empty reservoir);
+/// zero_sample keeps its M with W = 0. A finite one is returned as it is.
+template <class Reject>
+ACC_HD StoredReservoir sanitizeReservoir(const StoredReservoir& r, Reject&& reject) {
+    if (isFiniteNumber(r.W) && isFiniteNumber(r.p_hat)) return r;
+    if (reject()) return StoredReservoir{};
+    return StoredReservoir{kNoLight, 0.0f, r.M, 0.0f};
+}
+
 /// Spatial reuse's neighbour point of texel (x, y): uniform in the disc of
 /// `radius` texels (polar, sqrt for area), in continuous texel coordinates.
 /// Draws two numbers. cos and sin are the host's libm and the device's

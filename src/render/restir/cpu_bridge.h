@@ -81,7 +81,6 @@ public:
     const StoredReservoir& input(std::size_t px) const { return (*io_.in)[px]; }
     void output(std::size_t px, const StoredReservoir& r) { (*io_.out)[px] = r; }
     void keep(std::size_t px, const StoredReservoir& r) { (*io_.out)[px] = f_.codec.roundTrip(r); }
-    void store(std::size_t px, const StoredReservoir& r) { keep(px, f_.sanitize(r, px, c_)); }
     bool reject(std::size_t px) { return f_.reject(px, c_); }
     Recorder<Count>& recorder(std::size_t px, const GBufferTexel& g) {
         rec_.emplace(restir::recorder<Count>(pc_, px));

@@ -94,13 +94,6 @@ struct FrameContext {
     const LightTiles* tiles = nullptr;  ///< render.source tiles or regir: this frame's presampled tiles
     const RegirGrid* regir = nullptr;   ///< render.source regir: this frame's grid
 
-    /// A reservoir whose weights overflowed or went NaN: counted at px;
-    /// zero_sample keeps its M with W = 0, discard empties it.
-    StoredReservoir sanitize(StoredReservoir r, std::size_t px, LightingCounters& c) const {
-        if (std::isfinite(r.W) && std::isfinite(r.p_hat)) return r;
-        if (reject(px, c)) return StoredReservoir{};
-        return StoredReservoir{kNoLight, 0.0f, r.M, 0.0f};
-    }
     /// Count a non-finite value at px; true if the policy discards the reservoir.
     bool reject(std::size_t px, LightingCounters& c) const {
         ++c.nonFinite;
