@@ -1,5 +1,7 @@
 #include "accretion/render/estimators.h"
 
+#include "accretion/render/light_estimates.h"
+
 #include <algorithm>
 #include <bit>
 #include <chrono>
@@ -42,32 +44,47 @@ inline bool seen(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoin
     return false;
 }
 
+/// light_estimates.h's bridge on the CPU: Embree's shadow rays counted
+/// (seen), render --pixel's records when Traced (a template argument: the
+/// light loop of every other pixel has no trace test).
+template <ShadingModel M, Primitive P, bool Traced>
+struct CpuLightBridge {
+    static constexpr bool traced = Traced;
+    const ParticleBvh& bvh;
+    const LightArrays& L;
+    const VisibilityOptions& vis;
+    bool shadows;
+    LightingCounters& c;
+    RayCounters* rc;
+    PixelTrace* trace;
+
+    bool lightTerm(const ShadingPoint& sp, std::uint32_t i, LightTerm& t) const { return L.term<M>(sp, i, t); }
+    void countLightTerm() { ++c.lightTerms; }
+    bool seen(const ShadingPoint& sp, std::uint32_t i, const LightTerm& t) {
+        return accretion::seen<P>(bvh, L, sp, i, t, vis, shadows, c, rc);
+    }
+    void traceLight() { ++trace->lightsSeen; }
+    void traceTerm(std::uint32_t i, const LightTerm& t, bool v) { trace->terms.push_back({i, t.value, v}); }
+    void traceSample(const LightSample& x, bool term, const LightTerm& t, bool v) {
+        trace->samples.push_back({x.i, x.pdf, term ? t.value : Vec3(0.0f), v, v ? Vec3(DVec3(t.value) / double(x.pdf)) : Vec3(0.0f)});
+    }
+};
+
 /// The sum of f I G V over `lights` (every light i != j for exact; the near
-/// field for split), in double, one shadow ray per non-zero term.
+/// field for split): light_estimates.h's sumLightTerms.
 /// With a trace (render --pixel), every non-zero term and its V are recorded.
-/// (Traced is a template argument: the light loop of every other pixel has no trace test.)
 template <ShadingModel M, Primitive P, bool Traced = false, class Lights>
 DVec3 sumTerms(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint& sp, const Lights& lights,
                const VisibilityOptions& vis, bool shadows, LightingCounters& c, RayCounters* rc, PixelTrace* trace = nullptr) {
-    DVec3 sum(0.0);
-    for (const std::uint32_t i : lights) {
-        if (i == sp.self) continue;
-        if constexpr (Traced) ++trace->lightsSeen;
-        LightTerm t;
-        ++c.lightTerms;
-        if (!evalLight<M>(sp, L.position[i], L.emission[i], L.packed[i].dmin2, t)) continue;
-        const bool v = seen<P>(bvh, L, sp, i, t, vis, shadows, c, rc);
-        if (v) sum += DVec3(t.value);
-        if constexpr (Traced) trace->terms.push_back({i, t.value, v});
-    }
-    return sum;
+    CpuLightBridge<M, P, Traced> b{bvh, L, vis, shadows, c, rc, trace};
+    return sumLightTerms(b, sp, lights);
 }
 
 /// exact: every light i != j.
 template <ShadingModel M, Primitive P, bool Traced = false>
 DVec3 exactPixel(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint& sp, const VisibilityOptions& vis, bool shadows,
                  LightingCounters& c, RayCounters* rc, PixelTrace* trace = nullptr) {
-    return sumTerms<M, P, Traced>(bvh, L, sp, std::views::iota(0u, L.count), vis, shadows, c, rc, trace);
+    return sumTerms<M, P, Traced>(bvh, L, sp, LightRange{L.count}, vis, shadows, c, rc, trace);
 }
 
 /// One pixel's running sums (SampleSums: the non-finite policy applied to
@@ -122,28 +139,14 @@ void drawLights(const LightingInputs& in, const LightArrays& L, const ShadingPoi
     }
 }
 
-/// uniform / power / tree: the one-sample estimates f I G V / p(i) of drawn
-/// lights (a zero sample when no light or i = j); split: each sample is the
-/// near field's exact sum `near` plus the far light's f I G V / p_far(i).
+/// uniform / power / tree / split's far samples: light_estimates.h's
+/// shadeLightSamples into a pixel's sums.
 template <ShadingModel M, Primitive P, bool Traced = false>
 void shadeSamples(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint& sp, const LightSample* xs,
                   std::uint32_t count, const DVec3& near, const VisibilityOptions& vis, bool shadows, PixelSums& acc,
                   RayCounters* rc) {
-    const bool hasNear = near != DVec3(0.0);
-    LightingCounters& c = acc.c;
-    for (std::uint32_t k = 0; k < count; ++k) {
-        const LightSample& x = xs[k];
-        LightTerm t;
-        ++c.lightTerms;
-        const bool term = L.term<M>(sp, x.i, t);
-        const bool v = term && seen<P>(bvh, L, sp, x.i, t, vis, shadows, c, rc);
-        if (v) acc.add(near + DVec3(t.value) / double(x.pdf));
-        else if (hasNear) acc.add(near);
-        else acc.addZero();
-        if constexpr (Traced)
-            acc.trace->samples.push_back({x.i, x.pdf, term ? t.value : Vec3(0.0f), v,
-                                          v ? Vec3(DVec3(t.value) / double(x.pdf)) : Vec3(0.0f)});
-    }
+    CpuLightBridge<M, P, Traced> b{bvh, L, vis, shadows, acc.c, rc, acc.trace};
+    shadeLightSamples(b, sp, xs, count, near, acc);
 }
 
 /// ris (docs/MODEL.md section 4): per sample, one reservoir streams M candidates

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include "accretion/core/error.h"
 #include "accretion/core/math.h"
 #include "accretion/lighting/reservoir_codec.h"
 

@@ -1,5 +1,7 @@
 #include "accretion/render/frame_renderer.h"
 
+#include "accretion/render/compose_image.h"
+
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -7,7 +9,6 @@
 #include <fmt/format.h>
 
 #include "accretion/counters/gpu_layouts.h"
-#include "accretion/render/compose_pixel.h"
 #include "accretion/render/estimator_table.h"
 
 namespace accretion {
@@ -74,41 +75,17 @@ void recordCompose(const GBuffer& gbuffer, const Particles& particles, const Par
 }
 
 /// composeImage: L = Le + Lr on hits (background on misses), depth, normal
-/// and particle AOVs of the G-buffer's window, and the frame's spp statistics.
+/// and particle AOVs of the G-buffer's window (composeLayers), and the
+/// frame's spp statistics.
 void composeImage(const GBuffer& gbuffer, const Particles& particles, const ShadingSettings& shading, FrameImage& img,
                   FrameStats& stats) {
-    const std::size_t pixels = gbuffer.texels.size();
-    img.L.resize(pixels);
-    img.Le.resize(pixels);
-    img.depth.resize(pixels);
-    img.normal.resize(pixels);
-    img.particle.resize(pixels);
-    const float se = static_cast<float>(shading.self_emission);
-    std::size_t hits = 0;
-    double sppSum = 0.0;
-    for (std::size_t px = 0; px < pixels; ++px) {
-        const GBufferTexel& g = gbuffer.texels[px];
-        if (!g.hit()) {
-            img.L[px] = shading.background;
-            img.Le[px] = img.normal[px] = Vec3(0.0f);
-            img.depth[px] = std::numeric_limits<float>::infinity();
-            img.particle[px] = kNoParticle;
-            continue;
-        }
-        ++hits;
-        img.particle[px] = g.particle;
-        if (!composeHit(se, particles.emission[g.particle], img.lighting.Lr[px], img.Le[px], img.L[px])) {
-            img.lighting.Lr_stderr[px] = Vec3(0.0f);
-            img.lighting.rejected[px] += 1.0f;
-            ++stats.nonFinite[Pass::composeImage];
-        }
-        img.depth[px] = g.depth;
-        img.normal[px] = g.normal;
-        sppSum += img.lighting.spp[px];
-        stats.maxSpp = std::max(stats.maxSpp, double(img.lighting.spp[px]));
-    }
-    stats.hitPixels = hits;
-    stats.meanSpp = hits ? sppSum / double(hits) : 0.0;
+    LightingImage& lit = img.lighting;
+    const ComposeTotals t = composeLayers(gbuffer.texels, particles.emission, shading,
+                                          {img.L, img.Le, img.depth, img.normal, img.particle, lit.Lr, lit.Lr_stderr, lit.rejected, lit.spp});
+    if (t.nonFinite) stats.nonFinite[Pass::composeImage] += t.nonFinite;
+    stats.hitPixels = t.hits;
+    stats.maxSpp = std::max(stats.maxSpp, t.maxSpp);
+    stats.meanSpp = t.hits ? t.sppSum / double(t.hits) : 0.0;
 }
 
 /// Cut every per-pixel layer of `img` (of the whole image) to its window:

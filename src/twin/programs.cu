@@ -13,6 +13,7 @@
 #include <optix.h>
 
 #include "accretion/lighting/shading.h"
+#include "accretion/render/light_estimates.h"
 #include "accretion/render/sample_sums.h"
 #include "accretion/render/shadow_query.h"
 #include "launch_params.h"
@@ -113,41 +114,45 @@ __device__ void addCounters(const LaunchCounters& c) {
     if (c.retests) atomicAdd(&params.counters->retests, c.retests);
 }
 
+/// light_estimates.h's bridge on the twin: optixTrace shadow rays with
+/// any-hit (visibility off: 1, no ray), counted in the launch's counters.
+template <ShadingModel M>
+struct DeviceLightBridge {
+    static constexpr bool traced = false;
+    LaunchCounters& c;
+    __device__ bool lightTerm(const ShadingPoint& sp, std::uint32_t i, LightTerm& t) const {
+        return twin::lightTerm<M>(params.lights, sp, i, t);
+    }
+    __device__ void countLightTerm() { ++c.lightTerms; }
+    __device__ bool seen(const ShadingPoint& sp, std::uint32_t i, const LightTerm& t) {
+        return !params.shadows || visible<true>(sp, i, t, c);
+    }
+};
+
+/// exact: light_estimates.h's sum over every light.
 template <ShadingModel M>
 __device__ DVec3 exactSum(const ShadingPoint& sp, LaunchCounters& c) {
-    DVec3 sum(0.0);
-    for (std::uint32_t i = 0; i < params.particleCount; ++i) {
-        if (i == sp.self) continue;
-        LightTerm t;
-        ++c.lightTerms;
-        if (!evalLight<M>(sp, params.position[i], params.emission[i], params.dmin2[i], t)) continue;
-        if (!params.shadows || visible<true>(sp, i, t, c)) sum += DVec3(t.value);
-    }
-    return sum;
+    DeviceLightBridge<M> b{c};
+    return sumLightTerms(b, sp, LightRange{params.particleCount});
 }
 
 /// uniform / power (src/render/estimators.cpp, runChunks): per chunk of up
 /// to 8 samples a stream of its own (pixel, frame, lightSampling, seed,
-/// chunk + 1); each sample one light from the source pmf and one shadow ray,
-/// f I G V / p(i) added in double; adaptive sampling (render.target_stderr)
-/// stops the pixel at the end of a round. The CPU draws a chunk's lights
-/// before shading them: the stream's numbers are the same.
+/// chunk + 1), the chunk's lights drawn from the source pmf, then shaded by
+/// light_estimates.h's shadeLightSamples (f I G V / p(i) added in double),
+/// as the CPU does; adaptive sampling (render.target_stderr) stops the pixel
+/// at the end of a round.
 template <ShadingModel M>
 __device__ void samplePixel(const ShadingPoint& sp, std::size_t px, SampleSums& s, LaunchCounters& c) {
     const SamplingParams& sampling = params.sampling;
     const LightingPlan& plan = sampling.plan;
+    DeviceLightBridge<M> b{c};
     for (std::uint64_t chunk = plan.begin; chunk < plan.end; ++chunk) {
         PortableRng rng(px, sampling.frame, RngPass::lightSampling, sampling.seed, chunk + 1);
         const std::uint32_t count = plan.chunkSamples(chunk);
-        for (std::uint32_t m = 0; m < count; ++m) {
-            const LightSample x = params.source.sample(rng);
-            LightTerm t;
-            ++c.lightTerms;
-            if (lightTerm<M>(params.lights, sp, x.i, t) && (!params.shadows || visible<true>(sp, x.i, t, c)))
-                s.add(DVec3(t.value) / double(x.pdf));
-            else
-                s.addZero();
-        }
+        LightSample xs[LightingPlan::kChunkSamples];
+        for (std::uint32_t m = 0; m < count; ++m) xs[m] = params.source.sample(rng);
+        shadeLightSamples(b, sp, xs, count, DVec3(0.0), s);
         if (plan.adaptive && (chunk + 1) % plan.chunksPerRound == 0 &&
             roundDone(s.sum, s.sumSq, s.n, static_cast<std::uint32_t>((chunk + 1) / plan.chunksPerRound), plan.samples,
                       sampling.maxSamples, sampling.targetStderr))

@@ -30,7 +30,7 @@
 #include "accretion/lighting/light_tree.h"
 #include "accretion/particles/particle_source.h"
 #include "accretion/render/accumulation.h"
-#include "accretion/render/compose_pixel.h"
+#include "accretion/render/compose_image.h"
 #include "accretion/render/frame_plan.h"
 #include "accretion/render/upsample_pixel.h"
 #include "accretion/scene/scene_parser.h"
@@ -497,7 +497,7 @@ void TwinRun::keepHistory(const Camera& camera, std::size_t n, const StoredReser
     history_ = true;
 }
 
-/// The frame's layers, composed (L = Le + Lr, the background on a miss) by composeImage's rule.
+/// The frame's layers, composed by composeImage's loop (composeLayers).
 GpuFrame TwinRun::composeFrame(const FramePlan& plan, const Particles& particles, std::uint32_t frame,
                                const CameraPose& pose, std::size_t& hits, std::size_t& nonFinite) const {
     const std::size_t pixels = std::size_t(W_) * H_;
@@ -508,39 +508,16 @@ GpuFrame TwinRun::composeFrame(const FramePlan& plan, const Particles& particles
     out.frame = frame;
     out.camera = pose;
     out.Lr = buf_.Lr.download<Vec3>(pixels);
-    out.L.resize(pixels);
-    out.Le.assign(pixels, Vec3(0.0f));
-    out.normal.assign(pixels, Vec3(0.0f));
-    out.depth.resize(pixels);
-    out.particle.resize(pixels);
     if (sampling_) {
         out.Lr_stderr = buf_.Lr_stderr.download<Vec3>(pixels);
         out.spp = buf_.spp.download<float>(pixels);
         const std::vector<std::uint32_t> rejected = buf_.rejectedSamples.download<std::uint32_t>(pixels);
         out.rejected.assign(rejected.begin(), rejected.end());
     }
-    const float se = static_cast<float>(s_.shading.self_emission);
-    hits = nonFinite = 0;
-    for (std::size_t px = 0; px < pixels; ++px) {
-        const GBufferTexel& g = gb[px];
-        out.particle[px] = g.particle;
-        if (!g.hit()) {
-            out.L[px] = s_.shading.background;
-            out.depth[px] = std::numeric_limits<float>::infinity();
-            out.Lr[px] = Vec3(0.0f);
-            continue;
-        }
-        ++hits;
-        if (!composeHit(se, particles.emission[g.particle], out.Lr[px], out.Le[px], out.L[px])) {
-            ++nonFinite;
-            if (sampling_) {  // as composeImage
-                out.Lr_stderr[px] = Vec3(0.0f);
-                out.rejected[px] += 1.0f;
-            }
-        }
-        out.depth[px] = g.depth;
-        out.normal[px] = g.normal;
-    }
+    const ComposeTotals t = composeLayers(gb, particles.emission, s_.shading,
+                                          {out.L, out.Le, out.depth, out.normal, out.particle, out.Lr, out.Lr_stderr, out.rejected, out.spp});
+    hits = t.hits;
+    nonFinite = t.nonFinite;
     if (a_.lrOnly) {
         out.L.clear();
         out.Le.clear();

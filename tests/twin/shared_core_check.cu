@@ -21,7 +21,9 @@
 #include <cuda_runtime.h>
 
 #include "accretion/core/rng.h"
+#include "accretion/render/light_estimates.h"
 #include "accretion/render/restir_passes.h"
+#include "accretion/render/sample_sums.h"
 #include "accretion/render/restir_steps.h"
 
 namespace {
@@ -258,6 +260,57 @@ ACC_HD void passCase(int k, const PassInputs* variants, Out& o) {
     o = Out{{r.y, bits(r.W), r.M, bits(r.p_hat), reuses[0], reuses[1], bits(Lr.x), bits(Lr.y) ^ bits(Lr.z)}};
 }
 
+// ---------------------------------------------------------------- the light loops
+// light_estimates.h's loops of the Monte Carlo estimators on the same grid
+// and lights: exact's sum over every light at texel k, and 64 uniform
+// samples (8 chunks of 8, each chunk's lights drawn first) into SampleSums.
+
+struct LightLoopBridge {
+    static constexpr bool traced = false;
+    const CheckBridge& lights;
+    ACC_HD bool lightTerm(const ShadingPoint& sp, std::uint32_t i, LightTerm& t) const { return lights.lightTerm(sp, i, t); }
+    ACC_HD void countLightTerm() const {}
+    ACC_HD bool seen(const ShadingPoint& sp, std::uint32_t i, const LightTerm& t) const {
+        restir::NoRecorder rec;
+        return lights.visible(sp, i, t, rec);
+    }
+};
+
+constexpr int kLoopCases = 2 * int(kGridW * kGridH);
+
+ACC_HD std::uint32_t lo(double v) {
+    std::uint64_t u;
+    std::memcpy(&u, &v, sizeof u);
+    return std::uint32_t(u) ^ std::uint32_t(u >> 32);
+}
+
+ACC_HD void loopCase(int k, const PassInputs* variants, Out& o) {
+    const std::uint32_t texels = kGridW * kGridH;
+    const std::size_t px = std::size_t(k) % texels;
+    const PassInputs& in = variants[0];
+    StoredReservoir unused;
+    std::uint32_t counts[2] = {0, 0};
+    const CheckBridge lights{in, unused, counts};
+    LightLoopBridge b{lights};
+    const GBufferTexel g = in.texels[px];
+    o = Out{};
+    if (!g.hit()) return;
+    const ShadingPoint sp = lights.shadingPoint(g);
+    if (k < int(texels)) {
+        const DVec3 sum = sumLightTerms(b, sp, LightRange{in.particles});
+        o = Out{{lo(sum.x), lo(sum.y), lo(sum.z), 1u, 0u, 0u, 0u, 0u}};
+        return;
+    }
+    SampleSums sums;
+    for (std::uint32_t chunk = 0; chunk < 8; ++chunk) {
+        PortableRng rng(px, 2, RngPass::lightSampling, 7, chunk + 1);
+        LightSample xs[8];
+        for (LightSample& x : xs) x = LightSample{rng.uniformInt(in.particles), 1.0f / float(in.particles)};
+        shadeLightSamples(b, sp, xs, 8, DVec3(0.0), sums);
+    }
+    o = Out{{lo(sums.sum.x), lo(sums.sum.y), lo(sums.sum.z), lo(sums.sumSq.x), lo(sums.sumSq.y), lo(sums.sumSq.z), sums.n, 2u}};
+}
+
 // ---------------------------------------------------------------- the hosts
 
 struct Inputs {
@@ -268,9 +321,9 @@ struct Inputs {
     PassInputs* passes;  ///< none, basic, pairwise
 };
 
-enum class Step { neighbours, reprojections, caps, candidates, combines, shades, passes };
+enum class Step { neighbours, reprojections, caps, candidates, combines, shades, passes, loops };
 constexpr Step kSteps[] = {Step::neighbours, Step::reprojections, Step::caps, Step::candidates, Step::combines, Step::shades,
-                           Step::passes};
+                           Step::passes, Step::loops};
 
 ACC_HD int caseCount(Step s) {
     switch (s) {
@@ -281,6 +334,7 @@ ACC_HD int caseCount(Step s) {
         case Step::combines: return kCombines;
         case Step::shades: return kShades;
         case Step::passes: return kPassCases;
+        case Step::loops: return kLoopCases;
     }
     return 0;
 }
@@ -294,6 +348,7 @@ ACC_HD void runCase(Step s, int k, const Inputs& in, Out& o) {
         case Step::combines: combineCase(k, in.offers, o); break;
         case Step::shades: shadeCase(k, in.shades, o); break;
         case Step::passes: passCase(k, in.passes, o); break;
+        case Step::loops: loopCase(k, in.passes, o); break;
     }
 }
 
@@ -311,6 +366,7 @@ const char* stepName(Step s) {
         case Step::combines: return "combineReservoirs";
         case Step::shades: return "shadeSample/occludedReservoir";
         case Step::passes: return "the pass bodies (restir_passes.h)";
+        case Step::loops: return "exact and uniform loops (light_estimates.h)";
     }
     return "?";
 }
