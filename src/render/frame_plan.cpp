@@ -15,6 +15,7 @@ void planRun(const Settings& s, FramePlan& plan) {
                               (s.camera.path == CameraPath::orbit && s.camera.orbit_speed == 0.0);
     const bool restir = estimatorInfo(s.render.estimator).reuse;
     plan.staticGeometry = staticParticles(s.particles) && staticCamera;
+    plan.updateInPlace = s.geometry.build == BuildPolicy::refit || s.geometry.build == BuildPolicy::partial;
     plan.alphaFilter = s.geometry.primitive == Primitive::billboard && s.geometry.alpha == AlphaMode::disc;
     plan.keepHistory = restir && s.restir.temporal && s.render.frames > 1;
     // A static scene's one BVH is also last frame's.

@@ -240,8 +240,7 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const L
     // refit and partial builds) keeps the origin of its first build.
     const CameraPose pose = cameras_.pose(frame);
     const Camera world = Camera::fromPose(pose, settings_.camera.width, settings_.camera.height);
-    const BuildPolicy policy = settings_.geometry.build;
-    const bool persistent = plan_.staticGeometry || policy == BuildPolicy::refit || policy == BuildPolicy::partial;
+    const bool persistent = plan_.staticGeometry || plan_.updateInPlace;
     if (!built_ || !persistent) origin_ = world.position;
     const Camera camera = world.rebased(origin_);
     stats.origin = origin_;

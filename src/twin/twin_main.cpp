@@ -130,7 +130,7 @@ private:
     void uploadClusterHint(const Particles& particles, bool recluster, bool first);
     LaunchParams launchParams(const FramePlan& plan, const Camera& camera, const Particles& particles,
                               std::uint32_t frame, std::uint64_t seed);
-    StoredReservoir* runRestir(LaunchParams& lp);
+    StoredReservoir* runRestir(const FramePlan& plan, LaunchParams& lp);
     StepTimes runPasses(const FramePlan& plan, LaunchParams& lp, const Clusters& clusters, bool recluster,
                         LaunchCounters& counters, StoredReservoir*& finalReservoirs);
     void keepHistory(const Camera& camera, std::size_t particleCount, const StoredReservoir* finalReservoirs);
@@ -148,7 +148,6 @@ private:
     const LightingPlan lightingPlan_;
     AccelOptions accelOptions_;
     const bool omm_;
-    const bool persistent_;    ///< refit or partial: one BVH updated in place
     Raygen shade_ = Raygen::shade;
     std::uint32_t gridW_, gridH_;  ///< restir's lighting grid (resolution_scale)
     std::string device_;
@@ -181,8 +180,7 @@ TwinRun::TwinRun(const Args& a, const Settings& settings)
       sampling_(!a.skipLighting && (settings.render.estimator == EstimatorKind::uniform ||
                                     settings.render.estimator == EstimatorKind::power)),
       lightingPlan_(planLighting(settings.render, H_)),
-      omm_(settings.geometry.alpha == AlphaMode::disc && settings.gpu.omm != OmmMode::off),
-      persistent_(settings.geometry.build == BuildPolicy::refit || settings.geometry.build == BuildPolicy::partial) {
+      omm_(settings.geometry.alpha == AlphaMode::disc && settings.gpu.omm != OmmMode::off) {
     if (a.shadowRays == "traverse" || a.shadowRays == "reorder") shade_ = Raygen::shadeTraverse;
     else if (a.shadowRays != "trace")
         throw InputError(fmt::format("command line --shadow-rays {}: expected trace, traverse or reorder", a.shadowRays));
@@ -378,11 +376,11 @@ LaunchParams TwinRun::launchParams(const FramePlan& plan, const Camera& camera, 
 /// (the CPU's Restir::render): generateCandidates, temporalResampling,
 /// spatialResampling x iterations, traceShadowRays, upsampleLighting.
 /// Returns the final reservoirs (the next frame's history).
-StoredReservoir* TwinRun::runRestir(LaunchParams& lp) {
+StoredReservoir* TwinRun::runRestir(const FramePlan& plan, LaunchParams& lp) {
     RestirParams& rp = lp.restir;
     const std::size_t pixels = std::size_t(rp.width) * rp.height;
     GpuTimer& timer = *timer_;
-    if (runPlan_.upsample) {
+    if (plan.upsample) {
         GpuScope t(timer, Pass::upsampleLighting, "reduceGBuffer");
         reduceGBuffer(lp, buf_.gridGbuffer.as<GBufferTexel>(), stream_);
     }
@@ -402,7 +400,7 @@ StoredReservoir* TwinRun::runRestir(LaunchParams& lp) {
         temporalResampling(lp, stream_);
         std::swap(a, b);
     }
-    const std::uint32_t iterations = s_.restir.spatial_neighbours > 0 ? s_.restir.spatial_iterations : 0;
+    const std::uint32_t iterations = plan.spatialIterations;
     if (iterations > 0) {
         GpuScope t(timer, Pass::spatialResampling);
         for (std::uint32_t it = 0; it < iterations; ++it) {
@@ -419,7 +417,7 @@ StoredReservoir* TwinRun::runRestir(LaunchParams& lp) {
         CUDA_CHECK(cudaMemcpyAsync(buf_.params.as<void>(), &lp, sizeof lp, cudaMemcpyHostToDevice, stream_));
         pipeline_->launch(shade_, buf_.params.address(), sizeof lp, rp.width, rp.height, stream_);
     }
-    if (runPlan_.upsample) {
+    if (plan.upsample) {
         GpuScope t(timer, Pass::upsampleLighting);
         upsampleLighting(lp, stream_);
     }
@@ -440,7 +438,7 @@ StepTimes TwinRun::runPasses(const FramePlan& plan, LaunchParams& lp, const Clus
     const bool instances = s_.geometry.layout == AccelLayout::instances;
     const std::size_t pixels = std::size_t(W_) * H_;
     const unsigned runs = a_.repeat > 1 ? a_.repeat + 1 : 1;
-    const bool buildOnce = persistent_ && (recluster || s_.geometry.build == BuildPolicy::partial);
+    const bool buildOnce = runPlan_.updateInPlace && (recluster || s_.geometry.build == BuildPolicy::partial);
     for (unsigned r = 0; r < runs; ++r) {
         lp.counters = r == 0 ? buf_.counters.as<LaunchCounters>() : nullptr;
         if (plan.buildClusters && (r == 0 || !buildOnce))
@@ -455,7 +453,7 @@ StepTimes TwinRun::runPasses(const FramePlan& plan, LaunchParams& lp, const Clus
             pipeline_->launch(Raygen::gbuffer, buf_.params.address(), sizeof lp, W_, H_, stream_);
         }
         if (plan.restir) {
-            finalReservoirs = runRestir(lp);
+            finalReservoirs = runRestir(plan, lp);
         } else if (plan.lighting) {
             GpuScope s(*timer_, Pass::estimateLighting);
             pipeline_->launch(sampling_ ? Raygen::sample : Raygen::exact, buf_.params.address(), sizeof lp, W_, H_, stream_);
@@ -535,13 +533,13 @@ void TwinRun::renderFrame(std::uint32_t frame, std::uint64_t seed) {
     const auto wall0 = std::chrono::steady_clock::now();
     const CameraPose pose = cameras_.pose(frame);
     const Camera world = Camera::fromPose(pose, W_, H_);
-    if (!built_ || !persistent_) origin_ = world.position;
+    if (!built_ || !runPlan_.updateInPlace) origin_ = world.position;
     const Camera camera = world.rebased(origin_);
     const FramePlan plan = planFrameAndLoad(frame);
     const Particles& particles = particles_;
     const std::size_t n = particles.size();
     const bool instances = s_.geometry.layout == AccelLayout::instances;
-    const bool recluster = plan.buildClusters && !instances && (!built_ || !persistent_);
+    const bool recluster = plan.buildClusters && !instances && (!built_ || !runPlan_.updateInPlace);
     const Clusters clusters = recluster ? clusterParticles(particles.position, s_.geometry.cluster_size) : Clusters{};
     if (plan.loadParticles) uploadParticles(particles, camera);
     if (recluster) clusters_ = clusters;

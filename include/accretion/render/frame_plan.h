@@ -38,6 +38,9 @@ struct FrameFacts {
 struct FramePlan {
     // Run-wide decisions (the same every frame).
     bool staticGeometry = false;  ///< static particles and camera: one BVH build for all frames
+    /// geometry.build refit or partial: one BVH updated in place from frame
+    /// to frame, in the coordinates of its first build (its origin kept).
+    bool updateInPlace = false;
     bool alphaFilter = false;     ///< disc alpha: filter (any-hit) callbacks attached
     bool keepHistory = false;     ///< restir temporal reuse over several frames: history buffers and motion kept
     bool previousBvh = false;     ///< a second BVH kept for basic_visibility
