@@ -193,7 +193,8 @@ std::map<Pass, double> predictMs(TuneContext& t, const std::vector<std::string>&
     measure(t, argv, prefix.string() + ".csv", "GPU time of " + what);
     std::map<Pass, double> ms;  // a pass's runs summed
     for (CostRow& r : readCounterCsv(prefix.string() + ".csv")) {
-        r.features[kColdWork] = coldWork(r.features[2], r.features[5], r.workingSetBytes, t.coefficients.cacheBytes);
+        r.features[CostFeature::cold_work] =
+            coldWork(r.features[CostFeature::rays], r.features[CostFeature::bytes], r.workingSetBytes, t.coefficients.cacheBytes);
         ms[r.pass.pass] += t.coefficients.predictMs(r.pass.pass, r.features);
     }
     return ms;

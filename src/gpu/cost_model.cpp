@@ -33,19 +33,9 @@ double coldWork(double rays, double bytes, double workingSetBytes, double cacheB
 }
 
 CostFeatures costFeatures(const PassReport& p, double cacheBytes) {
-    const double bytes = double(p.bytesRead + p.bytesWritten);
-    const BuildCounters& b = p.build;
-    return {double(p.threads),       double(p.warpSteps()),     double(p.rays),          double(p.blasEntries),
-            double(p.anyHits),       bytes,                     double(p.blasLevels),    double(p.ommLookups),
-            double(p.dispatches),    double(b.builds),          double(b.refits),
-            coldWork(double(p.rays), bytes, p.workingSetBytes, cacheBytes),
-            double(b.elements),      double(b.elementsSmall),   double(b.elementsMid),   double(b.primitives),
-            double(b.primitivesSmall), double(b.primitivesMid), double(b.customBuilds),  double(p.intersections),
-            double(p.tlasLevels),    double(p.misses),          double(p.segmentBoxes),
-            double(p.gathers),       double(b.sphereRefits),    double(p.ser.traversalBefore.steps),
-            p.rays ? double(p.dispatches) * double(p.segmentBoxes) / double(p.rays) : 0.0, double(p.wholeSegmentBoxes),
-            double(p.ser.gathersBefore.steps), double(p.ser.hitsBefore.warps), p.footprintBytes,
-            double(b.tlasInstancesMid)};
+    CostFeatures f{};
+    for (const CostFeatureInfo& c : kCostFeatureTable) f[c.feature] = c.value(p, cacheBytes);
+    return f;
 }
 
 CostCoefficients CostCoefficients::defaults() {
@@ -325,17 +315,13 @@ FeatureMask firstFeatures(std::size_t n) {
     return m;
 }
 
-std::size_t featureIndex(std::string_view name) {
-    return std::size_t(std::find(kCostFeatures.begin(), kCostFeatures.end(), name) - kCostFeatures.begin());
-}
-
 /// The counters a pass family is fitted on: buildClusters its builds and
 /// dispatches, every other pass all but the builds (isBuildFeature).
 FeatureMask passFeatures(Pass pass) {
     const bool build = pass == Pass::buildClusters;
     FeatureMask m{};
     for (std::size_t k = 0; k < m.size(); ++k) m[k] = isBuildFeature(k) == build;
-    m[featureIndex("dispatches")] = true;
+    m[std::size_t(CostFeature::dispatches)] = true;
     return m;
 }
 
@@ -402,10 +388,8 @@ CostFeatures fitSelected(const std::vector<const CostRow*>& rows, const FeatureM
     const std::size_t nConfigs = distinctConfigs(rows).size();
     if (nConfigs < 4) return fitRows(rows, allowed, true);
     FeatureMask chosen{};
-    for (std::string_view launch : {"dispatches", "build_launches", "refit_launches"}) {
-        const std::size_t k = featureIndex(launch);
-        chosen[k] = allowed[k];
-    }
+    for (std::size_t k = 0; k < kCostFeatureCount; ++k)
+        if (kCostFeatureTable[k].launch) chosen[k] = allowed[k];
     double best = leaveOneConfigOut(rows, chosen);
     for (std::size_t step = 0; step < kCostFeatures.size() && step + 2 < nConfigs; ++step) {
         std::size_t pick = kCostFeatures.size();
@@ -433,7 +417,7 @@ CostFeatures fitSelected(const std::vector<const CostRow*>& rows, const FeatureM
 
 /// The rows with cold_work for a cache of `cacheBytes`.
 std::vector<CostRow> withCache(std::vector<CostRow> rows, double cacheBytes) {
-    for (CostRow& r : rows) r.features[kColdWork] = coldWork(r.features[2], r.features[5], r.workingSetBytes, cacheBytes);
+    for (CostRow& r : rows) r.features[CostFeature::cold_work] = coldWork(r.features[CostFeature::rays], r.features[CostFeature::bytes], r.workingSetBytes, cacheBytes);
     return rows;
 }
 

@@ -37,7 +37,7 @@ TEST_CASE("calibrate recovers known coefficients from exact synthetic timings", 
     for (CostRow& r : rows) r.measuredMs = truth.predictMs(r.features);
     const Calibration c = calibrate(rows);
     for (std::size_t k = 0; k < truth.ns.size(); ++k) {
-        INFO(kCostFeatures[k]);
+        INFO(kCostFeatures[std::size_t(k)]);
         CHECK(c.coefficients.ns[k] == Approx(truth.ns[k]).epsilon(1e-6));
     }
     CHECK(c.r2 == Approx(1.0).margin(1e-9));
@@ -55,11 +55,11 @@ TEST_CASE("calibrate with 2% timing noise stays within 10% and keeps a zero coef
     for (double x : c.coefficients.ns) CHECK(x >= 0.0);
     // With 140 rows and 2% noise the standard error of each coefficient is
     // ~1% of the largest-scale terms; 10% leaves room for the smallest ones.
-    for (std::size_t k : {0u, 1u, 2u, 4u, 5u}) {
-        INFO(kCostFeatures[k]);
+    for (const CostFeature k : {CostFeature::threads, CostFeature::warp_steps, CostFeature::rays, CostFeature::any_hits, CostFeature::bytes}) {
+        INFO(kCostFeatures[std::size_t(k)]);
         CHECK(c.coefficients.ns[k] == Approx(truth.ns[k]).epsilon(0.10));
     }
-    CHECK(c.coefficients.ns[3] < 0.02);
+    CHECK(c.coefficients.ns[CostFeature::blas_entries] < 0.02);
     CHECK(c.r2 > 0.99);
 }
 
@@ -69,14 +69,14 @@ TEST_CASE("NNLS clamps what unconstrained least squares would make negative", "[
     std::vector<double> b;
     for (int i = 0; i < 12; ++i) {
         CostFeatures f{};
-        f[0] = 1.0 + i;
-        f[1] = (i % 3) + 0.5;
-        f[2] = (i % 2);
-        f[3] = i * i * 0.1;
-        f[4] = (i % 5);
-        f[5] = 1.0;
+        f[CostFeature::threads] = 1.0 + i;
+        f[CostFeature::warp_steps] = (i % 3) + 0.5;
+        f[CostFeature::rays] = (i % 2);
+        f[CostFeature::blas_entries] = i * i * 0.1;
+        f[CostFeature::any_hits] = (i % 5);
+        f[CostFeature::bytes] = 1.0;
         A.push_back(f);
-        b.push_back(f[0] - f[1]);
+        b.push_back(f[CostFeature::threads] - f[CostFeature::warp_steps]);
     }
     const std::vector<double> x = nonNegativeLeastSquares(A, b);
     for (double v : x) CHECK(v >= 0.0);
@@ -99,28 +99,28 @@ TEST_CASE("the per-pass form predicts held-out configurations its form made exac
     // constant per BLAS, traced rays whose cost grows with the BLAS depths.
     CostCoefficients truth;
     truth.perPass[Pass::buildClusters] = {};
-    truth.perPass[Pass::buildClusters][8] = 5000.0;    // dispatches
-    truth.perPass[Pass::buildClusters][9] = 75000.0;   // build_launches
+    truth.perPass[Pass::buildClusters][CostFeature::dispatches] = 5000.0;
+    truth.perPass[Pass::buildClusters][CostFeature::build_launches] = 75000.0;
     truth.perPass[Pass::traceShadowRays] = {};
-    truth.perPass[Pass::traceShadowRays][2] = 1.5;     // rays
-    truth.perPass[Pass::traceShadowRays][6] = 0.03;    // blas_levels
-    truth.perPass[Pass::traceShadowRays][8] = 10000.0; // dispatches
+    truth.perPass[Pass::traceShadowRays][CostFeature::rays] = 1.5;
+    truth.perPass[Pass::traceShadowRays][CostFeature::blas_levels] = 0.03;
+    truth.perPass[Pass::traceShadowRays][CostFeature::dispatches] = 10000.0;
     std::mt19937 rng(7);
     std::uniform_real_distribution<double> u(0.0, 1.0);
     std::vector<CostRow> rows;
     for (int c = 0; c < 20; ++c) {
         const double builds = 100.0 + 5000.0 * u(rng), pixels = 2e5 + 2e6 * u(rng);
         CostRow b{"c" + std::to_string(c), {Pass::buildClusters}, {}, 0.0};
-        b.features[0] = builds;
-        b.features[5] = 8000.0 * 1e5 / builds;  // bytes: the same particles in more or fewer clusters
-        b.features[8] = 2.0;
-        b.features[9] = builds;
+        b.features[CostFeature::threads] = builds;
+        b.features[CostFeature::bytes] = 8000.0 * 1e5 / builds;  // the same particles in more or fewer clusters
+        b.features[CostFeature::dispatches] = 2.0;
+        b.features[CostFeature::build_launches] = builds;
         CostRow t{b.config, {Pass::traceShadowRays}, {}, 0.0};
-        t.features[0] = pixels;
-        t.features[2] = pixels * (0.2 + 0.3 * u(rng));
-        t.features[3] = t.features[2] * (2.0 + 6.0 * u(rng));
-        t.features[6] = t.features[3] * (4.0 + 8.0 * u(rng));
-        t.features[8] = 1.0;
+        t.features[CostFeature::threads] = pixels;
+        t.features[CostFeature::rays] = pixels * (0.2 + 0.3 * u(rng));
+        t.features[CostFeature::blas_entries] = t.features[CostFeature::rays] * (2.0 + 6.0 * u(rng));
+        t.features[CostFeature::blas_levels] = t.features[CostFeature::blas_entries] * (4.0 + 8.0 * u(rng));
+        t.features[CostFeature::dispatches] = 1.0;
         for (CostRow* r : {&b, &t}) {
             r->measuredMs = truth.predictMs(r->pass.pass, r->features);
             rows.push_back(*r);
@@ -158,23 +158,23 @@ TEST_CASE("the selected form keeps the counters that made the timings and drops 
     // unrelated to the time. per_pass fits all eleven; selected must find the
     // three that made the time (leave-one-configuration-out), and recover them.
     CostFeatures truth{};
-    truth[2] = 1.5;      // rays
-    truth[6] = 0.03;     // blas_levels
-    truth[8] = 300000.0; // dispatches
+    truth[CostFeature::rays] = 1.5;
+    truth[CostFeature::blas_levels] = 0.03;
+    truth[CostFeature::dispatches] = 300000.0;
     std::mt19937 rng(11);
     std::uniform_real_distribution<double> u(0.0, 1.0);
     std::normal_distribution<double> noise(0.0, 0.03);
     std::vector<CostRow> rows;
     for (int c = 0; c < 40; ++c) {
         CostRow t{"c" + std::to_string(c), {Pass::traceShadowRays}, {}, 0.0};
-        t.features[0] = 2e5 + 2e6 * u(rng);           // threads: unrelated here
-        t.features[1] = 1e4 + 1e5 * u(rng);           // warp_steps: unrelated
-        t.features[2] = 1e5 + 1e6 * u(rng);           // rays
-        t.features[4] = 1e5 * u(rng);                 // any_hits: unrelated
-        t.features[5] = 1e7 + 1e8 * u(rng);           // bytes: unrelated
-        t.features[6] = t.features[2] * (20.0 + 60.0 * u(rng));
-        t.features[7] = 1e5 * u(rng);                 // omm_lookups: unrelated
-        t.features[8] = 1.0;
+        t.features[CostFeature::threads] = 2e5 + 2e6 * u(rng);  // unrelated here
+        t.features[CostFeature::warp_steps] = 1e4 + 1e5 * u(rng);  // unrelated
+        t.features[CostFeature::rays] = 1e5 + 1e6 * u(rng);
+        t.features[CostFeature::any_hits] = 1e5 * u(rng);  // unrelated
+        t.features[CostFeature::bytes] = 1e7 + 1e8 * u(rng);  // unrelated
+        t.features[CostFeature::blas_levels] = t.features[CostFeature::rays] * (20.0 + 60.0 * u(rng));
+        t.features[CostFeature::omm_lookups] = 1e5 * u(rng);  // unrelated
+        t.features[CostFeature::dispatches] = 1.0;
         double ms = 0.0;
         for (std::size_t k = 0; k < truth.size(); ++k) ms += truth[k] * t.features[k] * 1e-6;
         t.measuredMs = ms * (1.0 + noise(rng));
@@ -182,12 +182,12 @@ TEST_CASE("the selected form keeps the counters that made the timings and drops 
     }
     const Calibration c = calibrate(rows, CostModelForm::selected);
     const CostFeatures& ns = c.coefficients.perPass.at(Pass::traceShadowRays);
-    for (std::size_t k : {2u, 6u, 8u}) {
-        INFO(kCostFeatures[k]);
+    for (const CostFeature k : {CostFeature::rays, CostFeature::blas_levels, CostFeature::dispatches}) {
+        INFO(kCostFeatures[std::size_t(k)]);
         CHECK(ns[k] == Approx(truth[k]).epsilon(0.15));
     }
-    for (std::size_t k : {0u, 1u, 4u, 5u, 7u}) {
-        INFO(kCostFeatures[k]);
+    for (const CostFeature k : {CostFeature::threads, CostFeature::warp_steps, CostFeature::any_hits, CostFeature::bytes, CostFeature::omm_lookups}) {
+        INFO(kCostFeatures[std::size_t(k)]);
         CHECK(ns[k] == 0.0);
     }
 }
@@ -205,11 +205,11 @@ TEST_CASE("calibrate finds the cache of the working-set term that made the timin
     std::vector<CostRow> rows;
     for (int c = 0; c < int(kCostFeatures.size()) + 2; ++c) {  // at least one row per coefficient
         CostRow r{"c" + std::to_string(c), {Pass::traceGBuffer}, {}, 0.0};
-        r.features[0] = r.features[2] = 2e5 + 2e6 * u(rng);  // threads = rays
-        r.features[8] = 1.0;
+        r.features[CostFeature::threads] = r.features[CostFeature::rays] = 2e5 + 2e6 * u(rng);  // threads = rays
+        r.features[CostFeature::dispatches] = 1.0;
         r.workingSetBytes = std::ldexp(0.5 * 1024 * 1024, c % 10);
-        const double cold = coldWork(r.features[2], 0.0, r.workingSetBytes, cache);
-        r.measuredMs = (0.5 * r.features[2] + 2.0 * cold + 20000.0) * 1e-6;
+        const double cold = coldWork(r.features[CostFeature::rays], 0.0, r.workingSetBytes, cache);
+        r.measuredMs = (0.5 * r.features[CostFeature::rays] + 2.0 * cold + 20000.0) * 1e-6;
         rows.push_back(r);
     }
     for (CostModelForm form : {CostModelForm::per_pass, CostModelForm::selected}) {
@@ -217,8 +217,8 @@ TEST_CASE("calibrate finds the cache of the working-set term that made the timin
         const Calibration cal = calibrate(rows, form);
         CHECK(cal.coefficients.cacheBytes == cache);
         const CostFeatures& ns = cal.coefficients.perPass.at(Pass::traceGBuffer);
-        CHECK(ns[kColdWork] == Approx(2.0).epsilon(1e-6));
-        CHECK(ns[2] + ns[0] == Approx(0.5).epsilon(1e-6));  // threads and rays are the same column here
+        CHECK(ns[CostFeature::cold_work] == Approx(2.0).epsilon(1e-6));
+        CHECK(ns[CostFeature::rays] + ns[CostFeature::threads] == Approx(0.5).epsilon(1e-6));  // threads and rays are the same column here
         CHECK(cal.maxRelativeError < 1e-6);
     }
     // The cache travels with the coefficients.
@@ -230,13 +230,13 @@ TEST_CASE("calibrate finds the cache of the working-set term that made the timin
 TEST_CASE("a presampling pass without timings is priced with generateCandidates' coefficients", "[gpu][cost]") {
     CostCoefficients c;
     c.ns = {};
-    c.ns[0] = 1.0;  // shared: 1 ns per unit of the first feature
+    c.ns[CostFeature::threads] = 1.0;  // shared: 1 ns per unit of the first feature
     CostFeatures candidates{};
-    candidates[1] = 2.0;  // generateCandidates: 2 ns per unit of the second
+    candidates[CostFeature::warp_steps] = 2.0;  // generateCandidates: 2 ns per unit of the second
     c.perPass[Pass::generateCandidates] = candidates;
     CostFeatures f{};
-    f[0] = 1e6;
-    f[1] = 1e6;
+    f[CostFeature::threads] = 1e6;
+    f[CostFeature::warp_steps] = 1e6;
     // 1e6 units x 2 ns = 2 ms by the proxy; the shared form would give 1 ms.
     CHECK(c.predictMs(Pass::presampleLightTiles, f) == Approx(2.0));
     CHECK(c.predictMs(Pass::presampleRegirGrid, f) == Approx(2.0));
@@ -291,20 +291,20 @@ TEST_CASE("the build pass is fitted on the build counters, the other passes on t
     for (int c = 0; c < int(kCostFeatures.size()) + 2; ++c) {  // at least one row per coefficient
         const double clusters = 10.0 + 100.0 * c;
         CostRow b{"c" + std::to_string(c), {Pass::buildClusters}, {}, 0.0};
-        b.features[0] = clusters;  // threads
-        b.features[8] = 1.0;       // dispatches
-        b.features[9] = clusters;  // build_launches
+        b.features[CostFeature::threads] = clusters;
+        b.features[CostFeature::dispatches] = 1.0;
+        b.features[CostFeature::build_launches] = clusters;
         b.measuredMs = 0.01 + 0.075 * clusters;
         rows.push_back(b);
     }
     const Calibration c = calibrate(rows, CostModelForm::per_pass);
     const CostFeatures& ns = c.coefficients.perPass.at(Pass::buildClusters);
-    CHECK(ns[0] == 0.0);
-    CHECK(ns[9] == Approx(75000.0).epsilon(1e-6));
+    CHECK(ns[CostFeature::threads] == 0.0);
+    CHECK(ns[CostFeature::build_launches] == Approx(75000.0).epsilon(1e-6));
     CostFeatures instances{};
-    instances[0] = 1e6;  // a thread per particle, one launch
-    instances[8] = 1.0;
-    instances[9] = 1.0;
+    instances[CostFeature::threads] = 1e6;  // a thread per particle, one launch
+    instances[CostFeature::dispatches] = 1.0;
+    instances[CostFeature::build_launches] = 1.0;
     CHECK(c.coefficients.predictMs(Pass::buildClusters, instances) == Approx(0.085).epsilon(1e-6));
 }
 

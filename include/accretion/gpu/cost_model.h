@@ -14,6 +14,14 @@
 
 namespace accretion {
 
+/// The reads that miss a cache of `cacheBytes`: a traced pass's rays (else
+/// its bytes) times the levels of a tree over the working set that the cache
+/// cannot hold, log2(working set / cache), 0 when it fits. A BVH keeps its
+/// top levels cached and misses below them; random reads of a table grow
+/// their misses as it outgrows the cache (the H100 sweep of bench/gpu: 1M
+/// particles cost the G-buffer 1.7x the rays of 100K, with fewer BLAS levels).
+double coldWork(double rays, double bytes, double workingSetBytes, double cacheBytes);
+
 /// The counters a pass's predicted time is linear in (docs/MODEL.md section
 /// 6). The first six are the model's first form; the others came with
 /// measurements on a GPU (bench/gpu): the traversal inside the BLAS entered
@@ -48,32 +56,117 @@ namespace accretion {
 /// other threads' texels (the lighting grid of upsampling: 1.5x the time at
 /// scale 0.75 as at 0.5, for the same bytes asked). Counter CSVs without a
 /// column read it as 0.
-inline constexpr std::array<std::string_view, 32> kCostFeatures = {
-    "threads",          "warp_steps",          "rays",                 "blas_entries",     "any_hits",
-    "bytes",            "blas_levels",         "omm_lookups",          "dispatches",       "build_launches",
-    "refit_launches",   "cold_work",           "accel_elements",       "accel_elements_1k", "accel_elements_32k",
-    "build_primitives", "build_primitives_1k", "build_primitives_32k", "custom_builds",    "intersections",
-    "tlas_levels",      "misses",              "segment_boxes",    "gathers",
-    "sphere_refits",    "warp_segment_boxes",  "dispatch_path",
-    "whole_segment_boxes", "warp_gathers",     "hit_warps",           "footprint_bytes",
-    "tlas_instances_32k"};
-inline constexpr std::size_t kBaseCostFeatures = 6;
-inline constexpr std::size_t kColdWork = 11;
-/// Whether feature k prices acceleration-structure builds: buildClusters is
-/// fitted on these (and dispatches) alone, every other pass on the rest.
-/// A pass's counters of the other kind are 0 or, like the build pass's
-/// threads (one per cluster: collinear with its launches), say nothing of
-/// its time, and a fit that gives them weight extrapolates badly.
-constexpr bool isBuildFeature(std::size_t k) {
-    constexpr std::string_view build[] = {"build_launches",   "refit_launches",      "accel_elements",
-                                          "accel_elements_1k", "accel_elements_32k", "build_primitives",
-                                          "build_primitives_1k", "build_primitives_32k", "custom_builds",
-                                          "sphere_refits", "tlas_instances_32k"};
-    for (std::string_view b : build)
-        if (kCostFeatures[k] == b) return true;
-    return false;
+enum class CostFeature : std::uint8_t {
+    threads, warp_steps, rays, blas_entries, any_hits, bytes, blas_levels, omm_lookups, dispatches, build_launches,
+    refit_launches, cold_work, accel_elements, accel_elements_1k, accel_elements_32k, build_primitives, build_primitives_1k,
+    build_primitives_32k, custom_builds, intersections, tlas_levels, misses, segment_boxes, gathers, sphere_refits,
+    warp_segment_boxes, dispatch_path, whole_segment_boxes, warp_gathers, hit_warps, footprint_bytes, tlas_instances_32k,
+};
+inline constexpr std::size_t kCostFeatureCount = std::size_t(CostFeature::tlas_instances_32k) + 1;
+
+/// One row of the cost model's feature table: everything about a feature
+/// that the model, the counter CSVs, the coefficient files and calibrate read.
+struct CostFeatureInfo {
+    CostFeature feature;
+    std::string_view name;  ///< its column in counters.csv and key in coefficient files
+    /// Of the model's first form (shared): required in every counter CSV and
+    /// coefficient file (the later ones read as 0 where absent).
+    bool firstForm;
+    /// Prices acceleration-structure builds: buildClusters is fitted on
+    /// these (and dispatches) alone, every other pass on the rest. A pass's
+    /// counters of the other kind are 0 or, like the build pass's threads
+    /// (one per cluster: collinear with its launches), say nothing of its
+    /// time, and a fit that gives them weight extrapolates badly.
+    bool build;
+    /// A launch constant (a dispatch, a build or refit launch): always kept
+    /// by the selected form, whose forward selection adds work counters.
+    bool launch;
+    /// Its value for a pass (cold_work for a cache of `cacheBytes`).
+    double (*value)(const PassReport& pass, double cacheBytes);
+};
+
+namespace detail {
+using P = const PassReport&;
+inline double bytesOf(P p) { return double(p.bytesRead + p.bytesWritten); }
+}  // namespace detail
+
+inline constexpr std::array<CostFeatureInfo, kCostFeatureCount> kCostFeatureTable = {{
+    {CostFeature::threads, "threads", true, false, false, [](detail::P p, double) { return double(p.threads); }},
+    {CostFeature::warp_steps, "warp_steps", true, false, false, [](detail::P p, double) { return double(p.warpSteps()); }},
+    {CostFeature::rays, "rays", true, false, false, [](detail::P p, double) { return double(p.rays); }},
+    {CostFeature::blas_entries, "blas_entries", true, false, false, [](detail::P p, double) { return double(p.blasEntries); }},
+    {CostFeature::any_hits, "any_hits", true, false, false, [](detail::P p, double) { return double(p.anyHits); }},
+    {CostFeature::bytes, "bytes", true, false, false, [](detail::P p, double) { return detail::bytesOf(p); }},
+    {CostFeature::blas_levels, "blas_levels", false, false, false, [](detail::P p, double) { return double(p.blasLevels); }},
+    {CostFeature::omm_lookups, "omm_lookups", false, false, false, [](detail::P p, double) { return double(p.ommLookups); }},
+    {CostFeature::dispatches, "dispatches", false, false, true, [](detail::P p, double) { return double(p.dispatches); }},
+    {CostFeature::build_launches, "build_launches", false, true, true, [](detail::P p, double) { return double(p.build.builds); }},
+    {CostFeature::refit_launches, "refit_launches", false, true, true, [](detail::P p, double) { return double(p.build.refits); }},
+    {CostFeature::cold_work, "cold_work", false, false, false,
+     [](detail::P p, double cache) { return coldWork(double(p.rays), detail::bytesOf(p), p.workingSetBytes, cache); }},
+    {CostFeature::accel_elements, "accel_elements", false, true, false, [](detail::P p, double) { return double(p.build.elements); }},
+    {CostFeature::accel_elements_1k, "accel_elements_1k", false, true, false, [](detail::P p, double) { return double(p.build.elementsSmall); }},
+    {CostFeature::accel_elements_32k, "accel_elements_32k", false, true, false, [](detail::P p, double) { return double(p.build.elementsMid); }},
+    {CostFeature::build_primitives, "build_primitives", false, true, false, [](detail::P p, double) { return double(p.build.primitives); }},
+    {CostFeature::build_primitives_1k, "build_primitives_1k", false, true, false,
+     [](detail::P p, double) { return double(p.build.primitivesSmall); }},
+    {CostFeature::build_primitives_32k, "build_primitives_32k", false, true, false,
+     [](detail::P p, double) { return double(p.build.primitivesMid); }},
+    {CostFeature::custom_builds, "custom_builds", false, true, false, [](detail::P p, double) { return double(p.build.customBuilds); }},
+    {CostFeature::intersections, "intersections", false, false, false, [](detail::P p, double) { return double(p.intersections); }},
+    {CostFeature::tlas_levels, "tlas_levels", false, false, false, [](detail::P p, double) { return double(p.tlasLevels); }},
+    {CostFeature::misses, "misses", false, false, false, [](detail::P p, double) { return double(p.misses); }},
+    {CostFeature::segment_boxes, "segment_boxes", false, false, false, [](detail::P p, double) { return double(p.segmentBoxes); }},
+    {CostFeature::gathers, "gathers", false, false, false, [](detail::P p, double) { return double(p.gathers); }},
+    {CostFeature::sphere_refits, "sphere_refits", false, true, false, [](detail::P p, double) { return double(p.build.sphereRefits); }},
+    {CostFeature::warp_segment_boxes, "warp_segment_boxes", false, false, false,
+     [](detail::P p, double) { return double(p.ser.traversalBefore.steps); }},
+    {CostFeature::dispatch_path, "dispatch_path", false, false, false,
+     [](detail::P p, double) { return p.rays ? double(p.dispatches) * double(p.segmentBoxes) / double(p.rays) : 0.0; }},
+    {CostFeature::whole_segment_boxes, "whole_segment_boxes", false, false, false,
+     [](detail::P p, double) { return double(p.wholeSegmentBoxes); }},
+    {CostFeature::warp_gathers, "warp_gathers", false, false, false, [](detail::P p, double) { return double(p.ser.gathersBefore.steps); }},
+    {CostFeature::hit_warps, "hit_warps", false, false, false, [](detail::P p, double) { return double(p.ser.hitsBefore.warps); }},
+    {CostFeature::footprint_bytes, "footprint_bytes", false, false, false, [](detail::P p, double) { return p.footprintBytes; }},
+    {CostFeature::tlas_instances_32k, "tlas_instances_32k", false, true, false,
+     [](detail::P p, double) { return double(p.build.tlasInstancesMid); }},
+}};
+
+namespace detail {
+constexpr bool costTableInOrder() {
+    for (std::size_t k = 0; k < kCostFeatureTable.size(); ++k)
+        if (std::size_t(kCostFeatureTable[k].feature) != k) return false;
+    return true;
 }
-using CostFeatures = std::array<double, kCostFeatures.size()>;
+constexpr std::size_t firstFormCount() {
+    std::size_t n = 0;
+    while (n < kCostFeatureTable.size() && kCostFeatureTable[n].firstForm) ++n;
+    for (std::size_t k = n; k < kCostFeatureTable.size(); ++k)
+        if (kCostFeatureTable[k].firstForm) return 0;  // the first form's features come first
+    return n;
+}
+constexpr std::array<std::string_view, kCostFeatureCount> costFeatureNames() {
+    std::array<std::string_view, kCostFeatureCount> names{};
+    for (std::size_t k = 0; k < names.size(); ++k) names[k] = kCostFeatureTable[k].name;
+    return names;
+}
+}  // namespace detail
+static_assert(detail::costTableInOrder(), "kCostFeatureTable row k describes CostFeature k");
+
+/// The features' names, in table order (the columns of counters.csv).
+inline constexpr std::array<std::string_view, kCostFeatureCount> kCostFeatures = detail::costFeatureNames();
+/// The model's first form: the first kBaseCostFeatures features of the table.
+inline constexpr std::size_t kBaseCostFeatures = detail::firstFormCount();
+static_assert(kBaseCostFeatures > 0, "the first form's features come first in the table");
+constexpr const CostFeatureInfo& costFeatureInfo(std::size_t k) { return kCostFeatureTable[k]; }
+constexpr bool isBuildFeature(std::size_t k) { return kCostFeatureTable[k].build; }
+
+/// One value per feature, indexed by position or by CostFeature.
+struct CostFeatures : std::array<double, kCostFeatureCount> {
+    using std::array<double, kCostFeatureCount>::operator[];
+    double& operator[](CostFeature f) { return (*this)[std::size_t(f)]; }
+    double operator[](CostFeature f) const { return (*this)[std::size_t(f)]; }
+};
 
 /// The committed calibration (compiled in from this file of the source tree).
 inline constexpr const char* kDefaultCoefficientsFile = "bench/gpu/results/fit/coefficients_h100.json";
@@ -84,13 +177,6 @@ const char* defaultCoefficientsJson();
 /// chooses its own by cross-validation).
 inline constexpr double kDefaultCacheBytes = 4.0 * 1024 * 1024;
 
-/// The reads that miss a cache of `cacheBytes`: a traced pass's rays (else
-/// its bytes) times the levels of a tree over the working set that the cache
-/// cannot hold, log2(working set / cache), 0 when it fits. A BVH keeps its
-/// top levels cached and misses below them; random reads of a table grow
-/// their misses as it outgrows the cache (the H100 sweep of bench/gpu: 1M
-/// particles cost the G-buffer 1.7x the rays of 100K, with fewer BLAS levels).
-double coldWork(double rays, double bytes, double workingSetBytes, double cacheBytes);
 
 /// The model's forms. shared: one coefficient per base counter for every
 /// pass, fitted by least squares on ms (the first form). per_pass: each
@@ -106,6 +192,7 @@ inline const char* costModelFormName(CostModelForm f) {
     return f == CostModelForm::shared ? "shared" : f == CostModelForm::per_pass ? "per_pass" : "selected";
 }
 
+/// Every feature's value for a pass (the table's value column).
 CostFeatures costFeatures(const PassReport& pass, double cacheBytes);
 
 /// Nanoseconds per unit of each feature: predicted time = sum coefficient x counter.
