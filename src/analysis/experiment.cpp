@@ -6,7 +6,7 @@
 
 #include "accretion/core/error.h"
 #include "accretion/core/parse.h"
-#include "accretion/render/estimator_table.h"
+#include "accretion/scene/estimator_table.h"
 #include "accretion/scene/scene_parser.h"
 
 namespace accretion {
@@ -22,7 +22,7 @@ std::vector<EstimatorSpec> parseEstimatorSpecs(const std::string& list, const st
         EstimatorSpec spec;
         spec.label = entry;
         if (!parseEnum(parts[0], spec.kind))
-            fail("unknown estimator (exact, uniform, power, tree, split, ris, restir)");
+            fail(fmt::format("unknown estimator ({})", enumChoices<EstimatorKind>()));
         const std::string flag = fmt::format("{} {}", option, entry);
         spec.settings.push_back({"render.estimator", flag, [k = spec.kind](Settings& s) { s.render.estimator = k; }});
         for (std::size_t k = 1; k < parts.size(); ++k) {

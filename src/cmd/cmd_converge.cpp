@@ -21,7 +21,7 @@
 #include "accretion/io/plot.h"
 #include "accretion/io/report_table.h"
 #include "accretion/io/stats_writer.h"
-#include "accretion/render/estimator_table.h"
+#include "accretion/scene/estimator_table.h"
 #include "accretion/scene/scene_parser.h"
 #include "commands.h"
 
@@ -195,7 +195,7 @@ std::vector<Point> measureLevels(const ConvergeRun& run, const std::vector<Estim
             if (spent > 0.0 && spent + 2.2 * last > run.budget) break;  // the next level would overrun the budget
             EstimatorSpec level = spec;
             const std::string flag = fmt::format("--min-effort/--max-effort (level {})", effort);
-            if (spec.kind == EstimatorKind::restir)
+            if (estimatorInfo(spec.kind).reuse)  // effort: restir's candidates (one reservoir a pixel)
                 level.settings.push_back({"render.candidates", flag, [effort](Settings& st) { st.render.candidates = effort; }});
             else
                 level.settings.push_back({"render.samples", flag, [effort](Settings& st) { st.render.samples = effort; }});
@@ -214,7 +214,7 @@ std::vector<Point> measureLevels(const ConvergeRun& run, const std::vector<Estim
             points.push_back(p);
             spent += p.totalSeconds;
             last = p.totalSeconds;
-            if (spec.kind == EstimatorKind::exact) break;
+            if (estimatorInfo(spec.kind).sums) break;  // no samples: one level
         }
     }
     return points;

@@ -21,7 +21,7 @@
 #include "accretion/io/exr_output.h"
 #include "accretion/io/report_table.h"
 #include "accretion/io/stats_writer.h"
-#include "accretion/render/estimator_table.h"
+#include "accretion/scene/estimator_table.h"
 #include "accretion/render/frame_renderer.h"
 #include "accretion/scene/scene_parser.h"
 #include "commands.h"

@@ -2,7 +2,7 @@
 // markdown, the table docs/rendering.md carries.
 #include <fmt/core.h>
 
-#include "accretion/render/estimator_table.h"
+#include "accretion/scene/estimator_table.h"
 #include "commands.h"
 
 namespace accretion::cmd {

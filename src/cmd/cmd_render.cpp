@@ -23,7 +23,7 @@
 #include "accretion/io/preview.h"
 #include "accretion/io/stats_writer.h"
 #include "accretion/particles/particle_source.h"
-#include "accretion/render/estimator_table.h"
+#include "accretion/scene/estimator_table.h"
 #include "accretion/render/frame_renderer.h"
 #include "accretion/scene/scene_parser.h"
 #include "commands.h"

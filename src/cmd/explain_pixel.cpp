@@ -7,6 +7,7 @@
 
 #include <fmt/core.h>
 
+#include "accretion/scene/estimator_table.h"
 #include "accretion/lighting/shading.h"
 #include "accretion/particles/particle_source.h"
 #include "accretion/render/frame_renderer.h"
@@ -107,7 +108,8 @@ void printRestir(const PixelTrace& t, const Settings& s) {
 void explainPixel(const Settings& settings, std::uint32_t x, std::uint32_t y, bool quiet) {
     FrameRenderer renderer(settings, ParticleSource(settings), RenderOptions{quiet});
     const std::uint32_t first = settings.render.frame_start, last = first + settings.render.frames - 1;
-    const bool restir = settings.render.estimator == EstimatorKind::restir;
+    const EstimatorInfo& e = estimatorInfo(settings.render.estimator);
+    const bool restir = e.reuse;
     PixelTrace trace;
     trace.px = std::size_t(y) * settings.camera.width + x;
     FrameImage img;
@@ -124,14 +126,16 @@ void explainPixel(const Settings& settings, std::uint32_t x, std::uint32_t y, bo
         return;
     }
     fmt::print("hit: particle {} at depth {}, shading normal {}\n", img.particle[px], img.depth[px], rgb(img.normal[px]));
+    // What the trace recorded: the pass states of reuse, the terms of a sum,
+    // RIS's reservoirs, the near field and far samples, or the samples.
     if (restir) printRestir(trace, settings);
-    else if (settings.render.estimator == EstimatorKind::exact) printExact(trace, img.lighting.Lr[px]);
-    else if (settings.render.estimator == EstimatorKind::ris) printRis(trace);
-    else if (settings.render.estimator == EstimatorKind::split) printSplit(trace);
+    else if (e.sums) printExact(trace, img.lighting.Lr[px]);
+    else if (e.resampling) printRis(trace);
+    else if (e.nearField) printSplit(trace);
     else printSamples(trace);
     fmt::print("value (shortest round-trip decimals: the EXR's floats of a full render, bit for bit):\n");
     fmt::print("  L = {}\n  Le = {}\n  Lr = {}\n", rgb(img.L[px]), rgb(img.Le[px]), rgb(img.lighting.Lr[px]));
-    if (settings.render.estimator != EstimatorKind::exact)
+    if (!e.sums)
         fmt::print("  Lr_stderr = {}\n  spp = {}\n", rgb(img.lighting.Lr_stderr[px]), img.lighting.spp[px]);
     if (!img.lighting.rejected.empty() && img.lighting.rejected[px] > 0)
         fmt::print("  rejected = {} (non-finite samples)\n", img.lighting.rejected[px]);

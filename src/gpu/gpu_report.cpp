@@ -1,3 +1,4 @@
+#include "accretion/scene/estimator_table.h"
 #include "accretion/gpu/gpu_report.h"
 
 #include <bit>
@@ -104,12 +105,12 @@ GpuReport makeGpuReport(const FrameCounters& counters, const Settings& settings,
     const std::uint64_t lights = accel.particles;
     const LightSource source = settings.render.source;
     const RestirSettings& rs = settings.restir;
-    const bool presampled = source == LightSource::tiles || source == LightSource::regir;
+    const bool presampled = sourceInfo(source).presampled;
     const double lightBytes = double(lights) * (gpu_layout::kParticleRecord + (source == LightSource::power || presampled ? gpu_layout::kAliasEntry : 0u) +
                                                 (source == LightSource::tree ? 2u * gpu_layout::kLightTreeNode : 0u)) +
                               // the tiles, and the grid's slots
                               (presampled ? double(rs.tile_count) * rs.tile_size * gpu_layout::kRisEntry : 0.0) +
-                              (source == LightSource::regir ? std::pow(double(rs.regir_cells), 3.0) * rs.regir_lights_per_cell * gpu_layout::kRisEntry : 0.0);
+                              (sourceInfo(source).regirGrid ? std::pow(double(rs.regir_cells), 3.0) * rs.regir_lights_per_cell * gpu_layout::kRisEntry : 0.0);
     // A ray descends the TLAS before it enters any BLAS: its depth over the instances.
     const std::uint32_t tlasDepth = accel.tlasInstances > 1 ? std::uint32_t(std::bit_width(accel.tlasInstances - 1)) : 0u;
     for (PassReport& p : r.passes) {
@@ -119,9 +120,10 @@ GpuReport makeGpuReport(const FrameCounters& counters, const Settings& settings,
     }
 
     const std::uint64_t pixels = std::uint64_t(settings.camera.width) * settings.camera.height;
-    const double s = settings.render.estimator == EstimatorKind::restir ? settings.restir.resolution_scale : 1.0;
+    const bool reuse = estimatorInfo(settings.render.estimator).reuse;
+    const double s = reuse ? settings.restir.resolution_scale : 1.0;
     const std::uint64_t lightingPixels = static_cast<std::uint64_t>(double(pixels) * s * s + 0.5);
-    const bool temporal = settings.render.estimator == EstimatorKind::restir && settings.restir.temporal;
+    const bool temporal = reuse && settings.restir.temporal;
     r.layouts.reservoirBytes = static_cast<std::uint32_t>(reservoirBytes);
     r.layouts.gbufferTexelBytes = gpu_layout::kGBufferTexel;
     r.layouts.primaryPayloadBytes = gpu_layout::kPrimaryPayload;

@@ -5,7 +5,7 @@
 #include <fmt/format.h>
 
 #include "accretion/core/error.h"
-#include "accretion/render/estimator_table.h"
+#include "accretion/scene/estimator_table.h"
 
 namespace accretion {
 

@@ -25,7 +25,7 @@
 #include "accretion/lighting/near_field.h"
 #include "accretion/lighting/reservoir.h"
 #include "accretion/lighting/shading.h"
-#include "accretion/render/estimator_table.h"
+#include "accretion/scene/estimator_table.h"
 #include "accretion/render/sample_sums.h"
 #include "accretion/render/visibility.h"
 
@@ -706,7 +706,7 @@ void checkSamplerInputs(const LightingInputs& in) {
     // table: for it the table is there exactly when its source needs one.
     ACC_CHECK(e.resampling ? (need == LightSamplerKind::power) == (in.powerTable != nullptr)
                            : need != LightSamplerKind::power || in.powerTable);
-    ACC_CHECK(!e.resampling || (in.render.source != LightSource::tiles && in.render.source != LightSource::regir));
+    ACC_CHECK(!e.resampling || !sourceInfo(in.render.source).reuseOnly);
 }
 }  // namespace
 

@@ -32,10 +32,10 @@ void planPasses(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
     plan.lighting = !facts.lightingSkipped && facts.emissive && glm::length(s.shading.albedo) > 0.0f;
     plan.shadowRays = plan.lighting && s.shading.visibility;
     if (plan.lighting) plan.sampler = samplerFor(s.render);  // tiles and the ReGIR grid are drawn from the power table
-    const bool presampled = s.render.source == LightSource::tiles || s.render.source == LightSource::regir;
+    const LightSourceInfo& source = sourceInfo(s.render.source);
     plan.restir = plan.lighting && est.reuse;
-    plan.presampleTiles = plan.restir && presampled;
-    plan.presampleRegir = plan.restir && s.render.source == LightSource::regir;
+    plan.presampleTiles = plan.restir && source.presampled;
+    plan.presampleRegir = plan.restir && source.regirGrid;
     plan.temporal = plan.restir && plan.keepHistory && facts.historyAvailable;
     plan.spatialIterations = plan.restir && s.restir.spatial_neighbours > 0 ? s.restir.spatial_iterations : 0;
     plan.upsample = plan.restir && float(s.restir.resolution_scale) < 1.0f;

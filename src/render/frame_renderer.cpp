@@ -9,7 +9,7 @@
 #include <fmt/format.h>
 
 #include "accretion/counters/gpu_layouts.h"
-#include "accretion/render/estimator_table.h"
+#include "accretion/scene/estimator_table.h"
 
 namespace accretion {
 namespace {

@@ -1,3 +1,4 @@
+#include "accretion/scene/estimator_table.h"
 #include "accretion/scene/scene_parser.h"
 
 #include <algorithm>
@@ -282,7 +283,7 @@ void validate(const Settings& s, const std::map<std::string, std::string>& loc, 
         fail("render.output", "must be a file name ending in .exr (the EXR goes there, its previews and stats beside it)");
     if (s.render.frames > 1 && s.render.output.find("{frame}") == std::string::npos)
         fail("render.output", "a multi-frame render needs a {frame} pattern in the output path");
-    if (s.render.estimator == EstimatorKind::restir && s.restir.layout == ReservoirLayout::packed &&
+    if (estimatorInfo(s.render.estimator).reuse && s.restir.layout == ReservoirLayout::packed &&
         s.particles.file.empty() && s.particles.count > (std::uint64_t(1) << s.restir.light_bits))
         fail("restir.light_bits", fmt::format("{} bits address {} lights but particles.count = {}: the packed layout needs {} bits",
                                               s.restir.light_bits, std::uint64_t(1) << s.restir.light_bits,
@@ -310,7 +311,7 @@ void validate(const Settings& s, const std::map<std::string, std::string>& loc, 
         const std::vector<double>& crop = s.render.crop;
         const bool window = crop.size() == 4 && cropRendersAlone(s);
         const double pixels = window ? (crop[1] - crop[0]) * (crop[3] - crop[2]) : double(s.camera.width) * s.camera.height;
-        const double perPixel = s.render.estimator == EstimatorKind::restir ? 480.0 : 330.0;
+        const double perPixel = estimatorInfo(s.render.estimator).reuse ? 480.0 : 330.0;  // reservoirs and their history
         const double mb = (300.0 * particles + perPixel * pixels) / 1e6 + 60.0;
         const std::string image = window ? fmt::format("a {}x{} crop of {}x{}", crop[1] - crop[0], crop[3] - crop[2],
                                                        s.camera.width, s.camera.height)
@@ -325,7 +326,8 @@ void validate(const Settings& s, const std::map<std::string, std::string>& loc, 
                  fmt::format("{} particles at {} need about {:.0f} MB, more than this machine's {:.0f} MB of physical "
                              "memory", particles, image, mb, physicalMb));
     }
-    if (s.render.estimator == EstimatorKind::ris && (s.render.source == LightSource::tiles || s.render.source == LightSource::regir))
+    if (estimatorInfo(s.render.estimator).resampling && !estimatorInfo(s.render.estimator).reuse &&
+        sourceInfo(s.render.source).reuseOnly)
         fail("render.source", fmt::format("\"{}\" is a restir source: its presampled lights are drawn once per frame, and ris "
                                           "averages many samples of one frame, which would converge to that frame's draw, not "
                                           "to Lr (use uniform, power or tree)", enumName(s.render.source)));

@@ -17,6 +17,7 @@
 #include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
+#include "accretion/scene/estimator_table.h"
 #include "accretion/core/atomic_file.h"
 #include "accretion/core/error.h"
 #include "accretion/core/median.h"
@@ -73,8 +74,7 @@ void requireSupported(const Settings& s, bool lighting) {
     if (lighting && !estimatorInfo(e).twin) refuse(fmt::format("render.estimator = \"{}\"", enumName(e)));
     if (lighting && estimatorInfo(e).reuse) {
         const RestirSettings& r = s.restir;
-        if (s.render.source == LightSource::tiles) refuse("render.source = \"tiles\"");
-        if (s.render.source == LightSource::regir) refuse("render.source = \"regir\"");
+        if (!sourceInfo(s.render.source).twin) refuse(fmt::format("render.source = \"{}\"", enumName(s.render.source)));
         if (r.layout != ReservoirLayout::full) refuse("restir.layout = \"packed\"");
         if (r.basic_visibility) refuse("restir.basic_visibility");
         if (r.candidate_visibility) refuse("restir.candidate_visibility");
@@ -177,8 +177,7 @@ FrameFacts planningFacts(const Args& a) {
 TwinRun::TwinRun(const Args& a, const Settings& settings)
     : a_(a), s_(settings), settingsToml_(settingsToToml(settings)), source_(settings), cameras_(settings.camera),
       W_(settings.camera.width), H_(settings.camera.height), runPlan_(planFrame(settings, planningFacts(a))),
-      sampling_(!a.skipLighting && (settings.render.estimator == EstimatorKind::uniform ||
-                                    settings.render.estimator == EstimatorKind::power)),
+      sampling_(!a.skipLighting && !estimatorInfo(settings.render.estimator).sums && !estimatorInfo(settings.render.estimator).resampling),
       lightingPlan_(planLighting(settings.render, H_)),
       omm_(settings.geometry.alpha == AlphaMode::disc && settings.gpu.omm != OmmMode::off) {
     if (a.shadowRays == "traverse" || a.shadowRays == "reorder") shade_ = Raygen::shadeTraverse;

@@ -7,7 +7,7 @@
 
 #include "accretion/core/pass.h"
 #include "accretion/particles/particles.h"
-#include "accretion/render/estimator_table.h"
+#include "accretion/scene/estimator_table.h"
 #include "accretion/render/pixel_window.h"
 #include "accretion/scene/settings.h"
 

@@ -403,13 +403,6 @@ struct Settings {
     }
 };
 
-/// Whether render.crop traces, lights and holds its window alone (each pixel
-/// as in the whole image): for every estimator but restir (spatial reuse
-/// reads the neighbours, history is the whole frame's), and not in counting
-/// mode (the GPU's dispatch is the whole frame). FramePlan::traced and the
-/// memory estimate of the settings read it.
-inline bool cropRendersAlone(const Settings& s) { return s.render.estimator != EstimatorKind::restir && !s.gpu.counters; }
-
 /// Output path of a frame: {scene} and {frame} (zero-padded to 4) replaced.
 std::string expandPattern(std::string_view pattern, std::string_view scene, std::uint32_t frame);
 

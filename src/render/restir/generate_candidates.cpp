@@ -11,7 +11,7 @@ namespace {
 template <LightSource S>
 struct CpuSource {
     const FrameContext& f;
-    static constexpr bool presampled = S == LightSource::tiles || S == LightSource::regir;
+    static constexpr bool presampled = sourceInfo(S).presampled;
 
     /// Per candidate its light's record, and the source's reads: an alias
     /// entry, both children at every level of the tree, or an entry of a tile
@@ -42,7 +42,7 @@ struct CpuSource {
         std::uint32_t tile = 0;
         std::int64_t cell = -1;
         if constexpr (presampled) tile = f.tiles->tileOf(x, y, f.lg.width, f.in.frame, f.in.settings.render.seed);
-        if constexpr (S == LightSource::regir) cell = f.regir->jitteredCell(sp.x, float(f.rs.regir_jitter), rng);
+        if constexpr (sourceInfo(S).regirGrid) cell = f.regir->jitteredCell(sp.x, float(f.rs.regir_jitter), rng);
         return {f, sp, tile, cell};
     }
 };

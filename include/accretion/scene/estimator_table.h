@@ -1,0 +1,101 @@
+#pragma once
+#include <array>
+#include <string_view>
+
+#include "accretion/scene/settings.h"
+
+namespace accretion {
+
+/// The light sampler buildLightSampler builds.
+enum class LightSamplerKind { none, power, tree };
+
+/// What an estimator of Lr is and what it needs: the one place the
+/// settings' checks (scene_parser), the frame plan, the commands (converge,
+/// bias, experiment, render's outputs, the twin) and `accretion estimators`
+/// (docs/rendering.md's table) read it from. It lives in the scene layer so
+/// that the settings' checks can read it.
+struct EstimatorInfo {
+    EstimatorKind kind;
+    bool sums;                ///< sums every light (exact): no samples, no standard error
+    LightSamplerKind sampler; ///< the light sampler it draws from itself (ris and restir: their render.source's)
+    bool resampling;          ///< draws render.candidates candidates from render.source, keeps one by RIS
+    bool reuse;               ///< reservoirs reused across pixels and frames: restir's passes and history
+    bool unbiased;            ///< converges to exact whatever its settings (restir: only with a bias correction)
+    bool adaptive;            ///< render.target_stderr stops each pixel at its error
+    bool twin;                ///< accretion-optix runs it
+    bool nearField;           ///< sums each pixel's nearest render.near_lights lights exactly (0: the pilot chooses them)
+    std::string_view summary;
+};
+
+inline constexpr std::array<EstimatorInfo, 7> kEstimators = {{
+    {EstimatorKind::exact, true, LightSamplerKind::none, false, false, true, false, true, false,
+     "every light i != j with its shadow ray: the reference"},
+    {EstimatorKind::uniform, false, LightSamplerKind::none, false, false, true, true, true, false,
+     "S lights drawn uniformly per pixel, with the standard error"},
+    {EstimatorKind::power, false, LightSamplerKind::power, false, false, true, true, true, false,
+     "S lights drawn by luminance (alias table), with the standard error"},
+    {EstimatorKind::ris, false, LightSamplerKind::none, true, false, true, true, false, false,
+     "S reservoirs of render.candidates candidates from render.source, one shadow ray each"},
+    {EstimatorKind::restir, false, LightSamplerKind::none, true, true, false, false, true, false,
+     "ReSTIR DI: RIS candidates, temporal and spatial reuse, one shadow ray"},
+    {EstimatorKind::tree, false, LightSamplerKind::tree, false, false, true, true, false, false,
+     "S lights drawn from the light tree at the receiver, with the standard error"},
+    {EstimatorKind::split, false, LightSamplerKind::tree, false, false, true, true, false, true,
+     "the nearest lights summed, the far ones drawn from the light tree"},
+}};
+
+constexpr bool estimatorTableMatchesEnum() {
+    for (std::size_t k = 0; k < kEstimators.size(); ++k)
+        if (std::size_t(kEstimators[k].kind) != k) return false;
+    return kEstimators.size() == EnumNames<EstimatorKind>::names.size();
+}
+static_assert(estimatorTableMatchesEnum(), "kEstimators lists every EstimatorKind in enum order");
+
+constexpr const EstimatorInfo& estimatorInfo(EstimatorKind kind) { return kEstimators[std::size_t(kind)]; }
+
+/// What a candidate source (render.source) of ris and restir is and needs:
+/// the one place the settings' checks, the plan, generateCandidates' counters,
+/// the GPU memory model and the twin read it from.
+struct LightSourceInfo {
+    LightSource kind;
+    LightSamplerKind sampler; ///< the light sampler built for it (tiles and regir presample from the power table)
+    bool presampled;          ///< drawn from light tiles presampled each frame (presampleLightTiles)
+    bool regirGrid;           ///< drawn from a world-space grid of reservoirs (presampleRegirGrid)
+    bool reuseOnly;           ///< restir only: its tiles and grid are passes of restir's frame (ris refuses it)
+    bool twin;                ///< accretion-optix draws from it
+    std::string_view summary;
+};
+
+inline constexpr std::array<LightSourceInfo, 5> kLightSources = {{
+    {LightSource::uniform, LightSamplerKind::none, false, false, false, true, "every light alike"},
+    {LightSource::power, LightSamplerKind::power, false, false, false, true, "by luminance (the alias table)"},
+    {LightSource::tree, LightSamplerKind::tree, false, false, false, true, "the light tree at the receiver"},
+    {LightSource::tiles, LightSamplerKind::power, true, false, true, false, "RTXDI's light tiles, presampled by power"},
+    {LightSource::regir, LightSamplerKind::power, true, true, true, false,
+     "a world-space grid of light reservoirs (ReGIR), the tiles outside it"},
+}};
+
+constexpr bool sourceTableMatchesEnum() {
+    for (std::size_t k = 0; k < kLightSources.size(); ++k)
+        if (std::size_t(kLightSources[k].kind) != k) return false;
+    return kLightSources.size() == EnumNames<LightSource>::names.size();
+}
+static_assert(sourceTableMatchesEnum(), "kLightSources lists every LightSource in enum order");
+
+constexpr const LightSourceInfo& sourceInfo(LightSource kind) { return kLightSources[std::size_t(kind)]; }
+
+/// The light sampler a frame lit by `render`'s estimator needs: its own, or
+/// its render.source's.
+constexpr LightSamplerKind samplerFor(const RenderSettings& render) {
+    const EstimatorInfo& e = estimatorInfo(render.estimator);
+    return e.resampling ? sourceInfo(render.source).sampler : e.sampler;
+}
+
+/// Whether render.crop traces, lights and holds its window alone (each pixel
+/// as in the whole image): for every estimator without reuse (spatial reuse
+/// reads the neighbours, history is the whole frame's), and not in counting
+/// mode (the GPU's dispatch is the whole frame). FramePlan::traced and the
+/// memory estimate of the settings read it.
+constexpr bool cropRendersAlone(const Settings& s) { return !estimatorInfo(s.render.estimator).reuse && !s.gpu.counters; }
+
+}  // namespace accretion
