@@ -28,10 +28,11 @@ void planRun(const Settings& s, FramePlan& plan) {
 /// This frame's passes.
 void planPasses(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
     const EstimatorInfo& est = estimatorInfo(s.render.estimator);
-    plan.loadParticles = plan.buildClusters = !(plan.staticGeometry && facts.geometryBuilt);
+    plan.loadParticles = plan.buildClusters = plan.loadsParticles(facts);
     plan.lighting = !facts.lightingSkipped && facts.emissive && glm::length(s.shading.albedo) > 0.0f;
     plan.shadowRays = plan.lighting && s.shading.visibility;
     if (plan.lighting) plan.sampler = samplerFor(s.render);  // tiles and the ReGIR grid are drawn from the power table
+    plan.chooseNearLights = plan.lighting && est.nearField && s.render.near_lights == 0;
     const LightSourceInfo& source = sourceInfo(s.render.source);
     plan.restir = plan.lighting && est.reuse;
     plan.presampleTiles = plan.restir && source.presampled;
@@ -46,14 +47,14 @@ void describe(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
     const EstimatorKind est = s.render.estimator;
     const bool restir = estimatorInfo(est).reuse;
     const bool manyFrames = s.render.frames > 1;
-    auto step = [&](Pass pass, bool runs, std::string why) { plan.steps.push_back({pass, {}, runs, std::move(why)}); };
+    auto step = [&](Pass pass, std::string why) { plan.steps.push_back({pass, {}, true, std::move(why)}); };
     auto work = [&](std::string name, bool runs, std::string why) {
         plan.steps.push_back({std::nullopt, std::move(name), runs, std::move(why)});
     };
     const std::string once = "static particles and camera: built at the first frame";
-    step(Pass::loadParticles, plan.loadParticles,
+    step(Pass::loadParticles,
          !plan.loadParticles ? once : plan.staticGeometry && manyFrames ? "once: the particles do not move" : "every frame");
-    step(Pass::buildClusters, plan.buildClusters,
+    step(Pass::buildClusters,
          !plan.buildClusters ? once
          : plan.staticGeometry ? (manyFrames ? "once for all frames: static particles and camera" : "one frame")
                                : fmt::format("every frame ({})", enumName(s.geometry.build)));
@@ -68,38 +69,41 @@ void describe(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
     const std::string noLight = facts.lightingSkipped ? "no lighting passes: skipped by the command (geometry timed alone)"
                                 : !facts.emissive ? "no lighting passes: no particle emits"
                                                   : "no lighting passes: albedo 0";
-    step(Pass::buildLightSampler, plan.sampler != LightSamplerKind::none,
+    step(Pass::buildLightSampler,
          plan.sampler == LightSamplerKind::tree    ? "light tree"
          : plan.sampler == LightSamplerKind::power ? "alias table over light power"
          : dark ? noLight : fmt::format("{} samples lights uniformly", enumName(est)));
-    step(Pass::traceGBuffer, true,
+    if (estimatorInfo(est).nearField)
+        step(Pass::chooseNearLights, plan.chooseNearLights ? "the pilot picks render.near_lights from V(k) x (k + rho S) at 64 pixels across"
+                                     : dark ? noLight : fmt::format("render.near_lights = {}", s.render.near_lights));
+    step(Pass::traceGBuffer,
          plan.traced.isWhole(s.camera.width, s.camera.height)
              ? std::string("one primary ray per pixel")
              : fmt::format("one primary ray per pixel of render.crop's {}x{} window", plan.traced.width(), plan.traced.height()));
-    step(Pass::estimateLighting, plan.lighting,
+    step(Pass::estimateLighting,
          dark ? noLight : restir ? "the restir passes below" : std::string(enumName(est)));
     if (restir) {
         const RestirSettings& r = s.restir;
-        step(Pass::presampleLightTiles, plan.presampleTiles,
+        step(Pass::presampleLightTiles,
              plan.presampleTiles ? fmt::format("{} tiles x {} lights by power", r.tile_count, r.tile_size)
              : dark ? noLight : fmt::format("source {}: no light tiles", enumName(s.render.source)));
-        step(Pass::presampleRegirGrid, plan.presampleRegir,
+        step(Pass::presampleRegirGrid,
              plan.presampleRegir ? fmt::format("{}^3 cells x {} reservoirs of {} tile candidates", r.regir_cells,
                                                r.regir_lights_per_cell, r.regir_build_samples)
              : dark ? noLight : fmt::format("source {}: no ReGIR grid", enumName(s.render.source)));
-        step(Pass::generateCandidates, plan.restir,
+        step(Pass::generateCandidates,
              dark ? noLight : fmt::format("{} candidates from {}", s.render.candidates, enumName(s.render.source)));
-        step(Pass::temporalResampling, plan.temporal,
+        step(Pass::temporalResampling,
              plan.temporal ? "reprojection through particle motion"
              : dark ? noLight : !s.restir.temporal ? "temporal off: no history buffers or motion"
              : !manyFrames ? "one frame: no history buffers or motion" : "first frame: no history yet");
-        step(Pass::spatialResampling, plan.spatialIterations > 0,
+        step(Pass::spatialResampling,
              plan.spatialIterations ? fmt::format("{} neighbours x {}", s.restir.spatial_neighbours, s.restir.spatial_iterations)
                                     : (dark ? noLight : "no neighbours"));
-        step(Pass::traceShadowRays, plan.restir,
+        step(Pass::traceShadowRays,
              plan.shadowRays ? "one shadow ray per pixel"
              : dark ? noLight : "visibility off: the kept sample shaded with V = 1, no shadow rays");
-        step(Pass::upsampleLighting, plan.upsample,
+        step(Pass::upsampleLighting,
              plan.upsample ? fmt::format("lighting at scale {}", s.restir.resolution_scale) : "full-resolution lighting");
     } else {
         work("shadow rays", plan.shadowRays,
@@ -111,8 +115,8 @@ void describe(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
                     : fmt::format("estimator {}: no reservoirs", enumName(est)));
     work("counters", plan.counting,
          plan.counting ? "counting variants of every pass" : "counters off: no counting code in the loops");
-    step(Pass::composeImage, true, "Le + Lr");
-    step(Pass::writeOutputs, true, "EXR, PNG previews, stats (by the command)");
+    step(Pass::composeImage, "Le + Lr");
+    step(Pass::writeOutputs, "EXR, PNG previews, stats (by the command)");
 }
 
 }  // namespace
@@ -143,10 +147,31 @@ FramePlan planFrame(const Settings& settings, const FrameFacts& facts) {
     return plan;
 }
 
+bool FramePlan::runs(Pass pass) const {
+    switch (pass) {
+    case Pass::loadParticles: return loadParticles;
+    case Pass::buildLightSampler: return sampler != LightSamplerKind::none;
+    case Pass::chooseNearLights: return chooseNearLights;
+    case Pass::buildClusters: return buildClusters;
+    case Pass::traceGBuffer: return true;
+    case Pass::estimateLighting: return lighting;
+    case Pass::presampleLightTiles: return presampleTiles;
+    case Pass::presampleRegirGrid: return presampleRegir;
+    case Pass::generateCandidates: return restir;
+    case Pass::temporalResampling: return temporal;
+    case Pass::spatialResampling: return spatialIterations > 0;
+    case Pass::traceShadowRays: return restir;
+    case Pass::upsampleLighting: return upsample;
+    case Pass::composeImage: return true;
+    case Pass::writeOutputs: return true;
+    }
+    return false;
+}
+
 std::vector<Pass> FramePlan::passes() const {
     std::vector<Pass> out;
     for (const PlannedStep& s : steps)
-        if (s.pass && s.runs && *s.pass != Pass::writeOutputs) out.push_back(*s.pass);
+        if (s.pass && runs(*s.pass) && *s.pass != Pass::writeOutputs) out.push_back(*s.pass);
     return out;
 }
 
@@ -161,7 +186,7 @@ std::string formatPlan(const FramePlan& plan) {
     for (const PlannedStep& s : plan.steps) {
         const bool nested = s.pass && isNested(*s.pass);
         out += fmt::format("  {}{:<{}} {:<8} {}\n", nested ? "  " : "", s.name(), nested ? 22 : 24,
-                           s.runs ? "runs" : "skipped", s.why);
+                           plan.runs(s) ? "runs" : "skipped", s.why);
     }
     return out;
 }

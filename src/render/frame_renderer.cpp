@@ -130,7 +130,7 @@ const Particles& FrameRenderer::prepareGeometry(std::uint32_t frame, const Camer
     FrameFacts facts;
     facts.geometryBuilt = built_ && !options_.rebuildStatic;
     facts.historyAvailable = restir_ && restir_->hasHistory();
-    if (planFrame(settings_, facts).loadParticles) {
+    if (plan_.loadsParticles(facts)) {  // the run's plan: this frame's is made once its particles are known
         auto t = stats.timer.scope(Pass::loadParticles);
         loaded = source_.frame(frame);
         for (Vec3& p : loaded.position) p -= origin_;
@@ -170,9 +170,7 @@ void FrameRenderer::lightFrame(std::uint32_t frame, const Camera& camera, const 
         img.lighting.rejected.assign(pixels, 0.0f);
         return;
     }
-    const std::uint32_t nearLights = settings_.render.estimator == EstimatorKind::split && settings_.render.near_lights == 0
-                                         ? chooseFrameNearLights(frame, img.camera, particles, lightTree, stats)
-                                         : 0u;
+    const std::uint32_t nearLights = plan.chooseNearLights ? chooseFrameNearLights(frame, img.camera, particles, lightTree, stats) : 0u;
     auto t = stats.timer.scope(Pass::estimateLighting);
     if (plan.restir) {
         RestirInputs in{*bvh_, particles, gbuffer, camera, settings_, plan, frame, powerTable, lightTree,

@@ -249,7 +249,7 @@ FramePlan TwinRun::planFrameAndLoad(std::uint32_t frame) {
     FrameFacts facts = planningFacts(a_);
     facts.geometryBuilt = built_;
     facts.historyAvailable = history_;
-    if (planFrame(s_, facts).loadParticles) {
+    if (runPlan_.loadsParticles(facts)) {  // the run's plan: this frame's is made once its particles are known
         particles_ = particlesOf(frame);
         for (Vec3& p : particles_.position) p -= origin_;
     }

@@ -13,12 +13,13 @@
 
 namespace accretion {
 
-/// One line of a frame's plan: a pass (or the work inside one) and whether
-/// it runs, with what it does or why it is skipped.
+/// One line of a frame's plan, as `accretion plan` prints it: a pass (whether
+/// it runs is FramePlan::runs, decided once) or the work inside one, with
+/// what it does or why it is skipped.
 struct PlannedStep {
     std::optional<Pass> pass;  ///< a timed pass (stats' "passes"), else work inside one, named by `work`
     std::string work;
-    bool runs = true;
+    bool workRuns = true;      ///< the work's (a pass's is the plan's)
     std::string why;
     std::string_view name() const { return pass ? passName(*pass) : std::string_view(work); }
 };
@@ -54,6 +55,7 @@ struct FramePlan {
     bool buildClusters = true;    ///< build (or refit) the BVH
     bool lighting = true;         ///< any lighting pass at all
     LightSamplerKind sampler = LightSamplerKind::none;  ///< buildLightSampler
+    bool chooseNearLights = false;  ///< split's pilot picks render.near_lights (set to 0) for the frame
     bool shadowRays = true;       ///< visibility by shadow rays (off: V = 1)
     bool restir = false;          ///< the restir passes instead of estimateLighting's accumulation
     bool presampleTiles = false;  ///< presampleLightTiles (render.source tiles or regir)
@@ -63,6 +65,14 @@ struct FramePlan {
     bool upsample = false;        ///< upsampleLighting (restir at reduced resolution)
     std::vector<PlannedStep> steps;
 
+    /// Whether a frame with these facts loads (and builds) its particles: the
+    /// run-wide half of the decision, which the frame renderer needs before
+    /// the particles it plans with are loaded.
+    bool loadsParticles(const FrameFacts& facts) const { return !(staticGeometry && facts.geometryBuilt); }
+    /// Whether a pass runs this frame: the one mapping of the decisions above to passes.
+    bool runs(Pass pass) const;
+    /// Whether a line of steps runs.
+    bool runs(const PlannedStep& step) const { return step.pass ? runs(*step.pass) : step.workRuns; }
     /// The passes that run, in order (restir's inside estimateLighting), writeOutputs aside.
     std::vector<Pass> passes() const;
     const PlannedStep* find(Pass pass) const;
