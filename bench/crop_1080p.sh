@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Part 2 of issue 33: crops and single pixels at frame speed. disk_100k
+# Crops and single pixels at frame speed. disk_100k
 # frame 0 at 1920x1080, `split` at SPP samples (k from the pilot: one k for
 # the view, whatever the window), windows of 1x1 to 256x256 pixels about
 # (1000, 600) and the whole frame, RUNS runs each, interleaved; then one

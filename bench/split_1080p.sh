@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The 1080p target of issue 33: disk_100k frame 0 at 1920x1080, `split`
+# The reference at the GPU team's resolution: disk_100k frame 0 at 1920x1080, `split`
 # with k chosen by the pilot, at several sample counts; each run's wall
 # time, its passes (stats.json) and its relMSE of Lr against an exact 1080p
 # reference (made in row shards: docs/batches.md, "Shards"). Per k the

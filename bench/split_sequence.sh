@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The 64-frame sequence of issue 33: disk_100k frames 0..63 at 1920x1080,
+# The 64-frame reference sequence: disk_100k frames 0..63 at 1920x1080,
 # `split` at SPP samples with k from each frame's pilot.
 #   bench/split_sequence.sh time SPP OUTDIR
 #       one `render --frames 0:64` (seed 1), its wall time: the figure

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Seed 004's decision matrix from the twin's stats JSONs (bench/gpu/run.sh
+"""The layout decision matrix from the twin's stats JSONs (bench/gpu/run.sh
 steps layouts and streams): one row per configuration, frame 1 (after a
 history frame), median GPU ms per pass and the acceleration structure's
 memory.  Usage: layouts_table.py OUT.csv DIR..."""

@@ -134,7 +134,7 @@ step_sweep() {
     { echo config,pass,ms; for f in "$t"/*.timings.csv; do tail -n +2 "$f"; done; } > "$t/timings_${part%/*}.csv"
 }
 
-# Seed 004's build questions: rebuild / refit / partial, pooled / per-BLAS,
+# The build questions of the team's original design: rebuild / refit / partial, pooled / per-BLAS,
 # compaction, cluster size 100 / 1000, at 100K particles and 1080p.
 step_builds() {
     local s=scenes/disk_100k.toml f="-D camera.width=1920 -D camera.height=1080 --skip-lighting --repeat 7"
@@ -157,7 +157,7 @@ step_builds() {
     rm -f "$t"/*.gpuframe
 }
 
-# Seed 004's frame: 100K particles, restir at 1080p, per-pass GPU ms: the
+# The original design's frame: 100K particles, restir at 1080p, per-pass GPU ms: the
 # three shadow-ray paths, cluster sizes 100 and 1000, lighting at 0.75x and
 # 0.5x (restir.resolution_scale, with the upsampling pass), disc alpha by
 # any-hit and by 4- and 2-state micromaps.
@@ -203,7 +203,7 @@ step_layout_images() {
     one clusters_threads4 --build-threads 4
 }
 
-# Seed 004's decision matrix (bench/gpu/layouts.txt): every layout at 10K,
+# The layout decision matrix (bench/gpu/layouts.txt): every layout at 10K,
 # 100K and 1M particles, 720p and 1080p, restir (frame 1 after a history
 # frame), per-pass GPU ms (`accretion-optix --timings`) and the acceleration
 # structure's memory (the stats JSON). LAYOUT_PARTS=i/n runs the i-th of n parts;

@@ -373,7 +373,8 @@ LaunchParams TwinRun::launchParams(const FramePlan& plan, const Camera& camera, 
 
 /// The restir passes of a frame after the G-buffer, as the plan has them
 /// (the CPU's Restir::render): generateCandidates, temporalResampling,
-/// spatialResampling x iterations, traceShadowRays, upsampleLighting.
+/// spatialResampling x plan.spatialIterations, traceShadowRays, and with
+/// plan.upsample the reduced G-buffer first and upsampleLighting last.
 /// Returns the final reservoirs (the next frame's history).
 StoredReservoir* TwinRun::runRestir(const FramePlan& plan, LaunchParams& lp) {
     RestirParams& rp = lp.restir;

@@ -129,7 +129,7 @@ std::uint32_t farCutSize(const RenderSettings& render);
 /// lights and draws the one light from the rest (LightTree::sampleFar);
 /// `ris` averages S one-reservoir RIS estimates of M candidates each. Monte
 /// Carlo estimators also give their standard error. (`restir` keeps history
-/// across frames: see lighting/restir.h.)
+/// across frames: see render/restir.h.)
 /// Per-pixel, per-chunk PCG streams make the result independent of the
 /// thread count and of checkpoints. A NaN/Inf sample is rejected under
 /// render.nonfinite and counted. The whole frame in one call:
