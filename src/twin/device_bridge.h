@@ -7,23 +7,6 @@
 
 namespace accretion::twin {
 
-/// The ReuseParams of a launch.
-__device__ inline restir::ReuseParams reuseParams(const RestirParams& rp) {
-    restir::ReuseParams p;
-    p.frame = rp.frame;
-    p.seed = rp.seed;
-    p.width = rp.width;
-    p.height = rp.height;
-    p.scale = rp.scale;
-    p.normalThreshold = rp.normalThreshold;
-    p.depthThreshold = rp.depthThreshold;
-    p.mCap = rp.mCap;
-    p.candidates = rp.candidates;
-    p.neighbours = rp.neighbours;
-    p.radius = rp.radius;
-    return p;
-}
-
 /// The visibility of a bridge whose pass traces no shadow ray (the twin
 /// refuses restir.candidate_visibility: generateCandidates never asks).
 struct NoShadowRays {
@@ -76,11 +59,11 @@ public:
         std::uint32_t n_ = 0;
     };
 
-    __device__ DeviceBridge(const LaunchParams& p, const restir::ReuseParams& params, bool inPlace = false,
-                            Visibility visibility = {}, LaunchCounters* counters = nullptr)
-        : p_(p), params_(params), in_(inPlace ? p.restir.out : p.restir.in), visibility_(visibility), counters_(counters) {}
+    __device__ explicit DeviceBridge(const LaunchParams& p, bool inPlace = false, Visibility visibility = {},
+                                     LaunchCounters* counters = nullptr)
+        : p_(p), in_(inPlace ? p.restir.out : p.restir.in), visibility_(visibility), counters_(counters) {}
 
-    __device__ const restir::ReuseParams& params() const { return params_; }
+    __device__ const restir::ReuseParams& params() const { return p_.restir.reuse; }
     __device__ GBufferTexel texel(std::size_t px) const { return p_.restir.gbuffer[px]; }
     __device__ StoredReservoir input(std::size_t px) const { return in_[px]; }
     __device__ void output(std::size_t px, const StoredReservoir& r) const { p_.restir.out[px] = r; }
@@ -117,7 +100,6 @@ public:
 
 private:
     const LaunchParams& p_;
-    const restir::ReuseParams& params_;
     const StoredReservoir* in_;
     Visibility visibility_;
     LaunchCounters* counters_;

@@ -12,6 +12,7 @@
 #include "accretion/render/accumulation.h"
 #include "accretion/geometry/camera.h"
 #include "accretion/render/gbuffer_texel.h"
+#include "accretion/render/restir_passes.h"
 #include "accretion/render/shadow_query.h"
 #include "accretion/scene/settings.h"
 
@@ -57,20 +58,12 @@ struct SamplingParams {
 
 /// ReSTIR DI (docs/MODEL.md section 4) as the CPU's passes run it.
 struct RestirParams {
-    std::uint32_t frame = 0;
-    std::uint64_t seed = 0;
-    std::uint32_t candidates = 16;
-    // The lighting grid every restir pass runs on: the image at
-    // restir.resolution_scale (the image itself at 1), its G-buffer and Lr.
-    std::uint32_t width = 0, height = 0;
-    float scale = 1.0f;                  ///< lighting / image resolution
-    const GBufferTexel* gbuffer = nullptr;
-    Vec3* Lr = nullptr;
+    /// The passes' settings and the lighting grid every restir pass runs on:
+    /// the image at restir.resolution_scale (the image itself at 1).
+    restir::ReuseParams reuse;
+    const GBufferTexel* gbuffer = nullptr;  ///< the lighting grid's G-buffer
+    Vec3* Lr = nullptr;                     ///< and its Lr
     bool temporal = false;               ///< a history exists and temporal reuse is on
-    std::uint32_t neighbours = 0;
-    float radius = 30.0f;                ///< spatial disc radius (lighting texels, >= 1)
-    float normalThreshold = 0.9f, depthThreshold = 0.1f;
-    double mCap = 20.0;
     BiasCorrection bias = BiasCorrection::basic;
     bool visibilityReuse = false;
     bool discardNonFinite = false;       ///< render.nonfinite = discard

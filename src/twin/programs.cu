@@ -182,10 +182,9 @@ struct OptixShadowRays {
 template <ShadingModel SM, bool Traverse>
 __device__ void shadePixel() {
     const uint3 idx = optixGetLaunchIndex();
-    const std::size_t px = std::size_t(idx.y) * params.restir.width + idx.x;  // the lighting grid's texel
+    const std::size_t px = std::size_t(idx.y) * params.restir.reuse.width + idx.x;  // the lighting grid's texel
     LaunchCounters c;
-    const restir::ReuseParams reuse = reuseParams(params.restir);
-    DeviceBridge<SM, OptixShadowRays<Traverse>> b(params, reuse, true, OptixShadowRays<Traverse>{&c}, &c);
+    DeviceBridge<SM, OptixShadowRays<Traverse>> b(params, true, OptixShadowRays<Traverse>{&c}, &c);
     restir::traceShadowRayTexel(b, px);
     addCounters(c);
 }

@@ -11,44 +11,42 @@ namespace {
 __device__ inline bool pixelOf(const LaunchParams& p, std::uint32_t& x, std::uint32_t& y, std::size_t& px) {
     x = blockIdx.x * blockDim.x + threadIdx.x;
     y = blockIdx.y * blockDim.y + threadIdx.y;
-    px = std::size_t(y) * p.restir.width + x;
-    return x < p.restir.width && y < p.restir.height;
+    px = std::size_t(y) * p.restir.reuse.width + x;
+    return x < p.restir.reuse.width && y < p.restir.reuse.height;
 }
 
-/// generateCandidates: restir_passes.h's body over the device bridge and its source.
+/// body(bridge, px, x, y) on the thread's texel of the lighting grid, if it
+/// has one, through the device bridge.
+template <ShadingModel SM, class Body>
+__device__ inline void onTexel(const LaunchParams& p, Body&& body) {
+    std::uint32_t x, y;
+    std::size_t px;
+    if (!pixelOf(p, x, y, px)) return;
+    DeviceBridge<SM> b(p);
+    body(b, px, x, y);
+}
+
+// The restir passes: launches of restir_passes.h's bodies.
 template <ShadingModel SM>
 __global__ void generateCandidatesKernel(LaunchParams p) {
-    std::uint32_t x, y;
-    std::size_t px;
-    if (!pixelOf(p, x, y, px)) return;
-    const restir::ReuseParams params = reuseParams(p.restir);
-    DeviceBridge<SM> b(p, params);
-    restir::generateCandidatesTexel(b, DeviceSource{p}, px, x, y);
+    onTexel<SM>(p, [&](auto& b, std::size_t px, std::uint32_t x, std::uint32_t y) {
+        restir::generateCandidatesTexel(b, DeviceSource{p}, px, x, y);
+    });
 }
 
-/// temporalResampling: restir_passes.h's body over the device bridge.
 template <ShadingModel SM>
 __global__ void temporalResamplingKernel(LaunchParams p) {
-    std::uint32_t x, y;
-    std::size_t px;
-    if (!pixelOf(p, x, y, px)) return;
-    const restir::ReuseParams params = reuseParams(p.restir);
-    DeviceBridge<SM> b(p, params);
-    restir::temporalResamplingTexel(b, px);
+    onTexel<SM>(p, [&](auto& b, std::size_t px, std::uint32_t, std::uint32_t) { restir::temporalResamplingTexel(b, px); });
 }
 
-/// spatialResampling: restir_passes.h's body over the device bridge.
 template <ShadingModel SM>
 __global__ void spatialResamplingKernel(LaunchParams p, std::uint32_t iteration) {
-    std::uint32_t x, y;
-    std::size_t px;
-    if (!pixelOf(p, x, y, px)) return;
-    const restir::ReuseParams params = reuseParams(p.restir);
-    DeviceBridge<SM> b(p, params);
-    restir::spatialResamplingTexel(b, px, x, y, iteration);
+    onTexel<SM>(p, [&](auto& b, std::size_t px, std::uint32_t x, std::uint32_t y) {
+        restir::spatialResamplingTexel(b, px, x, y, iteration);
+    });
 }
 
-dim3 blocks(const LaunchParams& p) { return dim3((p.restir.width + 7) / 8, (p.restir.height + 7) / 8); }
+dim3 blocks(const LaunchParams& p) { return dim3((p.restir.reuse.width + 7) / 8, (p.restir.reuse.height + 7) / 8); }
 const dim3 kGroup(8, 8);
 
 /// launch.template operator()<SM>() with the frame's shading model.
@@ -67,7 +65,7 @@ __global__ void reduceGBufferKernel(LaunchParams p, GBufferTexel* grid) {
     std::size_t px;
     if (!pixelOf(p, x, y, px)) return;
     std::uint32_t fx, fy;
-    reducedTexelSource(x, y, p.restir.scale, p.camera.width, p.camera.height, fx, fy);
+    reducedTexelSource(x, y, p.restir.reuse.scale, p.camera.width, p.camera.height, fx, fy);
     grid[px] = p.gbuffer[std::size_t(fy) * p.camera.width + fx];
 }
 
@@ -77,8 +75,8 @@ __global__ void upsampleLightingKernel(LaunchParams p) {
     if (x >= p.camera.width || y >= p.camera.height) return;
     const std::size_t px = std::size_t(y) * p.camera.width + x;
     const RestirParams& rp = p.restir;
-    p.Lr[px] = upsamplePixel(p.gbuffer[px], x, y, rp.scale, rp.gbuffer, rp.width, rp.height, rp.Lr, p.albedo,
-                             rp.normalThreshold, rp.depthThreshold);
+    p.Lr[px] = upsamplePixel(p.gbuffer[px], x, y, rp.reuse.scale, rp.gbuffer, rp.reuse.width, rp.reuse.height, rp.Lr, p.albedo,
+                             rp.reuse.normalThreshold, rp.reuse.depthThreshold);
 }
 
 }  // namespace

@@ -13,7 +13,7 @@ void generateCandidates(const LaunchParams& p, cudaStream_t stream);
 void temporalResampling(const LaunchParams& p, cudaStream_t stream);
 void spatialResampling(const LaunchParams& p, std::uint32_t iteration, cudaStream_t stream);
 /// restir.resolution_scale < 1: the lighting grid's G-buffer from the image's
-/// (p.restir.width x height texels into `grid`), and upsampleLighting (the
+/// (p.restir.reuse.width x height texels into `grid`), and upsampleLighting (the
 /// CPU's bilateral rule, upsamplePixel) from p.restir.Lr into p.Lr.
 void reduceGBuffer(const LaunchParams& p, GBufferTexel* grid, cudaStream_t stream);
 void upsampleLighting(const LaunchParams& p, cudaStream_t stream);

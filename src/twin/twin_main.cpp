@@ -341,20 +341,10 @@ LaunchParams TwinRun::launchParams(const FramePlan& plan, const Camera& camera, 
     if (plan.restir) {
         RestirParams& rp = lp.restir;
         const RestirSettings& rs = s_.restir;
-        rp.frame = frame;
-        rp.seed = seed;
-        rp.candidates = s_.render.candidates;
-        rp.width = gridW_;
-        rp.height = gridH_;
-        rp.scale = plan.upsample ? float(gridW_) / float(W_) : 1.0f;
+        rp.reuse = restir::reuseParams(s_, frame, seed, gridW_, gridH_, plan.upsample ? float(gridW_) / float(W_) : 1.0f);
         rp.gbuffer = plan.upsample ? buf_.gridGbuffer.as<GBufferTexel>() : lp.gbuffer;
         rp.Lr = plan.upsample ? buf_.gridLr.as<Vec3>() : lp.Lr;
         rp.temporal = plan.temporal;
-        rp.neighbours = rs.spatial_neighbours;
-        rp.radius = std::max(1.0f, float(rs.spatial_radius) * rp.scale);
-        rp.normalThreshold = float(rs.normal_threshold);
-        rp.depthThreshold = float(rs.depth_threshold);
-        rp.mCap = rs.m_cap;
         rp.bias = rs.bias_correction;
         rp.visibilityReuse = rs.visibility_reuse;
         rp.discardNonFinite = s_.render.nonfinite == NonFinitePolicy::discard;
@@ -378,7 +368,7 @@ LaunchParams TwinRun::launchParams(const FramePlan& plan, const Camera& camera, 
 /// Returns the final reservoirs (the next frame's history).
 StoredReservoir* TwinRun::runRestir(const FramePlan& plan, LaunchParams& lp) {
     RestirParams& rp = lp.restir;
-    const std::size_t pixels = std::size_t(rp.width) * rp.height;
+    const std::size_t pixels = std::size_t(rp.reuse.width) * rp.reuse.height;
     GpuTimer& timer = *timer_;
     if (plan.upsample) {
         GpuScope t(timer, Pass::upsampleLighting, "reduceGBuffer");
@@ -415,7 +405,7 @@ StoredReservoir* TwinRun::runRestir(const FramePlan& plan, LaunchParams& lp) {
         rp.in = nullptr;
         rp.out = a;
         CUDA_CHECK(cudaMemcpyAsync(buf_.params.as<void>(), &lp, sizeof lp, cudaMemcpyHostToDevice, stream_));
-        pipeline_->launch(shade_, buf_.params.address(), sizeof lp, rp.width, rp.height, stream_);
+        pipeline_->launch(shade_, buf_.params.address(), sizeof lp, rp.reuse.width, rp.reuse.height, stream_);
     }
     if (plan.upsample) {
         GpuScope t(timer, Pass::upsampleLighting);

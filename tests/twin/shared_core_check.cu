@@ -486,17 +486,8 @@ int main() {
     Vec3* dEmission = toDevice(emission);
     std::vector<PassInputs> hostPasses, devicePasses;
     for (const BiasCorrection bias : {BiasCorrection::none, BiasCorrection::basic, BiasCorrection::pairwise}) {
-        restir::ReuseParams params;
-        params.frame = 5;
-        params.seed = 9;
-        params.width = kGridW;
-        params.height = kGridH;
-        params.normalThreshold = 0.95f;
-        params.depthThreshold = 0.1f;
-        params.mCap = 20.0;
-        params.neighbours = 8;
-        params.radius = 6.0f;
-        params.candidates = 12;
+        const restir::ReuseParams params{.frame = 5, .seed = 9, .width = kGridW, .height = kGridH, .normalThreshold = 0.95f,
+                                         .depthThreshold = 0.1f, .mCap = 20.0, .candidates = 12, .neighbours = 8, .radius = 6.0f};
         hostPasses.push_back({params, bias, grid.data(), current.data(), history.data(), centres.data(), texels, gridCam, emission.data()});
         devicePasses.push_back({params, bias, dGrid, dCurrent, dHistory, dCentres, texels, gridCam, dEmission});
     }

@@ -38,6 +38,7 @@
 // reservoir codec), the twin's src/twin/device_bridge.h (OptiX, nothing
 // counted). tests/twin/shared_core_check.cu runs these bodies on the GPU and
 // on the CPU through one bridge of its own and compares them bit for bit.
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <type_traits>
@@ -62,6 +63,26 @@ struct ReuseParams {
     std::uint32_t neighbours = 0;         ///< restir.spatial_neighbours
     float radius = 1.0f;                  ///< spatial disc radius in lighting texels (>= 1)
 };
+
+/// The ReuseParams of a frame: the lighting grid (width x height, `scale` x
+/// the image), the frame and seed of its streams, and the settings; the CPU
+/// and the twin both make theirs here.
+inline ReuseParams reuseParams(const Settings& s, std::uint32_t frame, std::uint64_t seed, std::uint32_t width,
+                               std::uint32_t height, float scale) {
+    ReuseParams p;
+    p.frame = frame;
+    p.seed = seed;
+    p.width = width;
+    p.height = height;
+    p.scale = scale;
+    p.normalThreshold = float(s.restir.normal_threshold);
+    p.depthThreshold = float(s.restir.depth_threshold);
+    p.mCap = s.restir.m_cap;
+    p.candidates = s.render.candidates;
+    p.neighbours = s.restir.spatial_neighbours;
+    p.radius = std::max(1.0f, float(s.restir.spatial_radius) * scale);
+    return p;
+}
 
 /// The counters of a thread that counts nothing (the GPU's bridge).
 struct NoRecorder {

@@ -15,19 +15,7 @@ namespace accretion::restir {
 
 /// The ReuseParams of a CPU frame.
 inline ReuseParams reuseParams(const FrameContext& f) {
-    ReuseParams p;
-    p.frame = f.in.frame;
-    p.seed = f.in.settings.render.seed;
-    p.width = f.lg.width;
-    p.height = f.lg.height;
-    p.scale = f.scale;
-    p.normalThreshold = float(f.rs.normal_threshold);
-    p.depthThreshold = float(f.rs.depth_threshold);
-    p.mCap = f.rs.m_cap;
-    p.candidates = f.in.settings.render.candidates;
-    p.neighbours = f.rs.spatial_neighbours;
-    p.radius = std::max(1.0f, float(f.rs.spatial_radius) * f.scale);
-    return p;
+    return reuseParams(f.in.settings, f.in.frame, f.in.settings.render.seed, f.lg.width, f.lg.height, f.scale);
 }
 
 /// What a CPU pass reads and writes: its input reservoirs, its output (the
