@@ -57,21 +57,11 @@ PassReport summarise(const PassCounters& pc, const GpuSettings& gpu, const SerKe
     for (const ThreadCounters& t : pc.threads) {
         p.threads += t.active;
         p.hitThreads += t.hit;
-        p.trips += t.trips;
         p.maxTrips = std::max(p.maxTrips, t.trips);
-        p.rays += t.rays;
-        p.proceeds += t.proceeds;
-        p.blasEntries += t.blasEntries;
-        p.anyHits += t.anyHits;
-        p.blasLevels += t.blasLevels;
-        p.ommLookups += t.ommLookups;
-        p.intersections += t.intersections;
-        p.misses += t.misses;
-        p.segmentBoxes += t.segmentBoxes;
-        p.wholeSegmentBoxes += t.wholeSegmentBoxes;
-        p.bytesRead += t.bytesRead;
-        p.gathers += t.gathers;
-        p.bytesWritten += t.bytesWritten;
+#define ACC_SUM(member, key, doc) p.member += t.member;
+        ACC_THREAD_COUNTERS(ACC_SUM)
+        ACC_RAY_COUNTERS(ACC_SUM)
+#undef ACC_SUM
     }
     p.ser = serOf(pc, gpu, key);
     adviseRayModel(p);
@@ -146,56 +136,47 @@ nlohmann::json simtJson(const SimtStats& s) {
 }  // namespace
 
 nlohmann::json toJson(const PassReport& p) {
-    return {{"pass", p.pass.label()},
-            {"width", p.width},
-            {"height", p.height},
-            {"threads", p.threads},
-            {"hit_threads", p.hitThreads},
-            {"blas_levels", p.blasLevels},
-            {"omm_lookups", p.ommLookups},
-            {"dispatches", p.dispatches},
-            {"blas_builds", p.build.blasBuilds},
-            {"blas_refits", p.build.blasRefits},
-            {"build_launches", p.build.builds},
-            {"refit_launches", p.build.refits},
-            {"accel_elements", p.build.elements},
-            {"build_primitives", p.build.primitives},
-            {"custom_builds", p.build.customBuilds},
-            {"sphere_refits", p.build.sphereRefits},
-            {"tlas_instances", p.build.tlasInstances},
-            {"tlas_instances_32k", p.build.tlasInstancesMid},
-            {"intersections", p.intersections},
-            {"misses", p.misses},
-            {"segment_boxes", p.segmentBoxes},
-            {"whole_segment_boxes", p.wholeSegmentBoxes},
-            {"gathers", p.gathers},
-            {"warp_segment_boxes", p.ser.traversalBefore.steps},
-            {"warp_gathers", p.ser.gathersBefore.steps},
-            {"hit_warps", p.ser.hitsBefore.warps},
-            {"footprint_bytes", p.footprintBytes},
-            {"tlas_levels", p.tlasLevels},
-            {"working_set_bytes", p.workingSetBytes},
-            {"trips", p.trips},
-            {"max_trips", p.maxTrips},
-            {"rays", p.rays},
-            {"proceeds", p.proceeds},
-            {"blas_entries", p.blasEntries},
-            {"blas_entries_per_ray", p.perRay(p.blasEntries)},
-            {"any_hit", p.anyHits},
-            {"any_hits_per_ray", p.perRay(p.anyHits)},
-            {"bytes_read", p.bytesRead},
-            {"bytes_written", p.bytesWritten},
-            {"warp_steps", p.warpSteps()},
-            {"simt_efficiency", {{"branch", simtJson(p.ser.branchBefore)}, {"loop", simtJson(p.ser.loopBefore)}}},
-            {"ser",
-             {{"key", p.ser.key},
-              {"branch_after", simtJson(p.ser.branchAfter)},
-              {"loop_after", simtJson(p.ser.loopAfter)},
-              {"distinct_sort_keys_per_warp_before", p.ser.distinctSortKeysBefore},
-              {"distinct_sort_keys_per_warp_after", p.ser.distinctSortKeysAfter},
-              {"reorder_steps", p.ser.reorderSteps},
-              {"predicted_speedup", p.ser.predictedSpeedup}}},
-            {"ray_model", {{"recommendation", p.rayModel}, {"reason", p.reason}}}};
+    nlohmann::json j = {{"pass", p.pass.label()},
+                        {"width", p.width},
+                        {"height", p.height},
+                        {"threads", p.threads},
+                        {"hit_threads", p.hitThreads},
+                        {"dispatches", p.dispatches},
+                        {"blas_builds", p.build.blasBuilds},
+                        {"blas_refits", p.build.blasRefits},
+                        {"build_launches", p.build.builds},
+                        {"refit_launches", p.build.refits},
+                        {"accel_elements", p.build.elements},
+                        {"build_primitives", p.build.primitives},
+                        {"custom_builds", p.build.customBuilds},
+                        {"sphere_refits", p.build.sphereRefits},
+                        {"tlas_instances", p.build.tlasInstances},
+                        {"tlas_instances_32k", p.build.tlasInstancesMid},
+                        {"warp_segment_boxes", p.ser.traversalBefore.steps},
+                        {"warp_gathers", p.ser.gathersBefore.steps},
+                        {"hit_warps", p.ser.hitsBefore.warps},
+                        {"footprint_bytes", p.footprintBytes},
+                        {"tlas_levels", p.tlasLevels},
+                        {"working_set_bytes", p.workingSetBytes},
+                        {"max_trips", p.maxTrips},
+                        {"blas_entries_per_ray", p.perRay(p.blasEntries)},
+                        {"any_hits_per_ray", p.perRay(p.anyHits)},
+                        {"warp_steps", p.warpSteps()},
+                        {"simt_efficiency", {{"branch", simtJson(p.ser.branchBefore)}, {"loop", simtJson(p.ser.loopBefore)}}},
+                        {"ser",
+                         {{"key", p.ser.key},
+                          {"branch_after", simtJson(p.ser.branchAfter)},
+                          {"loop_after", simtJson(p.ser.loopAfter)},
+                          {"distinct_sort_keys_per_warp_before", p.ser.distinctSortKeysBefore},
+                          {"distinct_sort_keys_per_warp_after", p.ser.distinctSortKeysAfter},
+                          {"reorder_steps", p.ser.reorderSteps},
+                          {"predicted_speedup", p.ser.predictedSpeedup}}},
+                        {"ray_model", {{"recommendation", p.rayModel}, {"reason", p.reason}}}};
+#define ACC_JSON(member, key, doc) j[key] = p.member;
+    ACC_THREAD_COUNTERS(ACC_JSON)
+    ACC_RAY_COUNTERS(ACC_JSON)
+#undef ACC_JSON
+    return j;
 }
 
 nlohmann::json toJson(const GpuReport& r) {

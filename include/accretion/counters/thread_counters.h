@@ -8,27 +8,49 @@
 
 namespace accretion {
 
-/// What one ray query did, as a GPU would count it (docs/MODEL.md section 6).
+// The GPU counters as tables (docs/MODEL.md section 6): each row is a
+// counter's member, its key in the reports' JSON, and what it counts. The
+// counter structs below, their sums (over a thread's rays, over a pass's
+// threads: PassReport in gpu/gpu_report.h) and the JSON keys are all
+// derived from these rows; the cost model's features (gpu/cost_model.h's
+// kCostFeatureTable) read the sums by member.
+
+/// What a ray query records, summed over a thread's rays.
+#define ACC_RAY_COUNTERS(X)                                                                                              \
+    X(blasEntries, "blas_entries", "TLAS leaves entered (BLAS traversals started)")                                      \
+    X(anyHits, "any_hit", "any-hit invocations (alpha-tested candidates)")                                               \
+    X(blasLevels, "blas_levels", "per BLAS entered, its depth: ceil(log2(primitives)) (traversal inside it)")           \
+    X(ommLookups, "omm_lookups", "candidate hits on micromapped triangles (the micromap looked up)")                     \
+    X(intersections, "intersections", "intersection-program invocations: boxes (aabbs layout) or spheres whose bounds "  \
+                                      "the ray entered")                                                                 \
+    X(misses, "misses", "1 when the query found nothing (a shadow ray unblocked): it traversed its whole segment")       \
+    X(segmentBoxes, "segment_boxes", "particles' boxes the ray crosses up to its hit or first blocker (where a "         \
+                                     "terminate-on-first-hit traversal may stop)")                                       \
+    X(wholeSegmentBoxes, "whole_segment_boxes", "the same over its whole segment (where it may have to look)")
+
+/// What a thread records of its own work, summed over a pass's threads.
+#define ACC_THREAD_COUNTERS(X)                                                                                           \
+    X(trips, "trips", "loop trips (candidates, neighbours, samples)")                                                   \
+    X(rays, "rays", "rays traced")                                                                                       \
+    X(proceeds, "proceeds", "RayQuery Proceed() iterations: candidates + 1 per ray")                                    \
+    X(bytesRead, "bytes_read", "G-buffer, reservoirs, particle records read")                                           \
+    X(gathers, "gathers", "reads at an index drawn or looked up, each a memory round trip the next step waits for: a "  \
+                          "light's record, an alias entry, a tree node, a tile's entry")                                 \
+    X(bytesWritten, "bytes_written", "G-buffer, reservoirs, radiance written")
+
+#define ACC_COUNTER_FIELD(member, key, doc) std::uint32_t member = 0;
+
+/// What one ray query did, as a GPU would count it (ACC_RAY_COUNTERS). Its
+/// boxes crossed say how much of the scene a ray crosses (a long ray
+/// through the dense inner disk enters many boxes whose particles it
+/// misses); BLAS depths say how deep it descends.
 struct RayCounters {
-    std::uint32_t blasEntries = 0;  ///< TLAS leaves entered (BLAS traversals started)
-    std::uint32_t anyHits = 0;      ///< any-hit invocations (alpha-tested candidates)
     std::uint32_t candidates = 0;   ///< non-opaque candidates seen (RayQuery Proceed() returning true)
-    std::uint32_t blasLevels = 0;   ///< per BLAS entered, its depth: ceil(log2(primitives)) (traversal inside it)
-    std::uint32_t ommLookups = 0;   ///< candidate hits on micromapped triangles (the micromap looked up)
-    std::uint32_t intersections = 0;///< intersection-program invocations: boxes (aabbs layout) or spheres whose bounds the ray entered
-    std::uint32_t misses = 0;       ///< 1 when the query found nothing (a shadow ray unblocked): it traversed its whole segment
-    /// Particles' boxes the ray passes through, whatever the layout: a
-    /// primary ray's up to its hit, a shadow ray's up to its first blocker
-    /// (where the traversal of a terminate-on-first-hit ray may stop), and
-    /// over its whole segment (where it may have to look: a long ray
-    /// through the dense inner disk enters many boxes whose particles it
-    /// misses). BLAS depths say how deep a ray descends; these say how much
-    /// of the scene it crosses.
-    std::uint32_t segmentBoxes = 0;
-    std::uint32_t wholeSegmentBoxes = 0;
+    ACC_RAY_COUNTERS(ACC_COUNTER_FIELD)
 };
 
-/// The work of one pixel's thread in one pass (docs/MODEL.md section 6). The
+/// The work of one pixel's thread in one pass (docs/MODEL.md section 6):
+/// ACC_THREAD_COUNTERS and the sums of ACC_RAY_COUNTERS over its rays. The
 /// branch key of a thread is (hit, type): a miss is key 0, a hit on a
 /// particle of type t is key 1 + t. cluster and hint feed SER sort keys.
 struct ThreadCounters {
@@ -37,41 +59,22 @@ struct ThreadCounters {
     std::uint8_t type = 0;          ///< particle type of the hit
     std::uint32_t cluster = 0;      ///< cluster (BLAS) of the hit
     std::uint32_t hint = 0;         ///< coherence hint (e.g. the sampled light's cluster)
-    std::uint32_t trips = 0;        ///< loop trips (candidates, neighbours, samples)
-    std::uint32_t rays = 0;         ///< rays traced
-    std::uint32_t proceeds = 0;     ///< RayQuery Proceed() iterations: candidates + 1 per ray
-    std::uint32_t blasEntries = 0;  ///< BLAS instances entered, summed over the thread's rays
-    std::uint32_t anyHits = 0;      ///< any-hit invocations
-    std::uint32_t blasLevels = 0;   ///< BLAS depths entered, summed over the thread's rays
-    std::uint32_t ommLookups = 0;   ///< micromap lookups, summed over the thread's rays
-    std::uint32_t intersections = 0;///< intersection-program invocations, summed over the thread's rays
-    std::uint32_t misses = 0;       ///< rays that found nothing (RayCounters::misses)
-    std::uint32_t segmentBoxes = 0; ///< particles' boxes crossed, summed over the thread's rays (RayCounters::segmentBoxes)
-    std::uint32_t wholeSegmentBoxes = 0; ///< the same over whole segments (RayCounters::wholeSegmentBoxes)
-    std::uint32_t bytesRead = 0;    ///< G-buffer, reservoirs, particle records read
-    /// Reads at an index drawn or looked up, each a memory round trip the
-    /// next step waits for: a light's record, an alias entry, a tree node,
-    /// a tile's entry. What a read costs beyond its bytes (power candidates:
-    /// 1.2x uniform's bytes, 2x their reads, 1.6-2x their time on the H100).
-    std::uint32_t gathers = 0;
-    std::uint32_t bytesWritten = 0; ///< G-buffer, reservoirs, radiance written
+    ACC_THREAD_COUNTERS(ACC_COUNTER_FIELD)
+    ACC_RAY_COUNTERS(ACC_COUNTER_FIELD)
 
     std::uint32_t branchKey() const { return hit ? 1u + type : 0u; }
     /// n rays whose counters sum to r.
     void addRays(const RayCounters& r, std::uint32_t n) {
         rays += n;
         proceeds += r.candidates + n;
-        blasEntries += r.blasEntries;
-        anyHits += r.anyHits;
-        blasLevels += r.blasLevels;
-        ommLookups += r.ommLookups;
-        intersections += r.intersections;
-        misses += r.misses;
-        segmentBoxes += r.segmentBoxes;
-        wholeSegmentBoxes += r.wholeSegmentBoxes;
+#define ACC_ADD_RAY(member, key, doc) member += r.member;
+        ACC_RAY_COUNTERS(ACC_ADD_RAY)
+#undef ACC_ADD_RAY
     }
     void addRay(const RayCounters& r) { addRays(r, 1); }
 };
+
+#undef ACC_COUNTER_FIELD
 
 /// buildClusters' acceleration-structure work as the cost model prices it.
 /// Every build or refit, of a BLAS or of the TLAS, is a launch plus a cost

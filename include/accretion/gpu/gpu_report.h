@@ -18,14 +18,12 @@ struct PassReport {
     PassRun pass;
     std::uint32_t width = 0, height = 0;
     std::uint64_t threads = 0, hitThreads = 0;
-    std::uint64_t trips = 0, rays = 0, proceeds = 0, blasEntries = 0, anyHits = 0;
-    std::uint64_t bytesRead = 0, bytesWritten = 0;
-    std::uint64_t gathers = 0;                                   ///< reads at a drawn or looked-up index (ThreadCounters::gathers)
-    std::uint64_t blasLevels = 0, ommLookups = 0;                 ///< BLAS depths entered, micromap lookups
-    std::uint64_t intersections = 0;                             ///< intersection-program invocations (boxes, spheres)
-    std::uint64_t misses = 0;                                    ///< rays that found nothing (a shadow ray unblocked)
-    std::uint64_t segmentBoxes = 0;                              ///< particles' boxes the rays crossed (RayCounters::segmentBoxes)
-    std::uint64_t wholeSegmentBoxes = 0;                         ///< the same over whole segments
+    // The sums over the pass's threads of ACC_THREAD_COUNTERS and
+    // ACC_RAY_COUNTERS (counters/thread_counters.h).
+#define ACC_PASS_SUM(member, key, doc) std::uint64_t member = 0;
+    ACC_THREAD_COUNTERS(ACC_PASS_SUM)
+    ACC_RAY_COUNTERS(ACC_PASS_SUM)
+#undef ACC_PASS_SUM
     std::uint64_t tlasLevels = 0;                                ///< rays x the TLAS's depth (log2 of its instances)
     std::uint64_t dispatches = 1;                                ///< kernel dispatches (PassCounters)
     BuildCounters build;                                          ///< buildClusters: launches, elements, TLAS instances
