@@ -209,20 +209,25 @@ step_layout_images() {
 # structure's memory (the stats JSON). LAYOUT_PARTS=i/n runs the i-th of n parts;
 # LAYOUT_LIST another list (bench/gpu/layouts_refit.txt); REPEAT the timed runs
 # per frame (3; a pass's time is their median).
-step_layouts() {
-    local t="$W/layouts" part=${LAYOUT_PARTS:-1/1} k=0
+# Times the "name -D overrides..." lines of list $2 (comments and blank lines
+# skipped), each on disk_100k's restir frame 1 after a history frame, $3
+# timed runs per frame, into $W/$1; with parts i/n ($4), the i-th of n parts.
+time_configs() {
+    local t="$W/$1" list=$2 repeat=$3 part=${4:-1/1} k=0
     mkdir -p "$t"
-    grep -v '^#' "${LAYOUT_LIST:-bench/gpu/layouts.txt}" | while read -r name args; do
+    grep -v '^#' "$list" | sed 's/ *#.*//' | while read -r name args; do
         [ -z "$name" ] && continue
         k=$((k + 1))
         [ $(((k - 1) % ${part#*/})) -eq $((${part%/*} - 1)) ] || continue
         # shellcheck disable=SC2086  # the overrides are words
-        timeout 120 $BIN scenes/disk_100k.toml -D render.estimator=restir $args --frames 0:2 --repeat "${REPEAT:-3}" -q \
+        timeout 120 $BIN scenes/disk_100k.toml -D render.estimator=restir $args --frames 0:2 --repeat "$repeat" -q \
             -o "$t/$name.{frame}.exr" --timings "$t/$name.timings.csv" --config "$name" < /dev/null \
-            || echo "layouts: $name failed"
+            || echo "$1: $name failed"
         rm -f "$t"/*.gpuframe
     done
 }
+
+step_layouts() { time_configs layouts "${LAYOUT_LIST:-bench/gpu/layouts.txt}" "${REPEAT:-3}" "${LAYOUT_PARTS:-1/1}"; }
 
 # The per-launch costs of many small builds: clusters of 25, 100 and 1000 at
 # 100K and 1M particles, 1080p, with the builds spread over 4 and 16 streams
@@ -247,18 +252,7 @@ step_streams() {
 
 # The configurations on tune's Pareto fronts (bench/gpu/front.txt, written
 # by bench/gpu/front_configs.py), timed as the layouts are.
-step_front() {
-    local t="$W/front"
-    mkdir -p "$t"
-    grep -v '^#' bench/gpu/front.txt | sed 's/ *#.*//' | while read -r name args; do
-        [ -z "$name" ] && continue
-        # shellcheck disable=SC2086  # the overrides are words
-        timeout 120 $BIN scenes/disk_100k.toml -D render.estimator=restir $args --frames 0:2 --repeat 5 -q \
-            -o "$t/$name.{frame}.exr" --timings "$t/$name.timings.csv" --config "$name" < /dev/null \
-            || echo "front: $name failed"
-        rm -f "$t"/*.gpuframe
-    done
-}
+step_front() { time_configs front bench/gpu/front.txt 5; }
 
 # Nsight Compute: average active threads per executed instruction of the
 # lighting kernels of a restir frame (quickstart, 320x180, frames 0-1; the

@@ -301,20 +301,8 @@ RTCBuildQuality sceneQuality(BuildPolicy p) {
 
 /// An Embree ray from o along d over [tnear, tfar], every mask bit set.
 RTCRay embreeRay(const Vec3& o, const Vec3& d, float tnear, float tfar) {
-    RTCRay ray;
-    ray.org_x = o.x;
-    ray.org_y = o.y;
-    ray.org_z = o.z;
-    ray.dir_x = d.x;
-    ray.dir_y = d.y;
-    ray.dir_z = d.z;
-    ray.tnear = tnear;
-    ray.tfar = tfar;
-    ray.time = 0.0f;
-    ray.mask = ~0u;
-    ray.id = 0;
-    ray.flags = 0;
-    return ray;
+    return RTCRay{.org_x = o.x, .org_y = o.y, .org_z = o.z, .tnear = tnear, .dir_x = d.x, .dir_y = d.y, .dir_z = d.z,
+                  .time = 0.0f, .tfar = tfar, .mask = ~0u, .id = 0, .flags = 0};
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <tuple>
 
 #include <fmt/format.h>
 
@@ -96,19 +97,11 @@ void cropLayers(FrameImage& img) {
     auto cut = [&](auto& layer) {
         if (!layer.empty()) layer = cropPixels(layer, img.width, w);
     };
-    cut(img.L);
-    cut(img.Le);
-    cut(img.lighting.Lr);
-    cut(img.lighting.Lr_stderr);
-    cut(img.lighting.spp);
-    cut(img.lighting.rejected);
-    cut(img.depth);
-    cut(img.normal);
-    cut(img.particle);
-    cut(img.reservoirs.W);
-    cut(img.reservoirs.M);
-    cut(img.reservoirs.light);
-    cut(img.reservoirs.p_hat);
+    LightingImage& lit = img.lighting;
+    ReservoirImage& res = img.reservoirs;
+    std::apply([&](auto&... layer) { (cut(layer), ...); },
+               std::tie(img.L, img.Le, lit.Lr, lit.Lr_stderr, lit.spp, lit.rejected, img.depth, img.normal, img.particle, res.W,
+                        res.M, res.light, res.p_hat));
     for (Heatmap& h : img.heatmaps) cut(h.values);
 }
 
