@@ -18,6 +18,7 @@
 #include "accretion/core/stop_signal.h"
 #include "accretion/io/accumulation_file.h"
 #include "accretion/io/checkpoint.h"
+#include "accretion/io/render_session.h"
 #include "accretion/core/atomic_file.h"
 #include "accretion/io/exr_output.h"
 #include "accretion/io/preview.h"
@@ -131,14 +132,6 @@ std::vector<FlagSetting> renderFlags(const RenderArgs& args) {
 /// Which frames this process renders and how a shard splits the work:
 /// accumulating estimators checkpoint and shard their samples (exact: row
 /// bands); adaptive sampling and restir shard whole frames instead.
-struct Sharding {
-    Shard shard;
-    bool accumulating = true;
-    bool bySamples = false;
-    std::uint32_t first = 0, end = 0;
-    Shard samples() const { return bySamples ? shard : Shard{}; }
-};
-
 Sharding planSharding(const Settings& settings, const RenderArgs& args) {
     Sharding s;
     s.shard = args.shard.empty() ? Shard{} : parseShard(args.shard, "--shard");
@@ -310,106 +303,20 @@ void runRender(const RenderArgs& args) {
     const OutputLock lock(stem + ".lock");  // one run at a time writes these outputs
     removeStaleTemporaries(std::filesystem::path(stem).parent_path());
     nlohmann::json stats = runStats(run, args.threads > 0 ? args.threads : tbb::info::default_concurrency());
-
-    // A checkpoint: where to start, and the sums of the frame in progress.
-    const Checkpoint checkpoint(stem + ".checkpoint", run.settingsToml, stats["shard"]);
-    std::uint32_t firstFrame = sharding.first;
-    std::optional<AccumulationFile> resumed = checkpoint.load(args.resume, firstFrame, sharding.end);
-    if (resumed) {
-        // The same settings hold the same pixels; a file that says otherwise was not written by this run.
-        const Accumulation& acc = resumed->acc;
-        const PixelWindow traced = planFrame(settings, FrameFacts{}).traced;
-        if (acc.width != settings.camera.width || acc.height != settings.camera.height || acc.window != traced)
-            throw InputError(fmt::format("{}: checkpoint of pixels [{}, {}) x [{}, {}) of {}x{}; this run lights [{}, {}) x [{}, {}) of {}x{}",
-                                         checkpoint.file().string(), acc.window.x0, acc.window.x1, acc.window.y0,
-                                         acc.window.y1, acc.width, acc.height, traced.x0, traced.x1, traced.y0, traced.y1,
-                                         settings.camera.width, settings.camera.height));
-        for (const auto& f : resumed->header.at("finished_frames")) stats["frames"].push_back(f);
-        firstFrame = resumed->header.at("frame").get<std::uint32_t>();
-        if (!args.quiet)
-            fmt::print(stderr, "accretion: resuming {} at frame {}, chunk {}{}\n", checkpoint.file().string(), firstFrame,
-                       resumed->acc.nextChunk,
-                       resumed->acc.bandRows || resumed->acc.bandCols
-                           ? fmt::format(", pixels before row {} column {} done", resumed->acc.bandRows, resumed->acc.bandCols)
-                           : std::string());
-    } else if (args.resume && !args.quiet) {  // nothing to resume: start afresh
-        fmt::print(stderr, "accretion: {}: starting from the beginning\n",
-                   sharding.accumulating ? fmt::format("no checkpoint at {}", checkpoint.file().string())
-                                         : std::string("restir keeps reservoir history across frames and is not checkpointed"));
-    }
-
-    const auto start = std::chrono::steady_clock::now();
-    // One signal path for every estimator: SIGINT and SIGTERM stop at the next
-    // safe point (a chunk of an accumulating estimator, else the end of a
-    // frame), with the frames written so far whole and the lock released.
-    const StopSignal stop;
-    auto lastCheckpoint = start;
-    auto saveCheckpoint = [&](std::uint32_t frame, const Accumulation& acc) {
-        checkpoint.save(frame, acc, stats["frames"]);
-        lastCheckpoint = std::chrono::steady_clock::now();
-    };
-    auto interrupt = [&](int signal, std::uint32_t frame, const Accumulation& acc) {
-        fmt::print(stderr, "accretion: {}: checkpoint {} (frame {}, chunk {}{}); continue with --resume\n",
-                   StopSignal::name(signal), checkpoint.file().string(), frame, acc.nextChunk,
-                   acc.bandRows || acc.bandCols
-                       ? fmt::format(", pixels before row {} column {} done", acc.bandRows, acc.bandCols)
-                       : std::string());
-        throw Interrupted{signal};
-    };
-    // restir keeps reservoir history across frames: no checkpoint, the frames done are kept.
-    auto stopBetweenFrames = [&](int signal, std::uint32_t next) {
-        fmt::print(stderr, "accretion: {}: stopped before frame {}; frames {}..{} are written ({} keeps reservoir history "
-                           "across frames and is not checkpointed: render the rest with --frames {}:{})\n",
-                   StopSignal::name(signal), next, firstFrame, next - 1, enumName(settings.render.estimator), next,
-                   sharding.end);
-        throw Interrupted{signal};
-    };
-
-    FrameRenderer renderer(settings, ParticleSource(settings), RenderOptions{args.quiet});
-    std::uint64_t shadowRays = 0;
-    double lightingSeconds = 0.0;
-    Accumulation sums;  // the frame's lighting sums (reused: no reallocation per frame)
-    for (std::uint32_t frame = firstFrame; frame < sharding.end; ++frame) {
-        if (!args.quiet)
-            fmt::print(stderr, "accretion: frame {} ({}/{})\n", frame, frame - settings.render.frame_start + 1,
-                       settings.render.frames);
-        LightingSession session;
-        session.shard = sharding.samples();
-        session.result = &sums;
-        if (resumed && resumed->header.at("frame").get<std::uint32_t>() == frame) session.resume = &resumed->acc;
-        session.afterChunk = [&](const Accumulation& acc) {
-            const int signal = stop.pending();
-            const double since = std::chrono::duration<double>(std::chrono::steady_clock::now() - lastCheckpoint).count();
-            if (signal || (args.checkpointEvery > 0.0 && since >= args.checkpointEvery)) saveCheckpoint(frame, acc);
-            if (signal) interrupt(signal, frame, acc);
-            return true;
-        };
-        FrameStats fs;
-        const FrameImage image = renderer.render(frame, fs, sharding.accumulating ? &session : nullptr);
-        resumed.reset();
-        const nlohmann::json fj = writeFrameOutputs(run, frame, image, fs, sums);
-        stats["frames"].push_back(fj);
-        shadowRays += fs.lighting.shadowRays;
-        lightingSeconds += fs.timer.seconds(Pass::estimateLighting);
+    RenderSession session(settings, stem + ".checkpoint", run.settingsToml, sharding,
+                          SessionOptions{args.resume, args.checkpointEvery, args.quiet}, stats);
+    const RenderSession::Totals t = session.run([&](std::uint32_t frame, const FrameImage& image, FrameStats& fs,
+                                                    const Accumulation& sums) {
+        nlohmann::json fj = writeFrameOutputs(run, frame, image, fs, sums);
         printFrame(settings, frame, fj, fs);
-        // Stopped between frames: the next frame starts from its first chunk.
-        if (const int signal = stop.pending(); signal && frame + 1 < sharding.end) {
-            if (!sharding.accumulating) stopBetweenFrames(signal, frame + 1);
-            Accumulation next;
-            next.reset(settings.camera.width, settings.camera.height,
-                       sharding.bySamples ? planLighting(settings.render, settings.camera.height, shard).begin : 0,
-                       &renderer.plan().traced);
-            saveCheckpoint(frame + 1, next);
-            interrupt(signal, frame + 1, next);
-        }
-    }
-    const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    stats["total_seconds"] = total;
+        return fj;
+    });
+    stats["total_seconds"] = t.seconds;
     stats["peak_rss_bytes"] = peakResidentBytes();
-    stats["shadow_rays_per_second"] = lightingSeconds > 0 ? double(shadowRays) / lightingSeconds : 0.0;
+    stats["shadow_rays_per_second"] = t.lightingSeconds > 0 ? double(t.shadowRays) / t.lightingSeconds : 0.0;
     writeRunOutputs(stem, run.settingsToml, stats, args.outputsFile);
-    checkpoint.remove();  // done: nothing left to resume
-    fmt::print("stats: {}.stats.json\nsettings: {}.settings.toml\ntotal: {:.2f} s\n", stem, stem, total);
+    session.finish();  // done: nothing left to resume
+    fmt::print("stats: {}.stats.json\nsettings: {}.settings.toml\ntotal: {:.2f} s\n", stem, stem, t.seconds);
 }
 
 }  // namespace
