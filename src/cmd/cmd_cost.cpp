@@ -9,6 +9,7 @@
 #include <fmt/core.h>
 #include <tbb/global_control.h>
 
+#include "accretion/analysis/experiment.h"
 #include "accretion/geometry/camera_track.h"
 #include "accretion/analysis/image_metrics.h"
 #include "accretion/core/error.h"
@@ -60,16 +61,8 @@ struct CountedFrame {
 };
 
 CountedFrame renderCounted(const Settings& s, const ParticleSource& source, std::uint32_t frame, std::uint32_t history) {
-    const std::uint32_t first = estimatorInfo(s.render.estimator).reuse ? frame - std::min(frame, history) : frame;
-    Settings run = s;  // the frames rendered, so that the pass plan keeps restir's history
-    run.render.frame_start = first;
-    run.render.frames = frame - first + 1;
-    FrameRenderer renderer(run, source, RenderOptions{true});
-    CountedFrame out;
-    for (std::uint32_t f = first; f <= frame; ++f) {
-        out.stats = FrameStats{};
-        out.image = renderer.render(f, out.stats);
-    }
+    ExperimentRender r = renderForExperiment(s, source, frame, history);  // restir's history frames first
+    CountedFrame out{std::move(r.image), std::move(r.stats), {}};
     if (s.gpu.counters) out.report = makeGpuReport(out.image.counters, s, out.stats.reservoirBytes);
     return out;
 }

@@ -1,7 +1,5 @@
 #include "accretion/render/estimators.h"
 
-#include "accretion/render/light_estimates.h"
-
 #include <algorithm>
 #include <bit>
 #include <chrono>
@@ -28,126 +26,12 @@
 #include "accretion/scene/estimator_table.h"
 #include "accretion/render/sample_sums.h"
 #include "accretion/render/visibility.h"
+#include "light_loops.h"
 
 namespace accretion {
+using namespace light_loops;
+
 namespace {
-
-/// V(x, p_i) of a light with a non-zero term t: one shadow ray, counted
-/// (visibility off: 1, no ray).
-template <Primitive P>
-inline bool seen(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint& sp, std::uint32_t i, const LightTerm& t,
-                 const VisibilityOptions& vis, bool shadows, LightingCounters& c, RayCounters* rc) {
-    if (!shadows) return true;
-    ++c.shadowRays;
-    if (visible<P>(bvh, vis, sp, i, L.packed[i].position, L.packed[i].radius, t, rc)) return true;
-    ++c.shadowOccluded;
-    return false;
-}
-
-/// light_estimates.h's bridge on the CPU: Embree's shadow rays counted
-/// (seen), render --pixel's records when Traced (a template argument: the
-/// light loop of every other pixel has no trace test).
-template <ShadingModel M, Primitive P, bool Traced>
-struct CpuLightBridge {
-    static constexpr bool traced = Traced;
-    const ParticleBvh& bvh;
-    const LightArrays& L;
-    const VisibilityOptions& vis;
-    bool shadows;
-    LightingCounters& c;
-    RayCounters* rc;
-    PixelTrace* trace;
-
-    bool lightTerm(const ShadingPoint& sp, std::uint32_t i, LightTerm& t) const { return L.term<M>(sp, i, t); }
-    void countLightTerm() { ++c.lightTerms; }
-    bool seen(const ShadingPoint& sp, std::uint32_t i, const LightTerm& t) {
-        return accretion::seen<P>(bvh, L, sp, i, t, vis, shadows, c, rc);
-    }
-    void traceLight() { ++trace->lightsSeen; }
-    void traceTerm(std::uint32_t i, const LightTerm& t, bool v) { trace->terms.push_back({i, t.value, v}); }
-    void traceSample(const LightSample& x, bool term, const LightTerm& t, bool v) {
-        trace->samples.push_back({x.i, x.pdf, term ? t.value : Vec3(0.0f), v, v ? Vec3(DVec3(t.value) / double(x.pdf)) : Vec3(0.0f)});
-    }
-};
-
-/// The sum of f I G V over `lights` (every light i != j for exact; the near
-/// field for split): light_estimates.h's sumLightTerms.
-/// With a trace (render --pixel), every non-zero term and its V are recorded.
-template <ShadingModel M, Primitive P, bool Traced = false, class Lights>
-DVec3 sumTerms(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint& sp, const Lights& lights,
-               const VisibilityOptions& vis, bool shadows, LightingCounters& c, RayCounters* rc, PixelTrace* trace = nullptr) {
-    CpuLightBridge<M, P, Traced> b{bvh, L, vis, shadows, c, rc, trace};
-    return sumLightTerms(b, sp, lights);
-}
-
-/// exact: every light i != j.
-template <ShadingModel M, Primitive P, bool Traced = false>
-DVec3 exactPixel(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint& sp, const VisibilityOptions& vis, bool shadows,
-                 LightingCounters& c, RayCounters* rc, PixelTrace* trace = nullptr) {
-    return sumTerms<M, P, Traced>(bvh, L, sp, LightRange{L.count}, vis, shadows, c, rc, trace);
-}
-
-/// One pixel's running sums (SampleSums: the non-finite policy applied to
-/// every sample added) and counters while its chunks run, loaded from and
-/// stored to the Accumulation, or resolved directly.
-struct PixelSums : SampleSums {
-    std::uint8_t done = 0;
-    std::uint32_t rejectedBefore = 0;  ///< `rejected` when loaded: the sweep's rejections are the rest
-    LightingCounters c;   ///< this pixel's work (added to its thread's when it finishes)
-    PixelTrace* trace = nullptr;  ///< render --pixel: this is the pixel traced
-
-    void load(const Accumulation& a, std::size_t px) {
-        sum = a.sum[px];
-        sumSq = a.sumSq[px];
-        n = a.n[px];
-        rejected = rejectedBefore = a.rejected[px];
-        done = a.done[px];
-    }
-    void store(Accumulation& a, std::size_t px) const {
-        a.sum[px] = sum;
-        a.sumSq[px] = sumSq;
-        a.n[px] = n;
-        a.rejected[px] = rejected;
-        a.done[px] = done;
-    }
-};
-
-/// Mean, standard error, spp and rejected count of one pixel's sums into
-/// `out` (resolveSums). Returns 1 if the value was zeroed.
-std::uint32_t resolvePixel(const DVec3& sum, const DVec3& sumSq, std::uint32_t n, std::uint32_t rejected, bool exact,
-                           LightingImage& out, std::size_t px) {
-    const std::uint32_t zeroed = resolveSums(sum, sumSq, n, exact, out.Lr[px], out.Lr_stderr[px], out.spp[px]) ? 1 : 0;
-    out.rejected[px] = float(rejected + zeroed);
-    return zeroed;
-}
-
-/// The lights of one chunk of uniform / power / tree / split (far) samples,
-/// in stream order, their records prefetched (a random light is a cache miss);
-/// `near`: split's near field (null for the others).
-template <EstimatorKind K>
-void drawLights(const LightingInputs& in, const LightArrays& L, const ShadingPoint& sp, const NearField* near, Rng& rng,
-                std::uint32_t count, LightSample* xs) {
-    for (std::uint32_t k = 0; k < count; ++k) {
-        if constexpr (K == EstimatorKind::power) xs[k] = sampleSource<true>(L, in.powerTable, rng);
-        else if constexpr (K == EstimatorKind::tree) xs[k] = in.lightTree->sample(sp, rng);
-        else if constexpr (K == EstimatorKind::split) xs[k] = in.lightTree->sampleFar(sp, *near, rng);
-        else xs[k] = sampleSource<false>(L, nullptr, rng);
-        if (xs[k].i < L.count) {
-            __builtin_prefetch(&L.packed[xs[k].i]);
-            in.bvh.prefetchExclusion(xs[k].i);
-        }
-    }
-}
-
-/// uniform / power / tree / split's far samples: light_estimates.h's
-/// shadeLightSamples into a pixel's sums.
-template <ShadingModel M, Primitive P, bool Traced = false>
-void shadeSamples(const ParticleBvh& bvh, const LightArrays& L, const ShadingPoint& sp, const LightSample* xs,
-                  std::uint32_t count, const DVec3& near, const VisibilityOptions& vis, bool shadows, PixelSums& acc,
-                  RayCounters* rc) {
-    CpuLightBridge<M, P, Traced> b{bvh, L, vis, shadows, acc.c, rc, acc.trace};
-    shadeLightSamples(b, sp, xs, count, near, acc);
-}
 
 /// ris (docs/MODEL.md section 4): per sample, one reservoir streams M candidates
 /// from the source pmf with w = p_hat / p_src, p_hat = luminance(f I G)
@@ -295,25 +179,6 @@ struct NearFieldCache {
     NearField spare[kGroupPixels];
     NearFieldCache() { std::fill(std::begin(particle), std::end(particle), kNoParticle); }
 };
-
-/// Particle j's centre with normal n, where its near field is found for
-/// all its pixels. Lambert: n is the billboard's, the same for every pixel
-/// of j; the other models' cuts do not use it.
-ShadingPoint particleCentre(const LightingInputs& in, std::uint32_t j, const Vec3& n) {
-    ShadingPoint centre{};
-    centre.x = in.particles.position[j];
-    centre.n = n;
-    centre.self = j;
-    return centre;
-}
-
-/// The k lights nearest to particle j's centre, other than j, and the far
-/// cut of at most `cutNodes` nodes seen from there: the near field of every
-/// pixel on j.
-void nearestToParticle(const LightingInputs& in, std::uint32_t j, std::uint32_t k, const Vec3& n, std::uint32_t cutNodes,
-                       NearField& out) {
-    in.lightTree->nearest(particleCentre(in, j, n), k, out, cutNodes);
-}
 
 /// The near field of particle j (a pixel on it has normal n), from the cache or found.
 const NearField& nearFieldOf(const LightingInputs& in, std::uint32_t j, const Vec3& n, NearFieldCache& cache,
@@ -560,139 +425,6 @@ LightingCounters dispatchPrimitive(const LightingInputs& in, const LightArrays& 
 }
 
 }  // namespace
-
-std::uint32_t nearLightCount(const RenderSettings& render, std::uint32_t chosen) {
-    if (render.near_lights > 0) return render.near_lights;
-    ACC_CHECK(chosen > 0);  // automatic k: the frame's pilot (FrameRenderer::chooseFrameNearLights) ran
-    return chosen;
-}
-
-std::uint32_t farCutSize(const RenderSettings& render) {
-    const std::uint32_t twice = render.samples >= NearField::kMaxCut / 2 ? NearField::kMaxCut : 2 * render.samples;
-    return std::clamp<std::uint32_t>(std::bit_ceil(twice), kMinFarCut, NearField::kMaxCut);
-}
-
-namespace {
-
-/// 64 far samples a pixel: with 16, V(k) came out noisy and low where the
-/// far field's rare bright draws dominate (disk_100k at 1080p, frames 0-2:
-/// V(1024) 0.32-0.36 and V(16) 1.6-2.6 against 0.55 and 1.34 measured by
-/// renders, so k jumped between 32 and 1024 from frame to frame); with 64,
-/// 0.46-0.54 and 1.6-1.7 for 0.2 s a frame instead of 0.15.
-constexpr std::uint32_t kPilotPixels = 256, kPilotSamples = 64;
-/// The pilot's far cut: one size whatever S, so that V(k) does not depend on
-/// S: the smallest a render uses (farCutSize); a larger one has about the
-/// same variance (disk_100k at 1080p, k = 1024: within 5% from 256 to 1024 nodes).
-constexpr std::uint32_t kPilotCutNodes = kMinFarCut;
-constexpr double kPilotEpsilon = 1e-2;  ///< relMSE's (analysis/image_metrics.h: kRelMseEpsilon)
-
-/// One pilot pixel at every candidate k: per-channel far-sample variance,
-/// and the estimate (near sum + far mean) at the largest k. The near fields
-/// are nearestToParticle's: one search for the largest k, whose first k
-/// lights are the search's for each smaller k.
-template <ShadingModel M, Primitive P>
-void pilotPixel(const LightingInputs& in, const LightArrays& L, const VisibilityOptions& vis, std::size_t px,
-                const std::vector<std::uint32_t>& ks, NearField& field, double* variance, DVec3& value) {
-    const GBufferTexel& g = in.gbuffer.texels[px];
-    const ShadingPoint sp = shadingPoint(g, in.particles);
-    const bool shadows = in.shading.visibility;
-    static_assert(kPilotSamples % LightingPlan::kChunkSamples == 0);
-    const ShadingPoint centre = particleCentre(in, g.particle, sp.n);
-    std::uint32_t nearest[NearField::kMaxLights];
-    const std::uint32_t found = in.lightTree->nearestLights(centre, ks.back(), nearest);
-    for (std::size_t c = 0; c < ks.size(); ++c) {
-        std::uint32_t lights[NearField::kMaxLights];
-        const std::uint32_t count = std::min(ks[c], found);
-        std::copy(nearest, nearest + count, lights);
-        lights[count] = g.particle;  // as nearest() adds it
-        in.lightTree->nearField(centre, lights, count + 1, field, kPilotCutNodes);
-        PixelSums far;  // the far samples alone, drawn and shaded as the render's are
-        far.discardNonFinite = in.render.nonfinite == NonFinitePolicy::discard;
-        // The same stream at every k: the candidates differ by their near field alone.
-        Rng rng(px, in.frame, RngPass::nearLightPilot, in.render.seed);
-        LightSample xs[LightingPlan::kChunkSamples];
-        for (std::uint32_t s = 0; s < kPilotSamples; s += LightingPlan::kChunkSamples) {
-            drawLights<EstimatorKind::split>(in, L, sp, &field, rng, LightingPlan::kChunkSamples, xs);
-            shadeSamples<M, P>(in.bvh, L, sp, xs, LightingPlan::kChunkSamples, DVec3(0.0), vis, shadows, far, nullptr);
-        }
-        const double n = std::max(far.n, 2u);
-        const DVec3 var = glm::max(DVec3(0.0), (far.sumSq - far.sum * far.sum / n) / (n - 1.0));
-        for (int ch = 0; ch < 3; ++ch) variance[c * 3 + ch] = var[ch];
-        if (c + 1 == ks.size())  // the pixel's value: the largest k's near sum and far mean
-            value = sumTerms<M, P>(in.bvh, L, sp, std::span<const std::uint32_t>(field.light, field.count), vis, shadows,
-                                   far.c, nullptr) + far.sum / n;
-    }
-}
-
-template <ShadingModel M, Primitive P>
-NearLightChoice choosePilot(const LightingInputs& in, const LightArrays& L) {
-    NearLightChoice choice;
-    std::vector<std::size_t> lit;
-    for (std::size_t px = 0; px < in.gbuffer.texels.size(); ++px)
-        if (in.gbuffer.texels[px].hit()) lit.push_back(px);
-    std::vector<std::size_t> pixels;
-    for (std::size_t i = 0; i < std::min<std::size_t>(lit.size(), kPilotPixels); ++i)
-        pixels.push_back(lit[i * lit.size() / std::min<std::size_t>(lit.size(), kPilotPixels)]);
-    std::vector<std::uint32_t> ks;
-    const std::uint32_t most = in.particles.size() > 1 ? std::uint32_t(in.particles.size() - 1) : 0u;
-    for (std::uint32_t k = 16; k <= NearField::kMaxNear; k *= 2) {
-        ks.push_back(std::min(k, most));
-        if (k >= most) break;
-    }
-    choice.pixels = static_cast<std::uint32_t>(pixels.size());
-    if (pixels.empty() || most == 0) {
-        choice.k = 16;
-        return choice;
-    }
-    std::vector<double> variance(pixels.size() * ks.size() * 3);
-    std::vector<DVec3> value(pixels.size());
-    const VisibilityOptions vis = VisibilityOptions::from(in.render);
-    tbb::enumerable_thread_specific<std::unique_ptr<NearField>> fields;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pixels.size(), 4), [&](const auto& r) {
-        std::unique_ptr<NearField>& field = fields.local();
-        if (!field) field = std::make_unique<NearField>();
-        for (std::size_t i = r.begin(); i != r.end(); ++i)
-            pilotPixel<M, P>(in, L, vis, pixels[i], ks, *field, &variance[i * ks.size() * 3], value[i]);
-    });
-    // V(k), summed in pixel order (the same whatever the threads).
-    const double samples = double(in.render.samples) * NearLightChoice::kFarSampleCost;
-    double best = std::numeric_limits<double>::infinity();
-    for (std::size_t c = 0; c < ks.size(); ++c) {
-        double v = 0.0;
-        for (std::size_t i = 0; i < pixels.size(); ++i)
-            for (int ch = 0; ch < 3; ++ch)
-                v += variance[(i * ks.size() + c) * 3 + ch] / (value[i][ch] * value[i][ch] + kPilotEpsilon);
-        v /= 3.0 * double(pixels.size());
-        const double cost = double(ks[c]) + samples;
-        choice.candidates.push_back({ks[c], v, cost});
-        // Ties (every far sample zero, or no far light left) go to the smaller k.
-        if (v * cost < best) {
-            best = v * cost;
-            choice.k = ks[c];
-        }
-    }
-    return choice;
-}
-
-}  // namespace
-
-NearLightChoice chooseNearLights(const LightingInputs& pilot) {
-    ACC_CHECK(pilot.lightTree);
-    const LightArrays L(pilot.particles, pilot.shading);
-    const bool spheres = pilot.bvh.settings().primitive == Primitive::sphere;
-    switch (pilot.shading.model) {
-    case ShadingModel::lambert:
-        return spheres ? choosePilot<ShadingModel::lambert, Primitive::sphere>(pilot, L)
-                       : choosePilot<ShadingModel::lambert, Primitive::billboard>(pilot, L);
-    case ShadingModel::sphere:
-        return spheres ? choosePilot<ShadingModel::sphere, Primitive::sphere>(pilot, L)
-                       : choosePilot<ShadingModel::sphere, Primitive::billboard>(pilot, L);
-    case ShadingModel::isotropic:
-        return spheres ? choosePilot<ShadingModel::isotropic, Primitive::sphere>(pilot, L)
-                       : choosePilot<ShadingModel::isotropic, Primitive::billboard>(pilot, L);
-    }
-    return {};
-}
 
 namespace {
 /// The light samplers an estimator needs were built for it (the plan's
