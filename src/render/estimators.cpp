@@ -220,6 +220,116 @@ void prepareNearField(const LightingInputs& in, const LightArrays& L, const Visi
                           : sumTerms<M, P>(in.bvh, L, p.sp, lights, vis, shadows, p.sums.c, rc);
 }
 
+/// What the groups of one sweep share.
+struct Sweep {
+    const LightingInputs& in;
+    const LightArrays& L;
+    const LightingPlan& plan;
+    Accumulation* acc;     ///< the sums, or null: resolved into out
+    LightingImage* out;
+    std::uint64_t c0, c1;  ///< the chunks swept
+    VisibilityOptions vis;
+    bool shadows;          ///< off: V = 1, no shadow rays
+};
+
+/// Counting mode (the whole image: slot = px): pixel px's thread, with its work (hit pixels: `p`).
+template <bool Count>
+void recordPixel(const Sweep& s, std::size_t px, const GroupPixel* p) {
+    if constexpr (Count) {
+        const GBufferTexel& g = s.in.gbuffer.texels[px];
+        ThreadCounters& t = s.in.counters->threads[px];
+        recordTexel(t, g, s.in.particles, s.in.bvh, gpu_layout::kGBufferTexel);
+        t.bytesWritten += gpu_layout::kRadiance;
+        if (!p) return;
+        t.trips = static_cast<std::uint32_t>(p->sums.c.lightTerms);
+        t.bytesRead += t.trips * gpu_layout::kParticleRecord;
+        t.addRays(p->rays, static_cast<std::uint32_t>(p->sums.c.shadowRays));
+    }
+}
+
+/// The hit pixels of texels [x0, x1) of row y into pix, their particles'
+/// records prefetched and their sums begun (loaded from the accumulation);
+/// a miss's outputs are 0. Returns how many.
+template <bool Count>
+std::uint32_t beginGroup(const Sweep& s, std::uint32_t y, std::uint32_t x0, std::uint32_t x1, GroupPixel* pix) {
+    const GBuffer& gb = s.in.gbuffer;
+    const std::size_t row = std::size_t(y) * gb.width, rowSlot = gb.window.index(x0, y) - x0;
+    std::uint32_t n = 0;
+    for (std::uint32_t x = x0; x != x1; ++x) {
+        const std::size_t slot = rowSlot + x;
+        const std::uint32_t j = gb.texels[slot].particle;
+        if (j == kNoParticle) {  // nothing to add: sums stay 0
+            recordPixel<Count>(s, row + x, nullptr);
+            if (!s.acc) {
+                s.out->Lr[slot] = s.out->Lr_stderr[slot] = Vec3(0.0f);
+                s.out->spp[slot] = s.out->rejected[slot] = 0.0f;
+            }
+            continue;
+        }
+        __builtin_prefetch(&s.in.particles.position[j]);
+        __builtin_prefetch(&s.in.particles.albedo[j]);
+        pix[n].px = row + x;
+        pix[n++].slot = slot;
+    }
+    for (std::uint32_t k = 0; k < n; ++k) {
+        GroupPixel& p = pix[k];
+        p.sp = shadingPoint(gb.texels[p.slot], s.in.particles);
+        p.sums = PixelSums{};
+        p.sums.discardNonFinite = s.in.render.nonfinite == NonFinitePolicy::discard;
+        p.rays = RayCounters{};
+        if (s.acc) p.sums.load(*s.acc, p.slot);
+        if (s.in.trace && s.in.trace->px == p.px) [[unlikely]] p.sums.trace = s.in.trace;
+    }
+    return n;
+}
+
+/// A group's hit pixels lit by the frame's estimator over the sweep's chunks.
+template <ShadingModel M, Primitive P, bool Count>
+void lightGroup(const Sweep& s, GroupPixel* pix, std::uint32_t n, std::unique_ptr<NearFieldCache>& cache) {
+    const LightingInputs& in = s.in;
+    switch (in.render.estimator) {
+    case EstimatorKind::exact:
+        for (std::uint32_t k = 0; k < n; ++k) {
+            PixelSums& sums = pix[k].sums;
+            RayCounters* rc = Count ? &pix[k].rays : nullptr;
+            const DVec3 v = sums.trace ? exactPixel<M, P, true>(in.bvh, s.L, pix[k].sp, s.vis, s.shadows, sums.c, rc, sums.trace)
+                                       : exactPixel<M, P>(in.bvh, s.L, pix[k].sp, s.vis, s.shadows, sums.c, rc);
+            if (finiteSum(v)) sums.sum = v;
+            else sums.reject();  // exact has one value: 0 either way
+            sums.n = 1;
+        }
+        return;
+    case EstimatorKind::split: {
+        if (!cache) cache = std::make_unique<NearFieldCache>();
+        std::uint64_t pinned = 0;  // the slots this group's pixels use
+        std::uint32_t spares = 0;
+        for (std::uint32_t k = 0; k < n; ++k)
+            if (!pix[k].sums.done) prepareNearField<M, P, Count>(in, s.L, s.vis, s.shadows, pix[k], *cache, pinned, spares);
+        return runChunks<M, P, Count, EstimatorKind::split>(in, s.L, s.plan, s.vis, s.shadows, s.c0, s.c1, pix, n);
+    }
+    case EstimatorKind::ris: return runChunks<M, P, Count, EstimatorKind::ris>(in, s.L, s.plan, s.vis, s.shadows, s.c0, s.c1, pix, n);
+    case EstimatorKind::power: return runChunks<M, P, Count, EstimatorKind::power>(in, s.L, s.plan, s.vis, s.shadows, s.c0, s.c1, pix, n);
+    case EstimatorKind::tree: return runChunks<M, P, Count, EstimatorKind::tree>(in, s.L, s.plan, s.vis, s.shadows, s.c0, s.c1, pix, n);
+    case EstimatorKind::uniform:
+        return runChunks<M, P, Count, EstimatorKind::uniform>(in, s.L, s.plan, s.vis, s.shadows, s.c0, s.c1, pix, n);
+    case EstimatorKind::restir: break;  // restir's passes (render/restir/), never a sweep
+    }
+    ACC_CHECK(!"a sweep of an estimator without sums");
+}
+
+/// Each pixel's sums stored (or resolved into the image), its counters added to c.
+template <bool Count>
+void finishGroup(const Sweep& s, GroupPixel* pix, std::uint32_t n, LightingCounters& c) {
+    for (std::uint32_t k = 0; k < n; ++k) {
+        GroupPixel& p = pix[k];
+        recordPixel<Count>(s, p.px, &p);
+        if (s.acc) p.sums.store(*s.acc, p.slot);
+        else p.sums.c.nonFinite += resolvePixel(p.sums.sum, p.sums.sumSq, p.sums.n, p.sums.rejected, s.plan.exact, *s.out, p.slot);
+        p.sums.c.nonFinite += p.sums.rejected - p.sums.rejectedBefore;
+        c += p.sums.c;
+    }
+}
+
 /// Runs chunks [c0, c1) over every pixel of `area` (exact: of its rows that
 /// the chunks are; a part of the G-buffer's window, whose layout `acc` and
 /// `out` share) in one parallel sweep, each pixel's sums in registers:
@@ -234,32 +344,15 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
                        const PixelWindow& area) {
     const GBuffer& gb = in.gbuffer;
     ACC_CHECK(gb.window.contains(area) && (!acc || acc->window == gb.window) && (acc || out->Lr.size() == gb.texels.size()));
-    const VisibilityOptions vis = VisibilityOptions::from(in.render);
-    const EstimatorKind kind = in.render.estimator;
-    const bool shadows = in.shading.visibility;  // off: V = 1, no shadow rays
+    const Sweep s{in, L, plan, acc, out, c0, c1, VisibilityOptions::from(in.render), in.shading.visibility};
     tbb::enumerable_thread_specific<LightingCounters> counters;
     tbb::enumerable_thread_specific<std::unique_ptr<NearFieldCache>> nearCaches;
-    // exact: chunks are row bands; Monte Carlo: every row, chunks are samples.
-    const std::uint32_t row0 = plan.exact ? static_cast<std::uint32_t>(std::clamp<std::uint64_t>(c0 * LightingPlan::kChunkRows, area.y0, area.y1))
-                                          : area.y0;
-    const std::uint32_t row1 = plan.exact ? static_cast<std::uint32_t>(std::clamp<std::uint64_t>(c1 * LightingPlan::kChunkRows, area.y0, area.y1))
-                                          : area.y1;
-    if (row0 >= row1 || area.x0 >= area.x1) return {};
-
-    // Counting mode (the whole image: slot = px): pixel px's thread, with its work (hit pixels: `p`).
-    const auto record = [&](std::size_t px, const GroupPixel* p) {
-        if constexpr (Count) {
-            const GBufferTexel& g = gb.texels[px];
-            ThreadCounters& t = in.counters->threads[px];
-            recordTexel(t, g, in.particles, in.bvh, gpu_layout::kGBufferTexel);
-            t.bytesWritten += gpu_layout::kRadiance;
-            if (!p) return;
-            t.trips = static_cast<std::uint32_t>(p->sums.c.lightTerms);
-            t.bytesRead += t.trips * gpu_layout::kParticleRecord;
-            t.addRays(p->rays, static_cast<std::uint32_t>(p->sums.c.shadowRays));
-        }
+    const auto rows = [&](std::uint64_t c, std::uint32_t whole) {
+        return plan.exact ? static_cast<std::uint32_t>(std::clamp<std::uint64_t>(c * LightingPlan::kChunkRows, area.y0, area.y1))
+                          : whole;
     };
-
+    const std::uint32_t row0 = rows(c0, area.y0), row1 = rows(c1, area.y1);
+    if (row0 >= row1 || area.x0 >= area.x1) return {};
     tbb::parallel_for(tbb::blocked_range2d<std::uint32_t>(row0, row1, 8, area.x0, area.x1, 8), [&](const auto& r) {
         LightingCounters& c = counters.local();
         GroupPixel pix[kGroupPixels];
@@ -267,76 +360,18 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
         for (std::uint32_t y = r.rows().begin(); y != r.rows().end(); ++y) {
             for (std::uint32_t x0 = r.cols().begin(); x0 < r.cols().end(); x0 += kGroupPixels) {
                 const std::uint32_t x1 = std::min(r.cols().end(), x0 + kGroupPixels);
-                const std::size_t row = std::size_t(y) * gb.width, rowSlot = gb.window.index(x0, y) - x0;
                 // The next group's texels (the next row's at a row's end) are
                 // read soon: a range's rows are short runs of the G-buffer.
+                const std::size_t rowSlot = gb.window.index(x0, y) - x0;
                 const std::size_t next = x1 < r.cols().end() ? rowSlot + x1 : rowSlot + gb.window.width() + r.cols().begin();
                 if (next + kGroupPixels <= gb.texels.size())
                     for (std::size_t b = 0; b < kGroupPixels * sizeof(GBufferTexel); b += 64)
                         __builtin_prefetch(reinterpret_cast<const char*>(&gb.texels[next]) + b);
-                // The group's hits first, their particles' records prefetched.
-                std::uint32_t n = 0;
-                for (std::uint32_t x = x0; x != x1; ++x) {
-                    const std::size_t slot = rowSlot + x;
-                    const std::uint32_t j = gb.texels[slot].particle;
-                    if (j == kNoParticle) {  // nothing to add: sums stay 0
-                        record(row + x, nullptr);
-                        if (!acc) {
-                            out->Lr[slot] = out->Lr_stderr[slot] = Vec3(0.0f);
-                            out->spp[slot] = out->rejected[slot] = 0.0f;
-                        }
-                        continue;
-                    }
-                    __builtin_prefetch(&in.particles.position[j]);
-                    __builtin_prefetch(&in.particles.albedo[j]);
-                    pix[n].px = row + x;
-                    pix[n++].slot = slot;
-                }
+                const std::uint32_t n = beginGroup<Count>(s, y, x0, x1, pix);
                 if (n == 0) continue;
                 hitPixels += n;
-                for (std::uint32_t k = 0; k < n; ++k) {
-                    GroupPixel& p = pix[k];
-                    p.sp = shadingPoint(gb.texels[p.slot], in.particles);
-                    p.sums = PixelSums{};
-                    p.sums.discardNonFinite = in.render.nonfinite == NonFinitePolicy::discard;
-                    p.rays = RayCounters{};
-                    if (acc) p.sums.load(*acc, p.slot);
-                    if (in.trace && in.trace->px == p.px) [[unlikely]] p.sums.trace = in.trace;
-                }
-                if (kind == EstimatorKind::exact) {
-                    for (std::uint32_t k = 0; k < n; ++k) {
-                        PixelSums& s = pix[k].sums;
-                        const DVec3 v = s.trace ? exactPixel<M, P, true>(in.bvh, L, pix[k].sp, vis, shadows, s.c, Count ? &pix[k].rays : nullptr, s.trace)
-                                              : exactPixel<M, P>(in.bvh, L, pix[k].sp, vis, shadows, s.c, Count ? &pix[k].rays : nullptr);
-                        if (finiteSum(v)) s.sum = v;
-                        else s.reject();  // exact has one value: 0 either way
-                        s.n = 1;
-                    }
-                } else if (kind == EstimatorKind::ris) {
-                    runChunks<M, P, Count, EstimatorKind::ris>(in, L, plan, vis, shadows, c0, c1, pix, n);
-                } else if (kind == EstimatorKind::power) {
-                    runChunks<M, P, Count, EstimatorKind::power>(in, L, plan, vis, shadows, c0, c1, pix, n);
-                } else if (kind == EstimatorKind::tree) {
-                    runChunks<M, P, Count, EstimatorKind::tree>(in, L, plan, vis, shadows, c0, c1, pix, n);
-                } else if (kind == EstimatorKind::split) {
-                    std::unique_ptr<NearFieldCache>& cache = nearCaches.local();
-                    if (!cache) cache = std::make_unique<NearFieldCache>();
-                    std::uint64_t pinned = 0;  // the slots this group's pixels use
-                    std::uint32_t spares = 0;
-                    for (std::uint32_t k = 0; k < n; ++k)
-                        if (!pix[k].sums.done) prepareNearField<M, P, Count>(in, L, vis, shadows, pix[k], *cache, pinned, spares);
-                    runChunks<M, P, Count, EstimatorKind::split>(in, L, plan, vis, shadows, c0, c1, pix, n);
-                } else {
-                    runChunks<M, P, Count, EstimatorKind::uniform>(in, L, plan, vis, shadows, c0, c1, pix, n);
-                }
-                for (std::uint32_t k = 0; k < n; ++k) {
-                    GroupPixel& p = pix[k];
-                    record(p.px, &p);
-                    if (acc) p.sums.store(*acc, p.slot);
-                    else p.sums.c.nonFinite += resolvePixel(p.sums.sum, p.sums.sumSq, p.sums.n, p.sums.rejected, plan.exact, *out, p.slot);
-                    p.sums.c.nonFinite += p.sums.rejected - p.sums.rejectedBefore;
-                    c += p.sums.c;
-                }
+                lightGroup<M, P, Count>(s, pix, n, nearCaches.local());
+                finishGroup<Count>(s, pix, n, c);
             }
         }
         // Work, not pixels: a hit pixel's samples (exact: its light terms, the
