@@ -57,85 +57,113 @@ struct TuneArgs : SceneArgs {
 };
 
 /// One point of the space: its label and the settings it overrides.
-struct Option {
-    std::string label;
-    std::vector<std::string> defines;  ///< section.key=value
+/// A geometry choice (none changes the image): the acceleration layout and
+/// cluster size, the build policy, and for disc alpha a 4-state micromap
+/// instead of the any-hit.
+struct GeometryChoice {
+    std::string layoutLabel;                 ///< "clusters of 100", "one BLAS", ...
+    AccelLayout layout = AccelLayout::clusters;
+    std::optional<std::uint32_t> clusterSize;  ///< geometry.cluster_size (none: the layout's own)
+    BuildPolicy build = BuildPolicy::rebuild;
+    bool omm = false;                        ///< gpu.omm = 4state at level 4 (else off)
+
+    std::string label() const { return fmt::format("{}, {}{}", layoutLabel, enumName(build), omm ? ", 4-state micromap L4" : ""); }
+    /// As -D overrides of the measurements' child processes (and their cache keys).
+    std::vector<std::string> defines() const {
+        std::vector<std::string> d = {fmt::format("geometry.layout={}", enumName(layout))};
+        if (clusterSize) d.push_back(fmt::format("geometry.cluster_size={}", *clusterSize));
+        d.push_back(fmt::format("geometry.build={}", enumName(build)));
+        if (omm) d.insert(d.end(), {"gpu.omm=4state", "gpu.omm_level=4"});
+        else d.push_back("gpu.omm=off");
+        return d;
+    }
 };
 
-/// The geometry choices (none changes the image): layout and cluster size,
-/// build policy, and for disc alpha the any-hit or a 4-state micromap.
-std::vector<Option> geometryOptions(const Settings& s) {
-    struct Layout {
-        std::string label;
-        std::vector<std::string> defines;
-    };
-    const std::string all = "geometry.cluster_size=10000000";
-    std::vector<Layout> layouts = {{"clusters of 100", {"geometry.layout=clusters", "geometry.cluster_size=100"}},
-                                   {"clusters of 1000", {"geometry.layout=clusters", "geometry.cluster_size=1000"}},
-                                   {"clusters of 10000", {"geometry.layout=clusters", "geometry.cluster_size=10000"}},
-                                   {"one BLAS", {"geometry.layout=clusters", all}},
-                                   {"instance per particle", {"geometry.layout=instances"}}};
-    if (s.geometry.primitive == Primitive::billboard) layouts.push_back({"one BLAS of boxes", {"geometry.layout=aabbs", all}});
-    std::vector<Option> out;
-    for (const Layout& l : layouts)
-        for (const char* build : {"rebuild", "refit"}) {  // every layout's refit is timed (bench/gpu/layouts_refit.txt)
-            std::vector<std::string> alphas = {""};
-            if (s.geometry.alpha == AlphaMode::disc && l.defines[0] != "geometry.layout=aabbs") alphas.push_back("omm");
-            for (const std::string& alpha : alphas) {
-                Option o{fmt::format("{}, {}{}", l.label, build, alpha.empty() ? "" : ", 4-state micromap L4"), l.defines};
-                o.defines.push_back(fmt::format("geometry.build={}", build));
-                if (!alpha.empty()) o.defines.insert(o.defines.end(), {"gpu.omm=4state", "gpu.omm_level=4"});
-                else o.defines.push_back("gpu.omm=off");
-                out.push_back(std::move(o));
+/// The geometry choices: layout and cluster size, rebuild or refit (every
+/// layout's refit is timed: bench/gpu/layouts_refit.txt), and for disc
+/// alpha the any-hit or a 4-state micromap (not for boxes).
+std::vector<GeometryChoice> geometryChoices(const Settings& s) {
+    constexpr std::uint32_t kAll = 10000000;
+    std::vector<GeometryChoice> layouts = {{"clusters of 100", AccelLayout::clusters, 100u},
+                                           {"clusters of 1000", AccelLayout::clusters, 1000u},
+                                           {"clusters of 10000", AccelLayout::clusters, 10000u},
+                                           {"one BLAS", AccelLayout::clusters, kAll},
+                                           {"instance per particle", AccelLayout::instances, std::nullopt}};
+    if (s.geometry.primitive == Primitive::billboard) layouts.push_back({"one BLAS of boxes", AccelLayout::aabbs, kAll});
+    std::vector<GeometryChoice> out;
+    for (const GeometryChoice& l : layouts)
+        for (const BuildPolicy build : {BuildPolicy::rebuild, BuildPolicy::refit})
+            for (const bool omm : {false, true}) {
+                if (omm && (s.geometry.alpha != AlphaMode::disc || l.layout == AccelLayout::aabbs)) continue;
+                GeometryChoice g = l;
+                g.build = build;
+                g.omm = omm;
+                out.push_back(g);
             }
-        }
     return out;
 }
 
-/// The lighting choices of `space`: candidate source and count, spatial
-/// neighbours and iterations, bias correction, visibility reuse and the
-/// lighting resolution. quick: 34 points around the GPU team's settings;
-/// full: the whole grid (1080 points: hours).
-std::vector<Option> lightingOptions(const std::string& space) {
+/// A lighting choice of restir: candidate source and count, spatial
+/// neighbours and iterations, bias correction, visibility reuse (with
+/// basic, V tested at the neighbours too: unbiased; pairwise cannot) and
+/// the lighting resolution.
+struct LightingChoice {
+    LightSource source = LightSource::power;
+    std::uint32_t candidates = 8;
+    std::uint32_t neighbours = 0, iterations = 1;
+    BiasCorrection bias = BiasCorrection::basic;
+    bool visibilityReuse = false;
+    double scale = 1.0;
+
+    std::string label() const {
+        return fmt::format("{} M={} nb={}x{} {}{} {:g}x", enumName(source), candidates, neighbours, iterations, enumName(bias),
+                           visibilityReuse ? "+vis" : "", scale);
+    }
+    /// As -D overrides of the measurements' child processes (and their cache keys).
+    std::vector<std::string> defines() const {
+        return {"render.estimator=restir",
+                fmt::format("render.source={}", enumName(source)),
+                fmt::format("render.candidates={}", candidates),
+                fmt::format("restir.spatial_neighbours={}", neighbours),
+                fmt::format("restir.spatial_iterations={}", iterations),
+                fmt::format("restir.bias_correction={}", enumName(bias)),
+                fmt::format("restir.visibility_reuse={}", visibilityReuse),
+                fmt::format("restir.basic_visibility={}", visibilityReuse && bias == BiasCorrection::basic),
+                fmt::format("restir.resolution_scale={:g}", scale)};
+    }
+};
+
+/// The lighting choices of `space`: quick, 34 points around the GPU team's
+/// settings; full, the whole grid (1080 points: hours).
+std::vector<LightingChoice> lightingChoices(const std::string& space) {
     struct Axes {
-        std::vector<std::string> sources;
+        std::vector<LightSource> sources;
         std::vector<std::uint32_t> candidates;
         std::vector<std::pair<std::uint32_t, std::uint32_t>> spatial;  // neighbours, iterations
-        std::vector<std::string> corrections;
+        std::vector<BiasCorrection> corrections;
         std::vector<bool> visibility;
         std::vector<double> scales;
     };
+    using enum BiasCorrection;
     Axes x;
     if (space == "full") {
-        x = {{"uniform", "power", "tree"}, {4, 8, 16, 32}, {{0, 1}, {3, 1}, {5, 1}, {5, 2}, {10, 1}},
-             {"none", "basic", "pairwise"}, {false, true}, {1.0, 0.75, 0.5}};
+        x = {{LightSource::uniform, LightSource::power, LightSource::tree}, {4, 8, 16, 32}, {{0, 1}, {3, 1}, {5, 1}, {5, 2}, {10, 1}},
+             {none, basic, pairwise}, {false, true}, {1.0, 0.75, 0.5}};
     } else if (space == "quick") {
-        x = {{"power", "tree"}, {8, 32}, {{0, 1}, {5, 1}}, {"basic", "pairwise"}, {false}, {1.0, 0.5}};
+        x = {{LightSource::power, LightSource::tree}, {8, 32}, {{0, 1}, {5, 1}}, {basic, pairwise}, {false}, {1.0, 0.5}};
     } else {
         throw InputError(fmt::format("command line --space {}: expected quick or full", space));
     }
-    auto option = [](const std::string& src, std::uint32_t m, std::pair<std::uint32_t, std::uint32_t> sp, const std::string& bc,
-                     bool vis, double scale) {
-        Option o;
-        o.label = fmt::format("{} M={} nb={}x{} {}{} {:g}x", src, m, sp.first, sp.second, bc, vis ? "+vis" : "", scale);
-        o.defines = {"render.estimator=restir", fmt::format("render.source={}", src), fmt::format("render.candidates={}", m),
-                     fmt::format("restir.spatial_neighbours={}", sp.first), fmt::format("restir.spatial_iterations={}", sp.second),
-                     fmt::format("restir.bias_correction={}", bc), fmt::format("restir.visibility_reuse={}", vis),
-                     // basic with visibility reuse tests V at the neighbours (unbiased); pairwise cannot.
-                     fmt::format("restir.basic_visibility={}", vis && bc == "basic"),
-                     fmt::format("restir.resolution_scale={:g}", scale)};
-        return o;
-    };
-    std::vector<Option> out;
-    for (const auto& src : x.sources)
+    std::vector<LightingChoice> out;
+    for (const LightSource src : x.sources)
         for (std::uint32_t m : x.candidates)
-            for (const auto& sp : x.spatial)
-                for (const auto& bc : x.corrections)
+            for (const auto& [nb, it] : x.spatial)
+                for (const BiasCorrection bc : x.corrections)
                     for (bool vis : x.visibility)
-                        for (double scale : x.scales) out.push_back(option(src, m, sp, bc, vis, scale));
+                        for (double scale : x.scales) out.push_back({src, m, nb, it, bc, vis, scale});
     if (space == "quick") {  // a biased correction and visibility reuse, beside the grid
-        out.push_back(option("tree", 16, {5, 1}, "none", false, 1.0));
-        out.push_back(option("tree", 16, {5, 1}, "pairwise", true, 1.0));
+        out.push_back({LightSource::tree, 16, 5, 1, none, false, 1.0});
+        out.push_back({LightSource::tree, 16, 5, 1, pairwise, true, 1.0});
     }
     return out;
 }
@@ -213,9 +241,9 @@ struct ErrorRow {
     bool biased = false;
 };
 
-ErrorRow measureError(TuneContext& t, const Option& o) {
+ErrorRow measureError(TuneContext& t, const LightingChoice& o) {
     std::string spec = "restir";
-    for (const std::string& d : o.defines)
+    for (const std::string& d : o.defines())
         if (d != "render.estimator=restir") spec += ":" + d;
     std::string key = t.sceneText + fmt::format("\nbias {} seeds {} frame {} {}x{} reference {}", spec, t.args.seeds, t.args.frame,
                                                 t.errorWidth, t.errorHeight, cacheKey(readWholeFile(t.reference, "tune")));
@@ -224,7 +252,7 @@ ErrorRow measureError(TuneContext& t, const Option& o) {
                                                           fmt::format("camera.height={}", t.errorHeight)});
     argv.insert(argv.end(), {"--reference", t.reference, "--estimators", spec, "--seeds", std::to_string(t.args.seeds), "--frame",
                              std::to_string(t.args.frame), "--history", "1", "-q", "-o", prefix.string()});
-    measure(t, argv, prefix.string() + ".json", "error of " + o.label);
+    measure(t, argv, prefix.string() + ".json", "error of " + o.label());
     const nlohmann::json j = nlohmann::json::parse(readWholeFile(prefix.string() + ".json", "tune"));
     const nlohmann::json& r = j.at("rows").at(0);
     return {r.at("rel_mse").get<double>(), r.at("z").get<double>(), r.at("energy_loss_pct").get<double>(),
@@ -251,7 +279,7 @@ std::string ensureReference(TuneContext& t, std::size_t particles) {
 
 /// A measured configuration of the front's search.
 struct ParetoPoint {
-    Option lighting;
+    LightingChoice lighting;
     double ms = 0.0;
     ErrorRow error;
     bool front = false;
@@ -272,26 +300,34 @@ void markFront(std::vector<ParetoPoint>& points) {
         }
 }
 
-void runTune(const TuneArgs& a) {
-    const Settings scene = loadSceneArgs(a, {{"render.estimator", "tune (restir)", [](Settings& s) { s.render.estimator = EstimatorKind::restir; }}});
-    requireWholeImage(scene, "tune");
+/// --error-size WIDTHxHEIGHT, each side 8 to 8192.
+void parseErrorSize(const std::string& text, std::uint32_t& width, std::uint32_t& height) {
+    const auto x = text.find('x');
+    try {
+        if (x == std::string::npos) throw std::invalid_argument("no x");
+        width = static_cast<std::uint32_t>(std::stoul(text.substr(0, x)));
+        height = static_cast<std::uint32_t>(std::stoul(text.substr(x + 1)));
+    } catch (const std::exception&) {
+        throw InputError(fmt::format("command line --error-size {}: expected WIDTHxHEIGHT, e.g. 320x180", text));
+    }
+    if (width < 8 || height < 8 || width > 8192 || height > 8192)
+        throw InputError(fmt::format("command line --error-size {}: each side 8 to 8192 pixels", text));
+}
+
+/// tune's numbers on the command line: the budget, --max-error, --error-size.
+void checkTuneArgs(const TuneArgs& a) {
     if (!(a.budgetMs > 0.0) || !std::isfinite(a.budgetMs)) throw InputError("command line --budget-ms: expected a positive number of ms");
     if (a.maxError && (!(*a.maxError > 0.0) || !std::isfinite(*a.maxError)))
         throw InputError("command line --max-error: expected a positive relMSE");
+    std::uint32_t w, h;
+    parseErrorSize(a.errorSize, w, h);
+}
+
+/// The search's context, once its command line is checked (checkTuneArgs):
+/// its outputs guarded, its cache and calibration, before any measurement.
+TuneContext prepareTune(const TuneArgs& a, const Settings& scene, const std::string& prefix) {
     TuneContext t{a};
-    const auto x = a.errorSize.find('x');
-    try {
-        if (x == std::string::npos) throw std::invalid_argument("no x");
-        t.errorWidth = static_cast<std::uint32_t>(std::stoul(a.errorSize.substr(0, x)));
-        t.errorHeight = static_cast<std::uint32_t>(std::stoul(a.errorSize.substr(x + 1)));
-    } catch (const std::exception&) {
-        throw InputError(fmt::format("command line --error-size {}: expected WIDTHxHEIGHT, e.g. 320x180", a.errorSize));
-    }
-    if (t.errorWidth < 8 || t.errorHeight < 8 || t.errorWidth > 8192 || t.errorHeight > 8192)
-        throw InputError(fmt::format("command line --error-size {}: each side 8 to 8192 pixels", a.errorSize));
-    const std::vector<Option> geometry = geometryOptions(scene);
-    const std::vector<Option> lighting = lightingOptions(a.space);
-    const std::string prefix = a.out.empty() ? "out/" + scene.sceneName + ".tune" : a.out;
+    parseErrorSize(a.errorSize, t.errorWidth, t.errorHeight);
     t.cache = a.cache.empty() ? std::filesystem::path("out") / "tune_cache" / scene.sceneName : std::filesystem::path(a.cache);
     OutputGuard guard = sceneInputs(scene);
     if (!a.reference.empty()) guard.addInput(a.reference);
@@ -307,83 +343,109 @@ void runTune(const TuneArgs& a) {
     for (const std::string& d : a.defines)
         if (d.rfind("gpu.coefficients", 0) != 0) t.sceneText += "\n-D " + d;
     t.sceneText += "\n-D render.estimator=restir";  // sceneArgv's
+    return t;
+}
 
-    t.steps = geometry.size() + 2 * lighting.size();
-    const std::size_t particles = ParticleSource(scene).frame(a.frame).size();
-    t.reference = ensureReference(t, particles);
+/// A geometry choice priced: its predicted GPU ms per pass at the scene's lighting.
+struct PricedGeometry {
+    GeometryChoice choice;
+    std::map<Pass, double> ms;
+};
 
-    // Geometry: the same image whatever it is; the fastest predicted frame.
-    Option base{"the scene's lighting", {}};
-    std::vector<std::pair<Option, std::map<Pass, double>>> geometryMs;
-    for (const Option& g : geometry) geometryMs.emplace_back(g, predictMs(t, g.defines, g.label));
-    const auto fastest = std::min_element(geometryMs.begin(), geometryMs.end(),
-                                          [](const auto& p, const auto& q) { return total(p.second) < total(q.second); });
-    const Option& chosen = fastest->first;
-    Table gt({{"geometry", "geometry (the image does not depend on it)", -44}, {"build_ms", "build ms", 9, "{:.3f}", "{:.6g}"},
-              {"gbuffer_ms", "G-buffer", 9, "{:.3f}", "{:.6g}"}, {"shadow_ms", "shadow", 9, "{:.3f}", "{:.6g}"},
-              {"frame_ms", "frame ms", 9, "{:.3f}", "{:.6g}"}});
-    const auto of = [](const std::map<Pass, double>& ms, Pass p) { return ms.count(p) ? ms.at(p) : 0.0; };
-    for (const auto& [g, ms] : geometryMs)
-        gt.add({g.label, of(ms, Pass::buildClusters), of(ms, Pass::traceGBuffer), of(ms, Pass::traceShadowRays), total(ms)});
-
-    // Lighting: error on the CPU, GPU time on the chosen geometry.
+/// The lighting choices on the chosen geometry: error on the CPU, GPU time
+/// priced; the Pareto front marked, sorted by time.
+std::vector<ParetoPoint> measureLighting(TuneContext& t, const GeometryChoice& chosen, const std::vector<LightingChoice>& lighting) {
     std::vector<ParetoPoint> points;
-    for (const Option& l : lighting) {
+    for (const LightingChoice& l : lighting) {
         ParetoPoint p{l};
-        std::vector<std::string> defines = chosen.defines;
-        defines.insert(defines.end(), l.defines.begin(), l.defines.end());
-        p.ms = total(predictMs(t, defines, l.label));
+        std::vector<std::string> defines = chosen.defines();
+        const std::vector<std::string> own = l.defines();
+        defines.insert(defines.end(), own.begin(), own.end());
+        p.ms = total(predictMs(t, defines, l.label()));
         p.error = measureError(t, l);
         points.push_back(std::move(p));
     }
     markFront(points);
     std::sort(points.begin(), points.end(), [](const ParetoPoint& p, const ParetoPoint& q) { return p.ms < q.ms; });
-    // The recommendation: under the budget (and --max-error), unbiased unless
-    // allowed; the lowest error, or with --max-error the fastest that meets it.
+    return points;
+}
+
+/// The recommendation: under the budget (and --max-error), unbiased unless
+/// allowed; the lowest error, or with --max-error the fastest that meets it.
+const ParetoPoint* recommend(const TuneArgs& a, const std::vector<ParetoPoint>& points) {
     const ParetoPoint* best = nullptr;
     for (const ParetoPoint& p : points) {
         if (p.ms > a.budgetMs || (p.error.biased && !a.allowBiased)) continue;
         if (a.maxError && p.error.relMse > *a.maxError) continue;
         if (!best || (a.maxError ? p.ms < best->ms : p.error.relMse < best->error.relMse)) best = &p;
     }
+    return best;
+}
 
+/// What tune found, as its report, CSV, JSON and plot read it.
+struct TuneResult {
+    std::vector<PricedGeometry> geometry;
+    const PricedGeometry* chosen = nullptr;     ///< the fastest
+    const PricedGeometry* triangles = nullptr;  ///< the fastest of triangles (not boxes)
+    std::vector<ParetoPoint> points;
+    const ParetoPoint* best = nullptr;
+};
+
+Table geometryTable(const TuneResult& r) {
+    Table gt({{"geometry", "geometry (the image does not depend on it)", -44}, {"build_ms", "build ms", 9, "{:.3f}", "{:.6g}"},
+              {"gbuffer_ms", "G-buffer", 9, "{:.3f}", "{:.6g}"}, {"shadow_ms", "shadow", 9, "{:.3f}", "{:.6g}"},
+              {"frame_ms", "frame ms", 9, "{:.3f}", "{:.6g}"}});
+    const auto of = [](const std::map<Pass, double>& ms, Pass p) { return ms.count(p) ? ms.at(p) : 0.0; };
+    for (const auto& [g, ms] : r.geometry)
+        gt.add({g.label(), of(ms, Pass::buildClusters), of(ms, Pass::traceGBuffer), of(ms, Pass::traceShadowRays), total(ms)});
+    return gt;
+}
+
+Table lightingTable(const TuneArgs& a, const TuneResult& r) {
     Table lt({{"lighting", "lighting (on the chosen geometry)", -36}, {"gpu_ms", "GPU ms", 9, "{:.3f}", "{:.6g}"},
               {"rel_mse", fmt::format("relMSE@{}", a.errorSize), 14, "{:.4g}", "{:.6g}"}, {"z", "bias z", 7, "{:.1f}", "{:.5g}"},
               {"energy_loss_pct", "loss %", 7, "{:.1f}", "{:.5g}"}, {"cpu_s", "CPU s", 7, "{:.2f}", "{:.5g}"},
               {"biased", "", 0, "{}", "{}", false}, {"front", "", 0, "{}", "{}", false},
               {"", "", 0, "{}", "{}", true, "  "}});
-    for (const ParetoPoint& p : points)
-        lt.add({p.lighting.label, p.ms, p.error.relMse, p.error.z, p.error.energyLossPct, p.error.cpuSecondsPerFrame, p.error.biased,
+    for (const ParetoPoint& p : r.points)
+        lt.add({p.lighting.label(), p.ms, p.error.relMse, p.error.z, p.error.energyLossPct, p.error.cpuSecondsPerFrame, p.error.biased,
                 p.front,
-                std::string(p.front ? "front" : "") + (p.error.biased ? " BIASED" : "") + (&p == best ? " <- recommended" : "")});
+                std::string(p.front ? "front" : "") + (p.error.biased ? " BIASED" : "") + (&p == r.best ? " <- recommended" : "")});
+    return lt;
+}
+
+/// The tables and the verdict on stdout.
+void printTune(const TuneArgs& a, const Settings& scene, const TuneContext& t, const TuneResult& r, const Table& gt, const Table& lt) {
     fmt::print("{}\n{}", gt.console(), lt.console());
-    fmt::print("geometry: {} ({:.3f} ms predicted at {}x{}, the scene's lighting)\nGPU time: {}\n", chosen.label,
-               total(fastest->second), scene.camera.width, scene.camera.height, t.coefficients.source);
+    const GeometryChoice& chosen = r.chosen->choice;
+    fmt::print("geometry: {} ({:.3f} ms predicted at {}x{}, the scene's lighting)\nGPU time: {}\n", chosen.label(),
+               total(r.chosen->ms), scene.camera.width, scene.camera.height, t.coefficients.source);
     // Procedural boxes beat triangles only where traversal is software: on
     // RT cores every box entered calls the intersection program on the SM
     // (docs/layouts.md). Name the fastest triangle layout beside them.
-    const auto triangles = std::min_element(geometryMs.begin(), geometryMs.end(), [](const auto& p, const auto& q) {
-        const bool pb = p.first.defines[0] == "geometry.layout=aabbs", qb = q.first.defines[0] == "geometry.layout=aabbs";
-        return pb != qb ? qb : total(p.second) < total(q.second);
-    });
-    if (chosen.defines[0] == "geometry.layout=aabbs" && triangles->first.defines[0] != "geometry.layout=aabbs")
+    if (chosen.layout == AccelLayout::aabbs && r.triangles->choice.layout != AccelLayout::aabbs)
         fmt::print("on a GPU with RT cores prefer {} ({:+.3f} ms here): boxes win only where traversal runs in software\n",
-                   triangles->first.label, total(triangles->second) - total(fastest->second));
-    if (best)
+                   r.triangles->choice.label(), total(r.triangles->ms) - total(r.chosen->ms));
+    if (const ParetoPoint* best = r.best)
         fmt::print("recommended under {:g} ms{}: {} + {}: {:.3f} GPU ms predicted, relMSE {:.4g} at {} ({} seeds){}\n", a.budgetMs,
-                   a.maxError ? fmt::format(" and relMSE {:g}", *a.maxError) : "", chosen.label, best->lighting.label, best->ms,
+                   a.maxError ? fmt::format(" and relMSE {:g}", *a.maxError) : "", chosen.label(), best->lighting.label(), best->ms,
                    best->error.relMse, a.errorSize, a.seeds, best->error.biased ? " BIASED" : "");
     else
         fmt::print("no {}configuration is under {:g} ms{}\n", a.allowBiased ? "" : "unbiased ", a.budgetMs,
                    a.maxError ? fmt::format(" with relMSE <= {:g}", *a.maxError) : "");
-
     std::fflush(stdout);
-    writeFileAtomic(prefix + ".csv", lt.csv());
+}
+
+/// PREFIX.json: what made the search and what it found.
+void writeTuneJson(const std::string& prefix, const TuneArgs& a, const Settings& scene, const TuneContext& t, const TuneResult& r,
+                   const Table& gt, const Table& lt) {
+    const GeometryChoice& chosen = r.chosen->choice;
     nlohmann::json recommended = nullptr;
-    if (best) {
-        std::vector<std::string> defines = chosen.defines;
-        defines.insert(defines.end(), best->lighting.defines.begin(), best->lighting.defines.end());
-        recommended = {{"geometry", chosen.label}, {"lighting", best->lighting.label}, {"defines", defines}, {"gpu_ms", best->ms},
+    if (const ParetoPoint* best = r.best) {
+        std::vector<std::string> defines = chosen.defines();
+        const std::vector<std::string> own = best->lighting.defines();
+        defines.insert(defines.end(), own.begin(), own.end());
+        recommended = {{"geometry", chosen.label()}, {"lighting", best->lighting.label()}, {"defines", defines}, {"gpu_ms", best->ms},
                        {"rel_mse", best->error.relMse}, {"biased", best->error.biased}};
     }
     writeJson(prefix + ".json", {{"version", std::string(version())}, {"command", "tune"}, {"scene", scene.scenePath},
@@ -391,9 +453,14 @@ void runTune(const TuneArgs& a) {
                                  {"budget_ms", a.budgetMs}, {"max_error", a.maxError ? nlohmann::json(*a.maxError) : nlohmann::json()},
                                  {"seeds", a.seeds}, {"frame", a.frame}, {"error_size", a.errorSize}, {"reference", t.reference},
                                  {"space", a.space}, {"coefficients", t.coefficients.source}, {"geometry", gt.json()},
-                                 {"fastest_triangle_geometry", triangles->first.label}, {"chosen_geometry", chosen.label},
+                                 {"fastest_triangle_geometry", r.triangles->choice.label()}, {"chosen_geometry", chosen.label()},
                                  {"lighting", lt.json()}, {"recommended", recommended}});
+}
+
+/// PREFIX.png: the configurations' error against predicted GPU ms, the front and the budget.
+void plotTune(const std::string& prefix, const TuneArgs& a, const Settings& scene, std::size_t particles, const TuneResult& r) {
     const std::string csv = gnuplotQuote(prefix + ".csv");
+    const ParetoPoint* best = r.best;
     const std::string script = fmt::format(
         "set datafile separator ','\nset logscale y\nset grid\nset key top right\n"
         "set title {0}\nset xlabel 'predicted GPU ms per frame ({1}; calibrated cost model)'\nset ylabel 'relMSE at {2} ({3} seeds)'\n"
@@ -404,11 +471,43 @@ void runTune(const TuneArgs& a) {
         "{5} skip 1 using 2:($8 != 0 ? $3 : NaN) with points pt 6 ps 2 lc rgb 'blue' title 'Pareto front'\n",
         gnuplotQuote(fmt::format("{} ({} particles) at {}x{}: budget {:g} ms", scene.sceneName, particles,
                                  scene.camera.width, scene.camera.height, a.budgetMs)),
-        chosen.label, a.errorSize, a.seeds, a.budgetMs, csv,
+        r.chosen->choice.label(), a.errorSize, a.seeds, a.budgetMs, csv,
         best ? fmt::format("set label 'recommended' at {},{} point pt 3 ps 3 lc rgb 'dark-green' offset 1,1 tc rgb 'dark-green'\n", best->ms,
                            best->error.relMse)
              : std::string());
     plotPng(prefix + ".png", script);
+}
+
+void runTune(const TuneArgs& a) {
+    const Settings scene = loadSceneArgs(a, {{"render.estimator", "tune (restir)", [](Settings& s) { s.render.estimator = EstimatorKind::restir; }}});
+    requireWholeImage(scene, "tune");
+    checkTuneArgs(a);
+    const std::vector<GeometryChoice> geometry = geometryChoices(scene);
+    const std::vector<LightingChoice> lighting = lightingChoices(a.space);
+    const std::string prefix = a.out.empty() ? "out/" + scene.sceneName + ".tune" : a.out;
+    TuneContext t = prepareTune(a, scene, prefix);
+    t.steps = geometry.size() + 2 * lighting.size();
+    const std::size_t particles = ParticleSource(scene).frame(a.frame).size();
+    t.reference = ensureReference(t, particles);
+
+    // Geometry: the same image whatever it is; the fastest predicted frame.
+    TuneResult r;
+    for (const GeometryChoice& g : geometry) r.geometry.push_back({g, predictMs(t, g.defines(), g.label())});
+    const auto faster = [](const PricedGeometry& p, const PricedGeometry& q) { return total(p.ms) < total(q.ms); };
+    r.chosen = &*std::min_element(r.geometry.begin(), r.geometry.end(), faster);
+    r.triangles = &*std::min_element(r.geometry.begin(), r.geometry.end(), [&](const PricedGeometry& p, const PricedGeometry& q) {
+        const bool pb = p.choice.layout == AccelLayout::aabbs, qb = q.choice.layout == AccelLayout::aabbs;
+        return pb != qb ? qb : faster(p, q);
+    });
+    // Lighting: error on the CPU, GPU time on the chosen geometry.
+    r.points = measureLighting(t, r.chosen->choice, lighting);
+    r.best = recommend(a, r.points);
+
+    const Table gt = geometryTable(r), lt = lightingTable(a, r);
+    printTune(a, scene, t, r, gt, lt);
+    writeFileAtomic(prefix + ".csv", lt.csv());
+    writeTuneJson(prefix, a, scene, t, r, gt, lt);
+    plotTune(prefix, a, scene, particles, r);
     fmt::print("tune: {}.csv, {}.json, {}.png (cache {})\n", prefix, prefix, prefix, t.cache.string());
 }
 
