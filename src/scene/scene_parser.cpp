@@ -252,13 +252,19 @@ private:
     std::set<std::string> sections_;
 };
 
-/// Cross-field rules, reported at the location of the offending key.
-void validate(const Settings& s, const std::map<std::string, std::string>& loc, std::string_view sourceName) {
-    auto fail = [&](const std::string& key, const std::string& msg) {
+/// Fails a cross-field rule at the location of the offending key.
+struct RuleFailure {
+    const std::map<std::string, std::string>& loc;
+    std::string_view sourceName;
+    [[noreturn]] void operator()(const std::string& key, const std::string& msg) const {
         auto it = loc.find(key);
         const std::string at = it != loc.end() ? it->second : std::string(sourceName);
         throw InputError(fmt::format("{}: {}: {}", at, key, msg));
-    };
+    }
+};
+
+/// The disk's radii and type bands, the camera's pose and path.
+void validateSceneShape(const Settings& s, const RuleFailure& fail) {
     if (!(s.particles.outer_radius > s.particles.inner_radius))
         fail("particles.outer_radius", fmt::format("must be greater than inner_radius ({})", s.particles.inner_radius));
     for (std::size_t k = 1; k < s.particles.type_bands.size(); ++k)
@@ -273,6 +279,10 @@ void validate(const Settings& s, const std::map<std::string, std::string>& loc, 
         fail("camera.file", "the file gives every frame's camera: leave camera.path at \"static\"");
     if (s.camera.path == CameraPath::linear && glm::length(s.camera.end_look_at - s.camera.end_position) <= 0.0f)
         fail("camera.end_look_at", "must differ from camera.end_position");
+}
+
+/// The visibility rule's far end, the frames and the output path.
+void validateOutputs(const Settings& s, const RuleFailure& fail) {
     if (s.render.offset_far == FarEnd::relative && !(s.render.offset_far_margin < 1.0))
         fail("render.offset_far_margin", "a relative far-end margin must be below 1 (TMax = d (1 - e))");
     if (static_cast<std::uint64_t>(s.render.frame_start) + s.render.frames > 0xffffffffull)
@@ -283,6 +293,10 @@ void validate(const Settings& s, const std::map<std::string, std::string>& loc, 
         fail("render.output", "must be a file name ending in .exr (the EXR goes there, its previews and stats beside it)");
     if (s.render.frames > 1 && s.render.output.find("{frame}") == std::string::npos)
         fail("render.output", "a multi-frame render needs a {frame} pattern in the output path");
+}
+
+/// The packed reservoirs' light bits, render.crop, adaptive sampling's cap.
+void validateSampling(const Settings& s, const RuleFailure& fail) {
     if (estimatorInfo(s.render.estimator).reuse && s.restir.layout == ReservoirLayout::packed &&
         s.particles.file.empty() && s.particles.count > (std::uint64_t(1) << s.restir.light_bits))
         fail("restir.light_bits", fmt::format("{} bits address {} lights but particles.count = {}: the packed layout needs {} bits",
@@ -299,33 +313,39 @@ void validate(const Settings& s, const std::map<std::string, std::string>& loc, 
     }
     if (s.render.target_stderr > 0.0 && s.render.max_samples < s.render.samples)
         fail("render.max_samples", fmt::format("must be at least render.samples ({}) when target_stderr is set", s.render.samples));
-    {
-        // Peak resident estimate from bench/results.json: ~300 B per particle
-        // (particles, clusters, BVH) and ~330 B per pixel (G-buffer, images,
-        // AOVs; reservoirs and history for restir), plus ~60 MB of libraries.
-        // A crop holds its window's pixels alone where cropRendersAlone
-        // (FramePlan::traced). Refused above
-        // render.memory_limit_mb, or else above the machine's physical memory
-        // (a run that cannot fit ends in an allocation failure).
-        const double particles = s.particles.file.empty() ? double(s.particles.count) : 0.0;
-        const std::vector<double>& crop = s.render.crop;
-        const bool window = crop.size() == 4 && cropRendersAlone(s);
-        const double pixels = window ? (crop[1] - crop[0]) * (crop[3] - crop[2]) : double(s.camera.width) * s.camera.height;
-        const double perPixel = estimatorInfo(s.render.estimator).reuse ? 480.0 : 330.0;  // reservoirs and their history
-        const double mb = (300.0 * particles + perPixel * pixels) / 1e6 + 60.0;
-        const std::string image = window ? fmt::format("a {}x{} crop of {}x{}", crop[1] - crop[0], crop[3] - crop[2],
-                                                       s.camera.width, s.camera.height)
-                                         : fmt::format("{}x{}", s.camera.width, s.camera.height);
-        const double physicalMb = double(physicalMemoryBytes()) / 1e6;
-        if (s.render.memory_limit_mb > 0.0 && mb > s.render.memory_limit_mb)
-            fail("render.memory_limit_mb",
-                 fmt::format("{} particles at {} need about {:.0f} MB, more than the limit of {:.0f} MB", particles, image,
-                             mb, s.render.memory_limit_mb));
-        if (s.render.memory_limit_mb <= 0.0 && physicalMb > 0.0 && mb > physicalMb)
-            fail(300.0 * particles > perPixel * pixels ? "particles.count" : "camera.width",
-                 fmt::format("{} particles at {} need about {:.0f} MB, more than this machine's {:.0f} MB of physical "
-                             "memory", particles, image, mb, physicalMb));
-    }
+}
+
+/// The run's memory, estimated before anything is allocated.
+void checkMemory(const Settings& s, const RuleFailure& fail) {
+    // Peak resident estimate from bench/results.json: ~300 B per particle
+    // (particles, clusters, BVH) and ~330 B per pixel (G-buffer, images,
+    // AOVs; reservoirs and history for restir), plus ~60 MB of libraries.
+    // A crop holds its window's pixels alone where cropRendersAlone
+    // (FramePlan::traced). Refused above
+    // render.memory_limit_mb, or else above the machine's physical memory
+    // (a run that cannot fit ends in an allocation failure).
+    const double particles = s.particles.file.empty() ? double(s.particles.count) : 0.0;
+    const std::vector<double>& crop = s.render.crop;
+    const bool window = crop.size() == 4 && cropRendersAlone(s);
+    const double pixels = window ? (crop[1] - crop[0]) * (crop[3] - crop[2]) : double(s.camera.width) * s.camera.height;
+    const double perPixel = estimatorInfo(s.render.estimator).reuse ? 480.0 : 330.0;  // reservoirs and their history
+    const double mb = (300.0 * particles + perPixel * pixels) / 1e6 + 60.0;
+    const std::string image = window ? fmt::format("a {}x{} crop of {}x{}", crop[1] - crop[0], crop[3] - crop[2],
+                                                   s.camera.width, s.camera.height)
+                                     : fmt::format("{}x{}", s.camera.width, s.camera.height);
+    const double physicalMb = double(physicalMemoryBytes()) / 1e6;
+    if (s.render.memory_limit_mb > 0.0 && mb > s.render.memory_limit_mb)
+        fail("render.memory_limit_mb",
+             fmt::format("{} particles at {} need about {:.0f} MB, more than the limit of {:.0f} MB", particles, image,
+                         mb, s.render.memory_limit_mb));
+    if (s.render.memory_limit_mb <= 0.0 && physicalMb > 0.0 && mb > physicalMb)
+        fail(300.0 * particles > perPixel * pixels ? "particles.count" : "camera.width",
+             fmt::format("{} particles at {} need about {:.0f} MB, more than this machine's {:.0f} MB of physical "
+                         "memory", particles, image, mb, physicalMb));
+}
+
+/// The candidate sources, the presampled tiles and grid, micromaps and alpha.
+void validateLightingAndGeometry(const Settings& s, const RuleFailure& fail) {
     if (estimatorInfo(s.render.estimator).resampling && !estimatorInfo(s.render.estimator).reuse &&
         sourceInfo(s.render.source).reuseOnly)
         fail("render.source", fmt::format("\"{}\" is a restir source: its presampled lights are drawn once per frame, and ris "
@@ -341,6 +361,16 @@ void validate(const Settings& s, const std::map<std::string, std::string>& loc, 
         fail("gpu.omm", "opacity micromaps apply to disc-alpha billboards (geometry.alpha = \"disc\")");
     if (s.geometry.primitive == Primitive::sphere && s.geometry.alpha == AlphaMode::disc)
         fail("geometry.alpha", "disc alpha applies to billboards only (primitive = \"sphere\")");
+}
+
+/// Cross-field rules, reported at the location of the offending key, in this order.
+void validate(const Settings& s, const std::map<std::string, std::string>& loc, std::string_view sourceName) {
+    const RuleFailure fail{loc, sourceName};
+    validateSceneShape(s, fail);
+    validateOutputs(s, fail);
+    validateSampling(s, fail);
+    checkMemory(s, fail);
+    validateLightingAndGeometry(s, fail);
 }
 
 /// A setting's value as TOML text; floats in their shortest round-trip form.
