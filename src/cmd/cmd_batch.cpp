@@ -207,6 +207,116 @@ void guardBatch(const BatchArgs& args, const std::vector<Job>& jobs, const std::
     }
 }
 
+/// A batch in progress: its jobs, their results so far (the summary), the
+/// renders running.
+class BatchRun {
+public:
+    BatchRun(const BatchArgs& args, const std::vector<Job>& jobs, std::string summaryPath,
+             std::map<std::string, nlohmann::json> previous)
+        : args_(args), jobs_(jobs), outDir_(args.outputDir), summaryPath_(std::move(summaryPath)), previous_(std::move(previous)),
+          results_(jobs.size()), start_(std::chrono::steady_clock::now()) {
+        summary_ = {{"version", std::string(version())}, {"jobs_file", args.jobsFile}, {"parallel", args.parallel},
+                    {"jobs", nlohmann::json::array()}};
+    }
+
+    /// Runs the jobs, args.parallel at a time; a signal is forwarded to the
+    /// running renders (they checkpoint and stop) and no job starts after it.
+    void run() {
+        StopSignal stop;
+        while (done_ < jobs_.size()) {
+            startJobs(stop);
+            if (stop.pending() && !forwarded_) {  // the renders checkpoint and stop
+                forwarded_ = stop.pending();
+                for (const Running& r : running_) ::kill(r.pid, forwarded_);
+                if (!args_.quiet)
+                    fmt::print(stderr, "accretion batch: {}: stopping {} running job(s)\n", StopSignal::name(forwarded_), running_.size());
+            }
+            if (running_.empty()) {
+                if (stop.pending()) break;
+                continue;
+            }
+            if (!reapOne()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        }
+        for (std::size_t k = 0; k < jobs_.size(); ++k)
+            if (results_[k].is_null()) results_[k] = {{"name", jobs_[k].name}, {"outcome", "not started"}};
+        save();
+    }
+
+    int ok() const { return summary_["counts"].value("ok", 0); }
+    int forwarded() const { return forwarded_; }
+
+private:
+    /// Jobs started up to the parallel limit (none after a stop request);
+    /// those an earlier batch finished are skipped.
+    void startJobs(const StopSignal& stop) {
+        while (!stop.pending() && next_ < jobs_.size() && running_.size() < std::size_t(args_.parallel)) {
+            const Job& j = jobs_[next_];
+            if (auto it = previous_.find(j.name); it != previous_.end()) {
+                results_[next_] = it->second;
+                results_[next_]["skipped"] = "finished in an earlier batch";
+                ++next_;
+                ++done_;
+                continue;
+            }
+            const std::filesystem::path log = outDir_ / (j.name + ".log");
+            std::error_code ec;
+            std::filesystem::create_directories(outDir_, ec);
+            if (ec) throw InputError(fmt::format("{}: cannot create output directory: {}", outDir_.string(), ec.message()));
+            const std::vector<std::string> argv = renderArgv(j, args_);
+            results_[next_] = {{"name", j.name}, {"outcome", "running"}, {"log", log.string()},
+                               {"command", fmt::format("accretion {}", fmt::join(argv.begin() + 1, argv.end(), " "))}};
+            running_.push_back({next_, spawnSelf(argv, log), std::chrono::steady_clock::now()});
+            if (!args_.quiet) fmt::print(stderr, "accretion batch: [{}/{}] {} started\n", next_ + 1, jobs_.size(), j.name);
+            ++next_;
+        }
+    }
+
+    /// One finished render's outcome recorded and the summary saved; false
+    /// when none has finished.
+    bool reapOne() {
+        int status = 0;
+        const pid_t pid = ::waitpid(-1, &status, WNOHANG);
+        if (pid <= 0) return false;
+        const auto it = std::find_if(running_.begin(), running_.end(), [&](const Running& r) { return r.pid == pid; });
+        if (it == running_.end()) return true;
+        nlohmann::json& r = results_[it->job];
+        recordOutcome(r, status, std::chrono::duration<double>(std::chrono::steady_clock::now() - it->start).count(),
+                      outputsFile(args_, jobs_[it->job]));
+        if (!args_.quiet)
+            fmt::print(stderr, "accretion batch: {} {} ({:.1f} s){}\n", r["name"].get<std::string>(), r["outcome"].get<std::string>(),
+                       r["seconds"].get<double>(), r.contains("error") ? ": " + r["error"].get<std::string>() : "");
+        running_.erase(it);
+        ++done_;
+        save();
+        return true;
+    }
+
+    void save() {
+        summary_["jobs"] = nlohmann::json::array();
+        std::map<std::string, int> counts;
+        for (const auto& r : results_)
+            if (!r.is_null()) {
+                summary_["jobs"].push_back(r);
+                ++counts[r.value("outcome", "")];
+            }
+        summary_["counts"] = counts;
+        summary_["total_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+        writeJson(summaryPath_, summary_);
+    }
+
+    const BatchArgs& args_;
+    const std::vector<Job>& jobs_;
+    std::filesystem::path outDir_;
+    std::string summaryPath_;
+    std::map<std::string, nlohmann::json> previous_;
+    nlohmann::json summary_;
+    std::vector<nlohmann::json> results_;
+    std::chrono::steady_clock::time_point start_;
+    std::vector<Running> running_;
+    std::size_t next_ = 0, done_ = 0;
+    int forwarded_ = 0;
+};
+
 void runBatch(BatchArgs args) {
     const std::vector<Job> jobs = batchJobs(args);
     const std::filesystem::path outDir(args.outputDir);
@@ -214,88 +324,11 @@ void runBatch(BatchArgs args) {
     guardBatch(args, jobs, summaryPath);
     refuseAnotherBatch(summaryPath, jobs);
     const OutputLock lock(std::filesystem::path(summaryPath).replace_extension(".lock"));  // one batch per summary
-    const std::map<std::string, nlohmann::json> previous = finishedJobs(summaryPath, args.resume);
-
-    nlohmann::json summary = {{"version", std::string(version())},
-                              {"jobs_file", args.jobsFile},
-                              {"parallel", args.parallel},
-                              {"jobs", nlohmann::json::array()}};
-    std::vector<nlohmann::json> results(jobs.size());
-    const auto batchStart = std::chrono::steady_clock::now();
-    auto save = [&] {
-        summary["jobs"] = nlohmann::json::array();
-        std::map<std::string, int> counts;
-        for (const auto& r : results)
-            if (!r.is_null()) {
-                summary["jobs"].push_back(r);
-                ++counts[r.value("outcome", "")];
-            }
-        summary["counts"] = counts;
-        summary["total_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - batchStart).count();
-        writeJson(summaryPath, summary);
-    };
-
-    StopSignal stop;
-    std::vector<Running> running;
-    std::size_t next = 0, done = 0;
-    int forwarded = 0;
-    while (done < jobs.size()) {
-        // Start jobs up to the parallel limit (none after a stop request).
-        while (!stop.pending() && next < jobs.size() && running.size() < std::size_t(args.parallel)) {
-            const Job& j = jobs[next];
-            if (auto it = previous.find(j.name); it != previous.end()) {
-                results[next] = it->second;
-                results[next]["skipped"] = "finished in an earlier batch";
-                ++next;
-                ++done;
-                continue;
-            }
-            const std::filesystem::path log = outDir / (j.name + ".log");
-            std::error_code ec;
-            std::filesystem::create_directories(outDir, ec);
-            if (ec) throw InputError(fmt::format("{}: cannot create output directory: {}", outDir.string(), ec.message()));
-            const std::vector<std::string> argv = renderArgv(j, args);
-            results[next] = {{"name", j.name}, {"outcome", "running"}, {"log", log.string()},
-                             {"command", fmt::format("accretion {}", fmt::join(argv.begin() + 1, argv.end(), " "))}};
-            running.push_back({next, spawnSelf(argv, log), std::chrono::steady_clock::now()});
-            if (!args.quiet) fmt::print(stderr, "accretion batch: [{}/{}] {} started\n", next + 1, jobs.size(), j.name);
-            ++next;
-        }
-        if (stop.pending() && !forwarded) {  // the renders checkpoint and stop
-            forwarded = stop.pending();
-            for (const Running& r : running) ::kill(r.pid, forwarded);
-            if (!args.quiet) fmt::print(stderr, "accretion batch: {}: stopping {} running job(s)\n", StopSignal::name(forwarded), running.size());
-        }
-        if (running.empty()) {
-            if (stop.pending()) break;
-            continue;
-        }
-        int status = 0;
-        const pid_t pid = ::waitpid(-1, &status, WNOHANG);
-        if (pid <= 0) {
-            std::this_thread::sleep_for(std::chrono::milliseconds(20));
-            continue;
-        }
-        const auto it = std::find_if(running.begin(), running.end(), [&](const Running& r) { return r.pid == pid; });
-        if (it == running.end()) continue;
-        nlohmann::json& r = results[it->job];
-        recordOutcome(r, status, std::chrono::duration<double>(std::chrono::steady_clock::now() - it->start).count(),
-                      outputsFile(args, jobs[it->job]));
-        if (!args.quiet)
-            fmt::print(stderr, "accretion batch: {} {} ({:.1f} s){}\n", r["name"].get<std::string>(), r["outcome"].get<std::string>(),
-                       r["seconds"].get<double>(), r.contains("error") ? ": " + r["error"].get<std::string>() : "");
-        running.erase(it);
-        ++done;
-        save();
-    }
-    for (std::size_t k = 0; k < jobs.size(); ++k)
-        if (results[k].is_null()) results[k] = {{"name", jobs[k].name}, {"outcome", "not started"}};
-    save();
-    const auto& counts = summary["counts"];
-    const int ok = counts.value("ok", 0);
-    fmt::print("batch: {} of {} jobs ok; summary {}\n", ok, jobs.size(), summaryPath);
-    if (forwarded) throw Interrupted{forwarded};
-    if (ok != int(jobs.size())) throw BatchFailed{};
+    BatchRun batch(args, jobs, summaryPath, finishedJobs(summaryPath, args.resume));
+    batch.run();
+    fmt::print("batch: {} of {} jobs ok; summary {}\n", batch.ok(), jobs.size(), summaryPath);
+    if (batch.forwarded()) throw Interrupted{batch.forwarded()};
+    if (batch.ok() != int(jobs.size())) throw BatchFailed{};
 }
 
 }  // namespace
