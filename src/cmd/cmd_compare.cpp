@@ -289,6 +289,33 @@ void runCompareOne(const CompareArgs& a) {
                    c.hdr.stopExposure);
 }
 
+/// The frame-to-frame change of the error, relative to the reference:
+/// mean ((e_t - e_t-1)^2 / (ref_t^2 + eps)) over the pixels whose reference
+/// sees the same particle in both frames (when ids are given; else every
+/// pixel), and the fraction of such pixels. NaN, NaN for the first frame.
+std::pair<double, double> flickerOf(const std::vector<Vec3>& error, const std::vector<Vec3>& lastError,
+                                    const std::vector<std::uint32_t>& ids, const std::vector<std::uint32_t>& lastIds,
+                                    const std::vector<Vec3>& reference) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    if (lastError.empty() || lastError.size() != error.size()) return {nan, nan};
+    const bool byParticle = !ids.empty() && ids.size() == lastIds.size();
+    double sum = 0.0;
+    std::size_t n = 0, pixels = 0;
+    for (std::size_t q = 0; q < error.size(); ++q) {
+        if (byParticle && (ids[q] != lastIds[q] || ids[q] == 0xffffffffu)) continue;
+        ++pixels;
+        for (int ch = 0; ch < 3; ++ch) {
+            const double d = double(error[q][ch]) - double(lastError[q][ch]), r = reference[q][ch];
+            if (!std::isfinite(d)) continue;
+            sum += d * d / (r * r + kRelMseEpsilon);
+            ++n;
+        }
+    }
+    return {n ? sum / double(n) : 0.0, double(pixels) / double(error.size())};
+}
+
+void plotSequence(const CompareArgs& a, const std::string& png, std::uint64_t frames);
+
 /// compare 'gpu.{frame}.exr' 'ref.{frame}.exr' --frames A:B --csv FILE:
 /// each frame's metrics, and the frame-to-frame change of the error
 /// (flicker: mean ((e_t - e_t-1)^2 / (ref_t^2 + eps)) over the pixels whose
@@ -337,36 +364,26 @@ void runCompareSequence(const CompareArgs& a) {
         // is seen in both frames (a moving camera or disk moves the rest).
         std::vector<std::uint32_t> ids;
         if (p.ref.whole() && p.x.whole()) ids = readExrUintChannel(reference, "particle.id");
-        double flicker = std::numeric_limits<double>::quiet_NaN(), tracked = std::numeric_limits<double>::quiet_NaN();
-        if (!lastError.empty() && lastError.size() == error.size()) {
-            const bool byParticle = !ids.empty() && ids.size() == lastIds.size();
-            double sum = 0.0;
-            std::size_t n = 0, pixels = 0;
-            for (std::size_t q = 0; q < error.size(); ++q) {
-                if (byParticle && (ids[q] != lastIds[q] || ids[q] == 0xffffffffu)) continue;
-                ++pixels;
-                for (int ch = 0; ch < 3; ++ch) {
-                    const double d = double(error[q][ch]) - double(lastError[q][ch]), r = p.rs[q][ch];
-                    if (!std::isfinite(d)) continue;
-                    sum += d * d / (r * r + kRelMseEpsilon);
-                    ++n;
-                }
-            }
-            flicker = n ? sum / double(n) : 0.0;
-            tracked = double(pixels) / double(error.size());
-        }
+        const auto [flicker, tracked] = flickerOf(error, lastError, ids, lastIds, p.rs);
         lastError = std::move(error);
         lastIds = std::move(ids);
         t.add({first + k, c.m.relMSE, c.m.MSE, c.m.MAPE, c.flip, flicker, tracked, std::uint64_t(c.m.nonFinite), image, reference});
         if (!a.json) fmt::print(stderr, "accretion: frame {}: relMSE {:.4g}, FLIP {:.4f}\n", first + k, c.m.relMSE, c.flip);
     }
     writeFileAtomic(a.csv, t.csv());
+    plotSequence(a, png, end - first);
+    fmt::print("{}", a.json ? t.json().dump(2) + "\n" : t.console());
+    fmt::print("per-frame table: {} (plot: {})\n", a.csv, png);
+}
+
+/// The sequence's plot: relMSE and flicker by frame, FLIP on the right axis.
+void plotSequence(const CompareArgs& a, const std::string& png, std::uint64_t frames) {
     const bool flip = a.flip != "none";
     std::string script = fmt::format(
         "set datafile separator ','\nset key outside top center horizontal box\nset grid\n"
         "set xlabel 'frame'\nset xtics {}\nset ylabel 'relMSE, flicker (relative squared error, unitless)'\nset logscale y\n"
         "set title {}\n",
-        end - first <= 20 ? "1" : "autofreq",
+        frames <= 20 ? "1" : "autofreq",
         gnuplotQuote(fmt::format("{} against {}\nflicker: relMSE of the error's change from the previous frame, where the same "
                                  "particle is seen", a.image, a.reference)));
     if (flip) script += fmt::format("set y2label '{} (mean, 0 to 1)'\nset y2range [0:*]\nset y2tics\nset ytics nomirror\n", flipName(a));
@@ -374,8 +391,6 @@ void runCompareSequence(const CompareArgs& a) {
                           gnuplotQuote(a.csv));
     if (flip) script += fmt::format(", '' using 1:5 axes x1y2 with linespoints title '{} (right axis)'", flipName(a));
     plotPng(png, script + "\n", 900, 560);
-    fmt::print("{}", a.json ? t.json().dump(2) + "\n" : t.console());
-    fmt::print("per-frame table: {} (plot: {})\n", a.csv, png);
 }
 
 void runCompare(const CompareArgs& a) {
