@@ -386,6 +386,53 @@ CameraFileContent readCsvCameras(const std::string& name, const std::string& tex
     return out;
 }
 
+/// The pose of an eye / look_at / up / fov record, checked.
+CameraPose poseFromLookAt(const std::string& where, const CameraRecord& r, const CameraConvention& convention) {
+    // The renderer traces in float: beyond 1e15 a position keeps no digit of the disk's scale.
+    constexpr double kFar = 1e15;
+    for (const auto& [what, v] : {std::pair{"eye", r.eye}, std::pair{"look_at", r.lookAt}})
+        if (!(std::fabs(v.x) <= kFar && std::fabs(v.y) <= kFar && std::fabs(v.z) <= kFar))
+            throw InputError(fmt::format("{}: {} ({:g}, {:g}, {:g}) is farther than 1e15 from the origin: the "
+                                         "renderer's float rays would lose every digit of the scene", where, what,
+                                         v.x, v.y, v.z));
+    if (glm::length(r.lookAt - r.eye) <= 0.0)
+        throw InputError(fmt::format("{}: look_at must differ from eye", where));
+    if (!(r.fov > 0.0 && r.fov < 179.0))
+        throw InputError(fmt::format("{}: fov: expected degrees in (0, 179), got {}", where, r.fov));
+    const DVec3 f = glm::normalize(r.lookAt - r.eye);
+    if (!(glm::length(r.up) > 0.0) || glm::length(glm::cross(f, glm::normalize(r.up))) < 1e-4)
+        throw InputError(fmt::format("{}: up must be non-zero and not parallel to the view direction", where));
+    CameraPose pose = CameraPose::lookAt(r.eye, r.lookAt, r.up, r.fov);
+    // A left-handed engine's look-at (DirectXMath's LookAtLH) puts
+    // right = up x forward: the mirror of the right-handed one. The
+    // record means what the engine's view matrix of it means, so a
+    // file may mix both forms without the image flipping between frames.
+    if (convention.handedness == CameraConvention::Handedness::left) pose.right = -pose.right;
+    return pose;
+}
+
+/// A record's jitter in pixels (NDC jitter converted), which must agree
+/// with its projection's off-centre terms when it has both.
+void applyJitter(const std::string& where, const CameraRecord& r, const CameraFileContent& content, const CameraSettings& settings,
+                 CameraPose& pose) {
+    const double w = double(settings.width), h = double(settings.height), up = clipUp(content.convention);
+    const double jx = content.ndcJitter ? r.jitter[0] * 0.5 * w : r.jitter[0];
+    const double jy = content.ndcJitter ? -r.jitter[1] * up * 0.5 * h : r.jitter[1];
+    if (r.matrices && (pose.jitterX != 0.0 || pose.jitterY != 0.0) &&
+        (std::fabs(pose.jitterX - jx) > 1e-6 || std::fabs(pose.jitterY - jy) > 1e-6))
+        throw InputError(fmt::format(
+            "{}: jitter ({}, {}) px differs from the projection's off-centre terms ({}, {}) px{}", where, jx, jy,
+            pose.jitterX, pose.jitterY,
+            std::fabs(pose.jitterX + jx) <= 1e-6 && std::fabs(pose.jitterY + jy) <= 1e-6
+                ? ": the opposite sign. accretion's jitter is where the sample lies from the pixel centre; a "
+                  "projection that moves the image jx px right (Direct3D's TAA: _31 += 2 jx / W) samples at -jx. "
+                  "Leave jitter out (it is read from the projection) or give the sample's offset "
+                  "(docs/gpu-frame-loop.md#jitter)"
+                : ""));
+    pose.jitterX = jx;
+    pose.jitterY = jy;
+}
+
 }  // namespace
 
 CameraTrack::CameraTrack(const CameraSettings& settings) : settings_(settings) {
@@ -396,51 +443,11 @@ CameraTrack::CameraTrack(const CameraSettings& settings) : settings_(settings) {
     const auto first = text.find_first_not_of(" \t\r\n");
     const CameraFileContent content = first != std::string::npos && text[first] == '{' ? readJsonCameras(name, text)
                                                                                        : readCsvCameras(name, text);
-    const double w = double(settings.width), h = double(settings.height), up = clipUp(content.convention);
     for (const auto& [where, r] : content.records) {
-        CameraPose pose;
-        if (r.matrices) {
-            pose = poseFromMatrices(fromStored(r.view, content.convention), fromStored(r.projection, content.convention),
-                                    content.convention, settings.width, settings.height, where);
-        } else {
-            // The renderer traces in float: beyond 1e15 a position keeps no digit of the disk's scale.
-            constexpr double kFar = 1e15;
-            for (const auto& [what, v] : {std::pair{"eye", r.eye}, std::pair{"look_at", r.lookAt}})
-                if (!(std::fabs(v.x) <= kFar && std::fabs(v.y) <= kFar && std::fabs(v.z) <= kFar))
-                    throw InputError(fmt::format("{}: {} ({:g}, {:g}, {:g}) is farther than 1e15 from the origin: the "
-                                                 "renderer's float rays would lose every digit of the scene", where, what,
-                                                 v.x, v.y, v.z));
-            if (glm::length(r.lookAt - r.eye) <= 0.0)
-                throw InputError(fmt::format("{}: look_at must differ from eye", where));
-            if (!(r.fov > 0.0 && r.fov < 179.0))
-                throw InputError(fmt::format("{}: fov: expected degrees in (0, 179), got {}", where, r.fov));
-            const DVec3 f = glm::normalize(r.lookAt - r.eye);
-            if (!(glm::length(r.up) > 0.0) || glm::length(glm::cross(f, glm::normalize(r.up))) < 1e-4)
-                throw InputError(fmt::format("{}: up must be non-zero and not parallel to the view direction", where));
-            pose = CameraPose::lookAt(r.eye, r.lookAt, r.up, r.fov);
-            // A left-handed engine's look-at (DirectXMath's LookAtLH) puts
-            // right = up x forward: the mirror of the right-handed one. The
-            // record means what the engine's view matrix of it means, so a
-            // file may mix both forms without the image flipping between frames.
-            if (content.convention.handedness == CameraConvention::Handedness::left) pose.right = -pose.right;
-        }
-        if (r.hasJitter) {
-            const double jx = content.ndcJitter ? r.jitter[0] * 0.5 * w : r.jitter[0];
-            const double jy = content.ndcJitter ? -r.jitter[1] * up * 0.5 * h : r.jitter[1];
-            if (r.matrices && (pose.jitterX != 0.0 || pose.jitterY != 0.0) &&
-                (std::fabs(pose.jitterX - jx) > 1e-6 || std::fabs(pose.jitterY - jy) > 1e-6))
-                throw InputError(fmt::format(
-                    "{}: jitter ({}, {}) px differs from the projection's off-centre terms ({}, {}) px{}", where, jx, jy,
-                    pose.jitterX, pose.jitterY,
-                    std::fabs(pose.jitterX + jx) <= 1e-6 && std::fabs(pose.jitterY + jy) <= 1e-6
-                        ? ": the opposite sign. accretion's jitter is where the sample lies from the pixel centre; a "
-                          "projection that moves the image jx px right (Direct3D's TAA: _31 += 2 jx / W) samples at -jx. "
-                          "Leave jitter out (it is read from the projection) or give the sample's offset "
-                          "(docs/gpu-frame-loop.md#jitter)"
-                        : ""));
-            pose.jitterX = jx;
-            pose.jitterY = jy;
-        }
+        CameraPose pose = r.matrices ? poseFromMatrices(fromStored(r.view, content.convention), fromStored(r.projection, content.convention),
+                                                        content.convention, settings.width, settings.height, where)
+                                     : poseFromLookAt(where, r, content.convention);
+        if (r.hasJitter) applyJitter(where, r, content, settings, pose);
         if (!(std::fabs(pose.jitterX) <= 0.5 && std::fabs(pose.jitterY) <= 0.5))
             throw InputError(fmt::format("{}: jitter ({:.6g}, {:.6g}) px is outside the pixel ([-0.5, 0.5]); check "
                                          "jitter_units", where, pose.jitterX, pose.jitterY));
