@@ -123,17 +123,27 @@ std::vector<std::string_view> words(std::string_view line) {
     return w;
 }
 
-/// Parse the header line by line (LF or CRLF); `fileSize` is the whole file's.
-PlyLayout parsePlyHeader(const std::string& name, std::string_view head, std::uint64_t fileSize) {
-    PlyLayout layout;
-    struct Element {
-        std::string name;
-        std::uint64_t count = 0;
-        std::uint64_t stride = 0;
-        std::size_t line = 0;
-    };
-    std::vector<Element> elements;
-    std::size_t pos = 0, lineNo = 0, vertexElement = ~std::size_t(0);
+/// An element of a PLY header: its records' count and bytes.
+struct PlyElement {
+    std::string name;
+    std::uint64_t count = 0;
+    std::uint64_t stride = 0;
+    std::size_t line = 0;
+};
+
+/// What the header's lines declare.
+struct PlyHeaderLines {
+    std::vector<PlyElement> elements;
+    std::size_t vertexElement = ~std::size_t(0);
+    std::vector<PlyProperty> vertexProperties;
+    std::uint64_t headerBytes = 0;  ///< up to and with the end_header line
+};
+
+/// The header's lines, LF or CRLF, checked one by one.
+PlyHeaderLines readPlyHeaderLines(const std::string& name, std::string_view head) {
+    PlyHeaderLines h;
+    std::vector<PlyElement>& elements = h.elements;
+    std::size_t pos = 0, lineNo = 0;
     bool sawFormat = false, ended = false;
     while (!ended) {
         const std::size_t nl = head.find('\n', pos);
@@ -163,13 +173,13 @@ PlyLayout parsePlyHeader(const std::string& name, std::string_view head, std::ui
             if (w.size() != 3) fail(fmt::format("expected 'element NAME COUNT', got '{}'", line));
             const std::optional<std::uint64_t> n = parseUnsigned(w[2]);
             if (!n) fail(fmt::format("element {}: count '{}' is not a non-negative integer", w[1], w[2]));
-            for (const Element& e : elements)
+            for (const PlyElement& e : elements)
                 if (e.name == w[1]) fail(fmt::format("element {} declared twice (first at line {})", w[1], e.line));
-            if (w[1] == "vertex") vertexElement = elements.size();
+            if (w[1] == "vertex") h.vertexElement = elements.size();
             elements.push_back({std::string(w[1]), *n, 0, lineNo});
         } else if (w[0] == "property") {
             if (elements.empty()) fail("property before any element");
-            Element& e = elements.back();
+            PlyElement& e = elements.back();
             if (w.size() >= 2 && w[1] == "list")
                 fail(fmt::format("element {}: list properties are not supported (the body size could not be checked)", e.name));
             if (w.size() == 2) fail(fmt::format("element {}: property without a name", e.name));
@@ -177,10 +187,10 @@ PlyLayout parsePlyHeader(const std::string& name, std::string_view head, std::ui
             PlyType kind;
             const std::size_t size = plyTypeSize(w[1], kind);
             if (!size) fail(fmt::format("unknown property type '{}'", w[1]));
-            if (elements.size() - 1 == vertexElement) {
-                for (const PlyProperty& q : layout.properties)
+            if (elements.size() - 1 == h.vertexElement) {
+                for (const PlyProperty& q : h.vertexProperties)
                     if (q.name == w[2]) fail(fmt::format("vertex property '{}' declared twice (first at line {})", w[2], q.line));
-                layout.properties.push_back({std::string(w[2]), kind, std::string(w[1]), std::size_t(e.stride), lineNo});
+                h.vertexProperties.push_back({std::string(w[2]), kind, std::string(w[1]), std::size_t(e.stride), lineNo});
             }
             e.stride += size;
         } else {
@@ -188,18 +198,13 @@ PlyLayout parsePlyHeader(const std::string& name, std::string_view head, std::ui
         }
     }
     if (!sawFormat) throw InputError(fmt::format("{}: PLY header has no format line", name));
-    if (vertexElement == ~std::size_t(0)) throw InputError(fmt::format("{}: PLY header has no vertex element", name));
-    // The body: every element's records, in order, exactly.
-    const std::uint64_t headerBytes = pos;
-    std::uint64_t body = 0, vertexStart = headerBytes;
-    for (std::size_t k = 0; k < elements.size(); ++k) {
-        const Element& e = elements[k];
-        std::uint64_t bytes = 0;
-        if (__builtin_mul_overflow(e.count, e.stride, &bytes) || __builtin_add_overflow(body, bytes, &body))
-            throw InputError(fmt::format("{}:{}: element {}: {} records of {} bytes cannot be a file", name, e.line, e.name,
-                                         e.count, e.stride));
-        if (k < vertexElement) vertexStart += bytes;
-    }
+    if (h.vertexElement == ~std::size_t(0)) throw InputError(fmt::format("{}: PLY header has no vertex element", name));
+    h.headerBytes = pos;
+    return h;
+}
+
+/// The vertex properties accretion reads, by field, each of a type it reads.
+void pickPlyFields(const std::string& name, PlyLayout& layout) {
     for (const PlyProperty& q : layout.properties)
         for (std::size_t k = 0; k < kFields.size(); ++k)
             if (q.name == kFields[k]) {
@@ -214,7 +219,26 @@ PlyLayout parsePlyHeader(const std::string& name, std::string_view head, std::ui
     for (int k = 0; k < 7; ++k)
         if (!layout.fields[k])
             throw InputError(fmt::format("{}: PLY vertex has no property '{}' (float or double)", name, kFields[k]));
-    const Element& v = elements[vertexElement];
+}
+
+/// Parse the header line by line (LF or CRLF); `fileSize` is the whole file's.
+PlyLayout parsePlyHeader(const std::string& name, std::string_view head, std::uint64_t fileSize) {
+    const PlyHeaderLines h = readPlyHeaderLines(name, head);
+    PlyLayout layout;
+    layout.properties = h.vertexProperties;
+    // The body: every element's records, in order, exactly.
+    const std::uint64_t headerBytes = h.headerBytes;
+    std::uint64_t body = 0, vertexStart = headerBytes;
+    for (std::size_t k = 0; k < h.elements.size(); ++k) {
+        const PlyElement& e = h.elements[k];
+        std::uint64_t bytes = 0;
+        if (__builtin_mul_overflow(e.count, e.stride, &bytes) || __builtin_add_overflow(body, bytes, &body))
+            throw InputError(fmt::format("{}:{}: element {}: {} records of {} bytes cannot be a file", name, e.line, e.name,
+                                         e.count, e.stride));
+        if (k < h.vertexElement) vertexStart += bytes;
+    }
+    pickPlyFields(name, layout);
+    const PlyElement& v = h.elements[h.vertexElement];
     if (fileSize - headerBytes != body) {
         const std::uint64_t have = fileSize - headerBytes;
         const std::uint64_t before = vertexStart - headerBytes;
