@@ -23,15 +23,10 @@ std::uint32_t spreadBits(std::uint32_t x) {
     return x;
 }
 
-}  // namespace
-
-Clusters clusterParticles(std::span<const Vec3> positions, std::uint32_t target) {
-    Clusters out;
+/// (Morton code << 32 | index) of every position in its bounding cube,
+/// sorted (ties broken by index: deterministic).
+std::vector<std::uint64_t> sortedMortonKeys(std::span<const Vec3> positions) {
     const std::size_t n = positions.size();
-    out.offset.push_back(0);
-    if (n == 0) return out;
-    target = std::max<std::uint32_t>(target, 1);
-
     using Box = std::pair<Vec3, Vec3>;
     const Box empty{Vec3(std::numeric_limits<float>::max()), Vec3(-std::numeric_limits<float>::max())};
     const Box box = tbb::parallel_reduce(
@@ -48,8 +43,6 @@ Clusters clusterParticles(std::span<const Vec3> positions, std::uint32_t target)
     const Vec3 ext = hi - lo;
     const float size = std::max({ext.x, ext.y, ext.z, 1e-30f});
     const float scale = float((1 << kBits) - 1) / size;
-
-    // (Morton code << 32 | index): sorted, ties broken by index: deterministic.
     std::vector<std::uint64_t> keys(n);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 8192), [&](const auto& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
@@ -60,10 +53,14 @@ Clusters clusterParticles(std::span<const Vec3> positions, std::uint32_t target)
         }
     });
     tbb::parallel_sort(keys.begin(), keys.end());
+    return keys;
+}
 
-    // Finest level whose non-empty cells average >= target particles. One
-    // pass: neighbours whose keys first differ at bit d are in different
-    // cells at every level l with 32 + 3 l <= d.
+/// The finest level whose non-empty cells average >= target particles. One
+/// pass: neighbours whose keys first differ at bit d are in different
+/// cells at every level l with 32 + 3 l <= d.
+int clusterLevel(const std::vector<std::uint64_t>& keys, std::uint32_t target) {
+    const std::size_t n = keys.size();
     using Histogram = std::array<std::size_t, kBits + 1>;
     const Histogram firstDiff = tbb::parallel_reduce(
         tbb::blocked_range<std::size_t>(1, std::max<std::size_t>(n, 1), 16384), Histogram{},
@@ -80,23 +77,29 @@ Clusters clusterParticles(std::span<const Vec3> positions, std::uint32_t target)
             for (int l = 0; l <= kBits; ++l) a[l] += b[l];
             return a;
         });
-    int level = kBits;  // cell = 2^level Morton units per axis; kBits = one cell
     for (int l = 0; l <= kBits; ++l) {
         std::size_t cells = 1;
         for (int m = l; m <= kBits; ++m) cells += firstDiff[m];
-        if (double(n) / double(cells) >= double(target)) {
-            level = l;
-            break;
-        }
+        if (double(n) / double(cells) >= double(target)) return l;
     }
-    const int shift = 32 + 3 * level;
+    return kBits;  // cell = 2^level Morton units per axis; kBits = one cell
+}
 
+}  // namespace
+
+Clusters clusterParticles(std::span<const Vec3> positions, std::uint32_t target) {
+    Clusters out;
+    const std::size_t n = positions.size();
+    out.offset.push_back(0);
+    if (n == 0) return out;
+    target = std::max<std::uint32_t>(target, 1);
+    const std::vector<std::uint64_t> keys = sortedMortonKeys(positions);
+    const int shift = 32 + 3 * clusterLevel(keys, target);
     out.particle.resize(n);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16384), [&](const auto& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) out.particle[i] = std::uint32_t(keys[i] & 0xffffffffu);
     });
-    out.offset.clear();
-    out.offset.push_back(0);
+    // Each cell of the level, cut into parts of about `target` particles.
     std::size_t begin = 0;
     for (std::size_t i = 1; i <= n; ++i) {
         if (i < n && (keys[i] >> shift) == (keys[i - 1] >> shift)) continue;
