@@ -333,56 +333,68 @@ void ParticleBvh::releaseBlas() {
 }
 
 void ParticleBvh::buildBlas(std::size_t c, const Particles& particles, bool create) {
+    if (create) createBlas(c);
+    writePrimitives(c, particles, create);
+}
+
+/// Cluster c's Embree scene and geometry (quads, points or user boxes), with
+/// the filters that exclude a query's receiver and light by identity.
+void ParticleBvh::createBlas(std::size_t c) {
+    const std::size_t n = clusters_.members(c).size();
+    const bool billboards = settings_.primitive == Primitive::billboard;
+    RTCGeometry geom;
+    RTCScene scene = rtcNewScene(device_.get());
+    rtcSetSceneBuildQuality(scene, sceneQuality(settings_.build));
+    // watertight: Embree's robust mode, so that no ray slips between a
+    // quad's two triangles along its diagonal (~30% slower shadow rays).
+    rtcSetSceneFlags(scene, (settings_.watertight ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE) |
+                                (settings_.build == BuildPolicy::refit ? RTC_SCENE_FLAG_DYNAMIC : RTC_SCENE_FLAG_NONE));
+    // Billboards are Embree quads (one primitive, builds ~1.5x faster than
+    // two triangles); the GPU's two triangles are recovered from uv.
+    const bool boxes = boxPrimitives();
+    geom = rtcNewGeometry(device_.get(), boxes        ? RTC_GEOMETRY_TYPE_USER
+                                         : billboards ? RTC_GEOMETRY_TYPE_QUAD
+                                                      : RTC_GEOMETRY_TYPE_SPHERE_POINT);
+    if (settings_.build == BuildPolicy::refit) rtcSetGeometryBuildQuality(geom, RTC_BUILD_QUALITY_REFIT);
+    if (boxes) {
+        BoxBlas& b = boxBlas_[c];
+        b = {boxes_.data() + clusters_.offset[c], clusters_.particle.data() + clusters_.offset[c], frames_.data(), &alpha_,
+             billboards && settings_.alpha == AlphaMode::disc, !billboards, settings_.layout == AccelLayout::instances};
+        rtcSetGeometryUserPrimitiveCount(geom, static_cast<unsigned>(n));
+        rtcSetGeometryUserData(geom, &b);
+        rtcSetGeometryBoundsFunction(geom, &boxBounds, &b);
+        rtcSetGeometryIntersectFunction(geom, &boxIntersect);
+        rtcSetGeometryOccludedFunction(geom, &boxOccluded);
+    } else if (billboards) {
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, sizeof(float) * 3, 4 * n);
+        auto* idx = static_cast<std::uint32_t*>(
+            rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT4, sizeof(std::uint32_t) * 4, n));
+        for (std::uint32_t k = 0; k < 4 * n; ++k) idx[k] = k;
+    } else {
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, sizeof(float) * 4, n);
+    }
+    // Every occlusion query excludes its receiver and light by identity
+    // (box primitives: in their own occlusion function).
+    const bool alpha = billboards && settings_.alpha == AlphaMode::disc;
+    if (boxes) {
+    } else if (alpha) {
+        rtcSetGeometryUserData(geom, const_cast<AlphaTest*>(&alpha_));
+        rtcSetGeometryIntersectFilterFunction(geom, &discAlphaFilter);
+    }
+    if (!boxes) rtcSetGeometryOccludedFilterFunction(geom, alpha ? &occlusionFilter<true> : &occlusionFilter<false>);
+    rtcAttachGeometryByID(scene, geom, 0);
+    rtcReleaseGeometry(geom);  // the scene keeps it
+    blas_[c] = scene;
+    geometry_[c] = geom;
+}
+
+/// Cluster c's primitives from the particles (its buffers written, the
+/// geometry and scene committed); `create`: its members' places recorded.
+void ParticleBvh::writePrimitives(std::size_t c, const Particles& particles, bool create) {
     const auto members = clusters_.members(c);
     const std::size_t n = members.size();
     const bool billboards = settings_.primitive == Primitive::billboard;
-    RTCGeometry geom;
-    if (create) {
-        RTCScene scene = rtcNewScene(device_.get());
-        rtcSetSceneBuildQuality(scene, sceneQuality(settings_.build));
-        // watertight: Embree's robust mode, so that no ray slips between a
-        // quad's two triangles along its diagonal (~30% slower shadow rays).
-        rtcSetSceneFlags(scene, (settings_.watertight ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE) |
-                                    (settings_.build == BuildPolicy::refit ? RTC_SCENE_FLAG_DYNAMIC : RTC_SCENE_FLAG_NONE));
-        // Billboards are Embree quads (one primitive, builds ~1.5x faster than
-        // two triangles); the GPU's two triangles are recovered from uv.
-        const bool boxes = boxPrimitives();
-        geom = rtcNewGeometry(device_.get(), boxes        ? RTC_GEOMETRY_TYPE_USER
-                                             : billboards ? RTC_GEOMETRY_TYPE_QUAD
-                                                          : RTC_GEOMETRY_TYPE_SPHERE_POINT);
-        if (settings_.build == BuildPolicy::refit) rtcSetGeometryBuildQuality(geom, RTC_BUILD_QUALITY_REFIT);
-        if (boxes) {
-            BoxBlas& b = boxBlas_[c];
-            b = {boxes_.data() + clusters_.offset[c], clusters_.particle.data() + clusters_.offset[c], frames_.data(), &alpha_,
-                 billboards && settings_.alpha == AlphaMode::disc, !billboards, settings_.layout == AccelLayout::instances};
-            rtcSetGeometryUserPrimitiveCount(geom, static_cast<unsigned>(n));
-            rtcSetGeometryUserData(geom, &b);
-            rtcSetGeometryBoundsFunction(geom, &boxBounds, &b);
-            rtcSetGeometryIntersectFunction(geom, &boxIntersect);
-            rtcSetGeometryOccludedFunction(geom, &boxOccluded);
-        } else if (billboards) {
-            rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, sizeof(float) * 3, 4 * n);
-            auto* idx = static_cast<std::uint32_t*>(
-                rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT4, sizeof(std::uint32_t) * 4, n));
-            for (std::uint32_t k = 0; k < 4 * n; ++k) idx[k] = k;
-        } else {
-            rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, sizeof(float) * 4, n);
-        }
-        // Every occlusion query excludes its receiver and light by identity
-        // (box primitives: in their own occlusion function).
-        const bool alpha = billboards && settings_.alpha == AlphaMode::disc;
-        if (boxes) {
-        } else if (alpha) {
-            rtcSetGeometryUserData(geom, const_cast<AlphaTest*>(&alpha_));
-            rtcSetGeometryIntersectFilterFunction(geom, &discAlphaFilter);
-        }
-        if (!boxes) rtcSetGeometryOccludedFilterFunction(geom, alpha ? &occlusionFilter<true> : &occlusionFilter<false>);
-        rtcAttachGeometryByID(scene, geom, 0);
-        rtcReleaseGeometry(geom);  // the scene keeps it
-        blas_[c] = scene;
-        geometry_[c] = geom;
-    }
-    geom = geometry_[c];
+    const RTCGeometry geom = geometry_[c];
     const bool boxes = boxPrimitives();
     auto* vtx = boxes ? nullptr : static_cast<float*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, 0));
     BoxPrimitive* box = boxes ? boxes_.data() + clusters_.offset[c] : nullptr;

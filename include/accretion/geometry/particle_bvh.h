@@ -160,6 +160,8 @@ public:
 private:
     void releaseBlas();
     void buildBlas(std::size_t c, const Particles& particles, bool create);
+    void createBlas(std::size_t c);
+    void writePrimitives(std::size_t c, const Particles& particles, bool create);
     void buildTlas();
     void buildCountingTlas();
     void buildProbe(const Particles& particles);
