@@ -115,6 +115,20 @@ void ParticleAccel::setClusters(const Clusters& clusters) {
     const std::size_t C = clusters.count(), n = clusters.particle.size();
     std::uint32_t largest = 0;
     for (std::size_t c = 0; c < C; ++c) largest = std::max(largest, offset_[c + 1] - offset_[c]);
+    setPrimitiveBuffers(C, n, largest);
+    sizeBlasMemory(C);
+    handles_.assign(C, 0);
+    partialCursor_ = 0;
+    stats_.blases = C;
+    stats_.instances = C;
+    stats_.primitives = primitivesPerParticle(options_) * n;
+    stats_.largestBlas = primitivesPerParticle(options_) * largest;
+}
+
+/// The build inputs' device buffers for every cluster: boxes, spheres and
+/// their radii, or quads' four corners with the shared index buffer (and
+/// the micromap indices).
+void ParticleAccel::setPrimitiveBuffers(std::size_t C, std::size_t n, std::uint32_t largest) {
     primitivePointers_.resize(C);
     radiusPointers_.assign(C, 0);
     if (options_.layout == AccelLayout::aabbs) {
@@ -146,7 +160,12 @@ void ParticleAccel::setClusters(const Clusters& clusters) {
         for (std::size_t c = 0; c < C; ++c) primitivePointers_[c] = primitives_.address() + 4 * std::size_t(offset_[c]) * sizeof(Vec3);
         stats_.inputBytes = 4 * n * sizeof(Vec3) + idx.size() * sizeof(std::uint32_t);
     }
+}
 
+/// Every BLAS's output bytes (computed once per cluster size: clusters of
+/// one size need the same memory), their places in the pool or their own
+/// allocations, and the scratch of the builds.
+void ParticleAccel::sizeBlasMemory(std::size_t C) {
     // Sizes per cluster size (clusters of one size need the same memory).
     const OptixAccelBuildOptions opts{buildFlags(), OPTIX_BUILD_OPERATION_BUILD, {}};
     std::map<std::uint32_t, OptixAccelBufferSizes> bySize;
@@ -186,12 +205,6 @@ void ParticleAccel::setClusters(const Clusters& clusters) {
         CUDA_CHECK(cudaMemGetInfo(&free1, &total));
         stats_.poolBytes = free0 > free1 ? free0 - free1 : 0;
     }
-    handles_.assign(C, 0);
-    partialCursor_ = 0;
-    stats_.blases = C;
-    stats_.instances = C;
-    stats_.primitives = primitivesPerParticle(options_) * n;
-    stats_.largestBlas = primitivesPerParticle(options_) * largest;
 }
 
 void ParticleAccel::issueLane(unsigned lane, unsigned lanes, std::size_t first, std::size_t count,
@@ -267,42 +280,34 @@ void ParticleAccel::buildUnitBillboard(cudaStream_t stream) {
     stats_.largestBlas = 2;
 }
 
-void ParticleAccel::build(const Clusters* clusters, const DeviceParticles& particles, cudaStream_t stream, GpuTimer& timer) {
+/// The instances layout: the unit billboard once; every frame the instances
+/// and the TLAS (refit: the TLAS updated after its first build).
+void ParticleAccel::buildInstances(const DeviceParticles& particles, cudaStream_t stream, GpuTimer& timer) {
     const BuildPolicy policy = options_.build;
-    if (instanced()) {
-        // The unit billboard once; every frame the instances and the TLAS
-        // (refit: the TLAS updated after its first build).
-        if (!unitHandle_) buildUnitBillboard(stream);
-        {
-            GpuScope s(timer, Pass::buildClusters, "writeInstances");
-            instances_.reserve(std::size_t(particles.count) * sizeof(OptixInstance));
-            writeInstances(particles.count, particles.position, particles.radius, particles.frames, unitHandle_,
-                           instances_.as<OptixInstance>(), stream);
-            CUDA_CHECK(cudaGetLastError());
-        }
-        stats_.refitted = policy == BuildPolicy::refit && built();
-        stats_.instances = particles.count;
-        stats_.primitives = 2;
-        stats_.rebuiltBlases = 0;
-        stats_.inputBytes = std::size_t(particles.count) * sizeof(OptixInstance);
-        {
-            GpuScope s(timer, Pass::buildClusters, "buildTlas");
-            buildTlas(particles, stream, timer);
-        }
-        return;
+    if (!unitHandle_) buildUnitBillboard(stream);
+    {
+        GpuScope s(timer, Pass::buildClusters, "writeInstances");
+        instances_.reserve(std::size_t(particles.count) * sizeof(OptixInstance));
+        writeInstances(particles.count, particles.position, particles.radius, particles.frames, unitHandle_,
+                       instances_.as<OptixInstance>(), stream);
+        CUDA_CHECK(cudaGetLastError());
     }
-    const bool keep = !clusters;
-    ACC_CHECK(clusters || (built() && (policy == BuildPolicy::refit || policy == BuildPolicy::partial)));
-    if (!keep) setClusters(*clusters);
+    stats_.refitted = policy == BuildPolicy::refit && built();
+    stats_.instances = particles.count;
+    stats_.primitives = 2;
+    stats_.rebuiltBlases = 0;
+    stats_.inputBytes = std::size_t(particles.count) * sizeof(OptixInstance);
+    {
+        GpuScope s(timer, Pass::buildClusters, "buildTlas");
+        buildTlas(particles, stream, timer);
+    }
+}
+
+/// The primitives of clusters [first, first + count) mod C from the
+/// particles: one or two ranges of their slots.
+void ParticleAccel::expandPrimitives(std::size_t first, std::size_t count, const DeviceParticles& particles, cudaStream_t stream,
+                                     GpuTimer& timer) {
     const std::size_t C = offset_.size() - 1;
-    const bool refit = keep && policy == BuildPolicy::refit;
-    std::size_t first = 0, count = C;
-    if (keep && policy == BuildPolicy::partial) {
-        count = std::min(C, static_cast<std::size_t>(std::ceil(options_.rebuildFraction * double(C))));
-        first = partialCursor_ % std::max<std::size_t>(C, 1);
-        partialCursor_ += count;
-    }
-    // The slots of clusters [first, first + count) mod C: one or two ranges.
     {
         GpuScope s(timer, Pass::buildClusters, "expandPrimitives");
         auto expand = [&](std::size_t c0, std::size_t c1) {
@@ -324,6 +329,43 @@ void ParticleAccel::build(const Clusters* clusters, const DeviceParticles& parti
         }
         CUDA_CHECK(cudaGetLastError());
     }
+}
+
+/// Every BLAS compacted into one pool (the sizes their builds emitted).
+void ParticleAccel::compactBlases(cudaStream_t stream, GpuTimer& timer) {
+    const std::size_t C = offset_.size() - 1;
+    GpuScope s(timer, Pass::buildClusters, "compactBlas");
+    std::vector<std::uint64_t> sizes = compactSizes_.download<std::uint64_t>(C);  // synchronises
+    std::vector<std::size_t> at(C);
+    std::size_t pool = 0;
+    for (std::size_t c = 0; c < C; ++c) {
+        at[c] = pool;
+        pool = alignUp(pool + sizes[c], kPoolAlignment);
+    }
+    compactPool_.reserve(pool);
+    stats_.blasBytes = 0;
+    for (std::size_t c = 0; c < C; ++c) {
+        OPTIX_CHECK(optixAccelCompact(context_, stream, handles_[c], compactPool_.address() + at[c], sizes[c], &handles_[c]));
+        stats_.blasBytes += sizes[c];
+    }
+    stats_.poolBytes = compactPool_.bytes();
+}
+
+void ParticleAccel::build(const Clusters* clusters, const DeviceParticles& particles, cudaStream_t stream, GpuTimer& timer) {
+    const BuildPolicy policy = options_.build;
+    if (instanced()) return buildInstances(particles, stream, timer);
+    const bool keep = !clusters;
+    ACC_CHECK(clusters || (built() && (policy == BuildPolicy::refit || policy == BuildPolicy::partial)));
+    if (!keep) setClusters(*clusters);
+    const std::size_t C = offset_.size() - 1;
+    const bool refit = keep && policy == BuildPolicy::refit;
+    std::size_t first = 0, count = C;
+    if (keep && policy == BuildPolicy::partial) {
+        count = std::min(C, static_cast<std::size_t>(std::ceil(options_.rebuildFraction * double(C))));
+        first = partialCursor_ % std::max<std::size_t>(C, 1);
+        partialCursor_ += count;
+    }
+    expandPrimitives(first, count, particles, stream, timer);
     const bool compact = options_.compact && !refit && policy != BuildPolicy::partial;
     if (compact) compactSizes_.reserve(C * sizeof(std::uint64_t));
     {
@@ -334,23 +376,7 @@ void ParticleAccel::build(const Clusters* clusters, const DeviceParticles& parti
     }
     stats_.blasBytes = 0;
     for (std::size_t c = 0; c < C; ++c) stats_.blasBytes += outputBytes_[c];
-    if (compact) {
-        GpuScope s(timer, Pass::buildClusters, "compactBlas");
-        std::vector<std::uint64_t> sizes = compactSizes_.download<std::uint64_t>(C);  // synchronises
-        std::vector<std::size_t> at(C);
-        std::size_t pool = 0;
-        for (std::size_t c = 0; c < C; ++c) {
-            at[c] = pool;
-            pool = alignUp(pool + sizes[c], kPoolAlignment);
-        }
-        compactPool_.reserve(pool);
-        stats_.blasBytes = 0;
-        for (std::size_t c = 0; c < C; ++c) {
-            OPTIX_CHECK(optixAccelCompact(context_, stream, handles_[c], compactPool_.address() + at[c], sizes[c], &handles_[c]));
-            stats_.blasBytes += sizes[c];
-        }
-        stats_.poolBytes = compactPool_.bytes();
-    }
+    if (compact) compactBlases(stream, timer);
     {
         GpuScope s(timer, Pass::buildClusters, "buildTlas");
         buildTlas(particles, stream, timer);

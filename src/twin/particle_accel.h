@@ -92,6 +92,11 @@ public:
 private:
     bool instanced() const { return options_.layout == AccelLayout::instances; }
     void setClusters(const Clusters& clusters);
+    void buildInstances(const DeviceParticles& particles, cudaStream_t stream, GpuTimer& timer);
+    void expandPrimitives(std::size_t first, std::size_t count, const DeviceParticles& particles, cudaStream_t stream, GpuTimer& timer);
+    void compactBlases(cudaStream_t stream, GpuTimer& timer);
+    void setPrimitiveBuffers(std::size_t C, std::size_t n, std::uint32_t largest);
+    void sizeBlasMemory(std::size_t C);
     /// Cluster c's build input; `usage` (which it points at) receives its micromap usage.
     OptixBuildInput blasInput(std::size_t c, OptixOpacityMicromapUsageCount& usage) const;
     unsigned buildFlags() const { return blasBuildFlags(options_); }
