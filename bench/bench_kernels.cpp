@@ -79,28 +79,21 @@ void BM_TargetPdf(benchmark::State& state) {
 }
 BENCHMARK(BM_TargetPdf);
 
-void BM_ReservoirUpdate(benchmark::State& state) {
-    Rng rng(4, 0, RngPass::restirCandidates, 0);
+/// A reservoir's streaming step: update (one candidate, RIS) or merge (a
+/// reservoir of M = 20, reuse), the same stream of weights.
+template <bool Merge>
+void BM_Reservoir(benchmark::State& state) {
+    Rng rng(Merge ? 5 : 4, 0, Merge ? RngPass::restirSpatial : RngPass::restirCandidates, 0);
     Reservoir r;
     std::uint32_t x = 0;
     for (auto _ : state) {
-        r.update(x++, rng.uniform(), 0.5f, rng.uniform());
+        if constexpr (Merge) r.merge(x++, rng.uniform(), 0.5f, 20, rng.uniform());
+        else r.update(x++, rng.uniform(), 0.5f, rng.uniform());
         benchmark::DoNotOptimize(r);
     }
     state.SetItemsProcessed(state.iterations());
 }
-BENCHMARK(BM_ReservoirUpdate);
-
-void BM_ReservoirMerge(benchmark::State& state) {
-    Rng rng(5, 0, RngPass::restirSpatial, 0);
-    Reservoir r;
-    std::uint32_t x = 0;
-    for (auto _ : state) {
-        r.merge(x++, rng.uniform(), 0.5f, 20, rng.uniform());
-        benchmark::DoNotOptimize(r);
-    }
-    state.SetItemsProcessed(state.iterations());
-}
-BENCHMARK(BM_ReservoirMerge);
+BENCHMARK(BM_Reservoir<false>)->Name("BM_ReservoirUpdate");
+BENCHMARK(BM_Reservoir<true>)->Name("BM_ReservoirMerge");
 
 }  // namespace
