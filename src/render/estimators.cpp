@@ -43,12 +43,13 @@ void risChunk(const ParticleBvh& bvh, const LightArrays& L, const AliasTable* ta
               const ShadingPoint& sp, std::uint32_t count, std::uint32_t candidates, const VisibilityOptions& vis, bool shadows,
               Rng& rng, PixelSums& acc, RayCounters* rc) {
     LightingCounters& c = acc.c;
+    const CandidateSampler<S> source{L, table, tree};
     for (std::uint32_t k = 0; k < count; ++k) {
         Reservoir r;
         LightTerm t_y{};
         bool discarded = false;
         for (std::uint32_t m = 0; m < candidates; ++m) {
-            const LightSample x = sampleCandidate<S>(L, table, tree, sp, rng);
+            const LightSample x = source.sample(sp, rng);
             LightTerm t{};
             float p_hat = 0.0f;
             ++c.lightTerms;

@@ -107,11 +107,13 @@ TEST_CASE("every light sampler draws in proportion to its pdf (one chi-square ha
     checkSampler({"tree", [&](Rng& rng) { return tree.sample(sp, rng); }, [&](std::uint32_t i) { return tree.pdf(sp, i); }},
                  N, lit);
     // The candidate sources of ris / restir (render.source) through the same harness.
-    checkSampler({"candidates: power", [&](Rng& rng) { return sampleCandidate<LightSource::power>(L, &power, &tree, sp, rng); },
-                  [&](std::uint32_t i) { return candidatePdf<LightSource::power>(L, &power, &tree, sp, i); }},
+    const CandidateSampler<LightSource::power> powerCandidates{L, &power, &tree};
+    checkSampler({"candidates: power", [&](Rng& rng) { return powerCandidates.sample(sp, rng); },
+                  [&](std::uint32_t i) { return powerCandidates.pmf(sp, i); }},
                  N, emits);
-    checkSampler({"candidates: tree", [&](Rng& rng) { return sampleCandidate<LightSource::tree>(L, &power, &tree, sp, rng); },
-                  [&](std::uint32_t i) { return candidatePdf<LightSource::tree>(L, &power, &tree, sp, i); }},
+    const CandidateSampler<LightSource::tree> treeCandidates{L, &power, &tree};
+    checkSampler({"candidates: tree", [&](Rng& rng) { return treeCandidates.sample(sp, rng); },
+                  [&](std::uint32_t i) { return treeCandidates.pmf(sp, i); }},
                  N, lit);
     // split: the far lights, drawn with the 20 nearest taken out of the tree
     // (a near light drawn would report a pdf that pdfFar gives as 0: a mismatch).

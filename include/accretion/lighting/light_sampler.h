@@ -7,6 +7,7 @@
 #include "accretion/lighting/light_sample.h"
 #include "accretion/lighting/light_tree.h"
 #include "accretion/particles/particles.h"
+#include "accretion/scene/estimator_table.h"
 
 namespace accretion {
 
@@ -14,7 +15,7 @@ namespace accretion {
 /// - uniform: sampleSource<false>, sourcePdf<false> (1 / N);
 /// - power: sampleSource<true>, sourcePdf<true> (an alias table over luminance(I_i));
 /// - tree: LightTree::sample, LightTree::pdf (receiver-dependent, light_tree.h);
-/// - ris / restir candidates by render.source: sampleCandidate, candidatePdf;
+/// - ris / restir candidates by render.source: CandidateSampler<S>::sample, pmf;
 /// - split's far field: LightTree::sampleFar, pdfFar (near_field.cpp);
 /// - restir's presampled sources: LightTiles::sample with the power pmf as
 ///   its marginal pdf (light_tiles.h), RegirGrid::sample whose pdf is 1 / W,
@@ -45,23 +46,29 @@ float sourcePdf(const LightArrays& L, const AliasTable* table, std::uint32_t i) 
     else return L.uniformPdf;
 }
 
-/// A candidate of ris / restir from render.source: uniform, power (alias
-/// table) or the light tree at the receiver. The tree may draw no light
+/// The light sampler of a render.source that draws at the receiver (as
+/// pbrt-v4's LightSampler: `sample` beside `pmf`, one type per source; the
+/// presampled sources are LightTiles and RegirGrid): uniform, power (alias
+/// table) or the light tree. What ris's and restir's candidates draw from,
+/// and what the chi-square harness checks. The tree may draw no light
 /// (kNoLightSample, pdf 0) where every light has zero importance: the
 /// caller counts it as a zero candidate.
 template <LightSource S>
-LightSample sampleCandidate(const LightArrays& L, const AliasTable* table, const LightTree* tree, const ShadingPoint& sp,
-                            Rng& rng) {
-    if constexpr (S == LightSource::tree) return tree->sample(sp, rng);
-    else return sampleSource<S == LightSource::power>(L, table, rng);
-}
+struct CandidateSampler {
+    static_assert(!sourceInfo(S).presampled, "a presampled source draws from its tiles or grid");
+    const LightArrays& L;
+    const AliasTable* table;  ///< power's alias table (kLightSources' sampler column)
+    const LightTree* tree;    ///< tree's light tree
 
-/// Probability that sampleCandidate<S> returns light i at the receiver.
-template <LightSource S>
-float candidatePdf(const LightArrays& L, const AliasTable* table, const LightTree* tree, const ShadingPoint& sp,
-                   std::uint32_t i) {
-    if constexpr (S == LightSource::tree) return tree->pdf(sp, i);
-    else return sourcePdf<S == LightSource::power>(L, table, i);
-}
+    LightSample sample(const ShadingPoint& sp, Rng& rng) const {
+        if constexpr (S == LightSource::tree) return tree->sample(sp, rng);
+        else return sampleSource<S == LightSource::power>(L, table, rng);
+    }
+    /// The probability that sample() returns light i at the receiver.
+    float pmf(const ShadingPoint& sp, std::uint32_t i) const {
+        if constexpr (S == LightSource::tree) return tree->pdf(sp, i);
+        else return sourcePdf<S == LightSource::power>(L, table, i);
+    }
+};
 
 }  // namespace accretion

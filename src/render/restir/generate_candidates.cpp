@@ -35,7 +35,7 @@ struct CpuSource {
         LightSample sample(Rng& g) const {
             if constexpr (S == LightSource::regir) return cell >= 0 ? f.regir->sample(std::uint32_t(cell), g) : f.tiles->sample(tile, g);
             else if constexpr (S == LightSource::tiles) return f.tiles->sample(tile, g);
-            else return sampleCandidate<S>(f.L, f.in.powerTable, f.in.lightTree, sp, g);
+            else return CandidateSampler<S>{f.L, f.in.powerTable, f.in.lightTree}.sample(sp, g);
         }
     };
     Drawer at(const ShadingPoint& sp, std::uint32_t x, std::uint32_t y, Rng& rng) const {
