@@ -1,7 +1,7 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine, from the repository root:
 #   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
-#                                      layout_images layouts streams front identity shared_core
+#                                      layout_images layouts streams front identity shared_core ab
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -315,6 +315,51 @@ step_identity() {
 CONFIGS
     rm -f "$t"/*.gpuframe
     return $differ
+}
+
+# This tree's twin against the old tree's (stage_deps.sh with OLD_COMMIT),
+# timed side by side: disk_100k at 1920x1080, restir and power (8 spp), and
+# quickstart's exact at 320x180; frame 1 after a history frame, 5 timed runs a frame,
+# the two twins alternating AB_ROUNDS (3) times; per pass the median ms of
+# each and their ratio (ab/ratios.csv).
+step_ab() {
+    local t="$W/ab" old=$D/old
+    [ -d "$old" ] || { echo "ab: no $old (stage_deps.sh with an old commit)"; return 1; }
+    mkdir -p "$t"
+    [ -x "$old/build-gpu/accretion-optix" ] || build_twin "$old" "$(cat "$D/old.commit")" "$t/build_old.log" || return 1
+    local hd="-D camera.width=1920 -D camera.height=1080"
+    local configs=("restir|scenes/disk_100k.toml -D render.estimator=restir $hd"
+                   "power|scenes/disk_100k.toml -D render.estimator=power -D render.samples=8 $hd"
+                   "exact|scenes/quickstart.toml -D render.estimator=exact -D camera.width=320 -D camera.height=180")
+    for round in $(seq "${AB_ROUNDS:-3}"); do
+        for c in "${configs[@]}"; do
+            for side in new old; do
+                local bin=$BIN dir=.
+                [ $side = old ] && bin=$old/build-gpu/accretion-optix && dir=$old
+                # shellcheck disable=SC2086  # the overrides are words
+                (cd "$dir" && timeout 200 "$bin" ${c#*|} --frames 0:2 --repeat 5 -q -o "$t/x.{frame}.exr" \
+                    --timings "$t/${c%%|*}.$side.$round.csv" --config "${c%%|*}" < /dev/null > /dev/null 2>&1) || echo "ab: $side ${c%%|*} failed"
+                rm -f "$t"/*.gpuframe "$t"/*.json
+            done
+        done
+    done
+    python3 - "$t" <<'PY'
+import csv, glob, statistics, sys, collections
+t = sys.argv[1]
+ms = collections.defaultdict(list)  # (config, pass, side) -> per round
+for f in glob.glob(f"{t}/*.csv"):
+    name = f.split("/")[-1].split(".")
+    if len(name) != 4: continue
+    for r in csv.DictReader(open(f)):
+        ms[(name[0], r["pass"], name[1])].append(float(r["ms"]))
+rows = ["config,pass,new_ms,old_ms,new_over_old"]
+for (config, p, side) in sorted(ms):
+    if side != "new" or (config, p, "old") not in ms: continue
+    n, o = statistics.median(ms[(config, p, "new")]), statistics.median(ms[(config, p, "old")])
+    rows.append(f"{config},{p},{n:.4f},{o:.4f},{n / o if o else float('nan'):.3f}")
+open(f"{t}/ratios.csv", "w").write("\n".join(rows) + "\n")
+print("\n".join(rows))
+PY
 }
 
 # The ReSTIR steps and pass bodies the CPU and the twin share (restir_steps.h,
