@@ -26,21 +26,25 @@ __device__ inline void onTexel(const LaunchParams& p, Body&& body) {
     body(b, px, x, y);
 }
 
-// The restir passes: launches of restir_passes.h's bodies.
+// The restir passes: launches of restir_passes.h's bodies. The bridge keeps
+// a reference to the launch's parameters: __grid_constant__ lets it point
+// into the parameter space, where a plain by-value parameter whose address
+// is taken is copied to every thread's local memory (temporalResampling at
+// 1080p on the H200: 0.84 ms with the copy, against 0.09 ms before the bridge).
 template <ShadingModel SM>
-__global__ void generateCandidatesKernel(LaunchParams p) {
+__global__ void generateCandidatesKernel(const __grid_constant__ LaunchParams p) {
     onTexel<SM>(p, [&](auto& b, std::size_t px, std::uint32_t x, std::uint32_t y) {
         restir::generateCandidatesTexel(b, DeviceSource{p}, px, x, y);
     });
 }
 
 template <ShadingModel SM>
-__global__ void temporalResamplingKernel(LaunchParams p) {
+__global__ void temporalResamplingKernel(const __grid_constant__ LaunchParams p) {
     onTexel<SM>(p, [&](auto& b, std::size_t px, std::uint32_t, std::uint32_t) { restir::temporalResamplingTexel(b, px); });
 }
 
 template <ShadingModel SM>
-__global__ void spatialResamplingKernel(LaunchParams p, std::uint32_t iteration) {
+__global__ void spatialResamplingKernel(const __grid_constant__ LaunchParams p, std::uint32_t iteration) {
     onTexel<SM>(p, [&](auto& b, std::size_t px, std::uint32_t x, std::uint32_t y) {
         restir::spatialResamplingTexel(b, px, x, y, iteration);
     });
