@@ -10,8 +10,12 @@
 /// without FMA contraction, so both sides round every operation alike.
 #if defined(__CUDACC__)
 #define ACC_HD __host__ __device__
+/// A shared per-pixel body: inlined into its kernel, so that its bridge and
+/// buffers stay in registers (a call passes them through local memory).
+#define ACC_HD_BODY __host__ __device__ __forceinline__
 #else
 #define ACC_HD
+#define ACC_HD_BODY inline
 #endif
 
 namespace accretion {

@@ -20,7 +20,7 @@ namespace accretion {
 /// light but the receiver's own particle, in double; one shadow ray per
 /// non-zero term.
 template <class B, class Lights>
-ACC_HD DVec3 sumLightTerms(B& b, const ShadingPoint& sp, const Lights& lights) {
+ACC_HD_BODY DVec3 sumLightTerms(B& b, const ShadingPoint& sp, const Lights& lights) {
     DVec3 sum(0.0);
     for (const std::uint32_t i : lights) {
         if (i == sp.self) continue;
@@ -40,7 +40,7 @@ ACC_HD DVec3 sumLightTerms(B& b, const ShadingPoint& sp, const Lights& lights) {
 /// receiver's own); split: each sample is the near field's exact sum `near`
 /// plus the far light's f I G V / p_far(i).
 template <class B, class Sums>
-ACC_HD void shadeLightSamples(B& b, const ShadingPoint& sp, const LightSample* xs, std::uint32_t count, const DVec3& near,
+ACC_HD_BODY void shadeLightSamples(B& b, const ShadingPoint& sp, const LightSample* xs, std::uint32_t count, const DVec3& near,
                               Sums& acc) {
     const bool hasNear = near != DVec3(0.0);
     for (std::uint32_t k = 0; k < count; ++k) {

@@ -99,7 +99,7 @@ struct NoRecorder {
 /// restir_steps.h; with candidate_visibility an occluded winner is dropped
 /// before reuse (Bitterli et al. 2020, Alg. 5).
 template <class B, class Source>
-ACC_HD void generateCandidatesTexel(B& b, const Source& source, std::size_t px, std::uint32_t x, std::uint32_t y) {
+ACC_HD_BODY void generateCandidatesTexel(B& b, const Source& source, std::size_t px, std::uint32_t x, std::uint32_t y) {
     const ReuseParams& p = b.params();
     const GBufferTexel g = b.texel(px);
     auto&& rec = b.recorder(px, g);
@@ -134,7 +134,7 @@ ACC_HD void generateCandidatesTexel(B& b, const Source& source, std::size_t px, 
 /// depth; the history's M capped at m_cap x M; combined with this frame's
 /// reservoir (restir.bias_correction).
 template <class B>
-ACC_HD void temporalResamplingTexel(B& b, std::size_t px) {
+ACC_HD_BODY void temporalResamplingTexel(B& b, std::size_t px) {
     const ReuseParams& p = b.params();
     const GBufferTexel g = b.texel(px);
     auto&& rec = b.recorder(px, g);
@@ -181,7 +181,7 @@ ACC_HD void temporalResamplingTexel(B& b, std::size_t px) {
 /// the grid, on a miss, or on normal and depth; combined with this texel's
 /// reservoir (restir.bias_correction).
 template <class B>
-ACC_HD void spatialResamplingTexel(B& b, std::size_t px, std::uint32_t x, std::uint32_t y, std::uint32_t iteration) {
+ACC_HD_BODY void spatialResamplingTexel(B& b, std::size_t px, std::uint32_t x, std::uint32_t y, std::uint32_t iteration) {
     const ReuseParams& p = b.params();
     const GBufferTexel g = b.texel(px);
     auto&& rec = b.recorder(px, g);
@@ -225,7 +225,7 @@ namespace accretion::restir {
 /// (render.nonfinite decides on the reservoir). Reads and writes the
 /// bridge's output reservoir in place.
 template <class B>
-ACC_HD void traceShadowRayTexel(B& b, std::size_t px) {
+ACC_HD_BODY void traceShadowRayTexel(B& b, std::size_t px) {
     b.writeLr(px, Vec3(0.0f));
     const GBufferTexel g = b.texel(px);
     auto&& rec = b.recorder(px, g);
