@@ -1,4 +1,4 @@
-// accretion estimators: the estimator table (render/estimator_table.h) as
+// accretion estimators: the estimator table (scene/estimator_table.h) as
 // markdown, the table docs/rendering.md carries.
 #include <fmt/core.h>
 
