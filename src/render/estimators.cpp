@@ -121,13 +121,10 @@ void runChunk(const LightingInputs& in, const LightArrays& L, const VisibilityOp
             if (p.sums.done) continue;
             Rng rng = stream(p);
             RayCounters* rc = Count ? &p.rays : nullptr;
-            switch (in.render.source) {
-            case LightSource::uniform: chunk.template operator()<LightSource::uniform>(p, rng, rc); break;
-            case LightSource::power: chunk.template operator()<LightSource::power>(p, rng, rc); break;
-            case LightSource::tree: chunk.template operator()<LightSource::tree>(p, rng, rc); break;
-            case LightSource::tiles:
-            case LightSource::regir: break;  // restir sources (refused for ris by the scene's validation)
-            }
+            withLightSource(in.render.source, [&]<LightSource S>() {
+                // restir's presampled sources: refused for ris by the scene's validation
+                if constexpr (!sourceInfo(S).presampled) chunk.template operator()<S>(p, rng, rc);
+            });
         }
     } else {
         for (std::uint32_t k = 0; k < n; ++k) {

@@ -1,5 +1,7 @@
 #pragma once
 #include <array>
+#include <type_traits>
+#include <utility>
 #include <string_view>
 
 #include "accretion/scene/settings.h"
@@ -83,6 +85,24 @@ constexpr bool sourceTableMatchesEnum() {
 static_assert(sourceTableMatchesEnum(), "kLightSources lists every LightSource in enum order");
 
 constexpr const LightSourceInfo& sourceInfo(LightSource kind) { return kLightSources[std::size_t(kind)]; }
+
+/// fn.template operator()<S>() with S the source `kind`, for every row of
+/// kLightSources (the one dispatch of a source to its compiled code: a new
+/// row is dispatched without a new case anywhere). fn returns void or a
+/// default-constructible value.
+template <class Fn>
+decltype(auto) withLightSource(LightSource kind, Fn&& fn) {
+    using R = decltype(fn.template operator()<kLightSources[0].kind>());
+    return [&]<std::size_t... I>(std::index_sequence<I...>) -> R {
+        if constexpr (std::is_void_v<R>) {
+            ((kind == kLightSources[I].kind ? (fn.template operator()<kLightSources[I].kind>(), true) : false) || ...);
+        } else {
+            R r{};
+            ((kind == kLightSources[I].kind ? (r = fn.template operator()<kLightSources[I].kind>(), true) : false) || ...);
+            return r;
+        }
+    }(std::make_index_sequence<kLightSources.size()>{});
+}
 
 /// The light sampler a frame lit by `render`'s estimator needs: its own, or
 /// its render.source's.

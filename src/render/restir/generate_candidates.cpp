@@ -62,16 +62,9 @@ LightingCounters generateCandidatesFrom(const FrameContext& f, std::vector<Store
 /// light tree, a light tile, a ReGIR cell) with target p_hat (no visibility);
 /// with candidate_visibility, an occluded winner is dropped before reuse.
 LightingCounters generateCandidates(const FrameContext& f, std::vector<StoredReservoir>& out) {
-    const LightSource source = f.in.settings.render.source;
     return dispatchKernel(f, [&]<ShadingModel SM, Primitive P, bool Count>() {
-        switch (source) {
-        case LightSource::power: return generateCandidatesFrom<SM, P, LightSource::power, Count>(f, out);
-        case LightSource::tree: return generateCandidatesFrom<SM, P, LightSource::tree, Count>(f, out);
-        case LightSource::tiles: return generateCandidatesFrom<SM, P, LightSource::tiles, Count>(f, out);
-        case LightSource::regir: return generateCandidatesFrom<SM, P, LightSource::regir, Count>(f, out);
-        case LightSource::uniform: break;
-        }
-        return generateCandidatesFrom<SM, P, LightSource::uniform, Count>(f, out);
+        return withLightSource(f.in.settings.render.source,
+                               [&]<LightSource S>() { return generateCandidatesFrom<SM, P, S, Count>(f, out); });
     });
 }
 
