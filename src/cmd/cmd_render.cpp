@@ -1,5 +1,4 @@
 // accretion render: frames of a scene to EXR + PNG preview + stats.json.
-#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <memory>
@@ -15,7 +14,6 @@
 #include "accretion/core/output_guard.h"
 #include "accretion/core/version.h"
 #include "accretion/gpu/gpu_report.h"
-#include "accretion/core/stop_signal.h"
 #include "accretion/io/accumulation_file.h"
 #include "accretion/io/checkpoint.h"
 #include "accretion/io/render_session.h"

@@ -314,20 +314,21 @@ void parseErrorSize(const std::string& text, std::uint32_t& width, std::uint32_t
         throw InputError(fmt::format("command line --error-size {}: each side 8 to 8192 pixels", text));
 }
 
-/// tune's numbers on the command line: the budget, --max-error, --error-size.
-void checkTuneArgs(const TuneArgs& a) {
+/// The search's context with tune's numbers on the command line checked:
+/// the budget, --max-error, --error-size (before anything is made).
+TuneContext checkTuneArgs(const TuneArgs& a) {
     if (!(a.budgetMs > 0.0) || !std::isfinite(a.budgetMs)) throw InputError("command line --budget-ms: expected a positive number of ms");
     if (a.maxError && (!(*a.maxError > 0.0) || !std::isfinite(*a.maxError)))
         throw InputError("command line --max-error: expected a positive relMSE");
-    std::uint32_t w, h;
-    parseErrorSize(a.errorSize, w, h);
-}
-
-/// The search's context, once its command line is checked (checkTuneArgs):
-/// its outputs guarded, its cache and calibration, before any measurement.
-TuneContext prepareTune(const TuneArgs& a, const Settings& scene, const std::string& prefix) {
     TuneContext t{a};
     parseErrorSize(a.errorSize, t.errorWidth, t.errorHeight);
+    return t;
+}
+
+/// The search's context, its command line checked (checkTuneArgs): its
+/// outputs guarded, its cache and calibration, before any measurement.
+void prepareTune(TuneContext& t, const Settings& scene, const std::string& prefix) {
+    const TuneArgs& a = t.args;
     t.cache = a.cache.empty() ? std::filesystem::path("out") / "tune_cache" / scene.sceneName : std::filesystem::path(a.cache);
     OutputGuard guard = sceneInputs(scene);
     if (!a.reference.empty()) guard.addInput(a.reference);
@@ -343,7 +344,6 @@ TuneContext prepareTune(const TuneArgs& a, const Settings& scene, const std::str
     for (const std::string& d : a.defines)
         if (d.rfind("gpu.coefficients", 0) != 0) t.sceneText += "\n-D " + d;
     t.sceneText += "\n-D render.estimator=restir";  // sceneArgv's
-    return t;
 }
 
 /// A geometry choice priced: its predicted GPU ms per pass at the scene's lighting.
@@ -481,11 +481,11 @@ void plotTune(const std::string& prefix, const TuneArgs& a, const Settings& scen
 void runTune(const TuneArgs& a) {
     const Settings scene = loadSceneArgs(a, {{"render.estimator", "tune (restir)", [](Settings& s) { s.render.estimator = EstimatorKind::restir; }}});
     requireWholeImage(scene, "tune");
-    checkTuneArgs(a);
+    TuneContext t = checkTuneArgs(a);
     const std::vector<GeometryChoice> geometry = geometryChoices(scene);
     const std::vector<LightingChoice> lighting = lightingChoices(a.space);
     const std::string prefix = a.out.empty() ? "out/" + scene.sceneName + ".tune" : a.out;
-    TuneContext t = prepareTune(a, scene, prefix);
+    prepareTune(t, scene, prefix);
     t.steps = geometry.size() + 2 * lighting.size();
     const std::size_t particles = ParticleSource(scene).frame(a.frame).size();
     t.reference = ensureReference(t, particles);

@@ -471,7 +471,7 @@ void checkSamplerInputs(const LightingInputs& in) {
     // table: for it the table is there exactly when its source needs one.
     ACC_CHECK(e.resampling ? (need == LightSamplerKind::power) == (in.powerTable != nullptr)
                            : need != LightSamplerKind::power || in.powerTable);
-    ACC_CHECK(!e.resampling || !sourceInfo(in.render.source).reuseOnly);
+    ACC_CHECK(!e.resampling || !sourceInfo(in.render.source).presampled);
 }
 }  // namespace
 

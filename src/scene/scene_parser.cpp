@@ -347,7 +347,7 @@ void checkMemory(const Settings& s, const RuleFailure& fail) {
 /// The candidate sources, the presampled tiles and grid, micromaps and alpha.
 void validateLightingAndGeometry(const Settings& s, const RuleFailure& fail) {
     if (estimatorInfo(s.render.estimator).resampling && !estimatorInfo(s.render.estimator).reuse &&
-        sourceInfo(s.render.source).reuseOnly)
+        sourceInfo(s.render.source).presampled)
         fail("render.source", fmt::format("\"{}\" is a restir source: its presampled lights are drawn once per frame, and ris "
                                           "averages many samples of one frame, which would converge to that frame's draw, not "
                                           "to Lr (use uniform, power or tree)", enumName(s.render.source)));

@@ -13,7 +13,6 @@
 #include <map>
 #include <set>
 #include <optional>
-#include <random>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <thread>

@@ -158,7 +158,6 @@ inline constexpr std::array<std::string_view, kCostFeatureCount> kCostFeatures =
 /// The model's first form: the first kBaseCostFeatures features of the table.
 inline constexpr std::size_t kBaseCostFeatures = detail::firstFormCount();
 static_assert(kBaseCostFeatures > 0, "the first form's features come first in the table");
-constexpr const CostFeatureInfo& costFeatureInfo(std::size_t k) { return kCostFeatureTable[k]; }
 constexpr bool isBuildFeature(std::size_t k) { return kCostFeatureTable[k].build; }
 
 /// One value per feature, indexed by position or by CostFeature.
@@ -176,7 +175,6 @@ const char* defaultCoefficientsJson();
 /// The cache the working-set term assumes before calibration (calibrate
 /// chooses its own by cross-validation).
 inline constexpr double kDefaultCacheBytes = 4.0 * 1024 * 1024;
-
 
 /// The model's forms. shared: one coefficient per base counter for every
 /// pass, fitted by least squares on ms (the first form). per_pass: each

@@ -3,6 +3,7 @@
 // frame loop, checkpoints every few seconds, and one signal path (SIGINT and
 // SIGTERM stop it at the next safe point, the frames written so far whole).
 // `accretion render` and batch's jobs run through it (docs/batches.md).
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <optional>

@@ -14,8 +14,8 @@
 namespace accretion {
 
 /// The layers composeLayers writes (sized to the texels), and the lighting
-/// layers it reads and amends. Lr_stderr, spp and rejected are empty for an
-/// estimator without them (restir, the twin's exact).
+/// layers it reads and amends. Lr_stderr, spp and rejected may be empty (the
+/// twin's exact and restir frames have none).
 struct ComposeLayers {
     std::vector<Vec3>& L;
     std::vector<Vec3>& Le;

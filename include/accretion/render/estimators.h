@@ -45,7 +45,7 @@ struct LightingCounters {
     }
 };
 
-/// Non-finite values rejected, per pass name (render.nonfinite).
+/// Non-finite values rejected, per pass (render.nonfinite).
 using PassRejections = std::map<Pass, std::uint64_t>;
 
 /// Everything the lighting estimators read.

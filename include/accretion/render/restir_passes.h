@@ -1,5 +1,5 @@
 #pragma once
-// The per-texel bodies of ReSTIR DI's reuse passes (docs/MODEL.md section 4),
+// The per-texel bodies of ReSTIR DI's passes (docs/MODEL.md section 4),
 // written once for the CPU and the GPU twin, as RTXDI writes its resampling
 // functions once over its RAB_* bridge. A body reads the frame, records what
 // one GPU thread does, and writes its output only through a bridge B:
@@ -214,10 +214,6 @@ ACC_HD_BODY void spatialResamplingTexel(B& b, std::size_t px, std::uint32_t x, s
     }
     b.keep(px, sanitizeReservoir(offers.combine(rng), [&] { return b.reject(px); }));
 }
-
-}  // namespace accretion::restir
-
-namespace accretion::restir {
 
 /// traceShadowRays at texel px: one shadow ray for the kept sample, Lr =
 /// f I G V W (shadeSample); with visibility reuse an occluded sample's

@@ -61,20 +61,20 @@ constexpr const EstimatorInfo& estimatorInfo(EstimatorKind kind) { return kEstim
 struct LightSourceInfo {
     LightSource kind;
     LightSamplerKind sampler; ///< the light sampler built for it (tiles and regir presample from the power table)
-    bool presampled;          ///< drawn from light tiles presampled each frame (presampleLightTiles)
+    /// Drawn from light tiles presampled once per frame (presampleLightTiles,
+    /// a pass of restir's frame): restir only. ris, which averages many
+    /// samples of one frame, would converge to that frame's draw.
+    bool presampled;
     bool regirGrid;           ///< drawn from a world-space grid of reservoirs (presampleRegirGrid)
-    bool reuseOnly;           ///< restir only: its tiles and grid are passes of restir's frame (ris refuses it)
     bool twin;                ///< accretion-optix draws from it
-    std::string_view summary;
 };
 
 inline constexpr std::array<LightSourceInfo, 5> kLightSources = {{
-    {LightSource::uniform, LightSamplerKind::none, false, false, false, true, "every light alike"},
-    {LightSource::power, LightSamplerKind::power, false, false, false, true, "by luminance (the alias table)"},
-    {LightSource::tree, LightSamplerKind::tree, false, false, false, true, "the light tree at the receiver"},
-    {LightSource::tiles, LightSamplerKind::power, true, false, true, false, "RTXDI's light tiles, presampled by power"},
-    {LightSource::regir, LightSamplerKind::power, true, true, true, false,
-     "a world-space grid of light reservoirs (ReGIR), the tiles outside it"},
+    {LightSource::uniform, LightSamplerKind::none, false, false, true},
+    {LightSource::power, LightSamplerKind::power, false, false, true},
+    {LightSource::tree, LightSamplerKind::tree, false, false, true},
+    {LightSource::tiles, LightSamplerKind::power, true, false, false},  // RTXDI's light tiles, presampled by power
+    {LightSource::regir, LightSamplerKind::power, true, true, false},   // ReGIR's grid of reservoirs, the tiles outside it
 }};
 
 constexpr bool sourceTableMatchesEnum() {

@@ -7,6 +7,19 @@
 
 namespace accretion::restir {
 
+/// One shadow ray of a restir pass on the CPU, toward light i of `lights`
+/// through `bvh`: counted (c.shadowRays) and its traversal recorded.
+template <Primitive P, bool Count>
+bool countedShadowRay(const ParticleBvh& bvh, const VisibilityOptions& vis, const LightArrays& lights, const ShadingPoint& sp,
+                      std::uint32_t i, const LightTerm& t, LightingCounters& c, Recorder<Count>& rec) {
+    ++c.shadowRays;
+    RayCounters rc;
+    const PackedLight& l = lights.packed[i];
+    const bool seen = visible<P>(bvh, vis, sp, i, l.position, l.radius, t, rec.rayCounters(rc));
+    rec.ray(rc);
+    return seen;
+}
+
 /// The offers of a CPU pass as restir_steps.h's Domains: each domain's
 /// p_hat from its own lights, the light terms counted, and basic's support
 /// test tracing the domain's frame when basic_visibility asks for it.
@@ -30,11 +43,7 @@ struct CpuDomains {
         LightTerm t;
         if (!d.lights->template term<SM>(d.sp, y, t) || !(luminance(t.value) > 0.0f)) return false;
         if (!(rs.basic_visibility && d.visibilityTested && shadows)) return true;
-        ++c.shadowRays;
-        RayCounters rc;
-        const PackedLight& l = d.lights->packed[y];
-        const bool seen = visible<P>(*d.bvh, vis, d.sp, y, l.position, l.radius, t, rec.rayCounters(rc));
-        rec.ray(rc);
+        const bool seen = countedShadowRay<P>(*d.bvh, vis, *d.lights, d.sp, y, t, c, rec);
         if (!seen) ++c.shadowOccluded;
         return seen;
     }

@@ -96,12 +96,7 @@ public:
     std::uint32_t clusterOf(std::uint32_t i) const { return f_.in.bvh.clusterOf(i); }
     bool shadows() const { return f_.shadows; }
     bool visible(const ShadingPoint& sp, std::uint32_t i, const LightTerm& t, Recorder<Count>& rec) {
-        ++c_.shadowRays;
-        RayCounters rc;
-        const PackedLight& l = f_.L.packed[i];
-        const bool seen = accretion::visible<P>(f_.in.bvh, f_.vis, sp, i, l.position, l.radius, t, rec.rayCounters(rc));
-        rec.ray(rc);
-        return seen;
+        return countedShadowRay<P>(f_.in.bvh, f_.vis, f_.L, sp, i, t, c_, rec);
     }
     void occluded() { ++c_.shadowOccluded; }
     bool dropOccludedCandidates() const { return f_.rs.candidate_visibility && f_.shadows; }
