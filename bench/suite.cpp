@@ -94,6 +94,12 @@ Settings diskScene(const std::string& sceneFile, std::uint32_t particles, std::u
     return s;
 }
 
+/// The same settings with another estimator.
+Settings withEstimator(Settings s, EstimatorKind estimator) {
+    s.render.estimator = estimator;
+    return s;
+}
+
 // ---------------------------------------------------------------- BVH build
 
 /// The limit: a bare loop that builds the same clusters (one quad BLAS each,
@@ -634,8 +640,7 @@ void Suite::benchRestirFrame() {
 void Suite::benchTreeReference() {
     if (!quick) {
         log("tree to 1% relative standard error (minutes)");
-        Settings tree = disk;
-        tree.render.estimator = EstimatorKind::tree;
+        Settings tree = withEstimator(disk, EstimatorKind::tree);
         tree.render.samples = 64;
         tree.render.target_stderr = 0.01;
         tree.render.max_samples = 4096;
@@ -657,9 +662,8 @@ void Suite::benchSplitReference() {
         Settings base = diskScene(scene, 100'000, 320, 180);
         const ParticleSource src(base);
         const SplitReference ref = renderSplitReference(base, src, 0, quick);
-        Settings tree = base, split = base;
-        tree.render.estimator = EstimatorKind::tree;
-        split.render.estimator = EstimatorKind::split;
+        const Settings tree = withEstimator(base, EstimatorKind::tree);
+        Settings split = withEstimator(base, EstimatorKind::split);
         split.render.near_lights = 1024;  // the automatic k of a long render, fixed so that the cost is a + b S
         const std::uint32_t most = quick ? 128 : 4096;
         const auto c = measureErrorCosts({tree, split}, src,
@@ -683,11 +687,8 @@ void Suite::benchSplitReference() {
         base.camera.width = 320;
         base.camera.height = 180;
         const ParticleSource src(base);
-        Settings exact = base;
-        exact.render.estimator = EstimatorKind::exact;
-        const auto ex = renderInterleaved({exact}, src, quick ? 1 : 3);
-        Settings split = base;
-        split.render.estimator = EstimatorKind::split;
+        const auto ex = renderInterleaved({withEstimator(base, EstimatorKind::exact)}, src, quick ? 1 : 3);
+        Settings split = withEstimator(base, EstimatorKind::split);
         split.render.near_lights = 1024;
         const ErrorCost sp = measureErrorCosts({split}, src, {levelsTo(split, src, ex[0].first, kTarget, 8, quick ? 128 : 4096)},
                                                ex[0].first, quick ? 1 : 3)[0];
@@ -711,10 +712,9 @@ void Suite::benchRestirSources() {
     Settings base = diskScene(scene, 100'000, 320, 180);
     const ParticleSource src(base);
     const SplitReference ref = renderSplitReference(base, src, 1, quick);
-    Settings uniform = base, restir = base;
-    uniform.render.estimator = EstimatorKind::uniform;
+    Settings uniform = withEstimator(base, EstimatorKind::uniform);
     uniform.render.samples = 16;
-    restir.render.estimator = EstimatorKind::restir;
+    Settings restir = withEstimator(base, EstimatorKind::restir);
     restir.render.source = LightSource::tree;
     restir.restir.bias_correction = BiasCorrection::pairwise;  // unbiased; with visibility reuse it loses ~4% (docs/experiments.md)
     const std::uint32_t seeds = quick ? 3 : 25;

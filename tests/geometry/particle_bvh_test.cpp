@@ -13,6 +13,12 @@ using namespace accretion;
 
 namespace {
 
+/// Calls f(x, y, direction) for the primary ray of every pixel of cam.
+template <class F> void forEachPixelRay(const Camera& cam, F&& f) {
+    for (std::uint32_t y = 0; y < cam.height; ++y)
+        for (std::uint32_t x = 0; x < cam.width; ++x) f(x, y, cam.pixelDirection(x, y));
+}
+
 /// Closest hit in [tnear, tfar) by brute force: billboard quads (optionally
 /// disc-tested) or spheres (d a unit vector).
 float bruteForce(const Particles& p, const std::vector<BillboardFrame>& frames, const GeometrySettings& g, const Vec3& o,
@@ -119,24 +125,22 @@ TEST_CASE("Embree hits match brute force for every geometry and build policy", "
             }
 
         int hits = 0, mismatches = 0;
-        for (std::uint32_t y = 0; y < cam.height; ++y)
-            for (std::uint32_t x = 0; x < cam.width; ++x) {
-                const Vec3 d = cam.pixelDirection(x, y);
-                std::uint32_t want;
-                const float tWant = bruteForce(p, frames, g, cam.position, d, 1e30f, want);
-                SurfaceHit hit;
-                const bool got = bvh.intersect(cam.position, d, 1e30f, hit);
-                if (want == std::numeric_limits<std::uint32_t>::max()) {
-                    mismatches += got;  // brute force saw nothing
-                    continue;
-                }
-                ++hits;
-                // Equal particle, or (edge/tie cases) an equally close hit.
-                if (!got || (hit.particle != want && std::fabs(hit.t - tWant) > 1e-4f * tWant)) ++mismatches;
-                // Occlusion of the segment up to just before the closest hit is empty.
-                if (bvh.occluded(cam.position, d, 0.0f, tWant * (1.0f - 1e-4f))) ++mismatches;
-                if (!bvh.occluded(cam.position, d, 0.0f, tWant * (1.0f + 1e-3f) + 1e-3f)) ++mismatches;
+        forEachPixelRay(cam, [&](std::uint32_t, std::uint32_t, const Vec3& d) {
+            std::uint32_t want;
+            const float tWant = bruteForce(p, frames, g, cam.position, d, 1e30f, want);
+            SurfaceHit hit;
+            const bool got = bvh.intersect(cam.position, d, 1e30f, hit);
+            if (want == std::numeric_limits<std::uint32_t>::max()) {
+                mismatches += got;  // brute force saw nothing
+                return;
             }
+            ++hits;
+            // Equal particle, or (edge/tie cases) an equally close hit.
+            if (!got || (hit.particle != want && std::fabs(hit.t - tWant) > 1e-4f * tWant)) ++mismatches;
+            // Occlusion of the segment up to just before the closest hit is empty.
+            if (bvh.occluded(cam.position, d, 0.0f, tWant * (1.0f - 1e-4f))) ++mismatches;
+            if (!bvh.occluded(cam.position, d, 0.0f, tWant * (1.0f + 1e-3f) + 1e-3f)) ++mismatches;
+        });
         REQUIRE(hits > 50);
         // Rays grazing a quad edge may legitimately differ by float rounding.
         REQUIRE(mismatches <= 2);
@@ -201,34 +205,32 @@ TEST_CASE("counting queries: same answers, BLAS entries bounded by the overlappe
         const Camera cam = Camera::atFrame(cs, frame);
         bvh.build(p, cam);
         std::uint64_t entries = 0, anyHits = 0, hits = 0;
-        for (std::uint32_t y = 0; y < cam.height; ++y)
-            for (std::uint32_t x = 0; x < cam.width; ++x) {
-                const Vec3 d = cam.pixelDirection(x, y);
-                SurfaceHit plain, counted;
-                RayCounters rc;
-                const bool a = bvh.intersect(cam.position, d, 1e30f, plain);
-                const bool b = bvh.intersect(cam.position, d, 1e30f, counted, &rc);
-                REQUIRE(a == b);
-                if (a) {
-                    REQUIRE(counted.particle == plain.particle);
-                    REQUIRE(counted.cluster == plain.cluster);
-                    REQUIRE(counted.t == plain.t);
-                    REQUIRE(rc.blasEntries >= 1);
-                    ++hits;
-                }
-                // Traversal enters every box that starts before the closest hit
-                // (tfar never drops below it), and no box the ray misses.
-                REQUIRE(rc.blasEntries <= overlappedClusters(bvh, cam.position, d, 1e30f));
-                REQUIRE(rc.blasEntries >= overlappedClusters(bvh, cam.position, d, a ? plain.t * (1.0f - 1e-4f) : 1e30f, -1e-5f));
-                if (g.alpha == AlphaMode::opaque) REQUIRE(rc.anyHits == 0);
-                REQUIRE(rc.candidates == rc.anyHits);
-                entries += rc.blasEntries;
-                anyHits += rc.anyHits;
-                RayCounters oc;
-                const float tfar = a ? plain.t * 1.01f : 1e30f;
-                REQUIRE(bvh.occluded(cam.position, d, 0.0f, tfar) == bvh.occluded(cam.position, d, 0.0f, tfar, {}, &oc));
-                REQUIRE(oc.blasEntries <= overlappedClusters(bvh, cam.position, d, tfar));
+        forEachPixelRay(cam, [&](std::uint32_t, std::uint32_t, const Vec3& d) {
+            SurfaceHit plain, counted;
+            RayCounters rc;
+            const bool a = bvh.intersect(cam.position, d, 1e30f, plain);
+            const bool b = bvh.intersect(cam.position, d, 1e30f, counted, &rc);
+            REQUIRE(a == b);
+            if (a) {
+                REQUIRE(counted.particle == plain.particle);
+                REQUIRE(counted.cluster == plain.cluster);
+                REQUIRE(counted.t == plain.t);
+                REQUIRE(rc.blasEntries >= 1);
+                ++hits;
             }
+            // Traversal enters every box that starts before the closest hit
+            // (tfar never drops below it), and no box the ray misses.
+            REQUIRE(rc.blasEntries <= overlappedClusters(bvh, cam.position, d, 1e30f));
+            REQUIRE(rc.blasEntries >= overlappedClusters(bvh, cam.position, d, a ? plain.t * (1.0f - 1e-4f) : 1e30f, -1e-5f));
+            if (g.alpha == AlphaMode::opaque) REQUIRE(rc.anyHits == 0);
+            REQUIRE(rc.candidates == rc.anyHits);
+            entries += rc.blasEntries;
+            anyHits += rc.anyHits;
+            RayCounters oc;
+            const float tfar = a ? plain.t * 1.01f : 1e30f;
+            REQUIRE(bvh.occluded(cam.position, d, 0.0f, tfar) == bvh.occluded(cam.position, d, 0.0f, tfar, {}, &oc));
+            REQUIRE(oc.blasEntries <= overlappedClusters(bvh, cam.position, d, tfar));
+        });
         REQUIRE(hits > 50);
         REQUIRE(entries >= hits);
         if (g.alpha == AlphaMode::disc) REQUIRE(anyHits >= hits);
@@ -258,24 +260,22 @@ TEST_CASE("box primitives: an instance entered per box is an intersection progra
     instances.build(p, cam);
     boxes.build(p, cam);
     std::uint64_t hits = 0, entries = 0, programs = 0;
-    for (std::uint32_t y = 0; y < cam.height; ++y)
-        for (std::uint32_t x = 0; x < cam.width; ++x) {
-            const Vec3 d = cam.pixelDirection(x, y);
-            SurfaceHit a, b;
-            RayCounters ra, rb;
-            const bool ha = instances.intersect(cam.position, d, 1e30f, a, &ra);
-            const bool hb = boxes.intersect(cam.position, d, 1e30f, b, &rb);
-            REQUIRE(ha == hb);
-            if (ha) REQUIRE(a.particle == b.particle);
-            REQUIRE(ra.intersections == 0);
-            REQUIRE(rb.blasEntries <= 1);  // the one BLAS of boxes, when its bounds are entered
-            REQUIRE(ra.blasEntries == rb.intersections);
-            REQUIRE(rb.intersections <= overlappedBoxes(p, boxes, cam.position, d, 0.0f, 1e30f, 1e-4f));
-            REQUIRE(rb.intersections >= overlappedBoxes(p, boxes, cam.position, d, 0.0f, hb ? b.t * (1.0f - 1e-4f) : 1e30f, -1e-4f));
-            hits += ha;
-            entries += ra.blasEntries;
-            programs += rb.intersections;
-        }
+    forEachPixelRay(cam, [&](std::uint32_t, std::uint32_t, const Vec3& d) {
+        SurfaceHit a, b;
+        RayCounters ra, rb;
+        const bool ha = instances.intersect(cam.position, d, 1e30f, a, &ra);
+        const bool hb = boxes.intersect(cam.position, d, 1e30f, b, &rb);
+        REQUIRE(ha == hb);
+        if (ha) REQUIRE(a.particle == b.particle);
+        REQUIRE(ra.intersections == 0);
+        REQUIRE(rb.blasEntries <= 1);  // the one BLAS of boxes, when its bounds are entered
+        REQUIRE(ra.blasEntries == rb.intersections);
+        REQUIRE(rb.intersections <= overlappedBoxes(p, boxes, cam.position, d, 0.0f, 1e30f, 1e-4f));
+        REQUIRE(rb.intersections >= overlappedBoxes(p, boxes, cam.position, d, 0.0f, hb ? b.t * (1.0f - 1e-4f) : 1e30f, -1e-4f));
+        hits += ha;
+        entries += ra.blasEntries;
+        programs += rb.intersections;
+    });
     REQUIRE(hits > 50);
     REQUIRE(entries == programs);
     REQUIRE(programs >= hits);
@@ -309,43 +309,41 @@ TEST_CASE("segment boxes: the particles' boxes a ray crosses, whatever the layou
     std::vector<BillboardFrame> frames(p.size());
     for (std::uint32_t i = 0; i < p.size(); ++i) frames[i] = bvhs[0]->frame(i);
     std::uint64_t primary = 0, shadow = 0, blockedRays = 0, shadowRays = 0, disagree = 0;
-    for (std::uint32_t y = 0; y < cam.height; ++y)
-        for (std::uint32_t x = 0; x < cam.width; ++x) {
-            const Vec3 d = cam.pixelDirection(x, y);
-            std::uint32_t first = 0;
-            for (std::size_t b = 0; b < bvhs.size(); ++b) {
-                SurfaceHit h;
-                RayCounters rc;
-                const bool hit = bvhs[b]->intersect(cam.position, d, 1e30f, h, &rc);
-                const float t = hit ? h.t : 1e30f;
-                REQUIRE(rc.segmentBoxes <= crossed(cam.position, d, 0.0f, t * (1.0f + 1e-4f), 1e-4f));
-                REQUIRE(rc.segmentBoxes >= crossed(cam.position, d, 0.0f, t * (1.0f - 1e-4f), -1e-4f));
-                if (b == 0) first = rc.segmentBoxes;
-                REQUIRE(rc.segmentBoxes == first);
-                REQUIRE(rc.wholeSegmentBoxes == rc.segmentBoxes);  // a primary ray's segment ends at its hit
-                if (!hit || b) continue;
-                primary += rc.segmentBoxes;
-                // A shadow ray from the hit to particle (x * 7 + y) % n: its whole segment.
-                const std::uint32_t light = (x * 7u + y) % std::uint32_t(p.size());
-                const Vec3 o = cam.position + h.t * d, to = p.position[light] - o;
-                const float t0 = 1e-3f, t1 = 1.0f - 1e-3f;
-                RayCounters sc;
-                const bool blocked = bvhs[b]->occluded(o, to, t0, t1, {}, &sc);
-                REQUIRE(sc.wholeSegmentBoxes <= crossed(o, to, t0 * (1.0f - 1e-4f), t1 * (1.0f + 1e-4f), 1e-4f));
-                REQUIRE(sc.wholeSegmentBoxes >= crossed(o, to, t0 * (1.0f + 1e-4f), t1 * (1.0f - 1e-4f), -1e-4f));
-                // Up to the first blocker, found here by testing every particle's quad.
-                std::uint32_t blocker;
-                const float first = bruteForce(p, frames, GeometrySettings{}, o, to, t1, blocker, t0);
-                disagree += blocked != (first < t1);  // a quad grazed at float precision
-                REQUIRE(sc.segmentBoxes <= crossed(o, to, t0 * (1.0f - 1e-4f), first * (1.0f + 1e-4f), 1e-4f));
-                REQUIRE(sc.segmentBoxes >= crossed(o, to, t0 * (1.0f + 1e-4f), first * (1.0f - 1e-4f), -1e-4f));
-                REQUIRE(sc.segmentBoxes <= sc.wholeSegmentBoxes);
-                if (!(first < t1)) REQUIRE(sc.segmentBoxes == sc.wholeSegmentBoxes);
-                blockedRays += blocked;
-                ++shadowRays;
-                shadow += sc.wholeSegmentBoxes;
-            }
+    forEachPixelRay(cam, [&](std::uint32_t x, std::uint32_t y, const Vec3& d) {
+        std::uint32_t first = 0;
+        for (std::size_t b = 0; b < bvhs.size(); ++b) {
+            SurfaceHit h;
+            RayCounters rc;
+            const bool hit = bvhs[b]->intersect(cam.position, d, 1e30f, h, &rc);
+            const float t = hit ? h.t : 1e30f;
+            REQUIRE(rc.segmentBoxes <= crossed(cam.position, d, 0.0f, t * (1.0f + 1e-4f), 1e-4f));
+            REQUIRE(rc.segmentBoxes >= crossed(cam.position, d, 0.0f, t * (1.0f - 1e-4f), -1e-4f));
+            if (b == 0) first = rc.segmentBoxes;
+            REQUIRE(rc.segmentBoxes == first);
+            REQUIRE(rc.wholeSegmentBoxes == rc.segmentBoxes);  // a primary ray's segment ends at its hit
+            if (!hit || b) continue;
+            primary += rc.segmentBoxes;
+            // A shadow ray from the hit to particle (x * 7 + y) % n: its whole segment.
+            const std::uint32_t light = (x * 7u + y) % std::uint32_t(p.size());
+            const Vec3 o = cam.position + h.t * d, to = p.position[light] - o;
+            const float t0 = 1e-3f, t1 = 1.0f - 1e-3f;
+            RayCounters sc;
+            const bool blocked = bvhs[b]->occluded(o, to, t0, t1, {}, &sc);
+            REQUIRE(sc.wholeSegmentBoxes <= crossed(o, to, t0 * (1.0f - 1e-4f), t1 * (1.0f + 1e-4f), 1e-4f));
+            REQUIRE(sc.wholeSegmentBoxes >= crossed(o, to, t0 * (1.0f + 1e-4f), t1 * (1.0f - 1e-4f), -1e-4f));
+            // Up to the first blocker, found here by testing every particle's quad.
+            std::uint32_t blocker;
+            const float first = bruteForce(p, frames, GeometrySettings{}, o, to, t1, blocker, t0);
+            disagree += blocked != (first < t1);  // a quad grazed at float precision
+            REQUIRE(sc.segmentBoxes <= crossed(o, to, t0 * (1.0f - 1e-4f), first * (1.0f + 1e-4f), 1e-4f));
+            REQUIRE(sc.segmentBoxes >= crossed(o, to, t0 * (1.0f + 1e-4f), first * (1.0f - 1e-4f), -1e-4f));
+            REQUIRE(sc.segmentBoxes <= sc.wholeSegmentBoxes);
+            if (!(first < t1)) REQUIRE(sc.segmentBoxes == sc.wholeSegmentBoxes);
+            blockedRays += blocked;
+            ++shadowRays;
+            shadow += sc.wholeSegmentBoxes;
         }
+    });
     REQUIRE(primary > 20);
     REQUIRE(shadow > primary);  // shadow segments cross the disk; primary rays stop at their first particle
     REQUIRE(blockedRays > 0);
