@@ -1,11 +1,16 @@
 #pragma once
 #include <cstdint>
 
+#include "accretion/render/gbuffer_texel.h"
+
 namespace accretion::gpu_layout {
 
 /// Bytes of the GPU's buffers as the counters charge them (docs/MODEL.md section 6).
-/// G-buffer texel: position float3 (12) + octahedral normal (4) + depth (4) + particle id (4).
-inline constexpr std::uint32_t kGBufferTexel = 24;
+/// G-buffer texel: the one the lighting passes stream, on the CPU and in the
+/// twin whose timings calibrate the model (particle id, local point, shading
+/// and geometric normals, depth: 44 B). A compact texel (octahedral normals,
+/// no geometric normal: 24 B) would read less; it is not what is timed.
+inline constexpr std::uint32_t kGBufferTexel = sizeof(GBufferTexel);
 /// Particle record: the raw 32-byte GPU record (position, radius, emission, opacity, type).
 inline constexpr std::uint32_t kParticleRecord = 32;
 /// Radiance written per pixel: RGBA16F.
