@@ -108,7 +108,7 @@ void runChunk(const LightingInputs& in, const LightArrays& L, const VisibilityOp
     const auto stream = [&](const GroupPixel& p) {
         return Rng(p.px, in.frame, RngPass::lightSampling, in.render.seed, chunk + 1);
     };
-    if constexpr (K == EstimatorKind::ris) {
+    if constexpr (estimatorInfo(K).resampling) {
         // The candidates' source: the plan built the power table or the light tree for it.
         const auto chunk = [&]<LightSource S>(GroupPixel& p, Rng& rng, RayCounters* rc) {
             if (p.sums.trace) [[unlikely]]  // render --pixel
@@ -285,34 +285,31 @@ std::uint32_t beginGroup(const Sweep& s, std::uint32_t y, std::uint32_t x0, std:
 template <ShadingModel M, Primitive P, bool Count>
 void lightGroup(const Sweep& s, GroupPixel* pix, std::uint32_t n, std::unique_ptr<NearFieldCache>& cache) {
     const LightingInputs& in = s.in;
-    switch (in.render.estimator) {
-    case EstimatorKind::exact:
-        for (std::uint32_t k = 0; k < n; ++k) {
-            PixelSums& sums = pix[k].sums;
-            RayCounters* rc = Count ? &pix[k].rays : nullptr;
-            const DVec3 v = sums.trace ? exactPixel<M, P, true>(in.bvh, s.L, pix[k].sp, s.vis, s.shadows, sums.c, rc, sums.trace)
-                                       : exactPixel<M, P>(in.bvh, s.L, pix[k].sp, s.vis, s.shadows, sums.c, rc);
-            if (finiteSum(v)) sums.sum = v;
-            else sums.reject();  // exact has one value: 0 either way
-            sums.n = 1;
+    withEstimatorKind(in.render.estimator, [&]<EstimatorKind K>() {
+        constexpr const EstimatorInfo& e = estimatorInfo(K);
+        if constexpr (e.reuse) {
+            ACC_CHECK(!"a sweep of an estimator with reuse");  // restir's passes (render/restir/), never a sweep
+        } else if constexpr (e.sums) {
+            for (std::uint32_t k = 0; k < n; ++k) {
+                PixelSums& sums = pix[k].sums;
+                RayCounters* rc = Count ? &pix[k].rays : nullptr;
+                const DVec3 v = sums.trace ? exactPixel<M, P, true>(in.bvh, s.L, pix[k].sp, s.vis, s.shadows, sums.c, rc, sums.trace)
+                                           : exactPixel<M, P>(in.bvh, s.L, pix[k].sp, s.vis, s.shadows, sums.c, rc);
+                if (finiteSum(v)) sums.sum = v;
+                else sums.reject();  // a sum has one value: 0 either way
+                sums.n = 1;
+            }
+        } else {
+            if constexpr (e.nearField) {
+                if (!cache) cache = std::make_unique<NearFieldCache>();
+                std::uint64_t pinned = 0;  // the slots this group's pixels use
+                std::uint32_t spares = 0;
+                for (std::uint32_t k = 0; k < n; ++k)
+                    if (!pix[k].sums.done) prepareNearField<M, P, Count>(in, s.L, s.vis, s.shadows, pix[k], *cache, pinned, spares);
+            }
+            runChunks<M, P, Count, K>(in, s.L, s.plan, s.vis, s.shadows, s.c0, s.c1, pix, n);
         }
-        return;
-    case EstimatorKind::split: {
-        if (!cache) cache = std::make_unique<NearFieldCache>();
-        std::uint64_t pinned = 0;  // the slots this group's pixels use
-        std::uint32_t spares = 0;
-        for (std::uint32_t k = 0; k < n; ++k)
-            if (!pix[k].sums.done) prepareNearField<M, P, Count>(in, s.L, s.vis, s.shadows, pix[k], *cache, pinned, spares);
-        return runChunks<M, P, Count, EstimatorKind::split>(in, s.L, s.plan, s.vis, s.shadows, s.c0, s.c1, pix, n);
-    }
-    case EstimatorKind::ris: return runChunks<M, P, Count, EstimatorKind::ris>(in, s.L, s.plan, s.vis, s.shadows, s.c0, s.c1, pix, n);
-    case EstimatorKind::power: return runChunks<M, P, Count, EstimatorKind::power>(in, s.L, s.plan, s.vis, s.shadows, s.c0, s.c1, pix, n);
-    case EstimatorKind::tree: return runChunks<M, P, Count, EstimatorKind::tree>(in, s.L, s.plan, s.vis, s.shadows, s.c0, s.c1, pix, n);
-    case EstimatorKind::uniform:
-        return runChunks<M, P, Count, EstimatorKind::uniform>(in, s.L, s.plan, s.vis, s.shadows, s.c0, s.c1, pix, n);
-    case EstimatorKind::restir: break;  // restir's passes (render/restir/), never a sweep
-    }
-    ACC_CHECK(!"a sweep of an estimator without sums");
+    });
 }
 
 /// Each pixel's sums stored (or resolved into the image), its counters added to c.

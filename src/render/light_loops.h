@@ -112,10 +112,11 @@ inline std::uint32_t resolvePixel(const DVec3& sum, const DVec3& sumSq, std::uin
 template <EstimatorKind K>
 void drawLights(const LightingInputs& in, const LightArrays& L, const ShadingPoint& sp, const NearField* near, Rng& rng,
                 std::uint32_t count, LightSample* xs) {
+    constexpr const EstimatorInfo& e = estimatorInfo(K);
     for (std::uint32_t k = 0; k < count; ++k) {
-        if constexpr (K == EstimatorKind::power) xs[k] = sampleSource<true>(L, in.powerTable, rng);
-        else if constexpr (K == EstimatorKind::tree) xs[k] = in.lightTree->sample(sp, rng);
-        else if constexpr (K == EstimatorKind::split) xs[k] = in.lightTree->sampleFar(sp, *near, rng);
+        if constexpr (e.sampler == LightSamplerKind::power) xs[k] = sampleSource<true>(L, in.powerTable, rng);
+        else if constexpr (e.sampler == LightSamplerKind::tree && e.nearField) xs[k] = in.lightTree->sampleFar(sp, *near, rng);
+        else if constexpr (e.sampler == LightSamplerKind::tree) xs[k] = in.lightTree->sample(sp, rng);
         else xs[k] = sampleSource<false>(L, nullptr, rng);
         if (xs[k].i < L.count) {
             __builtin_prefetch(&L.packed[xs[k].i]);

@@ -86,22 +86,33 @@ static_assert(sourceTableMatchesEnum(), "kLightSources lists every LightSource i
 
 constexpr const LightSourceInfo& sourceInfo(LightSource kind) { return kLightSources[std::size_t(kind)]; }
 
-/// fn.template operator()<S>() with S the source `kind`, for every row of
-/// kLightSources (the one dispatch of a source to its compiled code: a new
-/// row is dispatched without a new case anywhere). fn returns void or a
+/// fn.template operator()<K>() with K the `kind` of the row of `table`
+/// (an array of rows with a member `kind`, in enum order) that matches: the
+/// one dispatch of a runtime kind to the code compiled for it, so that a new
+/// row is dispatched without a new case anywhere. fn returns void or a
 /// default-constructible value.
-template <class Fn>
-decltype(auto) withLightSource(LightSource kind, Fn&& fn) {
-    using R = decltype(fn.template operator()<kLightSources[0].kind>());
+template <const auto& table, class Kind, class Fn>
+decltype(auto) withRow(Kind kind, Fn&& fn) {
+    using R = decltype(fn.template operator()<table[0].kind>());
     return [&]<std::size_t... I>(std::index_sequence<I...>) -> R {
         if constexpr (std::is_void_v<R>) {
-            ((kind == kLightSources[I].kind ? (fn.template operator()<kLightSources[I].kind>(), true) : false) || ...);
+            ((kind == table[I].kind ? (fn.template operator()<table[I].kind>(), true) : false) || ...);
         } else {
             R r{};
-            ((kind == kLightSources[I].kind ? (r = fn.template operator()<kLightSources[I].kind>(), true) : false) || ...);
+            ((kind == table[I].kind ? (r = fn.template operator()<table[I].kind>(), true) : false) || ...);
             return r;
         }
-    }(std::make_index_sequence<kLightSources.size()>{});
+    }(std::make_index_sequence<table.size()>{});
+}
+
+/// withRow over kEstimators: fn.template operator()<K>() for the estimator `kind`.
+template <class Fn> decltype(auto) withEstimatorKind(EstimatorKind kind, Fn&& fn) {
+    return withRow<kEstimators>(kind, std::forward<Fn>(fn));
+}
+
+/// withRow over kLightSources: fn.template operator()<S>() for the source `kind`.
+template <class Fn> decltype(auto) withLightSource(LightSource kind, Fn&& fn) {
+    return withRow<kLightSources>(kind, std::forward<Fn>(fn));
 }
 
 /// The light sampler a frame lit by `render`'s estimator needs: its own, or
