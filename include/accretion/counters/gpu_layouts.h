@@ -1,7 +1,7 @@
 #pragma once
 #include <cstdint>
 
-#include "accretion/render/gbuffer_texel.h"
+#include "accretion/core/gbuffer_texel_layout.h"
 
 namespace accretion::gpu_layout {
 
