@@ -1,6 +1,8 @@
 #include "accretion/analysis/view_check.h"
 
 #include <algorithm>
+#include <optional>
+#include <utility>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -23,15 +25,51 @@ std::vector<std::string> sceneLines(const std::string& toml) {
     return out;
 }
 
+namespace {
+
+/// The scene-defining settings as "section.key" -> value, in file order.
+std::vector<std::pair<std::string, std::string>> sceneKeys(const std::string& toml) {
+    std::vector<std::pair<std::string, std::string>> out;
+    std::string section;
+    for (const std::string& line : sceneLines(toml)) {
+        if (line.empty()) continue;
+        if (line[0] == '[') {
+            section = line.substr(1, line.find(']') - 1);
+            continue;
+        }
+        const auto eq = line.find(" = ");
+        if (eq == std::string::npos) out.emplace_back(section + "." + line, "");
+        else out.emplace_back(section + "." + line.substr(0, eq), line.substr(eq + 3));
+    }
+    return out;
+}
+
+/// The first scene-defining setting the two sides give differently, by key.
+std::optional<std::string> settingsDifference(const std::string& x, const std::string& r, const ViewSides& sides) {
+    const auto kx = sceneKeys(x), kr = sceneKeys(r);
+    const std::map<std::string, std::string> mx(kx.begin(), kx.end()), mr(kr.begin(), kr.end());
+    auto value = [](const std::map<std::string, std::string>& m, const std::string& key) {
+        const auto i = m.find(key);
+        return i == m.end() ? std::string("(not set)") : i->second.substr(0, 80);
+    };
+    for (const auto* keys : {&kx, &kr})
+        for (const auto& [key, v] : *keys)
+            if (value(mx, key) != value(mr, key))
+                return fmt::format("{} = {} {}, {} {}", key, value(mx, key), sides.image, value(mr, key), sides.reference);
+    return std::nullopt;
+}
+
+}  // namespace
+
 ViewCheck checkView(const std::map<std::string, std::string>& x, const std::map<std::string, std::string>& r,
-                    ViewKeys keys) {
+                    ViewKeys keys, const ViewSides& sides) {
     ViewCheck out;
     auto check = [&](const char* key, const char* what) {
         const auto i = x.find(key), j = r.find(key);
         if (i == x.end() || j == r.end()) out.unchecked.emplace_back(what);
         else if (i->second != j->second)
-            out.differences.push_back(
-                fmt::format("{}: {} here, {} in the reference", what, i->second.substr(0, 80), j->second.substr(0, 80)));
+            out.differences.push_back(fmt::format("{}: {} {}, {} {}", what, i->second.substr(0, 80), sides.image,
+                                                  j->second.substr(0, 80), sides.reference));
     };
     check("accretion:frame", "frame");
     if (keys == ViewKeys::all) {
@@ -45,23 +83,21 @@ ViewCheck checkView(const std::map<std::string, std::string>& x, const std::map<
         out.unchecked.emplace_back("scene settings");
         return out;
     }
-    const auto sx = sceneLines(i->second), sr = sceneLines(j->second);
-    for (std::size_t k = 0; k < std::max(sx.size(), sr.size()); ++k) {
-        const std::string lx = k < sx.size() ? sx[k] : "(none)", lr = k < sr.size() ? sr[k] : "(none)";
-        if (lx != lr) {
-            out.differences.push_back(fmt::format("scene settings: `{}` here, `{}` in the reference", lx, lr));
-            break;
-        }
-    }
+    if (auto d = settingsDifference(i->second, j->second, sides)) out.differences.push_back("scene settings: " + *d);
     return out;
 }
 
-void requireSceneView(const std::map<std::string, std::string>& attributes, const std::string& file, const Settings& scene,
-                      std::uint32_t frame, bool strict) {
+void requireSceneView(const std::map<std::string, std::string>& attributes, const std::string& file, FileRole role,
+                      const Settings& scene, std::uint32_t frame, bool strict) {
     const std::map<std::string, std::string> render = {{"accretion:frame", std::to_string(frame)},
                                                        {"accretion:settings", settingsToToml(scene)}};
-    reportViewCheck(checkView(render, attributes, ViewKeys::frameAndSettings),
-                    fmt::format("frame {} of {}", frame, scene.scenePath), file, strict, true);
+    const std::string sceneName = scene.scenePath.empty() ? std::string("the scene") : scene.scenePath;
+    const ViewSides sides{fmt::format("in {}", sceneName), fmt::format("in {}", file)};
+    const ViewCheck check = checkView(render, attributes, ViewKeys::frameAndSettings, sides);
+    const char* what = role == FileRole::reference ? "the reference" : "the GPU frame";
+    for (const std::string& d : check.differences)
+        throw InputError(fmt::format("{} ({}): not a render of frame {} of {}: {}", file, what, frame, sceneName, d));
+    reportViewCheck(check, fmt::format("{} ({})", file, what), sceneName, strict);
 }
 
 void reportViewCheck(const ViewCheck& check, const std::string& image, const std::string& reference, bool strict,

@@ -141,7 +141,7 @@ ExperimentRender readGpuRender(const std::string& file, const Settings& s, std::
     // The scene the frame was rendered from (its metadata, as the EXR's attributes name it).
     std::map<std::string, std::string> attributes;
     for (const auto& [key, value] : g.metadata) attributes["accretion:" + key] = value;
-    requireSceneView(attributes, file, s, frame, strict);
+    requireSceneView(attributes, file, FileRole::gpuFrame, s, frame, strict);
     requireFinitePixels(g.Lr, file, "Lr", g.width);
     ExperimentRender r;
     r.image.lighting.Lr = std::move(g.Lr);
@@ -241,7 +241,7 @@ void runBias(const BiasArgs& a) {
 
     const BiasReference ref = loadBiasReference(a.reference, scene);
     // The reference must be of the view measured: its frame and scene-defining settings.
-    requireSceneView(readExrAttributes(a.reference), a.reference, scene, frame, a.strict);
+    requireSceneView(readExrAttributes(a.reference), a.reference, FileRole::reference, scene, frame, a.strict);
     const ParticleSource source(scene);
     std::vector<BiasRow> rows;
     for (const EstimatorSpec& spec : specs) rows.push_back(measureBias(a, spec, base, source, frame, ref, prefix));

@@ -93,7 +93,7 @@ Reference loadReference(const std::string& pattern, const Settings& scene, std::
         throw InputError(fmt::format("{}: reference is {}x{}, the scene renders {}x{}", file, L.width, L.height,
                                      scene.camera.width, scene.camera.height));
     // Of the frame measured and the scene's settings; finite.
-    requireSceneView(readExrAttributes(file), file, scene, frame, false);
+    requireSceneView(readExrAttributes(file), file, FileRole::reference, scene, frame, false);
     Reference r;
     r.Lr = L.rgb;
     requireFinitePixels(r.Lr, file, "Lr", L.width);

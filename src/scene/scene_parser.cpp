@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <utility>
 #include <fstream>
 #include <map>
 #include <set>
@@ -271,6 +272,15 @@ void validateSceneShape(const Settings& s, const RuleFailure& fail) {
         if (!(s.particles.type_bands[k] > s.particles.type_bands[k - 1]))
             fail("particles.type_bands", "thresholds must increase");
     if (s.particles.type_bands.size() > 254) fail("particles.type_bands", "at most 254 thresholds");
+    // The renderer traces in float: beyond 1e15 a position keeps no digit of the
+    // disk's scale (and a view vector's length overflows), as camera files check.
+    constexpr float kFar = 1e15f;
+    for (const auto& [key, v] : {std::pair{"camera.position", s.camera.position}, std::pair{"camera.look_at", s.camera.look_at},
+                                 std::pair{"camera.end_position", s.camera.end_position},
+                                 std::pair{"camera.end_look_at", s.camera.end_look_at}})
+        if (!(std::fabs(v.x) <= kFar && std::fabs(v.y) <= kFar && std::fabs(v.z) <= kFar))
+            fail(key, fmt::format("({:g}, {:g}, {:g}) is farther than 1e15 from the origin: the renderer's float rays "
+                                  "would lose every digit of the scene", v.x, v.y, v.z));
     const Vec3 view = s.camera.look_at - s.camera.position;
     if (glm::length(view) <= 0.0f) fail("camera.look_at", "must differ from camera.position");
     if (glm::length(s.camera.up) <= 0.0f || glm::length(glm::cross(glm::normalize(view), glm::normalize(s.camera.up))) < 1e-4f)

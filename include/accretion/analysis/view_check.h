@@ -23,15 +23,26 @@ struct ViewCheck {
 /// frame and those sections (a render about to be made, whose camera its
 /// [camera] settings give).
 enum class ViewKeys { all, frameAndSettings };
-ViewCheck checkView(const std::map<std::string, std::string>& image, const std::map<std::string, std::string>& reference,
-                    ViewKeys keys = ViewKeys::all);
 
-/// `file` (its metadata `attributes`: a reference, a GPU frame) must be a
-/// render of frame `frame` of `scene`: the frame and the scene-defining
-/// settings, a difference an error; what it does not record a warning, an
-/// error when `strict`.
-void requireSceneView(const std::map<std::string, std::string>& attributes, const std::string& file, const Settings& scene,
-                      std::uint32_t frame, bool strict);
+/// How a difference names the two sides: "3 here, 0 in the reference".
+struct ViewSides {
+    std::string image = "here";
+    std::string reference = "in the reference";
+};
+
+ViewCheck checkView(const std::map<std::string, std::string>& image, const std::map<std::string, std::string>& reference,
+                    ViewKeys keys = ViewKeys::all, const ViewSides& sides = {});
+
+/// What a file checked against the scene is to the command that reads it.
+enum class FileRole { reference, gpuFrame };
+
+/// `file` (its metadata `attributes`; a reference or a GPU frame, as `role`
+/// says) must be a render of frame `frame` of `scene`: the frame and the
+/// scene-defining settings, a difference an error naming the file, its role
+/// and the setting by key; what it does not record a warning, an error when
+/// `strict`.
+void requireSceneView(const std::map<std::string, std::string>& attributes, const std::string& file, FileRole role,
+                      const Settings& scene, std::uint32_t frame, bool strict);
 
 /// The scene-defining sections of a settings TOML (what two renders of the
 /// same view share whatever their estimators): particles, camera, geometry, shading.
