@@ -54,6 +54,8 @@ struct TuneArgs : SceneArgs {
     std::uint32_t referenceSpp = 1024;
     std::string out, cache;
     bool allowBiased = false;
+    double biasBoundPct = 1.0;     ///< the energy bias a verdict of "unbiased" must be able to see
+    std::uint32_t maxSeeds = 64;   ///< the most seeds tune spends on one configuration to see it
 };
 
 /// One point of the space: its label and the settings it overrides.
@@ -234,29 +236,60 @@ double total(const std::map<Pass, double>& ms) {
     return s;
 }
 
+/// What the bias runs could say of a configuration: a bias found, none
+/// where one of --bias-bound would have shown, or too few seeds to tell.
+enum class BiasVerdict { unbiased, biased, unknown };
+constexpr const char* verdictName(BiasVerdict v) {
+    return v == BiasVerdict::unbiased ? "unbiased" : v == BiasVerdict::biased ? "biased" : "unknown";
+}
+
 /// One lighting configuration's error: bias's row (relMSE of one frame less
-/// the reference's noise, the mean signed error's z, the energy loss).
+/// the reference's noise, the mean signed error's z, the energy loss, the
+/// smallest energy bias its seeds detect 4 times in 5).
 struct ErrorRow {
-    double relMse = 0.0, z = 0.0, energyLossPct = 0.0, cpuSecondsPerFrame = 0.0;
-    bool biased = false;
+    double relMse = 0.0, z = 0.0, energyLossPct = 0.0, cpuSecondsPerFrame = 0.0, detectablePct = 0.0;
+    std::uint32_t seeds = 0;
+    BiasVerdict verdict = BiasVerdict::unknown;
+    bool biased() const { return verdict == BiasVerdict::biased; }
+    /// "BIASED", "" (unbiased to the bound), "bias unknown (bound 9.9%)".
+    std::string label() const {
+        if (verdict == BiasVerdict::biased) return "BIASED";
+        return verdict == BiasVerdict::unknown ? fmt::format("bias unknown (bound {:.2g}%)", detectablePct) : "";
+    }
 };
 
-ErrorRow measureError(TuneContext& t, const LightingChoice& o) {
+ErrorRow measureErrorSeeds(TuneContext& t, const LightingChoice& o, std::uint32_t seeds) {
     std::string spec = "restir";
     for (const std::string& d : o.defines())
         if (d != "render.estimator=restir") spec += ":" + d;
-    std::string key = t.sceneText + fmt::format("\nbias {} seeds {} frame {} {}x{} reference {}", spec, t.args.seeds, t.args.frame,
+    std::string key = t.sceneText + fmt::format("\nbias {} seeds {} frame {} {}x{} reference {}", spec, seeds, t.args.frame,
                                                 t.errorWidth, t.errorHeight, cacheKey(readWholeFile(t.reference, "tune")));
     const std::filesystem::path prefix = t.cache / (cacheKey(key) + ".bias");
     std::vector<std::string> argv = sceneArgv(t, "bias", {fmt::format("camera.width={}", t.errorWidth),
                                                           fmt::format("camera.height={}", t.errorHeight)});
-    argv.insert(argv.end(), {"--reference", t.reference, "--estimators", spec, "--seeds", std::to_string(t.args.seeds), "--frame",
+    argv.insert(argv.end(), {"--reference", t.reference, "--estimators", spec, "--seeds", std::to_string(seeds), "--frame",
                              std::to_string(t.args.frame), "--history", "1", "-q", "-o", prefix.string()});
-    measure(t, argv, prefix.string() + ".json", "error of " + o.label());
+    measure(t, argv, prefix.string() + ".json", fmt::format("error of {} ({} seeds)", o.label(), seeds));
     const nlohmann::json j = nlohmann::json::parse(readWholeFile(prefix.string() + ".json", "tune"));
     const nlohmann::json& r = j.at("rows").at(0);
-    return {r.at("rel_mse").get<double>(), r.at("z").get<double>(), r.at("energy_loss_pct").get<double>(),
-            r.at("seconds_per_frame").get<double>(), r.at("biased").get<bool>()};
+    ErrorRow e{r.at("rel_mse").get<double>(), r.at("z").get<double>(), r.at("energy_loss_pct").get<double>(),
+               r.at("seconds_per_frame").get<double>(), r.at("detectable_bias_pct").get<double>(), seeds};
+    e.verdict = r.at("biased").get<bool>()                ? BiasVerdict::biased
+              : e.detectablePct <= t.args.biasBoundPct ? BiasVerdict::unbiased
+                                                        : BiasVerdict::unknown;
+    return e;
+}
+
+/// The error with --seeds; where a bias of --bias-bound could hide in it,
+/// again with the seeds that would see one (the bound falls as 1/sqrt(seeds)),
+/// up to --max-seeds; past that the verdict stays "unknown", with its bound.
+ErrorRow measureError(TuneContext& t, const LightingChoice& o) {
+    const ErrorRow first = measureErrorSeeds(t, o, t.args.seeds);
+    if (first.verdict != BiasVerdict::unknown || !std::isfinite(first.detectablePct)) return first;
+    const double ratio = first.detectablePct / t.args.biasBoundPct;
+    const double needed = std::ceil(double(t.args.seeds) * ratio * ratio * 1.1);  // 10% spare: the bound is itself measured
+    if (needed > double(t.args.maxSeeds)) return first;
+    return measureErrorSeeds(t, o, static_cast<std::uint32_t>(needed));
 }
 
 /// The reference of the error measurements: given, or rendered once (exact
@@ -370,14 +403,22 @@ std::vector<ParetoPoint> measureLighting(TuneContext& t, const GeometryChoice& c
     return points;
 }
 
-/// The recommendation: under the budget (and --max-error), unbiased unless
-/// allowed; the lowest error, or with --max-error the fastest that meets it.
+/// The recommendation: under the budget (and --max-error), never biased
+/// unless allowed; a configuration whose seeds could see a bias of
+/// --bias-bound before one they could not (which is recommended only with
+/// its label, "bias unknown (bound X%)"); then the lowest error, or with
+/// --max-error the fastest that meets it.
 const ParetoPoint* recommend(const TuneArgs& a, const std::vector<ParetoPoint>& points) {
     const ParetoPoint* best = nullptr;
+    auto better = [&](const ParetoPoint& p, const ParetoPoint& q) {
+        const bool pk = p.error.verdict != BiasVerdict::unknown, qk = q.error.verdict != BiasVerdict::unknown;
+        if (pk != qk) return pk;
+        return a.maxError ? p.ms < q.ms : p.error.relMse < q.error.relMse;
+    };
     for (const ParetoPoint& p : points) {
-        if (p.ms > a.budgetMs || (p.error.biased && !a.allowBiased)) continue;
+        if (p.ms > a.budgetMs || (p.error.biased() && !a.allowBiased)) continue;
         if (a.maxError && p.error.relMse > *a.maxError) continue;
-        if (!best || (a.maxError ? p.ms < best->ms : p.error.relMse < best->error.relMse)) best = &p;
+        if (!best || better(p, *best)) best = &p;
     }
     return best;
 }
@@ -404,13 +445,17 @@ Table geometryTable(const TuneResult& r) {
 Table lightingTable(const TuneArgs& a, const TuneResult& r) {
     Table lt({{"lighting", "lighting (on the chosen geometry)", -36}, {"gpu_ms", "GPU ms", 9, "{:.3f}", "{:.6g}"},
               {"rel_mse", fmt::format("relMSE@{}", a.errorSize), 14, "{:.4g}", "{:.6g}"}, {"z", "bias z", 7, "{:.1f}", "{:.5g}"},
-              {"energy_loss_pct", "loss %", 7, "{:.1f}", "{:.5g}"}, {"cpu_s", "CPU s", 7, "{:.2f}", "{:.5g}"},
-              {"biased", "", 0, "{}", "{}", false}, {"front", "", 0, "{}", "{}", false},
+              {"energy_loss_pct", "loss %", 7, "{:.1f}", "{:.5g}"}, {"detectable_bias_pct", "bound %", 8, "{:.2g}", "{:.5g}"},
+              {"seeds", "seeds", 6}, {"cpu_s", "CPU s", 7, "{:.2f}", "{:.5g}"},
+              {"biased", "", 0, "{}", "{}", false}, {"bias_verdict", "", 0, "{}", "{}", false}, {"front", "", 0, "{}", "{}", false},
               {"", "", 0, "{}", "{}", true, "  "}});
-    for (const ParetoPoint& p : r.points)
-        lt.add({p.lighting.label(), p.ms, p.error.relMse, p.error.z, p.error.energyLossPct, p.error.cpuSecondsPerFrame, p.error.biased,
+    for (const ParetoPoint& p : r.points) {
+        const std::string bias = p.error.label();
+        lt.add({p.lighting.label(), p.ms, p.error.relMse, p.error.z, p.error.energyLossPct, p.error.detectablePct,
+                std::uint64_t(p.error.seeds), p.error.cpuSecondsPerFrame, p.error.biased(), std::string(verdictName(p.error.verdict)),
                 p.front,
-                std::string(p.front ? "front" : "") + (p.error.biased ? " BIASED" : "") + (&p == r.best ? " <- recommended" : "")});
+                std::string(p.front ? "front" : "") + (bias.empty() ? "" : " " + bias) + (&p == r.best ? " <- recommended" : "")});
+    }
     return lt;
 }
 
@@ -427,9 +472,10 @@ void printTune(const TuneArgs& a, const Settings& scene, const TuneContext& t, c
         fmt::print("on a GPU with RT cores prefer {} ({:+.3f} ms here): boxes win only where traversal runs in software\n",
                    r.triangles->choice.label(), total(r.triangles->ms) - total(r.chosen->ms));
     if (const ParetoPoint* best = r.best)
-        fmt::print("recommended under {:g} ms{}: {} + {}: {:.3f} GPU ms predicted, relMSE {:.4g} at {} ({} seeds){}\n", a.budgetMs,
+        fmt::print("recommended under {:g} ms{}: {} + {}: {:.3f} GPU ms predicted, relMSE {:.4g} at {} ({} seeds), {}\n", a.budgetMs,
                    a.maxError ? fmt::format(" and relMSE {:g}", *a.maxError) : "", chosen.label(), best->lighting.label(), best->ms,
-                   best->error.relMse, a.errorSize, a.seeds, best->error.biased ? " BIASED" : "");
+                   best->error.relMse, a.errorSize, best->error.seeds,
+                   best->error.label().empty() ? fmt::format("unbiased to {:.2g}%", best->error.detectablePct) : best->error.label());
     else
         fmt::print("no {}configuration is under {:g} ms{}\n", a.allowBiased ? "" : "unbiased ", a.budgetMs,
                    a.maxError ? fmt::format(" with relMSE <= {:g}", *a.maxError) : "");
@@ -446,11 +492,13 @@ void writeTuneJson(const std::string& prefix, const TuneArgs& a, const Settings&
         const std::vector<std::string> own = best->lighting.defines();
         defines.insert(defines.end(), own.begin(), own.end());
         recommended = {{"geometry", chosen.label()}, {"lighting", best->lighting.label()}, {"defines", defines}, {"gpu_ms", best->ms},
-                       {"rel_mse", best->error.relMse}, {"biased", best->error.biased}};
+                       {"rel_mse", best->error.relMse}, {"biased", best->error.biased()},
+                       {"bias_verdict", verdictName(best->error.verdict)}, {"detectable_bias_pct", best->error.detectablePct},
+                       {"seeds", best->error.seeds}};
     }
     writeJson(prefix + ".json", {{"version", std::string(version())}, {"command", "tune"}, {"scene", scene.scenePath},
                                  {"defines", a.defines}, {"settings", settingsToToml(scene)}, {"seed", scene.render.seed},
-                                 {"budget_ms", a.budgetMs}, {"max_error", a.maxError ? nlohmann::json(*a.maxError) : nlohmann::json()},
+                                 {"budget_ms", a.budgetMs}, {"bias_bound_pct", a.biasBoundPct}, {"max_seeds", a.maxSeeds}, {"max_error", a.maxError ? nlohmann::json(*a.maxError) : nlohmann::json()},
                                  {"seeds", a.seeds}, {"frame", a.frame}, {"error_size", a.errorSize}, {"reference", t.reference},
                                  {"space", a.space}, {"coefficients", t.coefficients.source}, {"geometry", gt.json()},
                                  {"fastest_triangle_geometry", r.triangles->choice.label()}, {"chosen_geometry", chosen.label()},
@@ -532,6 +580,12 @@ void addTuneCommand(CLI::App& app) {
         ->check(CLI::Range(1u, 1u << 20));
     cmd->add_option("--cache", args->cache, "Folder of cached measurements (default out/tune_cache/<scene>)");
     cmd->add_flag("--allow-biased", args->allowBiased, "Biased configurations may be recommended");
+    cmd->add_option("--bias-bound", args->biasBoundPct,
+                    "Energy bias (%) a configuration's seeds must be able to see for it to count as unbiased: tune adds "
+                    "seeds where such a bias could hide, up to --max-seeds, else labels it \"bias unknown (bound X%)\"")
+        ->check(finiteIn(1e-6, 100.0));
+    cmd->add_option("--max-seeds", args->maxSeeds, "The most seeds tune spends on one configuration's bias verdict")
+        ->check(CLI::Range(2u, 100000u));
     cmd->add_option("-o,--output", args->out, "Output prefix (default out/<scene>.tune): .csv, .json, .png");
     cmd->callback([args] { runTune(*args); });
 }
