@@ -1,6 +1,8 @@
 #include "accretion/analysis/experiment.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include <fmt/format.h>
 
@@ -55,6 +57,39 @@ Settings specSettings(const std::filesystem::path& scene, const std::vector<std:
     std::vector<FlagSetting> flags = base;
     flags.insert(flags.end(), spec.settings.begin(), spec.settings.end());
     return loadScene(scene, overrides, flags);
+}
+
+std::uint32_t steadyStateHistory(const Settings& settings) {
+    if (!estimatorInfo(settings.render.estimator).reuse || !settings.restir.temporal) return 0;
+    constexpr std::uint32_t kAtLeast = 8;
+    return std::max(kAtLeast, static_cast<std::uint32_t>(std::ceil(settings.restir.m_cap)));
+}
+
+HistoryChoice HistoryChoice::parse(const std::string& text) {
+    if (text == "steady") return {};
+    const auto n = parseUnsigned(text);
+    if (!n || *n > 0xfffffffeu)
+        throw InputError(fmt::format("command line --history {}: expected \"steady\" or a number of frames", text));
+    return {static_cast<std::uint32_t>(*n)};
+}
+
+std::uint32_t HistoryChoice::of(const Settings& settings) const {
+    if (!estimatorInfo(settings.render.estimator).reuse) return 0;
+    return frames ? *frames : steadyStateHistory(settings);
+}
+
+std::string HistoryChoice::label() const { return frames ? std::to_string(*frames) : std::string("steady"); }
+
+std::uint32_t historyBefore(const HistoryChoice& history, const Settings& settings, std::uint32_t frame, std::string_view what) {
+    const std::uint32_t h = history.of(settings);
+    if (h > frame)
+        throw InputError(fmt::format(
+            "command line --history {}: {} needs {} history frames before frame {} ({}), and frames start at 0: measure frame "
+            "{} or later (--frame, with a reference of that frame) or give --history {}",
+            history.label(), what, h, frame,
+            history.frames ? "as asked" : fmt::format("temporal reuse to its M cap of {:g}, at least 8", settings.restir.m_cap), h,
+            frame));
+    return h;
 }
 
 ExperimentRender renderForExperiment(const Settings& settings, const ParticleSource& source, std::uint32_t frame,

@@ -44,6 +44,7 @@ struct BiasArgs : ExperimentArgs {
 struct BiasRow {
     std::string label;
     std::uint32_t seeds = 0;
+    std::uint32_t history = 0;  ///< frames rendered before the measured one
     double meanError = 0.0;    ///< mean over seeds of the image-mean signed error (x - ref)
     double stderr = 0.0;       ///< its standard error (seeds and reference noise)
     double z = 0.0;
@@ -163,6 +164,7 @@ double detectableBiasPct(double stderr, double refMean, double zCritical) {
 BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vector<FlagSetting>& base,
                     const ParticleSource& source, std::uint32_t frame, const BiasReference& ref, const std::string& prefix) {
     const Settings specBase = specSettings(a.scene, a.defines, base, spec);
+    const std::uint32_t history = historyBefore(HistoryChoice::parse(a.history), specBase, frame, spec.label);
     const std::size_t pixels = ref.image.rgb.size();
     const double n = 3.0 * double(pixels);
     std::vector<DVec3> s1(pixels, DVec3(0.0)), s2(pixels, DVec3(0.0));
@@ -172,7 +174,7 @@ BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vec
         Settings s = specBase;
         s.render.seed = specBase.render.seed + k;
         const ExperimentRender r = a.gpuFrames.empty()
-                                       ? renderForExperiment(s, source, frame, a.history)
+                                       ? renderForExperiment(s, source, frame, history)
                                        : readGpuRender(gpuFramePath(a.gpuFrames, biasMapName(spec), s.render.seed), s, frame,
                                                        ref, a.strict);
         seconds += r.totalSeconds;
@@ -196,6 +198,7 @@ BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vec
     BiasRow row;
     row.label = spec.label;
     row.seeds = a.seeds;
+    row.history = history;
     row.meanError = e1 / S;
     const double seedVar = std::max(0.0, (e2 / S - row.meanError * row.meanError) * S / (S - 1.0));
     row.stderr = std::sqrt(seedVar / S + ref.meanStderr * ref.meanStderr);
@@ -219,7 +222,7 @@ BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vec
 /// The rows as the console, CSV and JSON give them.
 Table biasTable(const std::vector<BiasRow>& rows, double refMean, double zCritical) {
     auto hidden = [](const char* key, const char* csv) { return Column{key, "", 0, "{}", csv, false}; };
-    Table t({{"estimator", "estimator", -28}, {"seeds", "seeds", 6}, {"mean_signed_error", "mean error", 13, "{:.5g}", "{:.8g}"},
+    Table t({{"estimator", "estimator", -28}, {"seeds", "seeds", 6}, {"history_frames", "hist", 5}, {"mean_signed_error", "mean error", 13, "{:.5g}", "{:.8g}"},
              {"stderr", "stderr", 11, "{:.3g}", "{:.8g}"}, {"z", "z", 8, "{:.2f}", "{:.5g}"},
              hidden("energy_loss_pct", "{:.6g}"), hidden("energy_loss_stderr_pct", "{:.6g}"), {"", "energy loss %", 15},
              hidden("biased", "{}"), hidden("detectable_bias_pct", "{:.4g}"), {"seconds_per_render", "s/render", 9, "{:.3f}", "{:.6g}"},
@@ -227,7 +230,7 @@ Table biasTable(const std::vector<BiasRow>& rows, double refMean, double zCritic
              {"", fmt::format("verdict (|z| > {:.2f}: 99.9%)", zCritical), 0, "{}", "{}", true, "  "}});
     for (const BiasRow& r : rows) {
         const double lossSe = refMean > 0.0 ? 100.0 * r.stderr / refMean : 0.0;
-        t.add({r.label, std::uint64_t(r.seeds), r.meanError, r.stderr, r.z, r.energyLossPct, lossSe,
+        t.add({r.label, std::uint64_t(r.seeds), std::uint64_t(r.history), r.meanError, r.stderr, r.z, r.energyLossPct, lossSe,
                fmt::format("{:>8.3f} +- {:<5.3f}", r.energyLossPct, lossSe), r.biased, r.detectablePct, r.secondsPerRender,
                r.secondsPerFrame, r.relMse,
                r.biased ? "BIASED"
@@ -243,6 +246,7 @@ void runBias(const BiasArgs& a) {
     const auto specs = parseEstimatorSpecs(a.estimators, "--estimators");
     if (a.seeds < 2) throw InputError("command line --seeds: at least 2 seeds are needed for a standard error");
     const std::uint32_t frame = a.frame.value_or(scene.render.frame_start);
+    requireHistories(a, base, specs, frame);
     const auto threads = limitThreads(a.threads);
     const std::string prefix = a.out.empty() ? "out/" + scene.sceneName + ".bias" : a.out;
     OutputGuard guard = sceneInputs(scene);
@@ -279,16 +283,16 @@ void runBias(const BiasArgs& a) {
     writeFileAtomic(prefix + ".csv", table.csv());
     writeJson(prefix + ".json", {{"version", std::string(version())}, {"command", "bias"},
                                  {"scene", scene.scenePath}, {"reference", a.reference},
-                                 {"frame", frame}, {"history_frames", a.history}, {"z_critical", a.zCritical},
+                                 {"frame", frame}, {"history", a.history}, {"z_critical", a.zCritical},
                                  {"reference_mean", ref.mean}, {"reference_mean_stderr", ref.meanStderr},
                                  {"settings", settingsToToml(scene)}, {"rows", table.json()}});
     // Red bars: BIASED (|z| above the critical value); the title says what was measured.
     const std::string script = fmt::format(
         "set datafile separator ','\nset style fill solid 0.5\nset boxwidth 0.6\nset grid ytics\n"
         "set title {2}\nset ylabel 'energy loss % (bars: {0:.2f} standard errors)'\nset xtics rotate by -30\nset key off\n"
-        "plot {1} skip 1 using 0:(strcol(8) eq 'true' ? NaN : $6):xtic(1) with boxes lc rgb '#4682b4', "
-        "{1} skip 1 using 0:(strcol(8) eq 'true' ? $6 : NaN) with boxes lc rgb '#d62728', "
-        "{1} skip 1 using 0:6:($7*{0}) with yerrorbars lc rgb 'black' pt 0\n",
+        "plot {1} skip 1 using 0:($9 == 1 ? NaN : $7):xtic(1) with boxes lc rgb '#4682b4', "
+        "{1} skip 1 using 0:($9 == 1 ? $7 : NaN) with boxes lc rgb '#d62728', "
+        "{1} skip 1 using 0:7:($8*{0}) with yerrorbars lc rgb 'black' pt 0\n",
         a.zCritical, gnuplotQuote(prefix + ".csv"),
         gnuplotQuote(fmt::format("bias of {} frame {}, {} seeds (red: BIASED, |z| > {:.2f})",
                                  std::filesystem::path(scene.scenePath).filename().string(), frame, a.seeds, a.zCritical)));

@@ -159,14 +159,20 @@ std::vector<Point> measureSequence(const ConvergeRun& run, const std::vector<Est
     std::vector<Point> points;
     for (const EstimatorSpec& spec : specs) {
         Settings s = specSettings(a.scene, a.defines, run.base, spec);
-        s.render.frame_start = run.frame;
-        s.render.frames = a.sequence;
+        // The history before the first measured frame, rendered and not measured.
+        const std::uint32_t history = historyBefore(HistoryChoice::parse(a.history), s, run.frame, spec.label);
+        s.render.frame_start = run.frame - history;
+        s.render.frames = history + a.sequence;
         const std::uint64_t seed0 = s.render.seed;
         std::vector<SeedAverage> perFrame;
         for (std::uint32_t k = 0; k < a.sequence; ++k) perFrame.emplace_back(spec.label, run.frame + k, 0, a.seeds);
         for (std::uint32_t seed = 0; seed < a.seeds; ++seed) {
             s.render.seed = seed0 + seed;
             FrameRenderer renderer(s, run.source, RenderOptions{true});
+            for (std::uint32_t k = 0; k < history; ++k) {
+                FrameStats stats;
+                renderer.render(run.frame - history + k, stats);
+            }
             for (std::uint32_t k = 0; k < a.sequence; ++k) {
                 FrameStats stats;
                 const FrameImage img = renderer.render(run.frame + k, stats);
@@ -200,11 +206,12 @@ std::vector<Point> measureLevels(const ConvergeRun& run, const std::vector<Estim
             else
                 level.settings.push_back({"render.samples", flag, [effort](Settings& st) { st.render.samples = effort; }});
             Settings s = specSettings(a.scene, a.defines, run.base, level);
+            const std::uint32_t history = historyBefore(HistoryChoice::parse(a.history), s, run.frame, spec.label);
             SeedAverage avg(spec.label, run.frame, effort, a.seeds);
             const std::uint64_t seed0 = s.render.seed;
             for (std::uint32_t k = 0; k < a.seeds; ++k) {
                 s.render.seed = seed0 + k;
-                const ExperimentRender r = renderForExperiment(s, run.source, run.frame, a.history);
+                const ExperimentRender r = renderForExperiment(s, run.source, run.frame, history);
                 avg.add(r.image.lighting.Lr, ref, r.stats, r.frameSeconds, r.totalSeconds);
             }
             const Point p = avg.finish();
@@ -320,6 +327,7 @@ void runConverge(const ConvergeArgs& a) {
     if (std::uint64_t(frame) + a.sequence > 0xffffffffull)
         throw InputError(fmt::format("command line --frame {} --sequence {}: frames are 32-bit numbers (the last is "
                                      "4294967294)", frame, a.sequence));
+    requireHistories(a, base, specs, frame);
     const auto threads = limitThreads(a.threads);
     const std::string prefix = a.out.empty() ? "out/" + scene.sceneName + ".converge" : a.out;
     OutputGuard guard = sceneInputs(scene);
@@ -344,7 +352,7 @@ void runConverge(const ConvergeArgs& a) {
                                  {"reference", a.reference},
                                  {"frame", frame},
                                  {"budget_seconds", budget},
-                                 {"history_frames", a.history},
+                                 {"history", a.history},
                                  {"seeds_per_point", a.seeds},
                                  {"speedup_model", "baseline relMSE = c / seconds, c fitted over its curve"},
                                  {"estimators", a.estimators},

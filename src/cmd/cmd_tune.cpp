@@ -28,6 +28,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "accretion/analysis/experiment.h"
 #include "accretion/core/atomic_file.h"
 #include "accretion/core/error.h"
 #include "accretion/core/read_file.h"
@@ -47,7 +48,7 @@ struct TuneArgs : SceneArgs {
     double budgetMs = 0.0;
     std::optional<double> maxError;
     std::uint32_t seeds = 16;
-    std::uint32_t frame = 1;
+    std::optional<std::uint32_t> frame;  ///< default: render.frame_start + the steady state's history
     std::string errorSize = "320x180";
     std::string space = "quick";
     std::string reference;
@@ -184,6 +185,8 @@ struct TuneContext {
     std::string sceneText;  ///< version + scene file + overrides: every cache key starts with it
     std::uint32_t errorWidth = 0, errorHeight = 0;
     std::string reference;
+    std::uint32_t frame = 0;    ///< the measured frame
+    std::uint32_t history = 0;  ///< frames before it: restir's steady state (steadyStateHistory)
     CostCoefficients coefficients;  ///< what prices the counters
     std::size_t step = 0, steps = 0;
 };
@@ -214,11 +217,11 @@ std::vector<std::string> sceneArgv(const TuneContext& t, const std::string& comm
 /// Predicted GPU ms per pass of one configuration at the scene's
 /// resolution: its counters (`accretion cost`, cached) priced with the calibration.
 std::map<Pass, double> predictMs(TuneContext& t, const std::vector<std::string>& defines, const std::string& what) {
-    std::string key = t.sceneText + "\ncost frame " + std::to_string(t.args.frame);
+    std::string key = t.sceneText + fmt::format("\ncost frame {} history {}", t.frame, t.history);
     for (const std::string& d : defines) key += "\n" + d;
     const std::filesystem::path prefix = t.cache / (cacheKey(key) + ".cost");
     std::vector<std::string> argv = sceneArgv(t, "cost", defines);
-    argv.insert(argv.end(), {"--frames", fmt::format("{}:{}", t.args.frame, t.args.frame + 1), "--history", "1", "--overhead", "0",
+    argv.insert(argv.end(), {"--frames", fmt::format("{}:{}", t.frame, t.frame + 1), "--history", std::to_string(t.history), "--overhead", "0",
                              "--cluster-sizes", "", "--omm-levels", "", "--ser-keys", "hit", "-q", "-o", prefix.string() + ".json"});
     measure(t, argv, prefix.string() + ".csv", "GPU time of " + what);
     std::map<Pass, double> ms;  // a pass's runs summed
@@ -262,13 +265,13 @@ ErrorRow measureErrorSeeds(TuneContext& t, const LightingChoice& o, std::uint32_
     std::string spec = "restir";
     for (const std::string& d : o.defines())
         if (d != "render.estimator=restir") spec += ":" + d;
-    std::string key = t.sceneText + fmt::format("\nbias {} seeds {} frame {} {}x{} reference {}", spec, seeds, t.args.frame,
-                                                t.errorWidth, t.errorHeight, cacheKey(readWholeFile(t.reference, "tune")));
+    std::string key = t.sceneText + fmt::format("\nbias {} seeds {} frame {} history {} {}x{} reference {}", spec, seeds, t.frame,
+                                                t.history, t.errorWidth, t.errorHeight, cacheKey(readWholeFile(t.reference, "tune")));
     const std::filesystem::path prefix = t.cache / (cacheKey(key) + ".bias");
     std::vector<std::string> argv = sceneArgv(t, "bias", {fmt::format("camera.width={}", t.errorWidth),
                                                           fmt::format("camera.height={}", t.errorHeight)});
     argv.insert(argv.end(), {"--reference", t.reference, "--estimators", spec, "--seeds", std::to_string(seeds), "--frame",
-                             std::to_string(t.args.frame), "--history", "1", "-q", "-o", prefix.string()});
+                             std::to_string(t.frame), "--history", std::to_string(t.history), "-q", "-o", prefix.string()});
     measure(t, argv, prefix.string() + ".json", fmt::format("error of {} ({} seeds)", o.label(), seeds));
     const nlohmann::json j = nlohmann::json::parse(readWholeFile(prefix.string() + ".json", "tune"));
     const nlohmann::json& r = j.at("rows").at(0);
@@ -298,11 +301,11 @@ std::string ensureReference(TuneContext& t, std::size_t particles) {
     if (!t.args.reference.empty()) return t.args.reference;
     const bool exact = particles <= 20000;
     const std::string how = exact ? "exact" : fmt::format("split {} spp", t.args.referenceSpp);
-    const std::filesystem::path file = t.cache / (cacheKey(t.sceneText + fmt::format("\nreference {} frame {} {}x{}", how, t.args.frame,
+    const std::filesystem::path file = t.cache / (cacheKey(t.sceneText + fmt::format("\nreference {} frame {} {}x{}", how, t.frame,
                                                                                       t.errorWidth, t.errorHeight)) + ".ref.exr");
     std::vector<std::string> argv = sceneArgv(t, "render", {fmt::format("camera.width={}", t.errorWidth),
                                                             fmt::format("camera.height={}", t.errorHeight)});
-    argv.insert(argv.end(), {"--estimator", exact ? "exact" : "split", "--frames", fmt::format("{}:{}", t.args.frame, t.args.frame + 1),
+    argv.insert(argv.end(), {"--estimator", exact ? "exact" : "split", "--frames", fmt::format("{}:{}", t.frame, t.frame + 1),
                              "-o", file.string(), "--quiet"});
     if (!exact) argv.insert(argv.end(), {"--spp", std::to_string(t.args.referenceSpp)});
     ++t.steps;
@@ -462,6 +465,8 @@ Table lightingTable(const TuneArgs& a, const TuneResult& r) {
 /// The tables and the verdict on stdout.
 void printTune(const TuneArgs& a, const Settings& scene, const TuneContext& t, const TuneResult& r, const Table& gt, const Table& lt) {
     fmt::print("{}\n{}", gt.console(), lt.console());
+    fmt::print("measured at frame {} after {} history frames (restir's steady state: temporal reuse to its M cap of {:g})\n",
+               t.frame, t.history, scene.restir.m_cap);
     const GeometryChoice& chosen = r.chosen->choice;
     fmt::print("geometry: {} ({:.3f} ms predicted at {}x{}, the scene's lighting)\nGPU time: {}\n", chosen.label(),
                total(r.chosen->ms), scene.camera.width, scene.camera.height, t.coefficients.source);
@@ -499,7 +504,7 @@ void writeTuneJson(const std::string& prefix, const TuneArgs& a, const Settings&
     writeJson(prefix + ".json", {{"version", std::string(version())}, {"command", "tune"}, {"scene", scene.scenePath},
                                  {"defines", a.defines}, {"settings", settingsToToml(scene)}, {"seed", scene.render.seed},
                                  {"budget_ms", a.budgetMs}, {"bias_bound_pct", a.biasBoundPct}, {"max_seeds", a.maxSeeds}, {"max_error", a.maxError ? nlohmann::json(*a.maxError) : nlohmann::json()},
-                                 {"seeds", a.seeds}, {"frame", a.frame}, {"error_size", a.errorSize}, {"reference", t.reference},
+                                 {"seeds", a.seeds}, {"frame", t.frame}, {"history_frames", t.history}, {"error_size", a.errorSize}, {"reference", t.reference},
                                  {"space", a.space}, {"coefficients", t.coefficients.source}, {"geometry", gt.json()},
                                  {"fastest_triangle_geometry", r.triangles->choice.label()}, {"chosen_geometry", chosen.label()},
                                  {"lighting", lt.json()}, {"recommended", recommended}});
@@ -530,12 +535,16 @@ void runTune(const TuneArgs& a) {
     const Settings scene = loadSceneArgs(a, {{"render.estimator", "tune (restir)", [](Settings& s) { s.render.estimator = EstimatorKind::restir; }}});
     requireWholeImage(scene, "tune");
     TuneContext t = checkTuneArgs(a);
+    // The engine's operating point: the frame after the history that brings
+    // temporal reuse to its M cap (every lighting choice shares it).
+    t.frame = a.frame.value_or(scene.render.frame_start + steadyStateHistory(scene));
+    t.history = historyBefore(HistoryChoice{}, scene, t.frame, "tune");
     const std::vector<GeometryChoice> geometry = geometryChoices(scene);
     const std::vector<LightingChoice> lighting = lightingChoices(a.space);
     const std::string prefix = a.out.empty() ? "out/" + scene.sceneName + ".tune" : a.out;
     prepareTune(t, scene, prefix);
     t.steps = geometry.size() + 2 * lighting.size();
-    const std::size_t particles = ParticleSource(scene).frame(a.frame).size();
+    const std::size_t particles = ParticleSource(scene).frame(t.frame).size();
     t.reference = ensureReference(t, particles);
 
     // Geometry: the same image whatever it is; the fastest predicted frame.
@@ -571,7 +580,9 @@ void addTuneCommand(CLI::App& app) {
     cmd->add_option("--budget-ms", args->budgetMs, "GPU time budget of a frame, ms (the cost model's prediction)")->required();
     cmd->add_option("--max-error", args->maxError, "Recommend the fastest configuration with relMSE at most this (at --error-size)");
     cmd->add_option("--seeds", args->seeds, "Seeds per lighting configuration for its error and bias")->check(CLI::Range(2u, 100000u));
-    cmd->add_option("--frame", args->frame, "The measured frame (restir: after one history frame)");
+    cmd->add_option("--frame", args->frame,
+                    "The measured frame, after the history that brings temporal reuse to steady state (ceil(restir.m_cap) "
+                    "frames, at least 8; default: render.frame_start + that history)");
     cmd->add_option("--error-size", args->errorSize, "Resolution of the error measurements, WIDTHxHEIGHT");
     cmd->add_option("--space", args->space, "quick (34 lighting configurations) or full (1080: hours)");
     cmd->add_option("--reference", args->reference,

@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 #include <tbb/global_control.h>
 
+#include "accretion/analysis/experiment.h"
 #include "accretion/core/output_guard.h"
 #include "accretion/scene/scene_parser.h"
 
@@ -27,13 +28,18 @@ struct SceneArgs {
 /// against a reference, per estimator spec, over seeds.
 struct ExperimentArgs : SceneArgs {
     std::string reference, estimators, out;
-    std::uint32_t history = 8, seeds = 1;
+    std::string history = "steady";  ///< --history: "steady" or frames (HistoryChoice)
+    std::uint32_t seeds = 1;
     std::optional<std::uint32_t> frame;
 };
 
 /// Adds the scene options and --reference, --estimators, --frame, --history, -o,--out.
 void addExperimentOptions(CLI::App* cmd, ExperimentArgs& args, const std::string& referenceHelp,
                           const std::string& estimatorsHelp, const std::string& outHelp);
+
+/// Before any work: every spec's --history fits before `frame` (historyBefore).
+void requireHistories(const ExperimentArgs& args, const std::vector<FlagSetting>& base, const std::vector<EstimatorSpec>& specs,
+                      std::uint32_t frame);
 
 /// Thrown by batch when some job did not succeed (exit code 4).
 struct BatchFailed {};

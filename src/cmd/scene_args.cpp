@@ -86,8 +86,16 @@ void addExperimentOptions(CLI::App* cmd, ExperimentArgs& args, const std::string
     cmd->add_option("--frame", args.frame, "Frame measured (default render.frame_start)")
         ->check(unsignedNumber())
         ->check(CLI::Range(0u, 0xfffffffeu));
-    cmd->add_option("--history", args.history, "restir: frames rendered before the measured one");
+    cmd->add_option("--history", args.history,
+                    "restir: frames rendered before the measured one: steady (default: with temporal reuse until its M cap "
+                    "saturates, ceil(restir.m_cap) frames and at least 8; none without) or a number");
     cmd->add_option("-o,--out", args.out, outHelp);
+}
+
+void requireHistories(const ExperimentArgs& args, const std::vector<FlagSetting>& base, const std::vector<EstimatorSpec>& specs,
+                      std::uint32_t frame) {
+    const HistoryChoice history = HistoryChoice::parse(args.history);
+    for (const EstimatorSpec& spec : specs) historyBefore(history, specSettings(args.scene, args.defines, base, spec), frame, spec.label);
 }
 
 void requireWholeImage(const Settings& settings, std::string_view command) {

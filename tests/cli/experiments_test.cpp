@@ -71,9 +71,10 @@ TEST_CASE("compare prints relMSE, MSE and MAPE against the second image", "[cli]
 TEST_CASE("converge: error falls with effort, CSV and plot written", "[cli][experiments]") {
     const auto dir = accretion::test::scratchDir("converge");
     std::string out;
-    REQUIRE(runCommand(kBin + " render " + tinyScene() + " --quiet --estimator exact -o " + (dir / "exact.exr").string(), out) == 0);
+    REQUIRE(runCommand(kBin + " render " + tinyScene() + " --frames 20:21 --quiet --estimator exact -o " + (dir / "exact.exr").string(),
+                       out) == 0);
     const std::string cmd = kBin + " converge " + tinyScene() + " --quiet --reference " + (dir / "exact.exr").string() +
-                            " --estimators uniform,tree,restir:pairwise --budget 3s --max-effort 64 -o " + (dir / "c").string();
+                            " --frame 20 --estimators uniform,tree,restir:pairwise --budget 3s --max-effort 64 -o " + (dir / "c").string();
     INFO(cmd << "\n" << out);
     REQUIRE(runCommand(cmd, out) == 0);
     const auto rows = readCsv(dir / "c.csv");
@@ -94,10 +95,12 @@ TEST_CASE("converge: error falls with effort, CSV and plot written", "[cli][expe
 TEST_CASE("bias: 1/M restir is flagged, uniform Monte Carlo is not", "[cli][experiments][statistical]") {
     const auto dir = accretion::test::scratchDir("bias");
     std::string out;
-    REQUIRE(runCommand(kBin + " render " + tinyScene() + " --quiet --estimator exact -o " + (dir / "exact.exr").string(), out) == 0);
+    // restir measured at steady state (the default history: ceil(m_cap) = 20 frames before the measured one).
+    REQUIRE(runCommand(kBin + " render " + tinyScene() + " --frames 20:21 --quiet --estimator exact -o " + (dir / "exact.exr").string(),
+                       out) == 0);
     const std::string run = kBin + " bias " + tinyScene() + " -D render.samples=16 --quiet --reference " +
-                            (dir / "exact.exr").string() + " --estimators uniform,restir:none,uniform:render.samples=64 --seeds 24 --history 2 -o " +
-                            (dir / "b").string();
+                            (dir / "exact.exr").string() +
+                            " --frame 20 --estimators uniform,restir:none,uniform:render.samples=64 --seeds 24 -o " + (dir / "b").string();
     INFO(run << "\n" << out);
     REQUIRE(runCommand(run, out) == 0);
     const auto rows = readCsv(dir / "b.csv");
@@ -124,6 +127,13 @@ TEST_CASE("bias: 1/M restir is flagged, uniform Monte Carlo is not", "[cli][expe
     CHECK(r16 > 0.0);
     CHECK((r64 / r16 > 0.15 && r64 / r16 < 0.4));
     CHECK(std::stod(rows[2][perFrame]) < std::stod(rows[2][perRender]));
+    // The history each row rendered: restir's steady state, none for Monte Carlo.
+    CHECK(rows[1][col("history_frames")] == "0");
+    CHECK(rows[2][col("history_frames")] == "20");
+    // Short of it, a measurement is refused rather than made at another operating point.
+    CHECK(runCommand(kBin + " bias " + tinyScene() + " --quiet --reference " + (dir / "exact.exr").string() +
+                         " --frame 19 --estimators restir --seeds 2 -o " + (dir / "short").string(), out) == 1);
+    CHECK_THAT(out, Contains("--history steady: restir needs 20 history frames before frame 19"));
     // The bias a run can see falls with its noise: 4x the samples, half the
     // standard error of the image's mean (0.5; below 0.8 with 24 seeds' spread).
     const double b16 = std::stod(rows[1][bound]), b64 = std::stod(rows[3][bound]);

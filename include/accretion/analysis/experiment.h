@@ -1,4 +1,6 @@
 #pragma once
+#include <optional>
+#include <string_view>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -37,6 +39,31 @@ struct ExperimentRender {
     double frameSeconds = 0.0;  ///< wall time of the measured frame
     double totalSeconds = 0.0;  ///< including restir's history frames
 };
+
+/// The history frames that bring an estimator's reuse to steady state, as
+/// the engine runs it: for temporal reuse until the history's M cap
+/// saturates (a reservoir gains the current M a frame, up to m_cap times
+/// it: ceil(m_cap) frames) and at least 8; none without temporal reuse
+/// (nothing of a frame carries over to the next).
+std::uint32_t steadyStateHistory(const Settings& settings);
+
+/// --history: "steady" (steadyStateHistory of each configuration) or a
+/// number of frames; throws InputError naming the flag otherwise.
+struct HistoryChoice {
+    std::optional<std::uint32_t> frames;  ///< none: steady state
+    static HistoryChoice parse(const std::string& text);
+    /// The frames rendered before the measured one: none for an estimator
+    /// without reuse (nothing carries over), else the number asked or the
+    /// steady state's.
+    std::uint32_t of(const Settings& settings) const;
+    std::string label() const;  ///< "steady" or the number
+};
+
+/// The history frames of `settings` measured at `frame`: history.of(settings),
+/// refused (InputError naming --history and --frame) where fewer frames
+/// than that come before `frame`: a measurement short of its history is
+/// not the one asked for.
+std::uint32_t historyBefore(const HistoryChoice& history, const Settings& settings, std::uint32_t frame, std::string_view what);
 
 /// Render `frame` with the settings; restir first renders the `history`
 /// frames before it (frame - history .. frame - 1, clamped at 0), so its
