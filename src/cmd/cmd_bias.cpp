@@ -54,6 +54,7 @@ struct BiasRow {
     double relMse = 0.0;       ///< mean over seeds of one render's relMSE, less the reference's own noise
     bool biased = false;
     double detectablePct = 0.0;  ///< the smallest |energy bias| (%) this run detects with 80% probability
+    PassReuse reuse;             ///< restir: the measured frames' reuse offers by outcome, summed over the seeds
     std::vector<FloatChannel> map;  ///< the bias map, written once every estimator has been measured
     std::string settingsToml;       ///< the estimator's settings, recorded in its map
 };
@@ -169,6 +170,7 @@ BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vec
     const double n = 3.0 * double(pixels);
     std::vector<DVec3> s1(pixels, DVec3(0.0)), s2(pixels, DVec3(0.0));
     double e1 = 0.0, e2 = 0.0, seconds = 0.0, frameSeconds = 0.0, relMse = 0.0;
+    PassReuse reuse;
     Progress progress("bias " + spec.label + " (seeds)", a.seeds, a.quiet);
     for (std::uint32_t k = 0; k < a.seeds; ++k) {
         Settings s = specBase;
@@ -178,6 +180,7 @@ BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vec
                                        : readGpuRender(gpuFramePath(a.gpuFrames, biasMapName(spec), s.render.seed), s, frame,
                                                        ref, a.strict);
         seconds += r.totalSeconds;
+        for (const auto& [pass, counts] : r.stats.reuse) reuse[pass] += counts;
         frameSeconds += a.gpuFrames.empty() ? r.frameSeconds : r.totalSeconds;
         double e = 0.0;
         for (std::size_t p = 0; p < pixels; ++p) {
@@ -215,8 +218,26 @@ BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vec
     row.biased = std::fabs(row.z) > a.zCritical;
     row.detectablePct = detectableBiasPct(row.stderr, ref.mean, a.zCritical);
     row.map = biasMap(s1, s2, S, ref);
+    row.reuse = std::move(reuse);
     row.settingsToml = settingsToToml(specBase);
     return row;
+}
+
+/// One pass's reuse in words: "temporalResampling: 70% of 13144 kept (100%
+/// on the same particle); refused: 30% another particle".
+std::string reuseLine(Pass pass, const ReuseCounts& c) {
+    const double offered = double(c.offered());
+    auto pct = [&](std::uint64_t n, double of) { return of > 0.0 ? 100.0 * double(n) / of : 0.0; };
+    std::string line = fmt::format("{}: {:.0f}% of {} kept", passName(pass), pct(c.accepted(), offered), c.offered());
+    if (const std::uint64_t other = c.n[std::size_t(ReuseOutcome::otherParticle)])
+        line += fmt::format(" ({:.0f}% on another particle)", pct(other, double(c.accepted())));
+    std::string refused;
+    for (std::size_t k = 0; k < kReuseOutcomes; ++k)
+        if (!kept(ReuseOutcome(k)) && c.n[k])
+            refused += fmt::format("{}{:.0f}% {}", refused.empty() ? "" : ", ", pct(c.n[k], offered), kReuseOutcomeNames[k]);
+    if (!refused.empty()) line += "; refused: " + refused;
+    if (c.mCapped) line += fmt::format("; M cap bound {:.0f}% of kept", pct(c.mCapped, double(c.accepted())));
+    return line;
 }
 
 /// The rows as the console, CSV and JSON give them.
@@ -280,12 +301,21 @@ void runBias(const BiasArgs& a) {
 
     const Table table = biasTable(rows, ref.mean, a.zCritical);
     fmt::print("{}", table.console());
+    nlohmann::json reuse = nlohmann::json::object();
+    for (const BiasRow& r : rows) {
+        if (r.reuse.empty()) continue;
+        fmt::print("reuse of {} (the measured frames, {} seeds):\n", r.label, r.seeds);
+        for (const auto& [pass, counts] : r.reuse) {
+            fmt::print("  {}\n", reuseLine(pass, counts));
+            reuse[r.label][std::string(passName(pass))] = reuseCountsJson(counts);
+        }
+    }
     writeFileAtomic(prefix + ".csv", table.csv());
     writeJson(prefix + ".json", {{"version", std::string(version())}, {"command", "bias"},
                                  {"scene", scene.scenePath}, {"reference", a.reference},
                                  {"frame", frame}, {"history", a.history}, {"z_critical", a.zCritical},
                                  {"reference_mean", ref.mean}, {"reference_mean_stderr", ref.meanStderr},
-                                 {"settings", settingsToToml(scene)}, {"rows", table.json()}});
+                                 {"settings", settingsToToml(scene)}, {"rows", table.json()}, {"reuse", reuse}});
     // Red bars: BIASED (|z| above the critical value); the title says what was measured.
     const std::string script = fmt::format(
         "set datafile separator ','\nset style fill solid 0.5\nset boxwidth 0.6\nset grid ytics\n"

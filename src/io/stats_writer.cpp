@@ -2,12 +2,20 @@
 
 namespace accretion {
 
+nlohmann::json reuseCountsJson(const ReuseCounts& c) {
+    nlohmann::json outcomes = nlohmann::json::object();
+    for (std::size_t k = 0; k < kReuseOutcomes; ++k) outcomes[std::string(kReuseOutcomeNames[k])] = c.n[k];
+    return {{"offered", c.offered()}, {"accepted", c.accepted()}, {"m_capped", c.mCapped}, {"outcomes", outcomes}};
+}
+
 nlohmann::json frameStatsJson(const FrameStats& s) {
     nlohmann::json passes = nlohmann::json::object();
     for (const auto& [pass, seconds] : s.timer.all()) passes[std::string(passName(pass))] = seconds;
     nlohmann::json nonFinite = nlohmann::json::object();
     for (const auto& [pass, count] : s.nonFinite) nonFinite[std::string(passName(pass))] = count;
     const double lightingSeconds = s.timer.seconds(Pass::estimateLighting);
+    nlohmann::json reuse = nlohmann::json::object();
+    for (const auto& [pass, counts] : s.reuse) reuse[std::string(passName(pass))] = reuseCountsJson(counts);
 
     nlohmann::json j = {
         {"frame", s.frame},
@@ -21,9 +29,10 @@ nlohmann::json frameStatsJson(const FrameStats& s) {
           {"triangles", s.bvh.triangles},
           {"hit_pixels", s.hitPixels},
           {"light_terms", s.lighting.lightTerms},
-          {"reuse_accepted", s.lighting.reuseAccepted},
-          {"reuse_rejected", s.lighting.reuseRejected},
+          {"reuse_accepted", s.lighting.reuse.accepted()},
+          {"reuse_rejected", s.lighting.reuse.offered() - s.lighting.reuse.accepted()},
           {"nonfinite_rejected", nonFinite},
+          {"reuse", reuse},
           {"light_tree_nodes", s.lightTreeNodes},
           {"near_lights", s.nearLights.k},
           {"reservoir_bytes", s.reservoirBytes},

@@ -168,7 +168,7 @@ void FrameRenderer::lightFrame(std::uint32_t frame, const Camera& camera, const 
     if (plan.restir) {
         RestirInputs in{*bvh_, particles, gbuffer, camera, settings_, plan, frame, powerTable, lightTree,
                         plan.previousBvh ? previousBvh_.get() : nullptr, plan.counting ? &img.counters : nullptr, trace};
-        stats.lighting = restir_->render(in, img.lighting, img.reservoirs, stats.timer, stats.nonFinite);
+        stats.lighting = restir_->render(in, img.lighting, img.reservoirs, stats.timer, stats.nonFinite, stats.reuse);
         stats.reservoirBytes = restir_->reservoirBytes();
         if (img.lighting.rejected.empty()) img.lighting.rejected.assign(pixels, 0.0f);
         return;

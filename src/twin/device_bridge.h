@@ -77,7 +77,8 @@ public:
     __device__ bool reject(std::size_t px) const { return rejectAt(p_.restir, px); }
     __device__ restir::NoRecorder recorder(std::size_t, const GBufferTexel&) const { return {}; }
     __device__ std::uint32_t reservoirBytes() const { return sizeof(StoredReservoir); }
-    __device__ void reuse(bool) const {}
+    __device__ void reuse(ReuseOutcome) const {}
+    __device__ void historyCapped() const {}
     template <std::uint32_t N>
     __device__ Offers<N> offers() const { return Offers<N>(*this); }
 

@@ -124,10 +124,10 @@ TEST_CASE("restir: one frame or temporal off keeps no history, one neighbour-les
     CHECK_THAT(step(planPasses(s), Pass::temporalResampling).why, Catch::Contains("temporal off"));
     const auto none = render(s);
     CHECK_FALSE(none[2].timer.ran(Pass::temporalResampling));
-    CHECK(none[2].lighting.reuseAccepted + none[2].lighting.reuseRejected > 0);  // spatial still runs
+    CHECK(none[2].lighting.reuse.offered() > 0);  // spatial still runs
     s.restir.spatial_neighbours = 0;
     CHECK_FALSE(planPasses(s).runs(Pass::spatialResampling));
-    CHECK(render(s)[2].lighting.reuseAccepted + render(s)[2].lighting.reuseRejected == 0);
+    CHECK(render(s)[2].lighting.reuse.offered() == 0);
 }
 
 TEST_CASE("albedo 0: no lighting passes, exact: no reservoirs, counters off: no counting code", "[plan]") {

@@ -161,3 +161,63 @@ TEST_CASE("restir with candidates by power, from the light tree, light tiles or 
     CHECK(std::fabs(z) < 4.4);
     if (test::fullStatisticalPower()) CHECK(5.4 * r.stderr < 0.05 * oracle);  // a 5% bias is seen, as above
 }
+
+TEST_CASE("reuse outcomes: every offer counted once, a static view keeps all of its history, refusals say why", "[restir]") {
+    // Counted against the frame's own G-buffer, not the counters: each hit
+    // pixel offers one history (frame >= 1) and spatial_neighbours neighbours
+    // per iteration. With static particles and a static camera a pixel
+    // reprojects onto itself, so every history is kept; an orbiting camera
+    // moves pixels onto other particles and off the grid.
+    const bool animated = GENERATE(false, true);
+    Settings s = restirScene(animated);
+    s.render.estimator = EstimatorKind::restir;
+    s.render.frames = 3;
+    s.restir.spatial_iterations = 2;
+    FrameRenderer renderer(s, ParticleSource(s), RenderOptions{true});
+    for (std::uint32_t f = 0; f < 3; ++f) {
+        FrameStats stats;
+        const FrameImage img = renderer.render(f, stats);
+        std::uint64_t hits = 0;
+        for (const float spp : img.lighting.spp) hits += spp > 0.0f;  // restir: spp = 1 on a hit pixel
+        REQUIRE(hits > 100);
+        const ReuseCounts spatial = stats.reuse.at(Pass::spatialResampling);
+        CHECK(spatial.offered() == hits * s.restir.spatial_neighbours * s.restir.spatial_iterations);
+        CHECK(spatial.n[std::size_t(ReuseOutcome::particle)] == 0);  // spatial keeps neighbours on other particles
+        CHECK(spatial.n[std::size_t(ReuseOutcome::noHistory)] == 0);
+        CHECK(spatial.accepted() > 0);
+        if (f == 0) {
+            CHECK(stats.reuse.count(Pass::temporalResampling) == 0);  // no history yet
+            continue;
+        }
+        const ReuseCounts temporal = stats.reuse.at(Pass::temporalResampling);
+        CHECK(temporal.offered() == hits);
+        CHECK(temporal.n[std::size_t(ReuseOutcome::miss)] == 0);
+        CHECK(temporal.n[std::size_t(ReuseOutcome::otherParticle)] == 0);  // a kept history is this pixel's particle
+        if (!animated) CHECK(temporal.n[std::size_t(ReuseOutcome::sameParticle)] == hits);
+        else CHECK(temporal.accepted() < hits);
+        // Two spatial iterations of 5 neighbours multiply a reservoir's M by
+        // up to 36 a frame: past the cap (m_cap 20 x the current M) at once.
+        CHECK(temporal.mCapped > 0);
+        CHECK(temporal.mCapped <= temporal.accepted());
+    }
+}
+
+TEST_CASE("reuse outcomes: temporal reuse alone reaches its M cap after m_cap frames", "[restir]") {
+    // A static view, no spatial reuse: a kept history holds (k + 1) x M after
+    // k frames, cut to m_cap x M from frame m_cap + 1 on (history k M > m_cap M).
+    Settings s = restirScene(false);
+    s.render.estimator = EstimatorKind::restir;
+    s.restir.spatial_iterations = 0;
+    s.restir.m_cap = 3.0;
+    s.render.frames = 6;
+    FrameRenderer renderer(s, ParticleSource(s), RenderOptions{true});
+    for (std::uint32_t f = 0; f < 6; ++f) {
+        FrameStats stats;
+        renderer.render(f, stats);
+        if (f == 0) continue;
+        const ReuseCounts t = stats.reuse.at(Pass::temporalResampling);
+        INFO("frame " << f << ": " << t.mCapped << " of " << t.accepted() << " kept histories capped");
+        CHECK(t.accepted() == t.offered());
+        CHECK(t.mCapped == (f > 3 ? t.accepted() : 0));
+    }
+}

@@ -184,7 +184,9 @@ struct CheckBridge {
     ACC_HD void output(std::size_t, const StoredReservoir& r) const { out = r; }
     ACC_HD restir::NoRecorder recorder(std::size_t, const GBufferTexel&) const { return {}; }
     ACC_HD std::uint32_t reservoirBytes() const { return 16; }
-    ACC_HD void reuse(bool accepted) const { ++reuses[accepted ? 0 : 1]; }
+    // Each outcome, and each bound M cap, leaves its own trace in the counts compared.
+    ACC_HD void reuse(ReuseOutcome o) const { reuses[kept(o) ? 0 : 1] += 1u + (std::uint32_t(o) << 4); }
+    ACC_HD void historyCapped() const { reuses[0] += 1u << 20; }
     template <std::uint32_t N>
     ACC_HD Offers<N> offers() const { return Offers<N>{*this}; }
     ACC_HD bool historyHas(std::uint32_t j) const { return j < in.particles; }

@@ -9,4 +9,7 @@ namespace accretion {
 /// JSON of one frame's counts and pass times.
 nlohmann::json frameStatsJson(const FrameStats& stats);
 
+/// A pass's reuse offers: offered, accepted, m_capped and each outcome's count (kReuseOutcomeNames).
+nlohmann::json reuseCountsJson(const ReuseCounts& counts);
+
 }  // namespace accretion

@@ -24,6 +24,16 @@ ACC_HD inline bool similarSurface(const Vec3& n, float d, const Vec3& nq, float 
     return glm::dot(n, nq) >= normalThreshold && std::fabs(d - dq) <= depthThreshold * d;
 }
 
+/// similarSurface, saying which test refused: `accepted` when both pass,
+/// else normal (tested first) or depth.
+template <class Outcome>
+ACC_HD inline Outcome surfaceOutcome(const Vec3& n, float d, const Vec3& nq, float dq, float normalThreshold, float depthThreshold,
+                                     Outcome accepted) {
+    if (!(glm::dot(n, nq) >= normalThreshold)) return Outcome::normal;
+    if (!(std::fabs(d - dq) <= depthThreshold * d)) return Outcome::depth;
+    return accepted;
+}
+
 /// Pairwise MIS (Bitterli 2022, ch. 9.1.3): each of the k = n - 1
 /// neighbours forms a two-strategy balance heuristic with the canonical
 /// domain, whose confidence M_c is split over the k pairs.

@@ -10,9 +10,11 @@
 #include "accretion/geometry/particle_bvh.h"
 #include "accretion/counters/thread_counters.h"
 #include "accretion/lighting/light_sampler.h"
+#include "accretion/render/reuse_outcome.h"
 #include "accretion/render/accumulation.h"
 #include "accretion/render/pixel_window.h"
 #include "accretion/render/gbuffer.h"
+#include "accretion/render/reuse_outcome.h"
 #include "accretion/render/pixel_trace.h"
 #include "accretion/scene/settings.h"
 
@@ -31,22 +33,23 @@ struct LightingCounters {
     std::uint64_t lightTerms = 0;     ///< unshadowed terms evaluated
     std::uint64_t shadowRays = 0;     ///< occlusion queries
     std::uint64_t shadowOccluded = 0; ///< queries that found a blocker
-    std::uint64_t reuseAccepted = 0;  ///< restir: temporal/spatial neighbours resampled
-    std::uint64_t reuseRejected = 0;  ///< restir: neighbours rejected (off screen, particle, normal, depth)
+    ReuseCounts reuse;                ///< restir: temporal histories and spatial neighbours offered, by outcome
     std::uint64_t nonFinite = 0;      ///< NaN/Inf samples rejected (render.nonfinite)
     LightingCounters& operator+=(const LightingCounters& o) {
         nonFinite += o.nonFinite;
         lightTerms += o.lightTerms;
         shadowRays += o.shadowRays;
         shadowOccluded += o.shadowOccluded;
-        reuseAccepted += o.reuseAccepted;
-        reuseRejected += o.reuseRejected;
+        reuse += o.reuse;
         return *this;
     }
 };
 
 /// Non-finite values rejected, per pass (render.nonfinite).
 using PassRejections = std::map<Pass, std::uint64_t>;
+
+/// Reuse offers by outcome, per pass (temporalResampling, spatialResampling).
+using PassReuse = std::map<Pass, ReuseCounts>;
 
 /// Everything the lighting estimators read.
 struct LightingInputs {

@@ -53,6 +53,7 @@ struct FrameStats {
     double maxSpp = 0.0;              ///< and maximum
     std::size_t hitPixels = 0;
     PassRejections nonFinite;         ///< NaN/Inf rejected per pass (estimateLighting or the restir passes, composeImage)
+    PassReuse reuse;                  ///< restir: reuse offers by outcome, per pass
     PassTimer timer;                  ///< wall time per pass name
     double seconds = 0.0;             ///< whole frame
 };

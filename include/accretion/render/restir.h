@@ -62,9 +62,10 @@ public:
 
     /// Render Lr of one frame (spp = 1, no per-pixel standard error). Values
     /// that overflow or go NaN are rejected under render.nonfinite, counted
-    /// per pixel (out.rejected) and per pass (`rejected`).
+    /// per pixel (out.rejected) and per pass (`rejected`); the reuse
+    /// offers of each pass by outcome are added to `reuse`.
     LightingCounters render(const RestirInputs& in, LightingImage& out, ReservoirImage& aov, PassTimer& timer,
-                            PassRejections& rejected);
+                            PassRejections& rejected, PassReuse& reuse);
 
     /// A previous frame is kept for temporal reuse (FrameFacts::historyAvailable).
     bool hasHistory() const { return history_ != nullptr; }

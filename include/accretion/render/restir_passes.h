@@ -16,7 +16,8 @@
 //   Rec recorder(px, g)                      the thread's counters (Recorder<Count> on the CPU,
 //                                            NoRecorder on the GPU), its branch key recorded
 //   std::uint32_t reservoirBytes()           a stored reservoir's bytes (the codec's)
-//   void reuse(bool accepted)                an offered history or neighbour kept or rejected
+//   void reuse(ReuseOutcome o)               an offered history or neighbour kept or refused, and why
+//   void historyCapped()                     temporal: a kept history's M was cut to m_cap x M
 //   Offers offers<N>()                       an empty list of at most N offers:
 //                                              addCurrent(r, g)  a reservoir of this frame at texel g
 //                                              addHistory(r, q)  last frame's reservoir at its texel q
@@ -48,6 +49,7 @@
 #include "accretion/lighting/shading.h"
 #include "accretion/render/gbuffer_texel.h"
 #include "accretion/render/restir_steps.h"
+#include "accretion/render/reuse_outcome.h"
 
 namespace accretion::restir {
 
@@ -148,29 +150,31 @@ ACC_HD_BODY void temporalResamplingTexel(B& b, std::size_t px) {
     rec.write(R);
     const std::uint32_t j = g.particle;
     if (!b.historyHas(j)) {
-        b.reuse(false);
+        b.reuse(ReuseOutcome::noHistory);
         return;
     }
     const Vec3 xPrev = b.historyPosition(j) + g.local;  // frame-independent: relative to the particle
     float depth;
     std::size_t q = 0;
-    bool ok = reprojectPoint(b.historyCamera(), xPrev, p.scale, p.width, p.height, q, depth);
-    if (ok) {
-        rec.read(gpu_layout::kGBufferTexel);
-        const GBufferTexel gp = b.historyTexel(q);
-        ok = gp.particle == j && resampling::similarSurface(g.normal, depth, gp.normal, gp.depth, p.normalThreshold, p.depthThreshold);
-    }
-    if (!ok) {
-        b.reuse(false);
+    if (!reprojectPoint(b.historyCamera(), xPrev, p.scale, p.width, p.height, q, depth)) {
+        b.reuse(ReuseOutcome::offScreen);
         return;
     }
-    b.reuse(true);
+    rec.read(gpu_layout::kGBufferTexel);
+    const GBufferTexel gp = b.historyTexel(q);
+    const ReuseOutcome o = gp.particle != j ? ReuseOutcome::particle
+                                            : resampling::surfaceOutcome(g.normal, depth, gp.normal, gp.depth, p.normalThreshold,
+                                                                         p.depthThreshold, ReuseOutcome::sameParticle);
+    b.reuse(o);
+    if (!kept(o)) return;
     rec.read(R + gpu_layout::kParticleRecord);  // the previous reservoir and its light
     rec.gather(1);
     auto offers = b.template offers<2>();
     offers.addCurrent(cur, g);
     StoredReservoir prev = b.historyReservoir(q);
+    const std::uint32_t historyM = prev.M;
     prev.M = capHistoryM(prev.M, cur.M, p.mCap);
+    if (prev.M != historyM) b.historyCapped();
     offers.addHistory(prev, q);
     typename B::Rng rng(px, p.frame, RngPass::restirTemporal, p.seed);
     b.keep(px, sanitizeReservoir(offers.combine(rng), [&] { return b.reject(px); }));
@@ -198,16 +202,18 @@ ACC_HD_BODY void spatialResamplingTexel(B& b, std::size_t px, std::uint32_t x, s
     for (std::uint32_t s = 0; s < p.neighbours; ++s) {
         std::size_t q;
         if (!drawNeighbour(rng, p.radius, x, y, p.width, p.height, q)) {
-            b.reuse(false);
+            b.reuse(ReuseOutcome::offScreen);
             continue;
         }
         const GBufferTexel gn = b.texel(q);
         rec.read(gpu_layout::kGBufferTexel);
-        if (!gn.hit() || !resampling::similarSurface(g.normal, g.depth, gn.normal, gn.depth, p.normalThreshold, p.depthThreshold)) {
-            b.reuse(false);
-            continue;
-        }
-        b.reuse(true);
+        const ReuseOutcome o = !gn.hit() ? ReuseOutcome::miss
+                                         : resampling::surfaceOutcome(g.normal, g.depth, gn.normal, gn.depth, p.normalThreshold,
+                                                                      p.depthThreshold,
+                                                                      gn.particle == g.particle ? ReuseOutcome::sameParticle
+                                                                                                : ReuseOutcome::otherParticle);
+        b.reuse(o);
+        if (!kept(o)) continue;
         rec.read(R + gpu_layout::kParticleRecord);
         rec.gather(1);
         offers.addCurrent(b.input(q), gn);

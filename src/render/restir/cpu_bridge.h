@@ -76,7 +76,8 @@ public:
         return *rec_;
     }
     std::uint32_t reservoirBytes() const { return f_.codec.bytes(); }
-    void reuse(bool accepted) { ++(accepted ? c_.reuseAccepted : c_.reuseRejected); }
+    void reuse(ReuseOutcome o) { c_.reuse.add(o); }
+    void historyCapped() { ++c_.reuse.mCapped; }
     template <std::uint32_t N>
     Offers offers() { return Offers(*this); }
 

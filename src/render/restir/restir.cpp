@@ -13,12 +13,14 @@ namespace {
 /// spatialResampling (plan.spatialIterations times), traceShadowRays.
 /// With a trace (render --pixel), the reservoir of texel `traced` after each pass.
 LightingCounters runPasses(restir::FrameContext& f, std::vector<StoredReservoir>& a, std::vector<StoredReservoir>& b,
-                           std::vector<Vec3>& lowLr, PassTimer& timer, PassRejections& rejected, std::size_t traced) {
+                           std::vector<Vec3>& lowLr, PassTimer& timer, PassRejections& rejected, PassReuse& reuse,
+                           std::size_t traced) {
     const FramePlan& plan = f.in.plan;
     LightingCounters total;
     auto add = [&](Pass pass, const LightingCounters& c) {
         total += c;
         if (c.nonFinite) rejected[pass] += c.nonFinite;
+        if (c.reuse.offered()) reuse[pass] += c.reuse;
     };
     auto snapshot = [&](PassRun run, const std::vector<StoredReservoir>& r) {
         if (f.in.trace) f.in.trace->passes.push_back({run, r[traced]});
@@ -67,7 +69,7 @@ Restir::Restir(const Settings& settings, bool keepHistory)
     : rs_(settings.restir), keepHistory_(keepHistory), codec_(settings.restir) {}
 
 LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, ReservoirImage& aov, PassTimer& timer,
-                                PassRejections& rejected) {
+                                PassRejections& rejected, PassReuse& reuse) {
     const GBuffer& full = in.gbuffer;
     ACC_CHECK(full.whole());  // spatial reuse reads the neighbours, history is the whole frame's
     const std::size_t pixels = std::size_t(full.width) * full.height;
@@ -115,7 +117,7 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
                std::min(lg->width - 1, std::uint32_t(float(x) * f.scale));
     };
     const std::size_t traced = in.trace ? texelOf(std::uint32_t(in.trace->px % full.width), std::uint32_t(in.trace->px / full.width)) : 0;
-    LightingCounters counters = runPasses(f, a, b, lowLr, timer, rejected, traced);
+    LightingCounters counters = runPasses(f, a, b, lowLr, timer, rejected, reuse, traced);
 
     if (!plan.upsample) {
         out.Lr = lowLr;
