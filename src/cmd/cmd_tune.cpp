@@ -253,6 +253,15 @@ struct ErrorRow {
     double relMse = 0.0, z = 0.0, energyLossPct = 0.0, cpuSecondsPerFrame = 0.0, detectablePct = 0.0;
     std::uint32_t seeds = 0;
     BiasVerdict verdict = BiasVerdict::unknown;
+    nlohmann::json reuse;  ///< bias's reuse of the measured frames, per pass (stats.json's counts.reuse)
+    /// The share of `pass`'s offers kept, and of those on another particle (NaN where it did not run).
+    std::pair<double, double> kept(const char* pass) const {
+        if (!reuse.is_object() || !reuse.contains(pass)) return {std::nan(""), std::nan("")};
+        const nlohmann::json& r = reuse.at(pass);
+        const double offered = r.at("offered").get<double>(), accepted = r.at("accepted").get<double>();
+        const double other = r.at("outcomes").at("other_particle").get<double>();
+        return {offered > 0.0 ? 100.0 * accepted / offered : std::nan(""), accepted > 0.0 ? 100.0 * other / accepted : std::nan("")};
+    }
     bool biased() const { return verdict == BiasVerdict::biased; }
     /// "BIASED", "" (unbiased to the bound), "bias unknown (bound 9.9%)".
     std::string label() const {
@@ -277,6 +286,7 @@ ErrorRow measureErrorSeeds(TuneContext& t, const LightingChoice& o, std::uint32_
     const nlohmann::json& r = j.at("rows").at(0);
     ErrorRow e{r.at("rel_mse").get<double>(), r.at("z").get<double>(), r.at("energy_loss_pct").get<double>(),
                r.at("seconds_per_frame").get<double>(), r.at("detectable_bias_pct").get<double>(), seeds};
+    if (j.contains("reuse") && j.at("reuse").contains(spec)) e.reuse = j.at("reuse").at(spec);
     e.verdict = r.at("biased").get<bool>()                ? BiasVerdict::biased
               : e.detectablePct <= t.args.biasBoundPct ? BiasVerdict::unbiased
                                                         : BiasVerdict::unknown;
@@ -449,13 +459,17 @@ Table lightingTable(const TuneArgs& a, const TuneResult& r) {
     Table lt({{"lighting", "lighting (on the chosen geometry)", -36}, {"gpu_ms", "GPU ms", 9, "{:.3f}", "{:.6g}"},
               {"rel_mse", fmt::format("relMSE@{}", a.errorSize), 14, "{:.4g}", "{:.6g}"}, {"z", "bias z", 7, "{:.1f}", "{:.5g}"},
               {"energy_loss_pct", "loss %", 7, "{:.1f}", "{:.5g}"}, {"detectable_bias_pct", "bound %", 8, "{:.2g}", "{:.5g}"},
-              {"seeds", "seeds", 6}, {"cpu_s", "CPU s", 7, "{:.2f}", "{:.5g}"},
+              {"seeds", "seeds", 6}, {"temporal_kept_pct", "temp kept%", 10, "{:.0f}", "{:.4g}"},
+              {"spatial_kept_pct", "spat kept%", 10, "{:.0f}", "{:.4g}"}, {"spatial_other_particle_pct", "of them other%", 14, "{:.0f}", "{:.4g}"},
+              {"cpu_s", "CPU s", 7, "{:.2f}", "{:.5g}"},
               {"biased", "", 0, "{}", "{}", false}, {"bias_verdict", "", 0, "{}", "{}", false}, {"front", "", 0, "{}", "{}", false},
               {"", "", 0, "{}", "{}", true, "  "}});
     for (const ParetoPoint& p : r.points) {
         const std::string bias = p.error.label();
+        const double temporalKept = p.error.kept("temporalResampling").first;
+        const auto [spatialKept, spatialOther] = p.error.kept("spatialResampling");
         lt.add({p.lighting.label(), p.ms, p.error.relMse, p.error.z, p.error.energyLossPct, p.error.detectablePct,
-                std::uint64_t(p.error.seeds), p.error.cpuSecondsPerFrame, p.error.biased(), std::string(verdictName(p.error.verdict)),
+                std::uint64_t(p.error.seeds), temporalKept, spatialKept, spatialOther, p.error.cpuSecondsPerFrame, p.error.biased(), std::string(verdictName(p.error.verdict)),
                 p.front,
                 std::string(p.front ? "front" : "") + (bias.empty() ? "" : " " + bias) + (&p == r.best ? " <- recommended" : "")});
     }
@@ -501,13 +515,16 @@ void writeTuneJson(const std::string& prefix, const TuneArgs& a, const Settings&
                        {"bias_verdict", verdictName(best->error.verdict)}, {"detectable_bias_pct", best->error.detectablePct},
                        {"seeds", best->error.seeds}};
     }
+    nlohmann::json reuse = nlohmann::json::object();  // per lighting configuration, per pass: the offers by outcome
+    for (const ParetoPoint& p : r.points)
+        if (!p.error.reuse.is_null()) reuse[p.lighting.label()] = p.error.reuse;
     writeJson(prefix + ".json", {{"version", std::string(version())}, {"command", "tune"}, {"scene", scene.scenePath},
                                  {"defines", a.defines}, {"settings", settingsToToml(scene)}, {"seed", scene.render.seed},
                                  {"budget_ms", a.budgetMs}, {"bias_bound_pct", a.biasBoundPct}, {"max_seeds", a.maxSeeds}, {"max_error", a.maxError ? nlohmann::json(*a.maxError) : nlohmann::json()},
                                  {"seeds", a.seeds}, {"frame", t.frame}, {"history_frames", t.history}, {"error_size", a.errorSize}, {"reference", t.reference},
                                  {"space", a.space}, {"coefficients", t.coefficients.source}, {"geometry", gt.json()},
                                  {"fastest_triangle_geometry", r.triangles->choice.label()}, {"chosen_geometry", chosen.label()},
-                                 {"lighting", lt.json()}, {"recommended", recommended}});
+                                 {"lighting", lt.json()}, {"reuse", reuse}, {"recommended", recommended}});
 }
 
 /// PREFIX.png: the configurations' error against predicted GPU ms, the front and the budget.

@@ -407,6 +407,25 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
         CHECK(p["biased"].get<bool>() == (v == "biased"));
     }
     CHECK(r["bias_verdict"] == (anyUnbiased ? "unbiased" : "unknown"));
+    // Reuse per configuration, at the steady state it was measured at: no
+    // spatial pass without neighbours; every offer of the passes that ran counted.
+    CHECK(j["frame"] == 20);
+    CHECK(j["history_frames"] == 20);
+    for (const auto& p : rows) {
+        const std::string label = p["lighting"];
+        INFO(label);
+        const nlohmann::json& reuse = j.at("reuse").at(label);
+        CHECK(reuse.at("temporalResampling").at("offered").get<double>() > 0.0);
+        const double temporal = p["temporal_kept_pct"].get<double>();
+        CHECK((temporal > 0.0 && temporal <= 100.0));
+        if (label.find("nb=0x") != std::string::npos) {
+            CHECK(p["spatial_kept_pct"].is_null());
+            CHECK_FALSE(reuse.contains("spatialResampling"));
+        } else {
+            const double spatial = p["spatial_kept_pct"].get<double>();
+            CHECK((spatial >= 0.0 && spatial <= 100.0));
+        }
+    }
     for (const auto& p : rows)
         if (p["bias_verdict"] == r["bias_verdict"] && p["gpu_ms"].get<double>() <= 50.0)
             CHECK(p["rel_mse"].get<double>() >= r["rel_mse"].get<double>());
