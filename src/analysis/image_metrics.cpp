@@ -22,6 +22,22 @@ void requireFinitePixels(const std::vector<Vec3>& pixels, const std::string& fil
                                          layer, p % width, p / width));
 }
 
+double flickerRelMse(const std::vector<Vec3>& x, const std::vector<Vec3>& xPrev, const std::vector<Vec3>& ref,
+                     const std::vector<Vec3>& refPrev, double* change, double eps) {
+    ACC_CHECK(x.size() == ref.size() && xPrev.size() == ref.size() && refPrev.size() == ref.size());
+    double flicker = 0.0, own = 0.0;
+    for (std::size_t p = 0; p < ref.size(); ++p)
+        for (int c = 0; c < 3; ++c) {
+            const double r = ref[p][c], dr = r - double(refPrev[p][c]);
+            const double dx = double(x[p][c]) - double(xPrev[p][c]), w = 1.0 / (r * r + eps);
+            flicker += (dx - dr) * (dx - dr) * w;
+            own += dr * dr * w;
+        }
+    const double n = 3.0 * double(std::max<std::size_t>(ref.size(), 1));
+    if (change) *change = own / n;
+    return flicker / n;
+}
+
 ErrorMetrics computeErrors(const std::vector<Vec3>& x, const std::vector<Vec3>& ref, const std::vector<Vec3>* refStderr,
                            double eps, double tolerance) {
     ACC_CHECK(x.size() == ref.size());

@@ -57,6 +57,8 @@ struct Point {
     double seconds = 0.0, totalSeconds = 0.0;
     std::uint64_t shadowRays = 0, lightTerms = 0;
     ErrorMetrics err;
+    double flicker = NAN;          ///< --sequence: relMSE of the change from the previous frame against the reference's (mean over seeds)
+    double referenceChange = NAN;  ///< and the reference sequence's own change
 };
 
 /// The baseline's time to reach an error, from the Monte Carlo rate
@@ -166,6 +168,7 @@ std::vector<Point> measureSequence(const ConvergeRun& run, const std::vector<Est
         const std::uint64_t seed0 = s.render.seed;
         std::vector<SeedAverage> perFrame;
         for (std::uint32_t k = 0; k < a.sequence; ++k) perFrame.emplace_back(spec.label, run.frame + k, 0, a.seeds);
+        std::vector<double> flicker(a.sequence, 0.0), change(a.sequence, 0.0);
         for (std::uint32_t seed = 0; seed < a.seeds; ++seed) {
             s.render.seed = seed0 + seed;
             FrameRenderer renderer(s, run.source, RenderOptions{true});
@@ -173,17 +176,24 @@ std::vector<Point> measureSequence(const ConvergeRun& run, const std::vector<Est
                 FrameStats stats;
                 renderer.render(run.frame - history + k, stats);
             }
+            std::vector<Vec3> previous;
             for (std::uint32_t k = 0; k < a.sequence; ++k) {
                 FrameStats stats;
-                const FrameImage img = renderer.render(run.frame + k, stats);
+                FrameImage img = renderer.render(run.frame + k, stats);
                 perFrame[k].add(img.lighting.Lr, refs[k], stats, stats.seconds, stats.seconds);
+                if (k > 0) flicker[k] += flickerRelMse(img.lighting.Lr, previous, refs[k].Lr, refs[k - 1].Lr, &change[k]) / a.seeds;
+                previous = std::move(img.lighting.Lr);
             }
         }
-        for (SeedAverage& avg : perFrame) {
-            const Point p = avg.finish();
+        for (std::uint32_t k = 0; k < a.sequence; ++k) {
+            Point p = perFrame[k].finish();
+            if (k > 0) {
+                p.flicker = flicker[k];
+                p.referenceChange = change[k];
+            }
             if (!a.quiet)
-                fmt::print(stderr, "converge: {} frame {}: {:.3f} s, relMSE {:.4g}, MAPE {:.4g}\n", spec.label, p.frame,
-                           p.seconds, p.err.relMSE, p.err.MAPE);
+                fmt::print(stderr, "converge: {} frame {}: {:.3f} s, relMSE {:.4g}, MAPE {:.4g}, flicker {:.4g}\n", spec.label,
+                           p.frame, p.seconds, p.err.relMSE, p.err.MAPE, p.flicker);
             points.push_back(p);
         }
     }
@@ -232,10 +242,12 @@ Table pointsTable(const std::vector<Point>& points) {
     Table t({{"estimator"}, {"frame"}, {"effort"}, {"seconds", "", 0, "{}", "{:.6g}"}, {"total_seconds", "", 0, "{}", "{:.6g}"},
              {"shadow_rays"}, {"light_terms"}, {"relMSE", "", 0, "{}", "{:.8g}"}, {"MSE", "", 0, "{}", "{:.8g}"},
              {"MAPE", "", 0, "{}", "{:.8g}"}, {"relMSE_reference_noise", "", 0, "{}", "{:.8g}"},
-             {"relMSE_corrected", "", 0, "{}", "{:.8g}"}});
+             {"relMSE_corrected", "", 0, "{}", "{:.8g}"}, {"flicker", "", 0, "{}", "{:.8g}"},
+             {"reference_change", "", 0, "{}", "{:.8g}"}});
     for (const Point& p : points)
         t.add({p.label, std::uint64_t(p.frame), std::uint64_t(p.effort), p.seconds, p.totalSeconds, p.shadowRays,
-               p.lightTerms, p.err.relMSE, p.err.MSE, p.err.MAPE, p.err.relMSEFloor, p.err.relMSE - p.err.relMSEFloor});
+               p.lightTerms, p.err.relMSE, p.err.MSE, p.err.MAPE, p.err.relMSEFloor, p.err.relMSE - p.err.relMSEFloor,
+               p.flicker, p.referenceChange});
     return t;
 }
 
@@ -268,21 +280,21 @@ Table summaryTable(const std::vector<Point>& points, const std::vector<Estimator
     return t;
 }
 
-/// --sequence: relMSE (MAPE) at frames 0, 1, 3, 7, 15, ... of the sequence.
+/// --sequence: relMSE (MAPE) and flicker at frames 0, 1, 3, 7, 15, ... of the sequence.
 Table sequenceTable(const std::vector<Point>& points, const std::vector<EstimatorSpec>& specs, std::uint32_t frame,
                     std::uint32_t sequence) {
     std::vector<std::uint32_t> shown;
     for (std::uint32_t k = 1; k <= sequence; k *= 2) shown.push_back(k - 1);
     if (shown.back() != sequence - 1) shown.push_back(sequence - 1);
-    std::vector<Column> columns{{"", "relMSE (MAPE) at sequence frame", -44}};
-    for (std::uint32_t k : shown) columns.push_back({"", std::to_string(k), 15});
+    std::vector<Column> columns{{"", "relMSE (MAPE) flicker at sequence frame", -44}};
+    for (std::uint32_t k : shown) columns.push_back({"", std::to_string(k), 24});
     Table t(columns);
     for (const EstimatorSpec& spec : specs) {
         std::vector<Cell> row{spec.label};
         for (std::uint32_t k : shown)
             for (const Point& p : points)
                 if (p.label == spec.label && p.frame == frame + k)
-                    row.push_back(fmt::format("{:.3g} ({:.3f})", p.err.relMSE, p.err.MAPE));
+                    row.push_back(fmt::format("{:.3g} ({:.3f}) {:.3g}", p.err.relMSE, p.err.MAPE, p.flicker));
         t.add(row);
     }
     return t;

@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <map>
 
 #include <fstream>
 #include <regex>
@@ -301,4 +302,46 @@ TEST_CASE("bias --gpu-frames: frames read from files give the figures of renderi
     // Lr alone cannot be imported as render's EXR.
     CHECK(runCommand(kBin + " import-gpu " + (dir / "restir_basic.5.gpuframe").string(), out) == 1);
     CHECK_THAT(out, Contains("holds Lr alone"));
+}
+
+TEST_CASE("converge --sequence: flicker is two frames' error where frames are independent, less where reuse keeps it", "[cli][experiments][statistical]") {
+    // A static view (no motion): the reference's own change is 0, and the
+    // change of an estimate is its two frames' errors. Uniform Monte Carlo
+    // draws each frame anew, so its flicker is relMSE(t) + relMSE(t - 1) in
+    // expectation (8 seeds of ~6K pixels: within 20%); restir's temporal
+    // reuse carries its samples over, so its error persists and flickers less.
+    const auto dir = accretion::test::scratchDir("converge_flicker");
+    const std::string still = " -D particles.gm=0 -D camera.path=\"static\"";
+    std::string out;
+    REQUIRE(runCommand(kBin + " render " + tinyScene() + still + " --frames 20:24 --quiet --estimator exact -o " +
+                           (dir / "ref.{frame}.exr").string(), out) == 0);
+    const std::string cmd = kBin + " converge " + tinyScene() + still + " --quiet --reference " + (dir / "ref.{frame}.exr").string() +
+                            " --frame 20 --sequence 4 --seeds 8 --estimators uniform:render.samples=4,restir:pairwise -o " +
+                            (dir / "c").string();
+    INFO(cmd << "\n" << out);
+    REQUIRE(runCommand(cmd, out) == 0);
+    const auto rows = readCsv(dir / "c.csv");
+    const auto col = [&](const char* name) {
+        const auto i = std::find(rows[0].begin(), rows[0].end(), name);
+        REQUIRE(i != rows[0].end());
+        return std::size_t(i - rows[0].begin());
+    };
+    const std::size_t est = col("estimator"), frame = col("frame"), rel = col("relMSE"), flicker = col("flicker"),
+                      change = col("reference_change");
+    std::map<std::string, std::map<int, std::pair<double, double>>> by;  // estimator -> frame -> (relMSE, flicker)
+    for (std::size_t r = 1; r < rows.size(); ++r) {
+        by[rows[r][est]][std::stoi(rows[r][frame])] = {std::stod(rows[r][rel]), rows[r][flicker] == "nan" ? NAN : std::stod(rows[r][flicker])};
+        if (std::stoi(rows[r][frame]) > 20) CHECK(std::stod(rows[r][change]) == 0.0);
+    }
+    REQUIRE(by.size() == 2);
+    for (int f = 21; f < 24; ++f) {
+        const auto& u = by.at("uniform:render.samples=4");
+        const double ratio = u.at(f).second / (u.at(f).first + u.at(f - 1).first);
+        INFO("uniform frame " << f << ": flicker / (relMSE + previous relMSE) = " << ratio);
+        CHECK((ratio > 0.8 && ratio < 1.2));
+        const auto& r = by.at("restir:pairwise");
+        const double restirRatio = r.at(f).second / (r.at(f).first + r.at(f - 1).first);
+        INFO("restir frame " << f << ": " << restirRatio);
+        CHECK(restirRatio < 0.8 * ratio);
+    }
 }

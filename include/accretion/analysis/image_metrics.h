@@ -46,6 +46,15 @@ ErrorMetrics computeErrors(const std::vector<Vec3>& x, const std::vector<Vec3>& 
                            const std::vector<Vec3>* refStderr = nullptr, double eps = kRelMseEpsilon,
                            double tolerance = kAgreementTolerance);
 
+/// Flicker: the relMSE of an estimate's frame-to-frame change against the
+/// reference sequence's own change, mean over pixels and channels of
+/// ((x - xPrev) - (ref - refPrev))^2 / (ref^2 + eps). With independent noise
+/// in each frame it is the two frames' relMSE summed; temporal reuse, whose
+/// errors persist, flickers less than its error. `change` (optional) gets
+/// the reference's own change, ((ref - refPrev))^2 / (ref^2 + eps).
+double flickerRelMse(const std::vector<Vec3>& x, const std::vector<Vec3>& xPrev, const std::vector<Vec3>& ref,
+                     const std::vector<Vec3>& refPrev, double* change = nullptr, double eps = kRelMseEpsilon);
+
 /// An RGB layer of an EXR file, read with OpenEXR (half, float or uint
 /// channels, as floats): the pixels of its data window, which may be any
 /// part of (or reach outside) the display window of the whole image.
