@@ -5,6 +5,7 @@
 #include <limits>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -39,6 +40,7 @@ struct BiasArgs : ExperimentArgs {
     double zCritical = 3.29;  ///< two-sided 99.9%
     std::string gpuFrames;    ///< read each seed's image from these .gpuframe files instead of rendering it
     bool strict = false;      ///< a view check that cannot be performed is an error
+    std::string unshadowedReference;  ///< the view with shading.visibility = false: the error without visibility
 };
 
 struct BiasRow {
@@ -55,6 +57,7 @@ struct BiasRow {
     bool biased = false;
     double detectablePct = 0.0;  ///< the smallest |energy bias| (%) this run detects with 80% probability
     PassReuse reuse;             ///< restir: the measured frames' reuse offers by outcome, summed over the seeds
+    double relMseUnshadowed = NAN;  ///< --unshadowed-reference: relMSE of the same spec with every light visible
     std::vector<FloatChannel> map;  ///< the bias map, written once every estimator has been measured
     std::string settingsToml;       ///< the estimator's settings, recorded in its map
 };
@@ -248,12 +251,13 @@ Table biasTable(const std::vector<BiasRow>& rows, double refMean, double zCritic
              hidden("energy_loss_pct", "{:.6g}"), hidden("energy_loss_stderr_pct", "{:.6g}"), {"", "energy loss %", 15},
              hidden("biased", "{}"), hidden("detectable_bias_pct", "{:.4g}"), {"seconds_per_render", "s/render", 9, "{:.3f}", "{:.6g}"},
              {"seconds_per_frame", "s/frame", 8, "{:.3f}", "{:.6g}"}, {"rel_mse", "relMSE", 10, "{:.4g}", "{:.6g}"},
+             {"rel_mse_unshadowed", "unshadowed", 11, "{:.4g}", "{:.6g}"}, {"visibility_share_pct", "vis share%", 11, "{:.0f}", "{:.4g}"},
              {"", fmt::format("verdict (|z| > {:.2f}: 99.9%)", zCritical), 0, "{}", "{}", true, "  "}});
     for (const BiasRow& r : rows) {
         const double lossSe = refMean > 0.0 ? 100.0 * r.stderr / refMean : 0.0;
         t.add({r.label, std::uint64_t(r.seeds), std::uint64_t(r.history), r.meanError, r.stderr, r.z, r.energyLossPct, lossSe,
                fmt::format("{:>8.3f} +- {:<5.3f}", r.energyLossPct, lossSe), r.biased, r.detectablePct, r.secondsPerRender,
-               r.secondsPerFrame, r.relMse,
+               r.secondsPerFrame, r.relMse, r.relMseUnshadowed, 100.0 * (r.relMse - r.relMseUnshadowed) / r.relMse,
                r.biased ? "BIASED"
                         : fmt::format("no bias detected (a bias of {:.2g}% or more would show 4 times in 5)", r.detectablePct)});
     }
@@ -272,6 +276,7 @@ void runBias(const BiasArgs& a) {
     const std::string prefix = a.out.empty() ? "out/" + scene.sceneName + ".bias" : a.out;
     OutputGuard guard = sceneInputs(scene);
     guard.addInput(a.reference);
+    if (!a.unshadowedReference.empty()) guard.addInput(a.unshadowedReference);
     std::vector<std::string> suffixes = {".csv", ".png", ".json"};
     for (const EstimatorSpec& spec : specs)
         for (const char* ext : {".exr", ".z.png"}) suffixes.push_back("." + biasMapName(spec) + ext);
@@ -280,9 +285,25 @@ void runBias(const BiasArgs& a) {
     const BiasReference ref = loadBiasReference(a.reference, scene);
     // The reference must be of the view measured: its frame and scene-defining settings.
     requireSceneView(readExrAttributes(a.reference), a.reference, FileRole::reference, scene, frame, a.strict);
+    // The anatomy of the error: each spec again with every light visible,
+    // against a reference without visibility; what is left is light selection's.
+    std::vector<FlagSetting> unshadowed = base;
+    std::optional<BiasReference> refUnshadowed;
+    if (!a.unshadowedReference.empty()) {
+        if (!a.gpuFrames.empty())
+            throw InputError("command line --unshadowed-reference: not with --gpu-frames (the GPU frames are of one visibility)");
+        unshadowed.push_back({"shading.visibility", "--unshadowed-reference", [](Settings& s) { s.shading.visibility = false; }});
+        const Settings unshadowedScene = loadSceneArgs(a, unshadowed);
+        refUnshadowed = loadBiasReference(a.unshadowedReference, unshadowedScene);
+        requireSceneView(readExrAttributes(a.unshadowedReference), a.unshadowedReference, FileRole::reference, unshadowedScene,
+                         frame, a.strict);
+    }
     const ParticleSource source(scene);
     std::vector<BiasRow> rows;
-    for (const EstimatorSpec& spec : specs) rows.push_back(measureBias(a, spec, base, source, frame, ref, prefix));
+    for (const EstimatorSpec& spec : specs) {
+        rows.push_back(measureBias(a, spec, base, source, frame, ref, prefix));
+        if (refUnshadowed) rows.back().relMseUnshadowed = measureBias(a, spec, unshadowed, source, frame, *refUnshadowed, prefix).relMse;
+    }
 
     // Every output once every estimator has been measured: a failure leaves none.
     if (auto dir = std::filesystem::path(prefix).parent_path(); !dir.empty()) std::filesystem::create_directories(dir);
@@ -341,6 +362,9 @@ void addBiasCommand(CLI::App& app) {
     cmd->add_option("--seeds", args->seeds, "Independent renders per estimator")->check(CLI::Range(2u, 1000000u));
     cmd->add_flag("--strict", args->strict,
                   "A view check that cannot be made (a reference or GPU frame without accretion's metadata) is an error");
+    cmd->add_option("--unshadowed-reference", args->unshadowedReference,
+                    "The same view rendered with shading.visibility=false: each spec is measured again with every light "
+                    "visible against it; its relMSE is light selection's error, the rest visibility's share");
     cmd->add_option("--z", args->zCritical, "Two-sided critical |z| for the verdict (3.29: 99.9%)")->check(finiteIn(0.0, 1e6));
     cmd->add_option("--gpu-frames", args->gpuFrames,
                     "Read each seed's frame from the OptiX twin's .gpuframe files instead of rendering it: a pattern "

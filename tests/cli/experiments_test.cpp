@@ -131,6 +131,22 @@ TEST_CASE("bias: 1/M restir is flagged, uniform Monte Carlo is not", "[cli][expe
     // The history each row rendered: restir's steady state, none for Monte Carlo.
     CHECK(rows[1][col("history_frames")] == "0");
     CHECK(rows[2][col("history_frames")] == "20");
+    // The anatomy of the error: with every light visible, against a reference
+    // without visibility, the error left is light selection's; shadow rays add
+    // their own noise, so it is smaller, and the rest is visibility's share.
+    REQUIRE(runCommand(kBin + " render " + tinyScene() + " -D shading.visibility=false --frames 20:21 --quiet --estimator exact -o " +
+                           (dir / "unshadowed.exr").string(), out) == 0);
+    REQUIRE(runCommand(kBin + " bias " + tinyScene() + " -D render.samples=16 --quiet --reference " + (dir / "exact.exr").string() +
+                           " --unshadowed-reference " + (dir / "unshadowed.exr").string() +
+                           " --frame 20 --estimators uniform,restir:pairwise --seeds 8 -o " + (dir / "anatomy").string(), out) == 0);
+    const auto anatomy = readCsv(dir / "anatomy.csv");
+    REQUIRE(anatomy.size() == 3);
+    for (std::size_t r = 1; r < 3; ++r) {
+        const double all = std::stod(anatomy[r][col("rel_mse")]), unshadowed = std::stod(anatomy[r][col("rel_mse_unshadowed")]);
+        INFO(anatomy[r][0] << ": relMSE " << all << ", with every light visible " << unshadowed);
+        CHECK((unshadowed > 0.0 && unshadowed < all));
+        CHECK(std::stod(anatomy[r][col("visibility_share_pct")]) == Approx(100.0 * (all - unshadowed) / all).epsilon(1e-3));
+    }
     // Short of it, a measurement is refused rather than made at another operating point.
     CHECK(runCommand(kBin + " bias " + tinyScene() + " --quiet --reference " + (dir / "exact.exr").string() +
                          " --frame 19 --estimators restir --seeds 2 -o " + (dir / "short").string(), out) == 1);
