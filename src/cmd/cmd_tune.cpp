@@ -55,6 +55,7 @@ struct TuneArgs : SceneArgs {
     std::uint32_t referenceSpp = 1024;
     std::string out, cache;
     bool allowBiased = false;
+    bool anatomy = false;          ///< also the error with every light visible: visibility's share
     double biasBoundPct = 1.0;     ///< the energy bias a verdict of "unbiased" must be able to see
     std::uint32_t maxSeeds = 64;   ///< the most seeds tune spends on one configuration to see it
 };
@@ -185,6 +186,7 @@ struct TuneContext {
     std::string sceneText;  ///< version + scene file + overrides: every cache key starts with it
     std::uint32_t errorWidth = 0, errorHeight = 0;
     std::string reference;
+    std::string unshadowedReference;  ///< --anatomy: the reference with shading.visibility = false
     std::uint32_t frame = 0;    ///< the measured frame
     std::uint32_t history = 0;  ///< frames before it: restir's steady state (steadyStateHistory)
     CostCoefficients coefficients;  ///< what prices the counters
@@ -251,6 +253,7 @@ constexpr const char* verdictName(BiasVerdict v) {
 /// smallest energy bias its seeds detect 4 times in 5).
 struct ErrorRow {
     double relMse = 0.0, z = 0.0, energyLossPct = 0.0, cpuSecondsPerFrame = 0.0, detectablePct = 0.0;
+    double visibilitySharePct = NAN;  ///< --anatomy: the share of relMSE that every light visible removes
     std::uint32_t seeds = 0;
     BiasVerdict verdict = BiasVerdict::unknown;
     nlohmann::json reuse;  ///< bias's reuse of the measured frames, per pass (stats.json's counts.reuse)
@@ -276,17 +279,25 @@ ErrorRow measureErrorSeeds(TuneContext& t, const LightingChoice& o, std::uint32_
         if (d != "render.estimator=restir") spec += ":" + d;
     std::string key = t.sceneText + fmt::format("\nbias {} seeds {} frame {} history {} {}x{} reference {}", spec, seeds, t.frame,
                                                 t.history, t.errorWidth, t.errorHeight, cacheKey(readWholeFile(t.reference, "tune")));
+    if (!t.unshadowedReference.empty()) key += "\nunshadowed " + cacheKey(readWholeFile(t.unshadowedReference, "tune"));
     const std::filesystem::path prefix = t.cache / (cacheKey(key) + ".bias");
     std::vector<std::string> argv = sceneArgv(t, "bias", {fmt::format("camera.width={}", t.errorWidth),
                                                           fmt::format("camera.height={}", t.errorHeight)});
     argv.insert(argv.end(), {"--reference", t.reference, "--estimators", spec, "--seeds", std::to_string(seeds), "--frame",
                              std::to_string(t.frame), "--history", std::to_string(t.history), "-q", "-o", prefix.string()});
+    if (!t.unshadowedReference.empty()) argv.insert(argv.end(), {"--unshadowed-reference", t.unshadowedReference});
     measure(t, argv, prefix.string() + ".json", fmt::format("error of {} ({} seeds)", o.label(), seeds));
     const nlohmann::json j = nlohmann::json::parse(readWholeFile(prefix.string() + ".json", "tune"));
     const nlohmann::json& r = j.at("rows").at(0);
-    ErrorRow e{r.at("rel_mse").get<double>(), r.at("z").get<double>(), r.at("energy_loss_pct").get<double>(),
-               r.at("seconds_per_frame").get<double>(), r.at("detectable_bias_pct").get<double>(), seeds};
+    ErrorRow e;
+    e.relMse = r.at("rel_mse").get<double>();
+    e.z = r.at("z").get<double>();
+    e.energyLossPct = r.at("energy_loss_pct").get<double>();
+    e.cpuSecondsPerFrame = r.at("seconds_per_frame").get<double>();
+    e.detectablePct = r.at("detectable_bias_pct").get<double>();
+    e.seeds = seeds;
     if (j.contains("reuse") && j.at("reuse").contains(spec)) e.reuse = j.at("reuse").at(spec);
+    if (!t.unshadowedReference.empty()) e.visibilitySharePct = r.at("visibility_share_pct").get<double>();
     e.verdict = r.at("biased").get<bool>()                ? BiasVerdict::biased
               : e.detectablePct <= t.args.biasBoundPct ? BiasVerdict::unbiased
                                                         : BiasVerdict::unknown;
@@ -307,19 +318,21 @@ ErrorRow measureError(TuneContext& t, const LightingChoice& o) {
 
 /// The reference of the error measurements: given, or rendered once (exact
 /// up to 20K particles, else split at --reference-spp) and cached.
-std::string ensureReference(TuneContext& t, std::size_t particles) {
-    if (!t.args.reference.empty()) return t.args.reference;
+std::string ensureReference(TuneContext& t, std::size_t particles, bool visibility = true) {
+    if (!t.args.reference.empty() && visibility) return t.args.reference;
     const bool exact = particles <= 20000;
     const std::string how = exact ? "exact" : fmt::format("split {} spp", t.args.referenceSpp);
-    const std::filesystem::path file = t.cache / (cacheKey(t.sceneText + fmt::format("\nreference {} frame {} {}x{}", how, t.frame,
-                                                                                      t.errorWidth, t.errorHeight)) + ".ref.exr");
-    std::vector<std::string> argv = sceneArgv(t, "render", {fmt::format("camera.width={}", t.errorWidth),
-                                                            fmt::format("camera.height={}", t.errorHeight)});
+    const std::string unshadowed = visibility ? "" : ", every light visible";
+    const std::filesystem::path file = t.cache / (cacheKey(t.sceneText + fmt::format("\nreference {} frame {} {}x{}{}", how, t.frame,
+                                                                                      t.errorWidth, t.errorHeight, unshadowed)) + ".ref.exr");
+    std::vector<std::string> defines = {fmt::format("camera.width={}", t.errorWidth), fmt::format("camera.height={}", t.errorHeight)};
+    if (!visibility) defines.push_back("shading.visibility=false");
+    std::vector<std::string> argv = sceneArgv(t, "render", defines);
     argv.insert(argv.end(), {"--estimator", exact ? "exact" : "split", "--frames", fmt::format("{}:{}", t.frame, t.frame + 1),
                              "-o", file.string(), "--quiet"});
     if (!exact) argv.insert(argv.end(), {"--spp", std::to_string(t.args.referenceSpp)});
     ++t.steps;
-    measure(t, argv, file, fmt::format("reference ({}, {}x{})", how, t.errorWidth, t.errorHeight));
+    measure(t, argv, file, fmt::format("reference ({}, {}x{}{})", how, t.errorWidth, t.errorHeight, unshadowed));
     return file.string();
 }
 
@@ -461,6 +474,7 @@ Table lightingTable(const TuneArgs& a, const TuneResult& r) {
               {"energy_loss_pct", "loss %", 7, "{:.1f}", "{:.5g}"}, {"detectable_bias_pct", "bound %", 8, "{:.2g}", "{:.5g}"},
               {"seeds", "seeds", 6}, {"temporal_kept_pct", "temp kept%", 10, "{:.0f}", "{:.4g}"},
               {"spatial_kept_pct", "spat kept%", 10, "{:.0f}", "{:.4g}"}, {"spatial_other_particle_pct", "of them other%", 14, "{:.0f}", "{:.4g}"},
+              {"visibility_share_pct", "vis share%", 10, "{:.0f}", "{:.4g}"},
               {"cpu_s", "CPU s", 7, "{:.2f}", "{:.5g}"},
               {"biased", "", 0, "{}", "{}", false}, {"bias_verdict", "", 0, "{}", "{}", false}, {"front", "", 0, "{}", "{}", false},
               {"", "", 0, "{}", "{}", true, "  "}});
@@ -469,7 +483,8 @@ Table lightingTable(const TuneArgs& a, const TuneResult& r) {
         const double temporalKept = p.error.kept("temporalResampling").first;
         const auto [spatialKept, spatialOther] = p.error.kept("spatialResampling");
         lt.add({p.lighting.label(), p.ms, p.error.relMse, p.error.z, p.error.energyLossPct, p.error.detectablePct,
-                std::uint64_t(p.error.seeds), temporalKept, spatialKept, spatialOther, p.error.cpuSecondsPerFrame, p.error.biased(), std::string(verdictName(p.error.verdict)),
+                std::uint64_t(p.error.seeds), temporalKept, spatialKept, spatialOther, p.error.visibilitySharePct,
+                p.error.cpuSecondsPerFrame, p.error.biased(), std::string(verdictName(p.error.verdict)),
                 p.front,
                 std::string(p.front ? "front" : "") + (bias.empty() ? "" : " " + bias) + (&p == r.best ? " <- recommended" : "")});
     }
@@ -522,6 +537,7 @@ void writeTuneJson(const std::string& prefix, const TuneArgs& a, const Settings&
                                  {"defines", a.defines}, {"settings", settingsToToml(scene)}, {"seed", scene.render.seed},
                                  {"budget_ms", a.budgetMs}, {"bias_bound_pct", a.biasBoundPct}, {"max_seeds", a.maxSeeds}, {"max_error", a.maxError ? nlohmann::json(*a.maxError) : nlohmann::json()},
                                  {"seeds", a.seeds}, {"frame", t.frame}, {"history_frames", t.history}, {"error_size", a.errorSize}, {"reference", t.reference},
+                                 {"unshadowed_reference", t.unshadowedReference.empty() ? nlohmann::json() : nlohmann::json(t.unshadowedReference)},
                                  {"space", a.space}, {"coefficients", t.coefficients.source}, {"geometry", gt.json()},
                                  {"fastest_triangle_geometry", r.triangles->choice.label()}, {"chosen_geometry", chosen.label()},
                                  {"lighting", lt.json()}, {"reuse", reuse}, {"recommended", recommended}});
@@ -563,6 +579,7 @@ void runTune(const TuneArgs& a) {
     t.steps = geometry.size() + 2 * lighting.size();
     const std::size_t particles = ParticleSource(scene).frame(t.frame).size();
     t.reference = ensureReference(t, particles);
+    if (a.anatomy) t.unshadowedReference = ensureReference(t, particles, false);
 
     // Geometry: the same image whatever it is; the fastest predicted frame.
     TuneResult r;
@@ -608,6 +625,9 @@ void addTuneCommand(CLI::App& app) {
         ->check(CLI::Range(1u, 1u << 20));
     cmd->add_option("--cache", args->cache, "Folder of cached measurements (default out/tune_cache/<scene>)");
     cmd->add_flag("--allow-biased", args->allowBiased, "Biased configurations may be recommended");
+    cmd->add_flag("--anatomy", args->anatomy,
+                  "Also measure each configuration with every light visible against a reference without visibility (rendered "
+                  "once): visibility's share of its error (twice the error measurements)");
     cmd->add_option("--bias-bound", args->biasBoundPct,
                     "Energy bias (%) a configuration's seeds must be able to see for it to count as unbiased: tune adds "
                     "seeds where such a bias could hide, up to --max-seeds, else labels it \"bias unknown (bound X%)\"")

@@ -473,6 +473,20 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
     }
     CHECK(more > 0);
 
+    // --anatomy: each configuration again with every light visible, against
+    // a reference without visibility that tune renders once: visibility's
+    // share of the error, mostly between 0 and 100% (one shadow ray a pixel
+    // is noise of its own).
+    REQUIRE(runCommand(cmd + " --anatomy -q", out) == 0);
+    const nlohmann::json an = nlohmann::json::parse(slurp(dir / "t.json"));
+    CHECK(an["unshadowed_reference"].is_string());
+    std::vector<double> shares;
+    for (const auto& p : an.at("lighting")) shares.push_back(p["visibility_share_pct"].get<double>());
+    std::sort(shares.begin(), shares.end());
+    const double median = shares[shares.size() / 2];
+    INFO("visibility's share of the error, median over the configurations: " << median << "%");
+    CHECK((median > 0.0 && median < 100.0));
+
     // Bad input: one clear error each, exit 1, nothing written.
     CHECK(runCommand(kBin + " tune " + tinyScene() + " --budget-ms 0 -o " + (dir / "bad").string(), out) == 1);
     CHECK_THAT(out, Contains("--budget-ms"));
