@@ -16,6 +16,8 @@
 // counters, with gpu.coefficients' calibration (the committed one by
 // default), so that a new calibration re-prices without measuring again.
 #include <algorithm>
+#include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -31,6 +33,7 @@
 #include "accretion/analysis/experiment.h"
 #include "accretion/core/atomic_file.h"
 #include "accretion/core/error.h"
+#include "accretion/core/parse.h"
 #include "accretion/core/read_file.h"
 #include "accretion/core/version.h"
 #include "accretion/gpu/cost_model.h"
@@ -191,20 +194,54 @@ struct TuneContext {
     std::uint32_t history = 0;  ///< frames before it: restir's steady state (steadyStateHistory)
     CostCoefficients coefficients;  ///< what prices the counters
     std::size_t step = 0, steps = 0;
+    /// Where the time goes, per kind of measurement (MeasureKind): seconds
+    /// of the runs this time, and of the cached ones when they were run.
+    struct Spent {
+        double seconds = 0.0, cachedSeconds = 0.0;
+        std::size_t runs = 0, cached = 0;
+    };
+    std::array<Spent, 3> spent{};
 };
 
+/// What a measurement is, for tune's account of its time.
+enum class MeasureKind { reference, gpuTime, error };
+constexpr std::array<const char*, 3> kMeasureKindNames = {"references", "GPU time (cost)", "error (bias)"};
+
 /// Runs `argv` (this executable) unless `result` exists; its log beside it.
-void measure(TuneContext& t, const std::vector<std::string>& argv, const std::filesystem::path& result, const std::string& what) {
+/// Its wall time is kept beside the result (RESULT.seconds), so that a
+/// cached rerun still says what the measurement cost.
+void measure(TuneContext& t, MeasureKind kind, const std::vector<std::string>& argv, const std::filesystem::path& result,
+             const std::string& what) {
     ++t.step;
+    TuneContext::Spent& spent = t.spent[std::size_t(kind)];
+    const std::filesystem::path secondsFile = result.string() + ".seconds";
     if (std::filesystem::exists(result)) {
         if (!t.args.quiet) fmt::print(stderr, "tune: [{}/{}] {} (cached)\n", t.step, t.steps, what);
+        ++spent.cached;
+        if (std::filesystem::exists(secondsFile))
+            spent.cachedSeconds += parseNumber(readWholeFile(secondsFile.string(), "tune")).value_or(0.0);
         return;
     }
     if (!t.args.quiet) fmt::print(stderr, "tune: [{}/{}] {}\n", t.step, t.steps, what);
     const std::filesystem::path log = result.string() + ".log";
+    const auto start = std::chrono::steady_clock::now();
     const int rc = runSelf(argv, log);
     if (rc != 0 || !std::filesystem::exists(result))
         throw InternalError(fmt::format("tune: {} failed (exit {}): {} (log {})", what, rc, lastLine(log), log.string()));
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    spent.seconds += seconds;
+    ++spent.runs;
+    writeFileAtomic(secondsFile.string(), fmt::format("{:.3f}", seconds));
+}
+
+/// Where tune's time went: per kind, the runs of this time and the cached ones' cost when run.
+nlohmann::json spentJson(const TuneContext& t) {
+    nlohmann::json j = nlohmann::json::object();
+    for (std::size_t k = 0; k < t.spent.size(); ++k) {
+        const TuneContext::Spent& s = t.spent[k];
+        j[kMeasureKindNames[k]] = {{"runs", s.runs}, {"seconds", s.seconds}, {"cached", s.cached}, {"cached_seconds", s.cachedSeconds}};
+    }
+    return j;
 }
 
 std::vector<std::string> sceneArgv(const TuneContext& t, const std::string& command, const std::vector<std::string>& defines) {
@@ -225,7 +262,7 @@ std::map<Pass, double> predictMs(TuneContext& t, const std::vector<std::string>&
     std::vector<std::string> argv = sceneArgv(t, "cost", defines);
     argv.insert(argv.end(), {"--frames", fmt::format("{}:{}", t.frame, t.frame + 1), "--history", std::to_string(t.history), "--overhead", "0",
                              "--cluster-sizes", "", "--omm-levels", "", "--ser-keys", "hit", "-q", "-o", prefix.string() + ".json"});
-    measure(t, argv, prefix.string() + ".csv", "GPU time of " + what);
+    measure(t, MeasureKind::gpuTime, argv, prefix.string() + ".csv", "GPU time of " + what);
     std::map<Pass, double> ms;  // a pass's runs summed
     for (CostRow& r : readCounterCsv(prefix.string() + ".csv")) {
         r.features[CostFeature::cold_work] =
@@ -286,7 +323,7 @@ ErrorRow measureErrorSeeds(TuneContext& t, const LightingChoice& o, std::uint32_
     argv.insert(argv.end(), {"--reference", t.reference, "--estimators", spec, "--seeds", std::to_string(seeds), "--frame",
                              std::to_string(t.frame), "--history", std::to_string(t.history), "-q", "-o", prefix.string()});
     if (!t.unshadowedReference.empty()) argv.insert(argv.end(), {"--unshadowed-reference", t.unshadowedReference});
-    measure(t, argv, prefix.string() + ".json", fmt::format("error of {} ({} seeds)", o.label(), seeds));
+    measure(t, MeasureKind::error, argv, prefix.string() + ".json", fmt::format("error of {} ({} seeds)", o.label(), seeds));
     const nlohmann::json j = nlohmann::json::parse(readWholeFile(prefix.string() + ".json", "tune"));
     const nlohmann::json& r = j.at("rows").at(0);
     ErrorRow e;
@@ -332,7 +369,7 @@ std::string ensureReference(TuneContext& t, std::size_t particles, bool visibili
                              "-o", file.string(), "--quiet"});
     if (!exact) argv.insert(argv.end(), {"--spp", std::to_string(t.args.referenceSpp)});
     ++t.steps;
-    measure(t, argv, file, fmt::format("reference ({}, {}x{}{})", how, t.errorWidth, t.errorHeight, unshadowed));
+    measure(t, MeasureKind::reference, argv, file, fmt::format("reference ({}, {}x{}{})", how, t.errorWidth, t.errorHeight, unshadowed));
     return file.string();
 }
 
@@ -513,6 +550,15 @@ void printTune(const TuneArgs& a, const Settings& scene, const TuneContext& t, c
     else
         fmt::print("no {}configuration is under {:g} ms{}\n", a.allowBiased ? "" : "unbiased ", a.budgetMs,
                    a.maxError ? fmt::format(" with relMSE <= {:g}", *a.maxError) : "");
+    std::string spent;
+    double total = 0.0;
+    for (std::size_t k = 0; k < t.spent.size(); ++k) {
+        const TuneContext::Spent& x = t.spent[k];
+        total += x.seconds + x.cachedSeconds;
+        spent += fmt::format("{}{} {:.0f} s ({} run{}, {} cached: {:.0f} s when run)", spent.empty() ? "" : "; ", kMeasureKindNames[k],
+                             x.seconds + x.cachedSeconds, x.runs, x.runs == 1 ? "" : "s", x.cached, x.cachedSeconds);
+    }
+    fmt::print("time: {:.0f} s of measurements: {}\n", total, spent);
     std::fflush(stdout);
 }
 
@@ -540,7 +586,7 @@ void writeTuneJson(const std::string& prefix, const TuneArgs& a, const Settings&
                                  {"unshadowed_reference", t.unshadowedReference.empty() ? nlohmann::json() : nlohmann::json(t.unshadowedReference)},
                                  {"space", a.space}, {"coefficients", t.coefficients.source}, {"geometry", gt.json()},
                                  {"fastest_triangle_geometry", r.triangles->choice.label()}, {"chosen_geometry", chosen.label()},
-                                 {"lighting", lt.json()}, {"reuse", reuse}, {"recommended", recommended}});
+                                 {"lighting", lt.json()}, {"reuse", reuse}, {"recommended", recommended}, {"time", spentJson(t)}});
 }
 
 /// PREFIX.png: the configurations' error against predicted GPU ms, the front and the budget.

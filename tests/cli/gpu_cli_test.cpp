@@ -436,6 +436,12 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
         if (g["geometry"] == j["chosen_geometry"]) CHECK(g["frame_ms"].get<double>() == fastest);
     CHECK(std::filesystem::exists(dir / "t.csv"));
 
+    // Where the time went: every measurement of the first run was run, none cached.
+    const nlohmann::json firstTime = j.at("time");
+    CHECK(firstTime["error (bias)"]["runs"] == 34);
+    CHECK(firstTime["error (bias)"]["cached"] == 0);
+    CHECK(firstTime["GPU time (cost)"]["runs"] == 12 + 34);
+    CHECK(firstTime["references"]["runs"] == 1);
     // A second run reads every measurement back and gives the same table.
     const std::string first = slurp(dir / "t.csv");
     std::filesystem::remove(dir / "t.csv");
@@ -451,6 +457,14 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
         }
     CHECK(measurements == 1 + 12 + 2 * 34);  // the reference, 6 layouts rebuilt and refitted, then cost and bias per lighting option
     CHECK(slurp(dir / "t.csv") == first);
+    // ... and accounts for the cached measurements with what they cost when run (kept beside them, to the ms).
+    const nlohmann::json again = nlohmann::json::parse(slurp(dir / "t.json")).at("time");
+    for (const char* kind : {"references", "GPU time (cost)", "error (bias)"}) {
+        INFO(kind);
+        CHECK(again[kind]["runs"] == 0);
+        CHECK(again[kind]["cached"] == firstTime[kind]["runs"]);
+        CHECK(again[kind]["cached_seconds"].get<double>() == Approx(firstTime[kind]["seconds"].get<double>()).margin(1e-3 * 50));
+    }
 
     // Where a bias of --bias-bound could hide in 3 seeds' verdict, tune runs
     // the seeds that would see it (the bound falls as 1/sqrt(seeds)) when
