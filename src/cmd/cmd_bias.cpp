@@ -264,6 +264,21 @@ Table biasTable(const std::vector<BiasRow>& rows, double refMean, double zCritic
     return t;
 }
 
+/// --unshadowed-reference, for the anatomy of the error: each spec again
+/// with every light visible (`flags` gains shading.visibility = false),
+/// against a reference without visibility; what is left is light selection's.
+std::optional<BiasReference> loadUnshadowedReference(const BiasArgs& a, std::vector<FlagSetting>& flags, std::uint32_t frame) {
+    if (a.unshadowedReference.empty()) return std::nullopt;
+    if (!a.gpuFrames.empty())
+        throw InputError("command line --unshadowed-reference: not with --gpu-frames (the GPU frames are of one visibility)");
+    flags.push_back({"shading.visibility", "--unshadowed-reference", [](Settings& s) { s.shading.visibility = false; }});
+    const Settings unshadowedScene = loadSceneArgs(a, flags);
+    BiasReference ref = loadBiasReference(a.unshadowedReference, unshadowedScene);
+    requireSceneView(readExrAttributes(a.unshadowedReference), a.unshadowedReference, FileRole::reference, unshadowedScene, frame,
+                     a.strict);
+    return ref;
+}
+
 void runBias(const BiasArgs& a) {
     const std::vector<FlagSetting> base = frameFlags(a.frames);
     const Settings scene = loadSceneArgs(a);
@@ -285,19 +300,8 @@ void runBias(const BiasArgs& a) {
     const BiasReference ref = loadBiasReference(a.reference, scene);
     // The reference must be of the view measured: its frame and scene-defining settings.
     requireSceneView(readExrAttributes(a.reference), a.reference, FileRole::reference, scene, frame, a.strict);
-    // The anatomy of the error: each spec again with every light visible,
-    // against a reference without visibility; what is left is light selection's.
     std::vector<FlagSetting> unshadowed = base;
-    std::optional<BiasReference> refUnshadowed;
-    if (!a.unshadowedReference.empty()) {
-        if (!a.gpuFrames.empty())
-            throw InputError("command line --unshadowed-reference: not with --gpu-frames (the GPU frames are of one visibility)");
-        unshadowed.push_back({"shading.visibility", "--unshadowed-reference", [](Settings& s) { s.shading.visibility = false; }});
-        const Settings unshadowedScene = loadSceneArgs(a, unshadowed);
-        refUnshadowed = loadBiasReference(a.unshadowedReference, unshadowedScene);
-        requireSceneView(readExrAttributes(a.unshadowedReference), a.unshadowedReference, FileRole::reference, unshadowedScene,
-                         frame, a.strict);
-    }
+    const std::optional<BiasReference> refUnshadowed = loadUnshadowedReference(a, unshadowed, frame);
     const ParticleSource source(scene);
     std::vector<BiasRow> rows;
     for (const EstimatorSpec& spec : specs) {

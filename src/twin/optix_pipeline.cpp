@@ -40,9 +40,6 @@ TwinPipeline::TwinPipeline(const std::filesystem::path& programs, bool validatio
     if (validation) options.validationMode = OPTIX_DEVICE_CONTEXT_VALIDATION_MODE_ALL;
     OPTIX_CHECK(optixDeviceContextCreate(nullptr, &options, &context_));
 
-    OptixModuleCompileOptions moduleOptions{};
-    moduleOptions.optLevel = OPTIX_COMPILE_OPTIMIZATION_DEFAULT;
-    moduleOptions.debugLevel = OPTIX_COMPILE_DEBUG_LEVEL_MINIMAL;
     OptixPipelineCompileOptions pipelineOptions{};
     pipelineOptions.usesMotionBlur = 0;
     pipelineOptions.traversableGraphFlags = OPTIX_TRAVERSABLE_GRAPH_FLAG_ALLOW_SINGLE_LEVEL_INSTANCING;
@@ -54,6 +51,17 @@ TwinPipeline::TwinPipeline(const std::filesystem::path& programs, bool validatio
                                              : layout == AccelLayout::aabbs ? OPTIX_PRIMITIVE_TYPE_FLAGS_CUSTOM
                                                                             : OPTIX_PRIMITIVE_TYPE_FLAGS_TRIANGLE;
     pipelineOptions.allowOpacityMicromaps = opacityMicromaps ? 1 : 0;
+    createModules(programs, pipelineOptions, spheres, sphereBuildFlags);
+    createProgramGroups(layout, spheres);
+    linkPipeline(pipelineOptions);
+    buildShaderBindingTables();
+}
+
+void TwinPipeline::createModules(const std::filesystem::path& programs, const OptixPipelineCompileOptions& pipelineOptions,
+                                 bool spheres, unsigned sphereBuildFlags) {
+    OptixModuleCompileOptions moduleOptions{};
+    moduleOptions.optLevel = OPTIX_COMPILE_OPTIMIZATION_DEFAULT;
+    moduleOptions.debugLevel = OPTIX_COMPILE_DEBUG_LEVEL_MINIMAL;
     const std::string ir = readBinary(programs);
     char log[4096];
     size_t logSize = sizeof log;
@@ -64,10 +72,13 @@ TwinPipeline::TwinPipeline(const std::filesystem::path& programs, bool validatio
         builtin.buildFlags = sphereBuildFlags;
         OPTIX_CHECK(optixBuiltinISModuleGet(context_, &moduleOptions, &pipelineOptions, &builtin, &sphereModule_));
     }
+}
 
+void TwinPipeline::createProgramGroups(AccelLayout layout, bool spheres) {
     auto group = [&](const OptixProgramGroupDesc& desc) {
         OptixProgramGroupOptions groupOptions{};
         OptixProgramGroup g = nullptr;
+        char log[4096];
         size_t size = sizeof log;
         OPTIX_CHECK(optixProgramGroupCreate(context_, &desc, 1, &groupOptions, log, &size, &g));
         return g;
@@ -105,11 +116,15 @@ TwinPipeline::TwinPipeline(const std::filesystem::path& programs, bool validatio
     };
     hitPrimary_ = hitGroup("__closesthit__primary", "__anyhit__primary");
     hitShadow_ = hitGroup("__closesthit__shadow", "__anyhit__shadow");
+}
+
+void TwinPipeline::linkPipeline(const OptixPipelineCompileOptions& pipelineOptions) {
     std::vector<OptixProgramGroup> all(std::begin(raygen_), std::end(raygen_));
     all.insert(all.end(), {miss_, hitPrimary_, hitShadow_});
     OptixPipelineLinkOptions linkOptions{};
     linkOptions.maxTraceDepth = 1;
-    logSize = sizeof log;
+    char log[4096];
+    size_t logSize = sizeof log;
     OPTIX_CHECK(optixPipelineCreate(context_, &pipelineOptions, &linkOptions, all.data(), unsigned(all.size()), log,
                                     &logSize, &pipeline_));
     OptixStackSizes stack{};
@@ -117,7 +132,9 @@ TwinPipeline::TwinPipeline(const std::filesystem::path& programs, bool validatio
     unsigned fromTraversal = 0, fromState = 0, continuation = 0;
     OPTIX_CHECK(optixUtilComputeStackSizes(&stack, 1, 0, 0, &fromTraversal, &fromState, &continuation));
     OPTIX_CHECK(optixPipelineSetStackSize(pipeline_, fromTraversal, fromState, continuation, 2));
+}
 
+void TwinPipeline::buildShaderBindingTables() {
     // Records: no data, headers only.
     std::vector<EmptyRecord> rg(int(Raygen::count)), ms(kRayTypes), hg(kRayTypes);
     for (int r = 0; r < int(Raygen::count); ++r) OPTIX_CHECK(optixSbtRecordPackHeader(raygen_[r], &rg[r]));

@@ -41,6 +41,14 @@ public:
                 cudaStream_t stream) const;
 
 private:
+    /// The constructor's steps: the module (and the built-in sphere module),
+    /// the program groups, the linked pipeline, the shader binding tables.
+    void createModules(const std::filesystem::path& programs, const OptixPipelineCompileOptions& pipelineOptions, bool spheres,
+                       unsigned sphereBuildFlags);
+    void createProgramGroups(AccelLayout layout, bool spheres);
+    void linkPipeline(const OptixPipelineCompileOptions& pipelineOptions);
+    void buildShaderBindingTables();
+
     OptixDeviceContext context_ = nullptr;
     OptixModule module_ = nullptr, sphereModule_ = nullptr;
     OptixProgramGroup raygen_[int(Raygen::count)] = {};

@@ -63,6 +63,49 @@ LightingCounters runPasses(restir::FrameContext& f, std::vector<StoredReservoir>
     return total;
 }
 
+/// The lighting grid at resolution_scale: each texel the G-buffer texel of
+/// the image pixel that contains its centre.
+GBuffer reduceToLightingGrid(const GBuffer& full, float scale) {
+    GBuffer reduced;
+    reduced.width = lightingGridExtent(full.width, scale);
+    reduced.height = lightingGridExtent(full.height, scale);
+    reduced.window = PixelWindow::whole(reduced.width, reduced.height);
+    reduced.texels.resize(std::size_t(reduced.width) * reduced.height);
+    for (std::uint32_t y = 0; y < reduced.height; ++y)
+        for (std::uint32_t x = 0; x < reduced.width; ++x) {
+            std::uint32_t fx, fy;
+            reducedTexelSource(x, y, scale, full.width, full.height, fx, fy);
+            reduced.texels[std::size_t(y) * reduced.width + x] = full.at(fx, fy);
+        }
+    return reduced;
+}
+
+/// Each hit pixel's spp, rejections and reservoir AOVs, from its lighting
+/// texel's final reservoir (texelOf: image pixel -> lighting texel).
+template <class TexelOf>
+void writeReservoirAovs(const GBuffer& full, const std::vector<StoredReservoir>& a, const std::vector<std::uint32_t>& lowRejected,
+                        const TexelOf& texelOf, LightingImage& out, ReservoirImage& aov) {
+    const std::size_t pixels = std::size_t(full.width) * full.height;
+    aov.W.assign(pixels, 0.0f);
+    aov.M.assign(pixels, 0.0f);
+    aov.light.assign(pixels, kNoLight);
+    aov.p_hat.assign(pixels, 0.0f);
+    out.rejected.assign(pixels, 0.0f);
+    for (std::uint32_t y = 0; y < full.height; ++y)
+        for (std::uint32_t x = 0; x < full.width; ++x) {
+            const std::size_t px = std::size_t(y) * full.width + x;
+            if (!full.texels[px].hit()) continue;
+            out.spp[px] = 1.0f;
+            const std::size_t lpx = texelOf(x, y);
+            const StoredReservoir& r = a[lpx];
+            out.rejected[px] = float(lowRejected[lpx]);
+            aov.W[px] = r.W;
+            aov.M[px] = float(r.M);
+            aov.light[px] = r.W > 0.0f ? r.y : kNoLight;
+            aov.p_hat[px] = r.p_hat;
+        }
+}
+
 }  // namespace
 
 Restir::Restir(const Settings& settings, bool keepHistory)
@@ -84,16 +127,7 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
     GBuffer reduced;
     const GBuffer* lg = &full;
     if (in.plan.upsample) {
-        reduced.width = lightingGridExtent(full.width, scale);
-        reduced.height = lightingGridExtent(full.height, scale);
-        reduced.window = PixelWindow::whole(reduced.width, reduced.height);
-        reduced.texels.resize(std::size_t(reduced.width) * reduced.height);
-        for (std::uint32_t y = 0; y < reduced.height; ++y)
-            for (std::uint32_t x = 0; x < reduced.width; ++x) {
-                std::uint32_t fx, fy;
-                reducedTexelSource(x, y, scale, full.width, full.height, fx, fy);
-                reduced.texels[std::size_t(y) * reduced.width + x] = full.at(fx, fy);
-            }
+        reduced = reduceToLightingGrid(full, scale);
         lg = &reduced;
     }
     const std::size_t lpixels = std::size_t(lg->width) * lg->height;
@@ -126,24 +160,7 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
         restir::upsampleLighting(full, *lg, in.particles, lowLr, f.scale, rs_, out.Lr);
         if (in.counters) restir::recordUpsample(in, *lg, in.counters->add(Pass::upsampleLighting, full.width, full.height));
     }
-    aov.W.assign(pixels, 0.0f);
-    aov.M.assign(pixels, 0.0f);
-    aov.light.assign(pixels, kNoLight);
-    aov.p_hat.assign(pixels, 0.0f);
-    out.rejected.assign(pixels, 0.0f);
-    for (std::uint32_t y = 0; y < full.height; ++y)
-        for (std::uint32_t x = 0; x < full.width; ++x) {
-            const std::size_t px = std::size_t(y) * full.width + x;
-            if (!full.texels[px].hit()) continue;
-            out.spp[px] = 1.0f;
-            const std::size_t lpx = texelOf(x, y);
-            const StoredReservoir& r = a[lpx];
-            out.rejected[px] = float(lowRejected[lpx]);
-            aov.W[px] = r.W;
-            aov.M[px] = float(r.M);
-            aov.light[px] = r.W > 0.0f ? r.y : kNoLight;
-            aov.p_hat[px] = r.p_hat;
-        }
+    writeReservoirAovs(full, a, lowRejected, texelOf, out, aov);
 
     // History for the next frame.
     if (!keepHistory_) return counters;
