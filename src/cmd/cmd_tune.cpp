@@ -617,7 +617,11 @@ void runTune(const TuneArgs& a) {
     // The engine's operating point: the frame after the history that brings
     // temporal reuse to its M cap (every lighting choice shares it).
     t.frame = a.frame.value_or(scene.render.frame_start + steadyStateHistory(scene));
-    t.history = historyBefore(HistoryChoice{}, scene, t.frame, "tune");
+    t.history = steadyStateHistory(scene);
+    if (t.history > t.frame)  // tune has no --history: its frame must come after the whole history
+        throw InputError(fmt::format("command line --frame {}: tune measures restir at steady state, after {} history frames "
+                                     "(temporal reuse to its M cap of {:g}, at least 8): measure frame {} or later",
+                                     t.frame, t.history, scene.restir.m_cap, t.history));
     const std::vector<GeometryChoice> geometry = geometryChoices(scene);
     const std::vector<LightingChoice> lighting = lightingChoices(a.space);
     const std::string prefix = a.out.empty() ? "out/" + scene.sceneName + ".tune" : a.out;
