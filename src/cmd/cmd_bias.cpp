@@ -9,6 +9,7 @@
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 #include <tbb/global_control.h>
 
@@ -26,6 +27,8 @@
 #include "accretion/io/plot.h"
 #include "accretion/io/report_table.h"
 #include "accretion/io/stats_writer.h"
+#include "accretion/render/pixel_window.h"
+#include "accretion/scene/estimator_table.h"
 #include "accretion/scene/scene_parser.h"
 #include "commands.h"
 
@@ -40,7 +43,8 @@ struct BiasArgs : ExperimentArgs {
     double zCritical = 3.29;  ///< two-sided 99.9%
     std::string gpuFrames;    ///< read each seed's image from these .gpuframe files instead of rendering it
     bool strict = false;      ///< a view check that cannot be performed is an error
-    std::string unshadowedReference;  ///< the view with shading.visibility = false: the error without visibility
+    std::vector<std::string> unshadowedReferences;  ///< the view with shading.visibility = false: the error without visibility
+    std::uint32_t cropMargin = 64;  ///< restir on a cropped reference: the pixels around each crop it renders for its reuse
 };
 
 struct BiasRow {
@@ -62,31 +66,82 @@ struct BiasRow {
     std::string settingsToml;       ///< the estimator's settings, recorded in its map
 };
 
-/// The reference: Lr, its per-pixel standard error when it has one, and its image mean.
+/// The reference: Lr over the pixels measured, the whole image or the crops
+/// of it that the --reference files hold (each its EXR data window, at the
+/// scene's resolution: a stratified set of crops measures the frame where
+/// the engine runs it, never downscaled), crop after crop; their per-pixel
+/// standard error when they have one, and the mean over those pixels.
 struct BiasReference {
-    RgbLayer image;
-    std::vector<Vec3> stderr;  ///< empty without an Lr_stderr layer
+    std::uint32_t width = 0, height = 0;  ///< the image
+    std::vector<PixelWindow> crops;       ///< the windows measured (the whole image: one, whole)
+    std::vector<std::string> files;       ///< one per crop
+    std::vector<Vec3> rgb;                ///< the crops' pixels, crop after crop, row by row
+    std::vector<Vec3> stderr;             ///< the same; empty without Lr_stderr layers
     double mean = 0.0, meanStderr = 0.0;
+    bool whole() const { return crops.size() == 1 && crops[0].isWhole(width, height); }
+    /// A per-pixel layer of the crops' pixels as the whole image, 0 outside them.
+    std::vector<float> scatter(const std::vector<float>& values) const {
+        std::vector<float> image(std::size_t(width) * height, 0.0f);
+        std::size_t k = 0;
+        for (const PixelWindow& w : crops)
+            for (std::uint32_t y = w.y0; y < w.y1; ++y)
+                for (std::uint32_t x = w.x0; x < w.x1; ++x) image[std::size_t(y) * width + x] = values[k++];
+        return image;
+    }
 };
 
-BiasReference loadBiasReference(const std::string& file, const Settings& scene) {
-    BiasReference r;
-    r.image = readExrLayer(file, "Lr");
-    if (!r.image.whole())
-        throw InputError(fmt::format("{}: a cropped reference (data window {}x{} at ({}, {})); bias measures whole images", file,
-                                     r.image.dataWidth, r.image.dataHeight, r.image.x0, r.image.y0));
-    if (r.image.width != scene.camera.width || r.image.height != scene.camera.height)
-        throw InputError(fmt::format("{}: reference is {}x{}, the scene renders {}x{}", file, r.image.width, r.image.height,
+/// One reference file's crop of the scene's view, checked.
+PixelWindow referenceCrop(const RgbLayer& image, const std::string& file, const Settings& scene) {
+    if (image.width != scene.camera.width || image.height != scene.camera.height)
+        throw InputError(fmt::format("{}: reference is {}x{}, the scene renders {}x{}", file, image.width, image.height,
                                      scene.camera.width, scene.camera.height));
-    if (exrHasLayer(file, "Lr_stderr")) r.stderr = readExrLayer(file, "Lr_stderr").rgb;
-    requireFinitePixels(r.image.rgb, file, "Lr", r.image.width);
-    if (!r.stderr.empty()) requireFinitePixels(r.stderr, file, "Lr_stderr", r.image.width);
-    const std::size_t pixels = r.image.rgb.size();
+    if (image.x0 < 0 || image.y0 < 0 || std::uint64_t(image.x0) + image.dataWidth > image.width ||
+        std::uint64_t(image.y0) + image.dataHeight > image.height || image.dataWidth == 0 || image.dataHeight == 0)
+        throw InputError(fmt::format("{}: data window {}x{} at ({}, {}) is not a window of the {}x{} image", file, image.dataWidth,
+                                     image.dataHeight, image.x0, image.y0, image.width, image.height));
+    return {std::uint32_t(image.x0), std::uint32_t(image.x0) + image.dataWidth, std::uint32_t(image.y0),
+            std::uint32_t(image.y0) + image.dataHeight};
+}
+
+/// The --reference files of one view: each of the scene's size and view
+/// (its frame and scene-defining settings), the crops apart, all with an
+/// Lr_stderr layer or none.
+BiasReference loadBiasReference(const std::vector<std::string>& files, const Settings& scene, std::uint32_t frame, bool strict,
+                                const char* option) {
+    BiasReference r;
+    r.width = scene.camera.width;
+    r.height = scene.camera.height;
+    for (const std::string& file : files) {
+        const RgbLayer image = readExrLayer(file, "Lr");
+        const PixelWindow crop = referenceCrop(image, file, scene);
+        for (std::size_t k = 0; k < r.crops.size(); ++k) {
+            const PixelWindow& o = r.crops[k];
+            if (crop.x0 < o.x1 && o.x0 < crop.x1 && crop.y0 < o.y1 && o.y0 < crop.y1)
+                throw InputError(fmt::format("command line {} {}: its pixels [{}, {}) x [{}, {}) overlap those of {}: a pixel is "
+                                             "measured once", option, file, crop.x0, crop.x1, crop.y0, crop.y1, r.files[k]));
+        }
+        requireFinitePixels(image.rgb, file, "Lr", image.dataWidth);
+        const bool hasStderr = exrHasLayer(file, "Lr_stderr");
+        if (!r.files.empty() && hasStderr != !r.stderr.empty())
+            throw InputError(fmt::format("command line {} {}: {} an Lr_stderr layer and {} {}: the references' noise is known for "
+                                         "all of them or none", option, file, hasStderr ? "has" : "has no", r.files[0],
+                                         hasStderr ? "has none" : "has one"));
+        if (hasStderr) {
+            const std::vector<Vec3> se = readExrLayer(file, "Lr_stderr").rgb;
+            requireFinitePixels(se, file, "Lr_stderr", image.dataWidth);
+            r.stderr.insert(r.stderr.end(), se.begin(), se.end());
+        }
+        requireSceneView(readExrAttributes(file), file, FileRole::reference, scene, frame, strict);
+        r.rgb.insert(r.rgb.end(), image.rgb.begin(), image.rgb.end());
+        r.crops.push_back(crop);
+        r.files.push_back(file);
+    }
+    const std::size_t pixels = r.rgb.size();
     const double n = 3.0 * double(pixels);
     double var = 0.0;
     for (std::size_t p = 0; p < pixels; ++p)
         for (int c = 0; c < 3; ++c) {
-            r.mean += r.image.rgb[p][c];
+            r.mean += r.rgb[p][c];
             if (!r.stderr.empty()) var += double(r.stderr[p][c]) * r.stderr[p][c];
         }
     r.mean /= n;
@@ -137,8 +192,8 @@ ExperimentRender readGpuRender(const std::string& file, const Settings& s, std::
                                bool strict) {
     GpuFrame g = readGpuFrame(file);
     auto meta = [&](const char* key) { return g.metadata.count(key) ? g.metadata.at(key) : std::string(); };
-    if (g.width != ref.image.width || g.height != ref.image.height)
-        throw InputError(fmt::format("{}: {}x{}, the reference is {}x{}", file, g.width, g.height, ref.image.width, ref.image.height));
+    if (g.width != ref.width || g.height != ref.height)
+        throw InputError(fmt::format("{}: {}x{}, the reference is {}x{}", file, g.width, g.height, ref.width, ref.height));
     if (g.frame != frame) throw InputError(fmt::format("{}: frame {}, bias measures frame {}", file, g.frame, frame));
     if (meta("seed") != std::to_string(s.render.seed))
         throw InputError(fmt::format("{}: seed {}, expected {}", file, meta("seed"), s.render.seed));
@@ -164,12 +219,34 @@ double detectableBiasPct(double stderr, double refMean, double zCritical) {
     return refMean > 0.0 ? 100.0 * (zCritical + kPower80) * stderr / refMean : std::numeric_limits<double>::infinity();
 }
 
+/// One seed's Lr over the reference's crops (crop after crop, as
+/// ref.rgb): each crop rendered alone, restir with --crop-margin around it
+/// (restir.crop_margin); the measured frames' times and reuse summed.
+ExperimentRender renderCrops(const BiasArgs& a, const Settings& s, const ParticleSource& source, std::uint32_t frame,
+                             std::uint32_t history, const BiasReference& ref) {
+    if (ref.whole()) return renderForExperiment(s, source, frame, history);
+    ExperimentRender all;
+    all.image.lighting.Lr.reserve(ref.rgb.size());
+    for (const PixelWindow& w : ref.crops) {
+        Settings c = s;
+        c.render.crop = {double(w.x0), double(w.x1), double(w.y0), double(w.y1)};
+        if (estimatorInfo(c.render.estimator).reuse) c.restir.crop_margin = a.cropMargin;
+        ExperimentRender r = renderForExperiment(c, source, frame, history);
+        const std::vector<Vec3>& lr = r.image.lighting.Lr;
+        all.image.lighting.Lr.insert(all.image.lighting.Lr.end(), lr.begin(), lr.end());
+        all.frameSeconds += r.frameSeconds;
+        all.totalSeconds += r.totalSeconds;
+        for (const auto& [pass, counts] : r.stats.reuse) all.stats.reuse[pass] += counts;
+    }
+    return all;
+}
+
 /// One estimator over the seeds: its row, and its bias map at prefix.<estimator>.exr.
 BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vector<FlagSetting>& base,
                     const ParticleSource& source, std::uint32_t frame, const BiasReference& ref, const std::string& prefix) {
     const Settings specBase = specSettings(a.scene, a.defines, base, spec);
     const std::uint32_t history = historyBefore(HistoryChoice::parse(a.history), specBase, frame, spec.label);
-    const std::size_t pixels = ref.image.rgb.size();
+    const std::size_t pixels = ref.rgb.size();
     const double n = 3.0 * double(pixels);
     std::vector<DVec3> s1(pixels, DVec3(0.0)), s2(pixels, DVec3(0.0));
     double e1 = 0.0, e2 = 0.0, seconds = 0.0, frameSeconds = 0.0, relMse = 0.0;
@@ -179,7 +256,7 @@ BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vec
         Settings s = specBase;
         s.render.seed = specBase.render.seed + k;
         const ExperimentRender r = a.gpuFrames.empty()
-                                       ? renderForExperiment(s, source, frame, history)
+                                       ? renderCrops(a, s, source, frame, history, ref)
                                        : readGpuRender(gpuFramePath(a.gpuFrames, biasMapName(spec), s.render.seed), s, frame,
                                                        ref, a.strict);
         seconds += r.totalSeconds;
@@ -187,13 +264,13 @@ BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vec
         frameSeconds += a.gpuFrames.empty() ? r.frameSeconds : r.totalSeconds;
         double e = 0.0;
         for (std::size_t p = 0; p < pixels; ++p) {
-            const DVec3 d = DVec3(r.image.lighting.Lr[p]) - DVec3(ref.image.rgb[p]);
+            const DVec3 d = DVec3(r.image.lighting.Lr[p]) - DVec3(ref.rgb[p]);
             s1[p] += d;
             s2[p] += d * d;
             e += d.x + d.y + d.z;
         }
         e /= n;
-        const ErrorMetrics m = computeErrors(r.image.lighting.Lr, ref.image.rgb, ref.stderr.empty() ? nullptr : &ref.stderr);
+        const ErrorMetrics m = computeErrors(r.image.lighting.Lr, ref.rgb, ref.stderr.empty() ? nullptr : &ref.stderr);
         relMse += m.relMSE - m.relMSEFloor;
         e1 += e;
         e2 += e * e;
@@ -267,16 +344,26 @@ Table biasTable(const std::vector<BiasRow>& rows, double refMean, double zCritic
 /// --unshadowed-reference, for the anatomy of the error: each spec again
 /// with every light visible (`flags` gains shading.visibility = false),
 /// against a reference without visibility; what is left is light selection's.
-std::optional<BiasReference> loadUnshadowedReference(const BiasArgs& a, std::vector<FlagSetting>& flags, std::uint32_t frame) {
-    if (a.unshadowedReference.empty()) return std::nullopt;
+std::optional<BiasReference> loadUnshadowedReference(const BiasArgs& a, std::vector<FlagSetting>& flags, std::uint32_t frame,
+                                                     const BiasReference& shadowed) {
+    if (a.unshadowedReferences.empty()) return std::nullopt;
     if (!a.gpuFrames.empty())
         throw InputError("command line --unshadowed-reference: not with --gpu-frames (the GPU frames are of one visibility)");
     flags.push_back({"shading.visibility", "--unshadowed-reference", [](Settings& s) { s.shading.visibility = false; }});
     const Settings unshadowedScene = loadSceneArgs(a, flags);
-    BiasReference ref = loadBiasReference(a.unshadowedReference, unshadowedScene);
-    requireSceneView(readExrAttributes(a.unshadowedReference), a.unshadowedReference, FileRole::reference, unshadowedScene, frame,
-                     a.strict);
+    BiasReference ref = loadBiasReference(a.unshadowedReferences, unshadowedScene, frame, a.strict, "--unshadowed-reference");
+    if (ref.crops != shadowed.crops)
+        throw InputError(fmt::format("command line --unshadowed-reference {}: its crops are not --reference's, in order (each "
+                                     "visibility-free reference is the same window as its reference)",
+                                     a.unshadowedReferences[0]));
     return ref;
+}
+
+/// The windows measured, [x0, x1, y0, y1] each.
+nlohmann::json cropsJson(const BiasReference& ref) {
+    nlohmann::json j = nlohmann::json::array();
+    for (const PixelWindow& w : ref.crops) j.push_back({w.x0, w.x1, w.y0, w.y1});
+    return j;
 }
 
 void runBias(const BiasArgs& a) {
@@ -290,18 +377,19 @@ void runBias(const BiasArgs& a) {
     const auto threads = limitThreads(a.threads);
     const std::string prefix = a.out.empty() ? "out/" + scene.sceneName + ".bias" : a.out;
     OutputGuard guard = sceneInputs(scene);
-    guard.addInput(a.reference);
-    if (!a.unshadowedReference.empty()) guard.addInput(a.unshadowedReference);
+    for (const std::string& r : a.references) guard.addInput(r);
+    for (const std::string& r : a.unshadowedReferences) guard.addInput(r);
     std::vector<std::string> suffixes = {".csv", ".png", ".json"};
     for (const EstimatorSpec& spec : specs)
         for (const char* ext : {".exr", ".z.png"}) suffixes.push_back("." + biasMapName(spec) + ext);
     checkOutputs(guard, prefix, suffixes, "-o");
 
-    const BiasReference ref = loadBiasReference(a.reference, scene);
-    // The reference must be of the view measured: its frame and scene-defining settings.
-    requireSceneView(readExrAttributes(a.reference), a.reference, FileRole::reference, scene, frame, a.strict);
+    // The references must be of the view measured: its frame and scene-defining settings.
+    const BiasReference ref = loadBiasReference(a.references, scene, frame, a.strict, "--reference");
+    if (!ref.whole() && !a.gpuFrames.empty())
+        throw InputError(fmt::format("command line --gpu-frames: the GPU frames are whole frames, {} is a crop", a.references[0]));
     std::vector<FlagSetting> unshadowed = base;
-    const std::optional<BiasReference> refUnshadowed = loadUnshadowedReference(a, unshadowed, frame);
+    const std::optional<BiasReference> refUnshadowed = loadUnshadowedReference(a, unshadowed, frame, ref);
     const ParticleSource source(scene);
     std::vector<BiasRow> rows;
     for (const EstimatorSpec& spec : specs) {
@@ -313,13 +401,16 @@ void runBias(const BiasArgs& a) {
     if (auto dir = std::filesystem::path(prefix).parent_path(); !dir.empty()) std::filesystem::create_directories(dir);
     for (std::size_t k = 0; k < rows.size(); ++k) {
         const std::string map = prefix + "." + biasMapName(specs[k]);
-        writeChannelsExr(map + ".exr", ref.image.width, ref.image.height, rows[k].map,
+        std::vector<FloatChannel> channels = rows[k].map;
+        for (FloatChannel& c : channels) c.values = ref.scatter(c.values);
+        writeChannelsExr(map + ".exr", ref.width, ref.height, channels,
                          {{"version", std::string(version())}, {"estimator", rows[k].label},
-                          {"seeds", std::to_string(a.seeds)}, {"reference", a.reference}, {"frame", std::to_string(frame)},
+                          {"seeds", std::to_string(a.seeds)}, {"reference", fmt::format("{}", fmt::join(a.references, " "))},
+                          {"frame", std::to_string(frame)},
                           {"settings", rows[k].settingsToml},
                           {"renderer", a.gpuFrames.empty() ? "accretion" : "accretion-optix (" + a.gpuFrames + ")"}});
-        const std::vector<float>& z = rows[k].map.back().values;
-        writeFalseColourPng(map + ".z.png", z, ref.image.width, ref.image.height,
+        const std::vector<float>& z = channels.back().values;
+        writeFalseColourPng(map + ".z.png", z, ref.width, ref.height,
                             {-2.0 * a.zCritical, 2.0 * a.zCritical, true,
                              fmt::format("{}: bias z per pixel (luminance), {} seeds", rows[k].label, a.seeds)});
     }
@@ -337,7 +428,8 @@ void runBias(const BiasArgs& a) {
     }
     writeFileAtomic(prefix + ".csv", table.csv());
     writeJson(prefix + ".json", {{"version", std::string(version())}, {"command", "bias"},
-                                 {"scene", scene.scenePath}, {"reference", a.reference},
+                                 {"scene", scene.scenePath}, {"reference", a.references}, {"crops", cropsJson(ref)},
+                                 {"crop_margin", ref.whole() ? nlohmann::json() : nlohmann::json(a.cropMargin)},
                                  {"frame", frame}, {"history", a.history}, {"z_critical", a.zCritical},
                                  {"reference_mean", ref.mean}, {"reference_mean_stderr", ref.meanStderr},
                                  {"settings", settingsToToml(scene)}, {"rows", table.json()}, {"reuse", reuse}});
@@ -360,15 +452,21 @@ void runBias(const BiasArgs& a) {
 void addBiasCommand(CLI::App& app) {
     auto args = std::make_shared<BiasArgs>();
     CLI::App* cmd = app.add_subcommand("bias", "Mean signed error over many seeds per estimator, with its standard error");
-    addExperimentOptions(cmd, *args, "Reference EXR with an Lr layer (and Lr_stderr if noisy)",
+    addExperimentOptions(cmd, *args, "Reference EXR with an Lr layer (and Lr_stderr if noisy): the whole view, or given once per crop, "
+                         "crops of it (each its data window, at the scene's resolution), measured together",
                          "Comma-separated specs, as for converge",
                          "Output prefix (default out/<scene>.bias): .csv, .png, .json, bias-map EXRs");
     cmd->add_option("--seeds", args->seeds, "Independent renders per estimator")->check(CLI::Range(2u, 1000000u));
     cmd->add_flag("--strict", args->strict,
                   "A view check that cannot be made (a reference or GPU frame without accretion's metadata) is an error");
-    cmd->add_option("--unshadowed-reference", args->unshadowedReference,
+    cmd->add_option("--crop-margin", args->cropMargin,
+                    "With cropped references: the pixels around each crop that restir renders for its reuse (restir.crop_margin)")
+        ->check(CLI::Range(0u, 16384u));
+    cmd->add_option("--unshadowed-reference", args->unshadowedReferences,
                     "The same view rendered with shading.visibility=false: each spec is measured again with every light "
-                    "visible against it; its relMSE is light selection's error, the rest visibility's share");
+                    "visible against it; its relMSE is light selection's error, the rest visibility's share (one per --reference, "
+                    "the same crops)")
+        ->allow_extra_args(false);
     cmd->add_option("--z", args->zCritical, "Two-sided critical |z| for the verdict (3.29: 99.9%)")->check(finiteIn(0.0, 1e6));
     cmd->add_option("--gpu-frames", args->gpuFrames,
                     "Read each seed's frame from the OptiX twin's .gpuframe files instead of rendering it: a pattern "

@@ -157,7 +157,7 @@ struct ConvergeRun {
 std::vector<Point> measureSequence(const ConvergeRun& run, const std::vector<EstimatorSpec>& specs) {
     const ConvergeArgs& a = run.a;
     std::vector<Reference> refs;
-    for (std::uint32_t k = 0; k < a.sequence; ++k) refs.push_back(loadReference(a.reference, run.scene, run.frame + k));
+    for (std::uint32_t k = 0; k < a.sequence; ++k) refs.push_back(loadReference(a.reference(), run.scene, run.frame + k));
     std::vector<Point> points;
     for (const EstimatorSpec& spec : specs) {
         Settings s = specSettings(a.scene, a.defines, run.base, spec);
@@ -203,7 +203,7 @@ std::vector<Point> measureSequence(const ConvergeRun& run, const std::vector<Est
 /// One frame: each estimator at doubling effort until its share of the budget is spent.
 std::vector<Point> measureLevels(const ConvergeRun& run, const std::vector<EstimatorSpec>& specs) {
     const ConvergeArgs& a = run.a;
-    const Reference ref = loadReference(a.reference, run.scene, run.frame);
+    const Reference ref = loadReference(a.reference(), run.scene, run.frame);
     std::vector<Point> points;
     for (const EstimatorSpec& spec : specs) {
         double spent = 0.0, last = 0.0;
@@ -327,15 +327,17 @@ void runConverge(const ConvergeArgs& a) {
     const std::vector<FlagSetting> base = frameFlags(a.frames);
     const Settings scene = loadSceneArgs(a);
     requireWholeImage(scene, "converge");
+    if (a.references.size() != 1)
+        throw InputError(fmt::format("command line --reference: converge measures against one reference ({} given)", a.references.size()));
     const auto specs = parseEstimatorSpecs(a.estimators, "--estimators");
     const double budget = parseSeconds(a.budget);
     const std::uint32_t frame = a.frame.value_or(scene.render.frame_start);
     if (a.minEffort > a.maxEffort)
         throw InputError(fmt::format("command line --min-effort {} --max-effort {}: no effort to try (the range is empty)",
                                      a.minEffort, a.maxEffort));
-    if (a.sequence > 0 && a.reference.find("{frame}") == std::string::npos)
+    if (a.sequence > 0 && a.reference().find("{frame}") == std::string::npos)
         throw InputError(fmt::format("command line --reference {}: --sequence measures each frame against its own "
-                                     "reference; give a {{frame}} pattern", a.reference));
+                                     "reference; give a {{frame}} pattern", a.reference()));
     if (std::uint64_t(frame) + a.sequence > 0xffffffffull)
         throw InputError(fmt::format("command line --frame {} --sequence {}: frames are 32-bit numbers (the last is "
                                      "4294967294)", frame, a.sequence));
@@ -343,7 +345,7 @@ void runConverge(const ConvergeArgs& a) {
     const auto threads = limitThreads(a.threads);
     const std::string prefix = a.out.empty() ? "out/" + scene.sceneName + ".converge" : a.out;
     OutputGuard guard = sceneInputs(scene);
-    guard.addInput(a.reference);
+    guard.addInput(a.reference());
     checkOutputs(guard, prefix, {".csv", ".png", ".json"}, "-o");
 
     const ParticleSource source(scene);
@@ -361,7 +363,7 @@ void runConverge(const ConvergeArgs& a) {
     writeJson(prefix + ".json", {{"version", std::string(version())},
                                  {"command", "converge"},
                                  {"scene", scene.scenePath},
-                                 {"reference", a.reference},
+                                 {"reference", a.reference()},
                                  {"frame", frame},
                                  {"budget_seconds", budget},
                                  {"history", a.history},

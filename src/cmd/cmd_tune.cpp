@@ -35,12 +35,14 @@
 #include "accretion/core/error.h"
 #include "accretion/core/parse.h"
 #include "accretion/core/read_file.h"
+#include "accretion/core/rng.h"
 #include "accretion/core/version.h"
 #include "accretion/gpu/cost_model.h"
 #include "accretion/io/plot.h"
 #include "accretion/io/report_table.h"
 #include "accretion/io/stats_writer.h"
 #include "accretion/particles/particle_source.h"
+#include "accretion/render/pixel_window.h"
 #include "child_process.h"
 #include "commands.h"
 
@@ -52,9 +54,11 @@ struct TuneArgs : SceneArgs {
     std::optional<double> maxError;
     std::uint32_t seeds = 16;
     std::optional<std::uint32_t> frame;  ///< default: render.frame_start + the steady state's history
-    std::string errorSize = "320x180";
+    std::string errorCrops = "4x2";     ///< strata of the frame, one crop each: COLUMNSxROWS
+    std::string cropSize = "192x108";   ///< each crop's size at the scene's resolution
+    std::uint32_t cropMargin = 64;      ///< the pixels around a crop restir renders for its reuse
     std::string space = "quick";
-    std::string reference;
+    std::vector<std::string> references;  ///< --reference: one per crop
     std::uint32_t referenceSpp = 1024;
     std::string out, cache;
     bool allowBiased = false;
@@ -187,9 +191,9 @@ struct TuneContext {
     const TuneArgs& args;
     std::filesystem::path cache;
     std::string sceneText;  ///< version + scene file + overrides: every cache key starts with it
-    std::uint32_t errorWidth = 0, errorHeight = 0;
-    std::string reference;
-    std::string unshadowedReference;  ///< --anatomy: the reference with shading.visibility = false
+    std::vector<PixelWindow> crops;  ///< where the error is measured: one crop per stratum of the frame
+    std::vector<std::string> references;           ///< one per crop
+    std::vector<std::string> unshadowedReferences;  ///< --anatomy: the references with shading.visibility = false
     std::uint32_t frame = 0;    ///< the measured frame
     std::uint32_t history = 0;  ///< frames before it: restir's steady state (steadyStateHistory)
     CostCoefficients coefficients;  ///< what prices the counters
@@ -314,15 +318,17 @@ ErrorRow measureErrorSeeds(TuneContext& t, const LightingChoice& o, std::uint32_
     std::string spec = "restir";
     for (const std::string& d : o.defines())
         if (d != "render.estimator=restir") spec += ":" + d;
-    std::string key = t.sceneText + fmt::format("\nbias {} seeds {} frame {} history {} {}x{} reference {}", spec, seeds, t.frame,
-                                                t.history, t.errorWidth, t.errorHeight, cacheKey(readWholeFile(t.reference, "tune")));
-    if (!t.unshadowedReference.empty()) key += "\nunshadowed " + cacheKey(readWholeFile(t.unshadowedReference, "tune"));
+    std::string key = t.sceneText + fmt::format("\nbias {} seeds {} frame {} history {} crop margin {}", spec, seeds, t.frame,
+                                                t.history, t.args.cropMargin);
+    for (const std::string& r : t.references) key += "\nreference " + cacheKey(readWholeFile(r, "tune"));
+    for (const std::string& r : t.unshadowedReferences) key += "\nunshadowed " + cacheKey(readWholeFile(r, "tune"));
     const std::filesystem::path prefix = t.cache / (cacheKey(key) + ".bias");
-    std::vector<std::string> argv = sceneArgv(t, "bias", {fmt::format("camera.width={}", t.errorWidth),
-                                                          fmt::format("camera.height={}", t.errorHeight)});
-    argv.insert(argv.end(), {"--reference", t.reference, "--estimators", spec, "--seeds", std::to_string(seeds), "--frame",
-                             std::to_string(t.frame), "--history", std::to_string(t.history), "-q", "-o", prefix.string()});
-    if (!t.unshadowedReference.empty()) argv.insert(argv.end(), {"--unshadowed-reference", t.unshadowedReference});
+    std::vector<std::string> argv = sceneArgv(t, "bias", {});
+    for (const std::string& r : t.references) argv.insert(argv.end(), {"--reference", r});
+    for (const std::string& r : t.unshadowedReferences) argv.insert(argv.end(), {"--unshadowed-reference", r});
+    argv.insert(argv.end(), {"--crop-margin", std::to_string(t.args.cropMargin), "--estimators", spec, "--seeds",
+                             std::to_string(seeds), "--frame", std::to_string(t.frame), "--history", std::to_string(t.history), "-q",
+                             "-o", prefix.string()});
     measure(t, MeasureKind::error, argv, prefix.string() + ".json", fmt::format("error of {} ({} seeds)", o.label(), seeds));
     const nlohmann::json j = nlohmann::json::parse(readWholeFile(prefix.string() + ".json", "tune"));
     const nlohmann::json& r = j.at("rows").at(0);
@@ -334,7 +340,7 @@ ErrorRow measureErrorSeeds(TuneContext& t, const LightingChoice& o, std::uint32_
     e.detectablePct = r.at("detectable_bias_pct").get<double>();
     e.seeds = seeds;
     if (j.contains("reuse") && j.at("reuse").contains(spec)) e.reuse = j.at("reuse").at(spec);
-    if (!t.unshadowedReference.empty()) e.visibilitySharePct = r.at("visibility_share_pct").get<double>();
+    if (!t.unshadowedReferences.empty()) e.visibilitySharePct = r.at("visibility_share_pct").get<double>();
     e.verdict = r.at("biased").get<bool>()                ? BiasVerdict::biased
               : e.detectablePct <= t.args.biasBoundPct ? BiasVerdict::unbiased
                                                         : BiasVerdict::unknown;
@@ -353,24 +359,29 @@ ErrorRow measureError(TuneContext& t, const LightingChoice& o) {
     return measureErrorSeeds(t, o, static_cast<std::uint32_t>(needed));
 }
 
-/// The reference of the error measurements: given, or rendered once (exact
-/// up to 20K particles, else split at --reference-spp) and cached.
-std::string ensureReference(TuneContext& t, std::size_t particles, bool visibility = true) {
-    if (!t.args.reference.empty() && visibility) return t.args.reference;
+/// The references of the error measurements, one per crop: given, or
+/// rendered once at the scene's resolution (exact up to 20K particles, else
+/// split at --reference-spp), each crop alone, and cached.
+std::vector<std::string> ensureReferences(TuneContext& t, std::size_t particles, bool visibility = true) {
+    if (!t.args.references.empty() && visibility) return t.args.references;
     const bool exact = particles <= 20000;
     const std::string how = exact ? "exact" : fmt::format("split {} spp", t.args.referenceSpp);
     const std::string unshadowed = visibility ? "" : ", every light visible";
-    const std::filesystem::path file = t.cache / (cacheKey(t.sceneText + fmt::format("\nreference {} frame {} {}x{}{}", how, t.frame,
-                                                                                      t.errorWidth, t.errorHeight, unshadowed)) + ".ref.exr");
-    std::vector<std::string> defines = {fmt::format("camera.width={}", t.errorWidth), fmt::format("camera.height={}", t.errorHeight)};
-    if (!visibility) defines.push_back("shading.visibility=false");
-    std::vector<std::string> argv = sceneArgv(t, "render", defines);
-    argv.insert(argv.end(), {"--estimator", exact ? "exact" : "split", "--frames", fmt::format("{}:{}", t.frame, t.frame + 1),
-                             "-o", file.string(), "--quiet"});
-    if (!exact) argv.insert(argv.end(), {"--spp", std::to_string(t.args.referenceSpp)});
-    ++t.steps;
-    measure(t, MeasureKind::reference, argv, file, fmt::format("reference ({}, {}x{}{})", how, t.errorWidth, t.errorHeight, unshadowed));
-    return file.string();
+    std::vector<std::string> files;
+    for (const PixelWindow& w : t.crops) {
+        const std::string crop = fmt::format("[{},{},{},{}]", w.x0, w.x1, w.y0, w.y1);
+        const std::filesystem::path file =
+            t.cache / (cacheKey(t.sceneText + fmt::format("\nreference {} frame {} crop {}{}", how, t.frame, crop, unshadowed)) + ".ref.exr");
+        std::vector<std::string> defines = {"render.crop=" + crop};
+        if (!visibility) defines.push_back("shading.visibility=false");
+        std::vector<std::string> argv = sceneArgv(t, "render", defines);
+        argv.insert(argv.end(), {"--estimator", exact ? "exact" : "split", "--frames", fmt::format("{}:{}", t.frame, t.frame + 1),
+                                 "-o", file.string(), "--quiet"});
+        if (!exact) argv.insert(argv.end(), {"--spp", std::to_string(t.args.referenceSpp)});
+        measure(t, MeasureKind::reference, argv, file, fmt::format("reference ({}, crop {}{})", how, crop, unshadowed));
+        files.push_back(file.string());
+    }
+    return files;
 }
 
 /// A measured configuration of the front's search.
@@ -396,28 +407,48 @@ void markFront(std::vector<ParetoPoint>& points) {
         }
 }
 
-/// --error-size WIDTHxHEIGHT, each side 8 to 8192.
-void parseErrorSize(const std::string& text, std::uint32_t& width, std::uint32_t& height) {
+/// AxB of two whole numbers 1..16384 (--error-crops, --crop-size).
+std::pair<std::uint32_t, std::uint32_t> parsePair(const std::string& text, const char* option, const char* example) {
     const auto x = text.find('x');
-    try {
-        if (x == std::string::npos) throw std::invalid_argument("no x");
-        width = static_cast<std::uint32_t>(std::stoul(text.substr(0, x)));
-        height = static_cast<std::uint32_t>(std::stoul(text.substr(x + 1)));
-    } catch (const std::exception&) {
-        throw InputError(fmt::format("command line --error-size {}: expected WIDTHxHEIGHT, e.g. 320x180", text));
-    }
-    if (width < 8 || height < 8 || width > 8192 || height > 8192)
-        throw InputError(fmt::format("command line --error-size {}: each side 8 to 8192 pixels", text));
+    const auto a = x == std::string::npos ? std::nullopt : parseUnsigned(text.substr(0, x));
+    const auto b = x == std::string::npos ? std::nullopt : parseUnsigned(text.substr(x + 1));
+    if (!a || !b || *a < 1 || *b < 1 || *a > 16384 || *b > 16384)
+        throw InputError(fmt::format("command line {} {}: expected AxB, two whole numbers from 1 to 16384, e.g. {}", option, text, example));
+    return {std::uint32_t(*a), std::uint32_t(*b)};
+}
+
+/// Where the error is measured, at the scene's resolution (never a
+/// downscaled frame: upsampling and reuse radii are in pixels): the frame
+/// cut into --error-crops strata, one --crop-size crop in each at a place
+/// drawn once per stratum (a fixed hash of its index), so that the crops'
+/// pixels are a stratified sample of the frame's. 1x1 with the frame's
+/// size measures the whole frame.
+std::vector<PixelWindow> errorCrops(const TuneArgs& a, const Settings& scene) {
+    const auto [cols, rows] = parsePair(a.errorCrops, "--error-crops", "4x2");
+    const auto [cw, ch] = parsePair(a.cropSize, "--crop-size", "192x108");
+    const std::uint32_t W = scene.camera.width, H = scene.camera.height;
+    const std::uint32_t sw = W / cols, sh = H / rows;
+    if (cw > sw || ch > sh)
+        throw InputError(fmt::format("command line --crop-size {}: a crop must fit its stratum, {}x{} for --error-crops {} of the "
+                                     "{}x{} frame", a.cropSize, sw, sh, a.errorCrops, W, H));
+    std::vector<PixelWindow> crops;
+    for (std::uint32_t r = 0; r < rows; ++r)
+        for (std::uint32_t c = 0; c < cols; ++c) {
+            const std::uint64_t h = mix64(0x9e3779b97f4a7c15ull * (std::uint64_t(r) * cols + c + 1));
+            const std::uint32_t x0 = c * sw + std::uint32_t((h & 0xffffffffu) % (sw - cw + 1));
+            const std::uint32_t y0 = r * sh + std::uint32_t((h >> 32) % (sh - ch + 1));
+            crops.push_back({x0, x0 + cw, y0, y0 + ch});
+        }
+    return crops;
 }
 
 /// The search's context with tune's numbers on the command line checked:
-/// the budget, --max-error, --error-size (before anything is made).
+/// the budget, --max-error (before anything is made; the crops with the scene).
 TuneContext checkTuneArgs(const TuneArgs& a) {
     if (!(a.budgetMs > 0.0) || !std::isfinite(a.budgetMs)) throw InputError("command line --budget-ms: expected a positive number of ms");
     if (a.maxError && (!(*a.maxError > 0.0) || !std::isfinite(*a.maxError)))
         throw InputError("command line --max-error: expected a positive relMSE");
     TuneContext t{a};
-    parseErrorSize(a.errorSize, t.errorWidth, t.errorHeight);
     return t;
 }
 
@@ -427,7 +458,7 @@ void prepareTune(TuneContext& t, const Settings& scene, const std::string& prefi
     const TuneArgs& a = t.args;
     t.cache = a.cache.empty() ? std::filesystem::path("out") / "tune_cache" / scene.sceneName : std::filesystem::path(a.cache);
     OutputGuard guard = sceneInputs(scene);
-    if (!a.reference.empty()) guard.addInput(a.reference);
+    for (const std::string& r : a.references) guard.addInput(r);
     checkOutputs(guard, prefix, {".csv", ".json", ".png"}, "-o");
     std::filesystem::create_directories(t.cache);
     if (auto dir = std::filesystem::path(prefix).parent_path(); !dir.empty()) std::filesystem::create_directories(dir);
@@ -507,7 +538,7 @@ Table geometryTable(const TuneResult& r) {
 
 Table lightingTable(const TuneArgs& a, const TuneResult& r) {
     Table lt({{"lighting", "lighting (on the chosen geometry)", -36}, {"gpu_ms", "GPU ms", 9, "{:.3f}", "{:.6g}"},
-              {"rel_mse", fmt::format("relMSE@{}", a.errorSize), 14, "{:.4g}", "{:.6g}"}, {"z", "bias z", 7, "{:.1f}", "{:.5g}"},
+              {"rel_mse", "relMSE", 10, "{:.4g}", "{:.6g}"}, {"z", "bias z", 7, "{:.1f}", "{:.5g}"},
               {"energy_loss_pct", "loss %", 7, "{:.1f}", "{:.5g}"}, {"detectable_bias_pct", "bound %", 8, "{:.2g}", "{:.5g}"},
               {"seeds", "seeds", 6}, {"temporal_kept_pct", "temp kept%", 10, "{:.0f}", "{:.4g}"},
               {"spatial_kept_pct", "spat kept%", 10, "{:.0f}", "{:.4g}"}, {"spatial_other_particle_pct", "of them other%", 14, "{:.0f}", "{:.4g}"},
@@ -531,8 +562,10 @@ Table lightingTable(const TuneArgs& a, const TuneResult& r) {
 /// The tables and the verdict on stdout.
 void printTune(const TuneArgs& a, const Settings& scene, const TuneContext& t, const TuneResult& r, const Table& gt, const Table& lt) {
     fmt::print("{}\n{}", gt.console(), lt.console());
-    fmt::print("measured at frame {} after {} history frames (restir's steady state: temporal reuse to its M cap of {:g})\n",
-               t.frame, t.history, scene.restir.m_cap);
+    fmt::print("measured at frame {} after {} history frames (restir's steady state: temporal reuse to its M cap of {:g}), at "
+               "{}x{} on {} crops of {} ({} strata; restir with {} pixels of margin)\n",
+               t.frame, t.history, scene.restir.m_cap, scene.camera.width, scene.camera.height, t.crops.size(), a.cropSize,
+               a.errorCrops, a.cropMargin);
     const GeometryChoice& chosen = r.chosen->choice;
     fmt::print("geometry: {} ({:.3f} ms predicted at {}x{}, the scene's lighting)\nGPU time: {}\n", chosen.label(),
                total(r.chosen->ms), scene.camera.width, scene.camera.height, t.coefficients.source);
@@ -543,9 +576,9 @@ void printTune(const TuneArgs& a, const Settings& scene, const TuneContext& t, c
         fmt::print("on a GPU with RT cores prefer {} ({:+.3f} ms here): boxes win only where traversal runs in software\n",
                    r.triangles->choice.label(), total(r.triangles->ms) - total(r.chosen->ms));
     if (const ParetoPoint* best = r.best)
-        fmt::print("recommended under {:g} ms{}: {} + {}: {:.3f} GPU ms predicted, relMSE {:.4g} at {} ({} seeds), {}\n", a.budgetMs,
+        fmt::print("recommended under {:g} ms{}: {} + {}: {:.3f} GPU ms predicted, relMSE {:.4g} ({} seeds), {}\n", a.budgetMs,
                    a.maxError ? fmt::format(" and relMSE {:g}", *a.maxError) : "", chosen.label(), best->lighting.label(), best->ms,
-                   best->error.relMse, a.errorSize, best->error.seeds,
+                   best->error.relMse, best->error.seeds,
                    best->error.label().empty() ? fmt::format("unbiased to {:.2g}%", best->error.detectablePct) : best->error.label());
     else
         fmt::print("no {}configuration is under {:g} ms{}\n", a.allowBiased ? "" : "unbiased ", a.budgetMs,
@@ -560,6 +593,12 @@ void printTune(const TuneArgs& a, const Settings& scene, const TuneContext& t, c
     }
     fmt::print("time: {:.0f} s of measurements: {}\n", total, spent);
     std::fflush(stdout);
+}
+
+nlohmann::json cropsJson(const std::vector<PixelWindow>& crops) {
+    nlohmann::json j = nlohmann::json::array();
+    for (const PixelWindow& w : crops) j.push_back({w.x0, w.x1, w.y0, w.y1});
+    return j;
 }
 
 /// PREFIX.json: what made the search and what it found.
@@ -582,8 +621,9 @@ void writeTuneJson(const std::string& prefix, const TuneArgs& a, const Settings&
     writeJson(prefix + ".json", {{"version", std::string(version())}, {"command", "tune"}, {"scene", scene.scenePath},
                                  {"defines", a.defines}, {"settings", settingsToToml(scene)}, {"seed", scene.render.seed},
                                  {"budget_ms", a.budgetMs}, {"bias_bound_pct", a.biasBoundPct}, {"max_seeds", a.maxSeeds}, {"max_error", a.maxError ? nlohmann::json(*a.maxError) : nlohmann::json()},
-                                 {"seeds", a.seeds}, {"frame", t.frame}, {"history_frames", t.history}, {"error_size", a.errorSize}, {"reference", t.reference},
-                                 {"unshadowed_reference", t.unshadowedReference.empty() ? nlohmann::json() : nlohmann::json(t.unshadowedReference)},
+                                 {"seeds", a.seeds}, {"frame", t.frame}, {"history_frames", t.history}, {"error_crops", a.errorCrops}, {"crop_size", a.cropSize},
+                                 {"crop_margin", a.cropMargin}, {"crops", cropsJson(t.crops)}, {"references", t.references},
+                                 {"unshadowed_references", t.unshadowedReferences},
                                  {"space", a.space}, {"coefficients", t.coefficients.source}, {"geometry", gt.json()},
                                  {"fastest_triangle_geometry", r.triangles->choice.label()}, {"chosen_geometry", chosen.label()},
                                  {"lighting", lt.json()}, {"reuse", reuse}, {"recommended", recommended}, {"time", spentJson(t)}});
@@ -595,7 +635,7 @@ void plotTune(const std::string& prefix, const TuneArgs& a, const Settings& scen
     const ParetoPoint* best = r.best;
     const std::string script = fmt::format(
         "set datafile separator ','\nset logscale y\nset grid\nset key top right\n"
-        "set title {0}\nset xlabel 'predicted GPU ms per frame ({1}; calibrated cost model)'\nset ylabel 'relMSE at {2} ({3} seeds)'\n"
+        "set title {0}\nset xlabel 'predicted GPU ms per frame ({1}; calibrated cost model)'\nset ylabel 'relMSE on {2} ({3} seeds)'\n"
         "set arrow from {4},graph 0 to {4},graph 1 nohead dt 2 lc rgb 'gray40'\n"
         "set label 'budget' at {4},graph 0.95 right offset -0.5,0 tc rgb 'gray40'\n{6}"
         "plot {5} skip 1 using 2:($7 == 0 ? $3 : NaN) with points pt 7 lc rgb 'gray60' title 'configurations', "
@@ -603,7 +643,7 @@ void plotTune(const std::string& prefix, const TuneArgs& a, const Settings& scen
         "{5} skip 1 using 2:($8 != 0 ? $3 : NaN) with points pt 6 ps 2 lc rgb 'blue' title 'Pareto front'\n",
         gnuplotQuote(fmt::format("{} ({} particles) at {}x{}: budget {:g} ms", scene.sceneName, particles,
                                  scene.camera.width, scene.camera.height, a.budgetMs)),
-        r.chosen->choice.label(), a.errorSize, a.seeds, a.budgetMs, csv,
+        r.chosen->choice.label(), fmt::format("{} crops of {}", a.errorCrops, a.cropSize), a.seeds, a.budgetMs, csv,
         best ? fmt::format("set label 'recommended' at {},{} point pt 3 ps 3 lc rgb 'dark-green' offset 1,1 tc rgb 'dark-green'\n", best->ms,
                            best->error.relMse)
              : std::string());
@@ -625,11 +665,15 @@ void runTune(const TuneArgs& a) {
     const std::vector<GeometryChoice> geometry = geometryChoices(scene);
     const std::vector<LightingChoice> lighting = lightingChoices(a.space);
     const std::string prefix = a.out.empty() ? "out/" + scene.sceneName + ".tune" : a.out;
+    t.crops = errorCrops(a, scene);
     prepareTune(t, scene, prefix);
-    t.steps = geometry.size() + 2 * lighting.size();
+    t.steps = geometry.size() + 2 * lighting.size() + (a.references.empty() ? t.crops.size() : 0) + (a.anatomy ? t.crops.size() : 0);
     const std::size_t particles = ParticleSource(scene).frame(t.frame).size();
-    t.reference = ensureReference(t, particles);
-    if (a.anatomy) t.unshadowedReference = ensureReference(t, particles, false);
+    t.references = ensureReferences(t, particles);
+    if (!a.references.empty() && a.references.size() != t.crops.size())
+        throw InputError(fmt::format("command line --reference: {} given, one per crop of --error-crops {} ({})", a.references.size(),
+                                     a.errorCrops, t.crops.size()));
+    if (a.anatomy) t.unshadowedReferences = ensureReferences(t, particles, false);
 
     // Geometry: the same image whatever it is; the fastest predicted frame.
     TuneResult r;
@@ -662,15 +706,22 @@ void addTuneCommand(CLI::App& app) {
     addSceneOptions(cmd, *args, "");
     cmd->remove_option(cmd->get_option("--frames"));  // tune measures one frame: --frame
     cmd->add_option("--budget-ms", args->budgetMs, "GPU time budget of a frame, ms (the cost model's prediction)")->required();
-    cmd->add_option("--max-error", args->maxError, "Recommend the fastest configuration with relMSE at most this (at --error-size)");
+    cmd->add_option("--max-error", args->maxError, "Recommend the fastest configuration with relMSE at most this (on the crops)");
     cmd->add_option("--seeds", args->seeds, "Seeds per lighting configuration for its error and bias")->check(CLI::Range(2u, 100000u));
     cmd->add_option("--frame", args->frame,
                     "The measured frame, after the history that brings temporal reuse to steady state (ceil(restir.m_cap) "
                     "frames, at least 8; default: render.frame_start + that history)");
-    cmd->add_option("--error-size", args->errorSize, "Resolution of the error measurements, WIDTHxHEIGHT");
+    cmd->add_option("--error-crops", args->errorCrops,
+                    "Where the error is measured, at the scene's resolution: the frame cut into COLUMNSxROWS strata, one crop "
+                    "each (1x1 with --crop-size the frame's: the whole frame)");
+    cmd->add_option("--crop-size", args->cropSize, "Each crop's size in pixels, WIDTHxHEIGHT");
+    cmd->add_option("--crop-margin", args->cropMargin, "The pixels around each crop that restir renders for its reuse (restir.crop_margin)")
+        ->check(CLI::Range(0u, 16384u));
     cmd->add_option("--space", args->space, "quick (34 lighting configurations) or full (1080: hours)");
-    cmd->add_option("--reference", args->reference,
-                    "Reference EXR at --error-size and --frame (default: rendered once, exact up to 20K particles, else split)");
+    cmd->add_option("--reference", args->references,
+                    "Reference EXRs of --frame, one per crop in stratum order, row by row (default: rendered once, exact up to 20K "
+                    "particles, else split)")
+        ->allow_extra_args(false);
     cmd->add_option("--reference-spp", args->referenceSpp, "split's samples per pixel for the rendered reference")
         ->check(CLI::Range(1u, 1u << 20));
     cmd->add_option("--cache", args->cache, "Folder of cached measurements (default out/tune_cache/<scene>)");

@@ -27,7 +27,9 @@ struct SceneArgs {
 /// Options of the experiment commands (converge, bias): a scene measured
 /// against a reference, per estimator spec, over seeds.
 struct ExperimentArgs : SceneArgs {
-    std::string reference, estimators, out;
+    std::vector<std::string> references;  ///< --reference (bias: one per crop of the view; converge: one)
+    std::string estimators, out;
+    const std::string& reference() const { return references.front(); }
     std::string history = "steady";  ///< --history: "steady" or frames (HistoryChoice)
     std::uint32_t seeds = 1;
     std::optional<std::uint32_t> frame;

@@ -81,7 +81,7 @@ void addSceneOptions(CLI::App* cmd, SceneArgs& args, const std::string& framesHe
 void addExperimentOptions(CLI::App* cmd, ExperimentArgs& args, const std::string& referenceHelp,
                           const std::string& estimatorsHelp, const std::string& outHelp) {
     addSceneOptions(cmd, args, "Frames A:B (= render.frame_start, render.frames); the first is measured");
-    cmd->add_option("--reference", args.reference, referenceHelp)->required();
+    cmd->add_option("--reference", args.references, referenceHelp)->required()->allow_extra_args(false);
     cmd->add_option("--estimators", args.estimators, estimatorsHelp);
     cmd->add_option("--frame", args.frame, "Frame measured (default render.frame_start)")
         ->check(unsignedNumber())

@@ -34,8 +34,8 @@ Camera Camera::fromPose(const CameraPose& pose, std::uint32_t width, std::uint32
     c.sampleYD = 0.5 + pose.jitterY;
     c.sampleX = float(c.sampleXD);
     c.sampleY = float(c.sampleYD);
-    c.width = width;
-    c.height = height;
+    c.width = c.imageWidth = width;
+    c.height = c.imageHeight = height;
     return c;
 }
 

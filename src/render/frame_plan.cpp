@@ -9,6 +9,19 @@
 namespace accretion {
 namespace {
 
+/// restir with restir.crop_margin: render.crop and the margin around it,
+/// its corners on the 8-pixel grid of the traced tiles, within the image;
+/// else the whole image.
+PixelWindow restirWindow(const Settings& s) {
+    const PixelWindow whole = PixelWindow::whole(s.camera.width, s.camera.height);
+    if (!estimatorInfo(s.render.estimator).reuse || s.restir.crop_margin < 0.0 || s.render.crop.size() != 4) return whole;
+    const PixelWindow crop = PixelWindow::of(s);
+    const auto m = static_cast<std::uint32_t>(s.restir.crop_margin);
+    auto down = [&](std::uint32_t v) { return (v > m ? v - m : 0u) / 8u * 8u; };
+    auto up = [&](std::uint32_t v, std::uint32_t end) { return std::min<std::uint64_t>(end, (std::uint64_t(v) + m + 7u) / 8u * 8u); };
+    return {down(crop.x0), std::uint32_t(up(crop.x1, whole.x1)), down(crop.y0), std::uint32_t(up(crop.y1, whole.y1))};
+}
+
 /// The run-wide part of the plan: the same for every frame.
 void planRun(const Settings& s, FramePlan& plan) {
     const bool staticCamera = s.camera.path == CameraPath::static_pose ||
@@ -23,6 +36,9 @@ void planRun(const Settings& s, FramePlan& plan) {
     plan.counting = s.gpu.counters;
     ACC_CHECK(!restir || !cropRendersAlone(s));  // reuse reads the neighbours: the whole frame
     plan.traced = cropRendersAlone(s) ? PixelWindow::of(s) : PixelWindow::whole(s.camera.width, s.camera.height);
+    plan.frameWindow = restirWindow(s);
+    if (!plan.frameWindow.isWhole(s.camera.width, s.camera.height))
+        plan.traced = PixelWindow::whole(plan.frameWindow.width(), plan.frameWindow.height());
 }
 
 /// This frame's passes.
@@ -76,8 +92,12 @@ void describe(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
     if (estimatorInfo(est).nearField)
         step(Pass::chooseNearLights, plan.chooseNearLights ? "the pilot picks render.near_lights from V(k) x (k + rho S) at 64 pixels across"
                                      : dark ? noLight : fmt::format("render.near_lights = {}", s.render.near_lights));
+    const PixelWindow& fw = plan.frameWindow;
     step(Pass::traceGBuffer,
-         plan.traced.isWhole(s.camera.width, s.camera.height)
+         !fw.isWhole(s.camera.width, s.camera.height)
+             ? fmt::format("one primary ray per pixel of render.crop and its restir.crop_margin: the {}x{} window at ({}, {})",
+                           fw.width(), fw.height(), fw.x0, fw.y0)
+         : plan.traced.isWhole(s.camera.width, s.camera.height)
              ? std::string("one primary ray per pixel")
              : fmt::format("one primary ray per pixel of render.crop's {}x{} window", plan.traced.width(), plan.traced.height()));
     step(Pass::estimateLighting,

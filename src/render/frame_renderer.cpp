@@ -89,13 +89,15 @@ void composeImage(const GBuffer& gbuffer, const Particles& particles, const Shad
     stats.meanSpp = t.hits ? t.sppSum / double(t.hits) : 0.0;
 }
 
-/// Cut every per-pixel layer of `img` (of the whole image) to its window:
-/// restir and counting mode render the whole frame and keep render.crop's
-/// pixels. The counters stay the whole dispatch's.
-void cropLayers(FrameImage& img) {
-    const PixelWindow& w = img.window;
+/// Cut every per-pixel layer of `img` (rendered `rendered`, a window of the
+/// image) to img.window: restir and counting mode render the whole frame,
+/// restir with restir.crop_margin the crop's margin too, and keep
+/// render.crop's pixels. The counters stay the whole dispatch's.
+void cropLayers(FrameImage& img, const PixelWindow& rendered) {
+    const PixelWindow& c = img.window;
+    const PixelWindow w{c.x0 - rendered.x0, c.x1 - rendered.x0, c.y0 - rendered.y0, c.y1 - rendered.y0};
     auto cut = [&](auto& layer) {
-        if (!layer.empty()) layer = cropPixels(layer, img.width, w);
+        if (!layer.empty()) layer = cropPixels(layer, rendered.width(), w);
     };
     LightingImage& lit = img.lighting;
     ReservoirImage& res = img.reservoirs;
@@ -233,7 +235,11 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const L
     const Camera world = Camera::fromPose(pose, settings_.camera.width, settings_.camera.height);
     const bool persistent = plan_.staticGeometry || plan_.updateInPlace;
     if (!built_ || !persistent) origin_ = world.position;
-    const Camera camera = world.rebased(origin_);
+    // The frame's image: the whole, or restir's window of it (plan.frameWindow).
+    const PixelWindow fw = plan_.frameWindow;
+    const Camera camera = fw.isWhole(world.width, world.height)
+                              ? world.rebased(origin_)
+                              : world.rebased(origin_).window(fw.x0, fw.y0, fw.width(), fw.height());
     stats.origin = origin_;
     PassTimer& timer = stats.timer;
 
@@ -277,7 +283,13 @@ FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const L
         img.counters.accel = bvh_->accelCounters();
         img.heatmaps = counterHeatmaps(img.counters, img.width, img.height);
     }
-    if (traced != img.window) cropLayers(img);
+    if (camera.isWindow()) {  // the layers are the window's: cut to render.crop, in the image's coordinates
+        cropLayers(img, fw);
+        img.width = world.width;
+        img.height = world.height;
+    } else if (traced != img.window) {
+        cropLayers(img, PixelWindow::whole(img.width, img.height));
+    }
     stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return img;
 }

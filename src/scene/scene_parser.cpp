@@ -321,6 +321,11 @@ void validateSampling(const Settings& s, const RuleFailure& fail) {
                                             "0 <= y0 < y1 <= height; x1 and y1 are past the window)",
                                             c[0], c[1], c[2], c[3], s.camera.width, s.camera.height));
     }
+    if (const double m = s.restir.crop_margin; m != -1.0) {
+        if (m < 0.0 || m != std::floor(m)) fail("restir.crop_margin", fmt::format("a number of pixels, or -1 for the whole frame (got {})", m));
+        if (s.render.crop.empty()) fail("restir.crop_margin", "is the margin of render.crop, which is not set");
+        if (s.gpu.counters) fail("restir.crop_margin", "gpu.counters counts the GPU's dispatch, which is the whole frame");
+    }
     if (s.render.target_stderr > 0.0 && s.render.max_samples < s.render.samples)
         fail("render.max_samples", fmt::format("must be at least render.samples ({}) when target_stderr is set", s.render.samples));
 }

@@ -11,6 +11,7 @@
 
 #include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "accretion/analysis/image_metrics.h"
 #include "accretion/io/exr_output.h"
@@ -360,4 +361,57 @@ TEST_CASE("converge --sequence: flicker is two frames' error where frames are in
         INFO("restir frame " << f << ": " << restirRatio);
         CHECK(restirRatio < 0.8 * ratio);
     }
+}
+
+TEST_CASE("bias over crops of the view: each pixel's figures are the whole frame's, restir's with a margin over the whole frame",
+          "[cli][experiments][crops]") {
+    const auto dir = accretion::test::scratchDir("bias_crops");
+    std::string out;
+    const std::string scene = tinyScene() + " --quiet --frames 20:21";
+    REQUIRE(runCommand(kBin + " render " + scene + " --estimator exact -o " + (dir / "whole.exr").string(), out) == 0);
+    // Two crops of the 96x64 frame, rendered alone: the references of a stratified measurement.
+    REQUIRE(runCommand(kBin + " render " + scene + " --estimator exact -D render.crop=[8,40,8,32] -o " + (dir / "a.exr").string(), out) == 0);
+    REQUIRE(runCommand(kBin + " render " + scene + " --estimator exact -D render.crop=[56,88,30,54] -o " + (dir / "b.exr").string(), out) == 0);
+    const std::string common = kBin + " bias " + tinyScene() + " --quiet --frame 20 --seeds 3 --estimators ris,restir:pairwise ";
+    REQUIRE(runCommand(common + "--reference " + (dir / "whole.exr").string() + " -o " + (dir / "w").string(), out) == 0);
+    // A margin beyond the frame: restir renders the whole frame for each crop.
+    const std::string crops = "--reference " + (dir / "a.exr").string() + " --reference " + (dir / "b.exr").string();
+    REQUIRE(runCommand(common + crops + " --crop-margin 1000 -o " + (dir / "c").string(), out) == 0);
+    INFO(out);
+    // The bias maps: the crops' pixels are the whole run's bit for bit (ris
+    // renders a crop alone as the whole frame does; restir renders the whole
+    // frame here), zero elsewhere.
+    for (const char* est : {"ris", "restir_pairwise"}) {
+        INFO(est);
+        const RgbLayer whole = readExrLayer(dir / fmt::format("w.{}.exr", est), "bias");
+        const RgbLayer cropped = readExrLayer(dir / fmt::format("c.{}.exr", est), "bias");
+        REQUIRE(cropped.width == 96);
+        std::size_t inside = 0, same = 0, zeroOutside = 0, outside = 0;
+        for (std::uint32_t y = 0; y < 64; ++y)
+            for (std::uint32_t x = 0; x < 96; ++x) {
+                const std::size_t p = std::size_t(y) * 96 + x;
+                const bool in = (x >= 8 && x < 40 && y >= 8 && y < 32) || (x >= 56 && x < 88 && y >= 30 && y < 54);
+                if (in) {
+                    ++inside;
+                    same += cropped.rgb[p] == whole.rgb[p];
+                } else {
+                    ++outside;
+                    zeroOutside += cropped.rgb[p] == Vec3(0.0f);
+                }
+            }
+        CHECK(inside == 2 * 32 * 24);
+        CHECK(same == inside);
+        CHECK(zeroOutside == outside);
+    }
+    const nlohmann::json j = nlohmann::json::parse(readFile(dir / "c.json"));
+    CHECK(j["crops"].size() == 2);
+    CHECK(j["crop_margin"] == 1000);
+    CHECK(j.at("reuse").contains("restir:pairwise"));
+    // With the default margin restir renders each crop's window alone: its
+    // figures move (another window, other edges) but stay of one estimator.
+    REQUIRE(runCommand(common + crops + " -o " + (dir / "m").string(), out) == 0);
+    // Overlapping crops and a reference of another size are refused, naming the files.
+    CHECK(runCommand(common + crops + " --reference " + (dir / "a.exr").string() + " -o " + (dir / "bad").string(), out) == 1);
+    CHECK_THAT(out, Contains("a.exr") && Contains("overlap"));
+    CHECK_FALSE(std::filesystem::exists(dir / "bad.json"));
 }

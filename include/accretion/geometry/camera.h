@@ -38,6 +38,12 @@ struct Camera {
     /// pose's jitter; float and double as the rays use them.
     float sampleX = 0.5f, sampleY = 0.5f;
     double sampleXD = 0.5, sampleYD = 0.5;
+    /// A window of a larger image (window()): that image's size, and where
+    /// this camera's pixel (0, 0) lies in it. The whole image by default
+    /// (fromPose): the offsets are 0 and the image is width x height.
+    std::uint32_t imageWidth = 0, imageHeight = 0;
+    float pixelX0 = 0.0f, pixelY0 = 0.0f;
+    double pixelX0D = 0.0, pixelY0D = 0.0;
 
     /// The camera of a frame along the scene's path.
     static Camera atFrame(const CameraSettings& s, std::uint32_t frame);
@@ -46,20 +52,37 @@ struct Camera {
     /// The camera of a pose: its float basis is the rounding of the double one.
     static Camera fromPose(const CameraPose& pose, std::uint32_t width, std::uint32_t height);
 
+    /// The camera of the w x h window at (x0, y0) of this camera's image: its
+    /// pixel (x, y) is the image's (x0 + x, y0 + y), the same ray bit for bit
+    /// (integers below 2^24 add exactly), and project() gives window pixels.
+    /// A renderer that runs on the window's pixels alone (restir.crop_margin)
+    /// renders that part of the image.
+    Camera window(std::uint32_t x0, std::uint32_t y0, std::uint32_t w, std::uint32_t h) const {
+        Camera c = *this;
+        c.width = w;
+        c.height = h;
+        c.pixelX0 = pixelX0 + float(x0);
+        c.pixelY0 = pixelY0 + float(y0);
+        c.pixelX0D = pixelX0D + double(x0);
+        c.pixelY0D = pixelY0D + double(y0);
+        return c;
+    }
+    bool isWindow() const { return width != imageWidth || height != imageHeight; }
+
     /// Unit direction of the ray through pixel (x, y)'s sample position (the
     /// centre, jittered); y = 0 is the top row.
     ACC_HD Vec3 pixelDirection(std::uint32_t x, std::uint32_t y) const {
-        const float aspect = float(width) / float(height);
-        const float sx = ((float(x) + sampleX) / float(width) * 2.0f - 1.0f) * tanHalfFov * aspect;
-        const float sy = (1.0f - (float(y) + sampleY) / float(height) * 2.0f) * tanHalfFov;
+        const float aspect = float(imageWidth) / float(imageHeight);
+        const float sx = ((float(x) + pixelX0 + sampleX) / float(imageWidth) * 2.0f - 1.0f) * tanHalfFov * aspect;
+        const float sy = (1.0f - (float(y) + pixelY0 + sampleY) / float(imageHeight) * 2.0f) * tanHalfFov;
         return glm::normalize(forward + sx * right + sy * up);
     }
 
     /// The same ray in double: what primary hits are refined along.
     ACC_HD DVec3 pixelRay(std::uint32_t x, std::uint32_t y) const {
-        const double aspect = double(width) / double(height);
-        const double sx = ((double(x) + sampleXD) / double(width) * 2.0 - 1.0) * tanHalfFovD * aspect;
-        const double sy = (1.0 - (double(y) + sampleYD) / double(height) * 2.0) * tanHalfFovD;
+        const double aspect = double(imageWidth) / double(imageHeight);
+        const double sx = ((double(x) + pixelX0D + sampleXD) / double(imageWidth) * 2.0 - 1.0) * tanHalfFovD * aspect;
+        const double sy = (1.0 - (double(y) + pixelY0D + sampleYD) / double(imageHeight) * 2.0) * tanHalfFovD;
         return glm::normalize(forwardD + sx * rightD + sy * upD);
     }
 
@@ -71,7 +94,7 @@ struct Camera {
         return c;
     }
 
-    /// Continuous pixel coordinates (the frame's sample positions at +0.5, so
+    /// Continuous pixel coordinates (of the window, for a window camera; the frame's sample positions at +0.5, so
     /// that a jittered frame's own samples project to pixel centres) and
     /// camera-space depth of a world point; false when it is not in front of
     /// the camera.
@@ -79,11 +102,11 @@ struct Camera {
         const Vec3 d = p - position;
         depth = glm::dot(d, forward);
         if (!(depth > 0.0f)) return false;
-        const float aspect = float(width) / float(height);
+        const float aspect = float(imageWidth) / float(imageHeight);
         const float sx = glm::dot(d, right) / (depth * tanHalfFov * aspect);
         const float sy = glm::dot(d, up) / (depth * tanHalfFov);
-        px = (sx + 1.0f) * 0.5f * float(width) - (sampleX - 0.5f);
-        py = (1.0f - sy) * 0.5f * float(height) - (sampleY - 0.5f);
+        px = (sx + 1.0f) * 0.5f * float(imageWidth) - (sampleX - 0.5f) - pixelX0;
+        py = (1.0f - sy) * 0.5f * float(imageHeight) - (sampleY - 0.5f) - pixelY0;
         return true;
     }
 };

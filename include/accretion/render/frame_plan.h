@@ -50,6 +50,11 @@ struct FramePlan {
     /// render.crop's window where cropRendersAlone (settings.h), else the
     /// whole image, whose layers are cut to the crop after the frame.
     PixelWindow traced;
+    /// The part of the image the frame renders as an image of its own: the
+    /// whole image, or for restir with restir.crop_margin render.crop and
+    /// that margin around it (aligned to 8 pixels, within the image), seen
+    /// through Camera::window. `traced` is then that window, whole.
+    PixelWindow frameWindow;
     // This frame.
     bool loadParticles = true;    ///< load (or generate) the particles
     bool buildClusters = true;    ///< build (or refit) the BVH

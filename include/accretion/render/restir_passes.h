@@ -64,6 +64,15 @@ struct ReuseParams {
     std::uint32_t candidates = 16;        ///< render.candidates
     std::uint32_t neighbours = 0;         ///< restir.spatial_neighbours
     float radius = 1.0f;                  ///< spatial disc radius in lighting texels (>= 1)
+    /// A lighting grid that is a window of the frame's (restir.crop_margin):
+    /// the whole grid's width and the window's origin in it (0: the grid is
+    /// the whole). A texel's streams are keyed by its index in the whole
+    /// grid, so a window draws each texel's numbers as the whole frame does.
+    std::uint32_t wholeWidth = 0, originX = 0, originY = 0;
+    ACC_HD std::uint64_t streamKey(std::size_t px) const {
+        if (wholeWidth == 0) return px;
+        return (std::uint64_t(px / width) + originY) * wholeWidth + px % width + originX;
+    }
 };
 
 /// The ReuseParams of a frame: the lighting grid (width x height, `scale` x
@@ -113,7 +122,7 @@ ACC_HD_BODY void generateCandidatesTexel(B& b, const Source& source, std::size_t
     rec.gather(M * source.gathers());
     rec.write(b.reservoirBytes());
     const ShadingPoint sp = b.shadingPoint(g);
-    typename B::Rng rng(px, p.frame, RngPass::restirCandidates, p.seed);
+    typename B::Rng rng(p.streamKey(px), p.frame, RngPass::restirCandidates, p.seed);
     const auto drawer = source.at(sp, x, y, rng);
     Reservoir r;
     if (!resampleCandidates(
@@ -176,7 +185,7 @@ ACC_HD_BODY void temporalResamplingTexel(B& b, std::size_t px) {
     prev.M = capHistoryM(prev.M, cur.M, p.mCap);
     if (prev.M != historyM) b.historyCapped();
     offers.addHistory(prev, q);
-    typename B::Rng rng(px, p.frame, RngPass::restirTemporal, p.seed);
+    typename B::Rng rng(p.streamKey(px), p.frame, RngPass::restirTemporal, p.seed);
     b.keep(px, sanitizeReservoir(offers.combine(rng), [&] { return b.reject(px); }));
 }
 
@@ -196,7 +205,7 @@ ACC_HD_BODY void spatialResamplingTexel(B& b, std::size_t px, std::uint32_t x, s
     rec.read(R + gpu_layout::kParticleRecord);
     rec.gather(1);
     rec.write(R);
-    typename B::Rng rng(px ^ (std::uint64_t(iteration) << 40), p.frame, RngPass::restirSpatial, p.seed);
+    typename B::Rng rng(p.streamKey(px) ^ (std::uint64_t(iteration) << 40), p.frame, RngPass::restirSpatial, p.seed);
     auto offers = b.template offers<kMaxOffers>();
     offers.addCurrent(b.input(px), g);
     for (std::uint32_t s = 0; s < p.neighbours; ++s) {

@@ -285,6 +285,7 @@ struct RestirSettings {
     double normal_threshold = 0.9;           ///< reject a neighbour whose normal . n is below this
     double depth_threshold = 0.1;            ///< reject a neighbour whose depth differs by more than this fraction
     double resolution_scale = 1.0;           ///< lighting resolution relative to the image (bilateral upsample)
+    double crop_margin = -1.0;               ///< with render.crop: the pixels around it restir renders for its reuse (-1: the whole frame)
     ReservoirLayout layout = ReservoirLayout::full; ///< stored reservoir: full (16 B) or packed
     std::uint32_t light_bits = 20;           ///< packed: bits of the light index (the rest of 32 hold M)
     bool half_weights = true;                ///< packed: W and p_hat as half floats (8 B) rather than floats (12 B)
@@ -311,6 +312,7 @@ struct RestirSettings {
         v.field("normal_threshold", normal_threshold, "neighbour rejection: minimum normal dot product", Range{-1.0, 1.0});
         v.field("depth_threshold", depth_threshold, "neighbour rejection: maximum relative depth difference", kNonNegative);
         v.field("resolution_scale", resolution_scale, "lighting resolution / image resolution (bilateral upsample)", Range{0.0, 1.0, true});
+        v.field("crop_margin", crop_margin, "with render.crop: restir renders the crop and this many pixels around it (a window of the frame, aligned to 8 pixels), not the whole frame; a neighbour or history beyond it is off-screen (-1: the whole frame)", Range{-1.0, 16384.0});
         v.field("layout", layout, "stored reservoir layout: full (16 B) or packed (light index + M in 32 bits, weights)");
         v.field("light_bits", light_bits, "packed: light index bits (M gets 32 - light_bits)", Range{1, 31});
         v.field("half_weights", half_weights, "packed: W and p_hat as half floats (8 B) instead of floats (12 B)");

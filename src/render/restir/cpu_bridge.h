@@ -15,7 +15,11 @@ namespace accretion::restir {
 
 /// The ReuseParams of a CPU frame.
 inline ReuseParams reuseParams(const FrameContext& f) {
-    return reuseParams(f.in.settings, f.in.frame, f.in.settings.render.seed, f.lg.width, f.lg.height, f.scale);
+    ReuseParams p = reuseParams(f.in.settings, f.in.frame, f.in.settings.render.seed, f.lg.width, f.lg.height, f.scale);
+    p.wholeWidth = f.wholeWidth;
+    p.originX = f.originX;
+    p.originY = f.originY;
+    return p;
 }
 
 /// What a CPU pass reads and writes: its input reservoirs, its output (the

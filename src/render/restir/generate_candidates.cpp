@@ -41,7 +41,9 @@ struct CpuSource {
     Drawer at(const ShadingPoint& sp, std::uint32_t x, std::uint32_t y, Rng& rng) const {
         std::uint32_t tile = 0;
         std::int64_t cell = -1;
-        if constexpr (presampled) tile = f.tiles->tileOf(x, y, f.lg.width, f.in.frame, f.in.settings.render.seed);
+        if constexpr (presampled)  // by the texel's place in the whole grid (a window's too)
+            tile = f.tiles->tileOf(x + f.originX, y + f.originY, f.wholeWidth ? f.wholeWidth : f.lg.width, f.in.frame,
+                                   f.in.settings.render.seed);
         if constexpr (sourceInfo(S).regirGrid) cell = f.regir->jitteredCell(sp.x, float(f.rs.regir_jitter), rng);
         return {f, sp, tile, cell};
     }

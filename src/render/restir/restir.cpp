@@ -114,7 +114,7 @@ Restir::Restir(const Settings& settings, bool keepHistory)
 LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, ReservoirImage& aov, PassTimer& timer,
                                 PassRejections& rejected, PassReuse& reuse) {
     const GBuffer& full = in.gbuffer;
-    ACC_CHECK(full.whole());  // spatial reuse reads the neighbours, history is the whole frame's
+    ACC_CHECK(full.whole());  // spatial reuse reads the neighbours, history is the frame's (or its window's: restir.crop_margin)
     const std::size_t pixels = std::size_t(full.width) * full.height;
     out.Lr.assign(pixels, Vec3(0.0f));
     out.Lr_stderr.assign(pixels, Vec3(0.0f));
@@ -143,6 +143,11 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
                    VisibilityOptions::from(in.settings.render), plan.shadowRays, in.counters,
                    lowRejected.data()};
 
+    if (in.camera.isWindow()) {  // restir.crop_margin: the frame's window, each texel keyed by its place in the whole grid
+        f.originX = std::uint32_t(in.camera.pixelX0 * f.scale);
+        f.originY = std::uint32_t(in.camera.pixelY0 * f.scale);
+        f.wholeWidth = lg == &full ? in.camera.imageWidth : lightingGridExtent(in.camera.imageWidth, scale);
+    }
     std::vector<StoredReservoir> a(lpixels), b(lpixels);
     std::vector<Vec3> lowLr(lpixels);
     // The lighting texel of image pixel (x, y).
@@ -150,7 +155,13 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
         return std::size_t(std::min(lg->height - 1, std::uint32_t(float(y) * f.scale))) * lg->width +
                std::min(lg->width - 1, std::uint32_t(float(x) * f.scale));
     };
-    const std::size_t traced = in.trace ? texelOf(std::uint32_t(in.trace->px % full.width), std::uint32_t(in.trace->px / full.width)) : 0;
+    std::size_t traced = 0;
+    if (in.trace) {  // its pixel of the image, in this frame's window
+        const auto x = std::uint32_t(in.trace->px % in.camera.imageWidth) - std::uint32_t(in.camera.pixelX0);
+        const auto y = std::uint32_t(in.trace->px / in.camera.imageWidth) - std::uint32_t(in.camera.pixelY0);
+        ACC_CHECK(x < full.width && y < full.height);
+        traced = texelOf(x, y);
+    }
     LightingCounters counters = runPasses(f, a, b, lowLr, timer, rejected, reuse, traced);
 
     if (!plan.upsample) {

@@ -91,6 +91,8 @@ struct FrameContext {
     bool shadows;               ///< plan.shadowRays: trace shadow rays (off: V = 1)
     FrameCounters* counters;    ///< counting mode: per-pass thread records
     std::uint32_t* rejected;    ///< per lighting texel: non-finite values rejected (render.nonfinite)
+    /// The lighting grid as a window of the frame's (restir.crop_margin; ReuseParams).
+    std::uint32_t wholeWidth = 0, originX = 0, originY = 0;
     const LightTiles* tiles = nullptr;  ///< render.source tiles or regir: this frame's presampled tiles
     const RegirGrid* regir = nullptr;   ///< render.source regir: this frame's grid
 
