@@ -44,7 +44,7 @@ struct BiasArgs : ExperimentArgs {
     std::string gpuFrames;    ///< read each seed's image from these .gpuframe files instead of rendering it
     bool strict = false;      ///< a view check that cannot be performed is an error
     std::vector<std::string> unshadowedReferences;  ///< the view with shading.visibility = false: the error without visibility
-    std::uint32_t cropMargin = 64;  ///< restir on a cropped reference: the pixels around each crop it renders for its reuse
+    std::uint32_t cropMargin = 32;  ///< restir on a cropped reference: the pixels around each crop it renders for its reuse
 };
 
 struct BiasRow {

@@ -55,8 +55,8 @@ struct TuneArgs : SceneArgs {
     std::uint32_t seeds = 16;
     std::optional<std::uint32_t> frame;  ///< default: render.frame_start + the steady state's history
     std::string errorCrops = "4x2";     ///< strata of the frame, one crop each: COLUMNSxROWS
-    std::string cropSize = "192x108";   ///< each crop's size at the scene's resolution
-    std::uint32_t cropMargin = 64;      ///< the pixels around a crop restir renders for its reuse
+    std::string cropSize = "160x90";    ///< each crop's size at the scene's resolution
+    std::uint32_t cropMargin = 32;      ///< the pixels around a crop restir renders for its reuse
     std::string space = "quick";
     std::vector<std::string> references;  ///< --reference: one per crop
     std::uint32_t referenceSpp = 1024;
