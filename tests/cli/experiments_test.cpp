@@ -406,7 +406,16 @@ TEST_CASE("bias over crops of the view: each pixel's figures are the whole frame
     const nlohmann::json j = nlohmann::json::parse(readFile(dir / "c.json"));
     CHECK(j["crops"].size() == 2);
     CHECK(j["crop_margin"] == 1000);
-    CHECK(j.at("reuse").contains("restir:pairwise"));
+    // restir's reuse is counted over the crops' pixels alone (a margin's are
+    // not measured): one temporal offer per hit pixel of the crops and seed.
+    const std::vector<std::uint32_t> ids = readExrUintChannel(dir / "whole.exr", "particle.id");
+    REQUIRE(ids.size() == 96 * 64);
+    std::size_t hits = 0;
+    for (std::uint32_t y = 0; y < 64; ++y)
+        for (std::uint32_t x = 0; x < 96; ++x)
+            hits += ((x >= 8 && x < 40 && y >= 8 && y < 32) || (x >= 56 && x < 88 && y >= 30 && y < 54)) && ids[std::size_t(y) * 96 + x] != 0xffffffffu;
+    CHECK(hits > 100);
+    CHECK(j.at("reuse").at("restir:pairwise").at("temporalResampling").at("offered").get<std::size_t>() == 3 * hits);
     // With the default margin restir renders each crop's window alone: its
     // figures move (another window, other edges) but stay of one estimator.
     REQUIRE(runCommand(common + crops + " -o " + (dir / "m").string(), out) == 0);

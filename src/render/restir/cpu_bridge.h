@@ -80,8 +80,11 @@ public:
         return *rec_;
     }
     std::uint32_t reservoirBytes() const { return f_.codec.bytes(); }
-    void reuse(ReuseOutcome o) { c_.reuse.add(o); }
-    void historyCapped() { ++c_.reuse.mCapped; }
+    void reuse(ReuseOutcome o) {
+        if (counted_) c_.reuse.add(o);
+    }
+    void historyCapped() { c_.reuse.mCapped += counted_; }
+    void countReuse(bool counted) { counted_ = counted; }
     template <std::uint32_t N>
     Offers offers() { return Offers(*this); }
 
@@ -116,6 +119,7 @@ private:
     LightingCounters& c_;
     Scratch& scratch_;
     std::optional<Recorder<Count>> rec_;
+    bool counted_ = true;  ///< this texel's reuse counts (FrameContext::counted)
 };
 
 /// Runs body(bridge, px, x, y) over the lighting grid (forEachPixel's tiles),
@@ -126,6 +130,7 @@ LightingCounters forEachTexel(const FrameContext& f, Pass pass, const CpuBuffers
     PassCounters* pc = passCounters<Count>(f, pass);
     return forEachPixel(f.lg.width, f.lg.height, [&](std::size_t px, std::uint32_t x, std::uint32_t y, LightingCounters& c, Scratch& s) {
         CpuBridge<SM, P, Count> b(f, p, pc, io, c, s);
+        b.countReuse(f.counted.contains(x, y));
         body(b, px, x, y);
     });
 }

@@ -148,6 +148,12 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
         f.originY = std::uint32_t(in.camera.pixelY0 * f.scale);
         f.wholeWidth = lg == &full ? in.camera.imageWidth : lightingGridExtent(in.camera.imageWidth, scale);
     }
+    if (!in.settings.render.crop.empty()) {  // reuse is counted over render.crop's texels, not the rest rendered for it
+        const PixelWindow crop = PixelWindow::of(in.settings);
+        const auto at = [&](std::uint32_t v, float o) { return std::uint32_t(std::max(0.0f, (float(v) - o) * f.scale)); };
+        f.counted = {at(crop.x0, in.camera.pixelX0), at(crop.x1, in.camera.pixelX0), at(crop.y0, in.camera.pixelY0),
+                     at(crop.y1, in.camera.pixelY0)};
+    }
     std::vector<StoredReservoir> a(lpixels), b(lpixels);
     std::vector<Vec3> lowLr(lpixels);
     // The lighting texel of image pixel (x, y).

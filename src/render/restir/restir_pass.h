@@ -93,6 +93,9 @@ struct FrameContext {
     std::uint32_t* rejected;    ///< per lighting texel: non-finite values rejected (render.nonfinite)
     /// The lighting grid as a window of the frame's (restir.crop_margin; ReuseParams).
     std::uint32_t wholeWidth = 0, originX = 0, originY = 0;
+    /// The texels whose reuse offers are counted (stats' reuse): render.crop's
+    /// on a window of the frame, not its margin's; else every texel.
+    PixelWindow counted{0, ~0u, 0, ~0u};
     const LightTiles* tiles = nullptr;  ///< render.source tiles or regir: this frame's presampled tiles
     const RegirGrid* regir = nullptr;   ///< render.source regir: this frame's grid
 
