@@ -329,12 +329,14 @@ Table biasTable(const std::vector<BiasRow>& rows, double refMean, double zCritic
              hidden("biased", "{}"), hidden("detectable_bias_pct", "{:.4g}"), {"seconds_per_render", "s/render", 9, "{:.3f}", "{:.6g}"},
              {"seconds_per_frame", "s/frame", 8, "{:.3f}", "{:.6g}"}, {"rel_mse", "relMSE", 10, "{:.4g}", "{:.6g}"},
              {"rel_mse_unshadowed", "unshadowed", 11, "{:.4g}", "{:.6g}"}, {"visibility_share_pct", "vis share%", 11, "{:.0f}", "{:.4g}"},
+             {"light_selection_share_pct", "sel share%", 11, "{:.0f}", "{:.4g}"},
              {"", fmt::format("verdict (|z| > {:.2f}: 99.9%)", zCritical), 0, "{}", "{}", true, "  "}});
     for (const BiasRow& r : rows) {
         const double lossSe = refMean > 0.0 ? 100.0 * r.stderr / refMean : 0.0;
         t.add({r.label, std::uint64_t(r.seeds), std::uint64_t(r.history), r.meanError, r.stderr, r.z, r.energyLossPct, lossSe,
                fmt::format("{:>8.3f} +- {:<5.3f}", r.energyLossPct, lossSe), r.biased, r.detectablePct, r.secondsPerRender,
                r.secondsPerFrame, r.relMse, r.relMseUnshadowed, 100.0 * (r.relMse - r.relMseUnshadowed) / r.relMse,
+               100.0 * r.relMseUnshadowed / r.relMse,
                r.biased ? "BIASED"
                         : fmt::format("no bias detected (a bias of {:.2g}% or more would show 4 times in 5)", r.detectablePct)});
     }

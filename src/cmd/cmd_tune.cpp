@@ -543,6 +543,7 @@ Table lightingTable(const TuneArgs& a, const TuneResult& r) {
               {"seeds", "seeds", 6}, {"temporal_kept_pct", "temp kept%", 10, "{:.0f}", "{:.4g}"},
               {"spatial_kept_pct", "spat kept%", 10, "{:.0f}", "{:.4g}"}, {"spatial_other_particle_pct", "of them other%", 14, "{:.0f}", "{:.4g}"},
               {"visibility_share_pct", "vis share%", 10, "{:.0f}", "{:.4g}"},
+              {"light_selection_share_pct", "sel share%", 10, "{:.0f}", "{:.4g}"},
               {"cpu_s", "CPU s", 7, "{:.2f}", "{:.5g}"},
               {"biased", "", 0, "{}", "{}", false}, {"bias_verdict", "", 0, "{}", "{}", false}, {"front", "", 0, "{}", "{}", false},
               {"", "", 0, "{}", "{}", true, "  "}});
@@ -552,6 +553,7 @@ Table lightingTable(const TuneArgs& a, const TuneResult& r) {
         const auto [spatialKept, spatialOther] = p.error.kept("spatialResampling");
         lt.add({p.lighting.label(), p.ms, p.error.relMse, p.error.z, p.error.energyLossPct, p.error.detectablePct,
                 std::uint64_t(p.error.seeds), temporalKept, spatialKept, spatialOther, p.error.visibilitySharePct,
+                100.0 - p.error.visibilitySharePct,
                 p.error.cpuSecondsPerFrame, p.error.biased(), std::string(verdictName(p.error.verdict)),
                 p.front,
                 std::string(p.front ? "front" : "") + (bias.empty() ? "" : " " + bias) + (&p == r.best ? " <- recommended" : "")});

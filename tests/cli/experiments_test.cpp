@@ -147,6 +147,7 @@ TEST_CASE("bias: 1/M restir is flagged, uniform Monte Carlo is not", "[cli][expe
         INFO(anatomy[r][0] << ": relMSE " << all << ", with every light visible " << unshadowed);
         CHECK((unshadowed > 0.0 && unshadowed < all));
         CHECK(std::stod(anatomy[r][col("visibility_share_pct")]) == Approx(100.0 * (all - unshadowed) / all).epsilon(1e-3));
+        CHECK(std::stod(anatomy[r][col("light_selection_share_pct")]) == Approx(100.0 * unshadowed / all).epsilon(1e-3));
     }
     // Short of it, a measurement is refused rather than made at another operating point.
     CHECK(runCommand(kBin + " bias " + tinyScene() + " --quiet --reference " + (dir / "exact.exr").string() +
