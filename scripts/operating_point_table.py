@@ -11,6 +11,8 @@ print("| configuration | relMSE | every light visible | visibility share | energ
 print("|---|---|---|---|---|---|---|---|")
 for f in sorted(out.glob("*.json"), key=lambda p: p.stat().st_mtime):
     j = json.loads(f.read_text())
+    if j.get("command") != "bias":
+        continue
     r = j["rows"][0]
     reuse = next(iter(j.get("reuse", {}).values()), {})
 

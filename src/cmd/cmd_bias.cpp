@@ -361,13 +361,6 @@ std::optional<BiasReference> loadUnshadowedReference(const BiasArgs& a, std::vec
     return ref;
 }
 
-/// The windows measured, [x0, x1, y0, y1] each.
-nlohmann::json cropsJson(const BiasReference& ref) {
-    nlohmann::json j = nlohmann::json::array();
-    for (const PixelWindow& w : ref.crops) j.push_back({w.x0, w.x1, w.y0, w.y1});
-    return j;
-}
-
 void runBias(const BiasArgs& a) {
     const std::vector<FlagSetting> base = frameFlags(a.frames);
     const Settings scene = loadSceneArgs(a);
@@ -430,7 +423,7 @@ void runBias(const BiasArgs& a) {
     }
     writeFileAtomic(prefix + ".csv", table.csv());
     writeJson(prefix + ".json", {{"version", std::string(version())}, {"command", "bias"},
-                                 {"scene", scene.scenePath}, {"reference", a.references}, {"crops", cropsJson(ref)},
+                                 {"scene", scene.scenePath}, {"reference", a.references}, {"crops", windowsJson(ref.crops)},
                                  {"crop_margin", ref.whole() ? nlohmann::json() : nlohmann::json(a.cropMargin)},
                                  {"frame", frame}, {"history", a.history}, {"z_critical", a.zCritical},
                                  {"reference_mean", ref.mean}, {"reference_mean_stderr", ref.meanStderr},

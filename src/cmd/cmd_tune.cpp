@@ -597,12 +597,6 @@ void printTune(const TuneArgs& a, const Settings& scene, const TuneContext& t, c
     std::fflush(stdout);
 }
 
-nlohmann::json cropsJson(const std::vector<PixelWindow>& crops) {
-    nlohmann::json j = nlohmann::json::array();
-    for (const PixelWindow& w : crops) j.push_back({w.x0, w.x1, w.y0, w.y1});
-    return j;
-}
-
 /// PREFIX.json: what made the search and what it found.
 void writeTuneJson(const std::string& prefix, const TuneArgs& a, const Settings& scene, const TuneContext& t, const TuneResult& r,
                    const Table& gt, const Table& lt) {
@@ -624,7 +618,7 @@ void writeTuneJson(const std::string& prefix, const TuneArgs& a, const Settings&
                                  {"defines", a.defines}, {"settings", settingsToToml(scene)}, {"seed", scene.render.seed},
                                  {"budget_ms", a.budgetMs}, {"bias_bound_pct", a.biasBoundPct}, {"max_seeds", a.maxSeeds}, {"max_error", a.maxError ? nlohmann::json(*a.maxError) : nlohmann::json()},
                                  {"seeds", a.seeds}, {"frame", t.frame}, {"history_frames", t.history}, {"error_crops", a.errorCrops}, {"crop_size", a.cropSize},
-                                 {"crop_margin", a.cropMargin}, {"crops", cropsJson(t.crops)}, {"references", t.references},
+                                 {"crop_margin", a.cropMargin}, {"crops", windowsJson(t.crops)}, {"references", t.references},
                                  {"unshadowed_references", t.unshadowedReferences},
                                  {"space", a.space}, {"coefficients", t.coefficients.source}, {"geometry", gt.json()},
                                  {"fastest_triangle_geometry", r.triangles->choice.label()}, {"chosen_geometry", chosen.label()},

@@ -2,6 +2,12 @@
 
 namespace accretion {
 
+nlohmann::json windowsJson(const std::vector<PixelWindow>& windows) {
+    nlohmann::json j = nlohmann::json::array();
+    for (const PixelWindow& w : windows) j.push_back({w.x0, w.x1, w.y0, w.y1});
+    return j;
+}
+
 nlohmann::json reuseCountsJson(const ReuseCounts& c) {
     nlohmann::json outcomes = nlohmann::json::object();
     for (std::size_t k = 0; k < kReuseOutcomes; ++k) outcomes[std::string(kReuseOutcomeNames[k])] = c.n[k];

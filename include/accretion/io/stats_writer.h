@@ -11,5 +11,7 @@ nlohmann::json frameStatsJson(const FrameStats& stats);
 
 /// A pass's reuse offers: offered, accepted, m_capped and each outcome's count (kReuseOutcomeNames).
 nlohmann::json reuseCountsJson(const ReuseCounts& counts);
+/// Pixel windows (crops) as [[x0, x1, y0, y1], ...].
+nlohmann::json windowsJson(const std::vector<PixelWindow>& windows);
 
 }  // namespace accretion
