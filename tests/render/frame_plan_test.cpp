@@ -288,3 +288,25 @@ TEST_CASE("every estimator and source: the plan builds the light sampler the est
             CHECK(stats[0].timer.ran(Pass::buildLightSampler) == (expected != LightSamplerKind::none));
         }
 }
+
+TEST_CASE("restir on a crop with a margin: the window traced is the crop and its margin on the 8-pixel grid, within the image",
+          "[plan][restir][window]") {
+    Settings s;
+    s.camera.width = 200;
+    s.camera.height = 100;
+    s.render.estimator = EstimatorKind::restir;
+    s.render.crop = {50, 90, 3, 40};
+    const PixelWindow whole = PixelWindow::whole(200, 100);
+    CHECK(planFrame(s, FrameFacts{}).frameWindow == whole);  // no margin: the whole frame, cut afterwards
+    CHECK(planFrame(s, FrameFacts{}).traced == whole);
+    s.restir.crop_margin = 20;
+    const FramePlan p = planFrame(s, FrameFacts{});
+    CHECK(p.frameWindow == PixelWindow{24, 112, 0, 64});  // 30 -> 24, 110 -> 112, -17 -> 0, 60 -> 64
+    CHECK(p.traced == PixelWindow::whole(88, 64));
+    CHECK_THAT(formatPlan(p), Catch::Contains("the 88x64 window at (24, 0)"));
+    s.restir.crop_margin = 1000;  // beyond the image on every side: the whole frame
+    CHECK(planFrame(s, FrameFacts{}).frameWindow == whole);
+    s.render.estimator = EstimatorKind::split;  // a crop of any other estimator renders alone, the margin unused
+    CHECK(planFrame(s, FrameFacts{}).traced == PixelWindow::of(s));
+    CHECK(planFrame(s, FrameFacts{}).frameWindow == whole);
+}
