@@ -411,6 +411,7 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
     // spatial pass without neighbours; every offer of the passes that ran counted.
     CHECK(j["frame"] == 20);
     CHECK(j["history_frames"] == 20);
+    CHECK(j["cost_history_frames"] == 2);  // the counted frame's temporal pass runs; its price does not need the M cap
     for (const auto& p : rows) {
         const std::string label = p["lighting"];
         INFO(label);
