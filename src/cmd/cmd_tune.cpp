@@ -669,13 +669,13 @@ void runTune(const TuneArgs& a) {
     const std::vector<LightingChoice> lighting = lightingChoices(a.space);
     const std::string prefix = a.out.empty() ? "out/" + scene.sceneName + ".tune" : a.out;
     t.crops = errorCrops(a, scene);
+    if (!a.references.empty() && a.references.size() != t.crops.size())  // before anything is made
+        throw InputError(fmt::format("command line --reference: {} given, one per crop of --error-crops {} ({})", a.references.size(),
+                                     a.errorCrops, t.crops.size()));
     prepareTune(t, scene, prefix);
     t.steps = geometry.size() + 2 * lighting.size() + (a.references.empty() ? t.crops.size() : 0) + (a.anatomy ? t.crops.size() : 0);
     const std::size_t particles = ParticleSource(scene).frame(t.frame).size();
     t.references = ensureReferences(t, particles);
-    if (!a.references.empty() && a.references.size() != t.crops.size())
-        throw InputError(fmt::format("command line --reference: {} given, one per crop of --error-crops {} ({})", a.references.size(),
-                                     a.errorCrops, t.crops.size()));
     if (a.anatomy) t.unshadowedReferences = ensureReferences(t, particles, false);
 
     // Geometry: the same image whatever it is; the fastest predicted frame.
