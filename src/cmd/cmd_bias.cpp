@@ -13,7 +13,9 @@
 #include <nlohmann/json.hpp>
 #include <tbb/global_control.h>
 
+#include "accretion/analysis/bias_test.h"
 #include "accretion/analysis/experiment.h"
+#include "accretion/analysis/student_t.h"
 #include "accretion/analysis/image_metrics.h"
 #include "accretion/analysis/view_check.h"
 #include "accretion/core/error.h"
@@ -53,7 +55,10 @@ struct BiasRow {
     std::uint32_t history = 0;  ///< frames rendered before the measured one
     double meanError = 0.0;    ///< mean over seeds of the image-mean signed error (x - ref)
     double stderr = 0.0;       ///< its standard error (seeds and reference noise)
-    double z = 0.0;
+    double z = 0.0;            ///< meanError / stderr: Student's t with `dof` degrees of freedom
+    double seedSd = 0.0;       ///< the seeds' sample standard deviation of the image-mean signed error
+    double dof = 0.0;          ///< Welch-Satterthwaite's, from the seeds' spread and the reference's
+    double critical = 0.0;     ///< the two-sided critical |t| at --z's significance
     double energyLossPct = 0.0;
     double secondsPerRender = 0.0;
     double secondsPerFrame = 0.0;  ///< the measured frame alone (restir: without its history frames)
@@ -210,15 +215,6 @@ ExperimentRender readGpuRender(const std::string& file, const Settings& s, std::
     return r;
 }
 
-/// The smallest |energy bias| in % of the reference's mean that a run with
-/// this standard error of the mean signed error finds (|z| > zCritical) with
-/// 80% probability: (zCritical + z_0.8) standard errors. A verdict of "no
-/// bias detected" says nothing about a bias below it.
-double detectableBiasPct(double stderr, double refMean, double zCritical) {
-    constexpr double kPower80 = 0.8416;  // the standard normal's 80% quantile
-    return refMean > 0.0 ? 100.0 * (zCritical + kPower80) * stderr / refMean : std::numeric_limits<double>::infinity();
-}
-
 /// One seed's Lr over the reference's crops (crop after crop, as
 /// ref.rgb): each crop rendered alone, restir with --crop-margin around it
 /// (restir.crop_margin); the measured frames' times and reuse summed.
@@ -283,8 +279,11 @@ BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vec
     row.seeds = a.seeds;
     row.history = history;
     row.meanError = e1 / S;
-    const double seedVar = std::max(0.0, (e2 / S - row.meanError * row.meanError) * S / (S - 1.0));
-    row.stderr = std::sqrt(seedVar / S + ref.meanStderr * ref.meanStderr);
+    row.seedSd = std::sqrt(std::max(0.0, (e2 / S - row.meanError * row.meanError) * S / (S - 1.0)));
+    const BiasTest test = biasTest(row.seedSd, a.seeds, ref.meanStderr, a.zCritical);
+    row.stderr = test.stderr;
+    row.dof = test.dof;
+    row.critical = test.critical;
     // No spread at all (a deterministic estimator against an exact
     // reference): any difference beyond float summation is a bias, not noise.
     const double tiny = 1e-6 * std::max(std::fabs(ref.mean), 1e-30);
@@ -295,8 +294,8 @@ BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vec
     row.secondsPerRender = seconds / S;
     row.relMse = relMse / S;
     row.secondsPerFrame = frameSeconds / S;
-    row.biased = std::fabs(row.z) > a.zCritical;
-    row.detectablePct = detectableBiasPct(row.stderr, ref.mean, a.zCritical);
+    row.biased = std::fabs(row.z) > row.critical;
+    row.detectablePct = ref.mean > 0.0 ? 100.0 * test.detectable / ref.mean : std::numeric_limits<double>::infinity();
     row.map = biasMap(s1, s2, S, ref);
     row.reuse = std::move(reuse);
     row.settingsToml = settingsToToml(specBase);
@@ -322,18 +321,21 @@ std::string reuseLine(Pass pass, const ReuseCounts& c) {
 
 /// The rows as the console, CSV and JSON give them.
 Table biasTable(const std::vector<BiasRow>& rows, double refMean, double zCritical) {
+    const double significance = 1.0 - 2.0 * (1.0 - normalCdf(zCritical));
     auto hidden = [](const char* key, const char* csv) { return Column{key, "", 0, "{}", csv, false}; };
     Table t({{"estimator", "estimator", -28}, {"seeds", "seeds", 6}, {"history_frames", "hist", 5}, {"mean_signed_error", "mean error", 13, "{:.5g}", "{:.8g}"},
-             {"stderr", "stderr", 11, "{:.3g}", "{:.8g}"}, {"z", "z", 8, "{:.2f}", "{:.5g}"},
+             {"stderr", "stderr", 11, "{:.3g}", "{:.8g}"}, {"z", "t", 8, "{:.2f}", "{:.5g}"},
+             hidden("seed_sd", "{:.8g}"), {"dof", "dof", 6, "{:.3g}", "{:.6g}"}, {"t_critical", "|t| >", 6, "{:.2f}", "{:.6g}"},
              hidden("energy_loss_pct", "{:.6g}"), hidden("energy_loss_stderr_pct", "{:.6g}"), {"", "energy loss %", 15},
              hidden("biased", "{}"), hidden("detectable_bias_pct", "{:.4g}"), {"seconds_per_render", "s/render", 9, "{:.3f}", "{:.6g}"},
              {"seconds_per_frame", "s/frame", 8, "{:.3f}", "{:.6g}"}, {"rel_mse", "relMSE", 10, "{:.4g}", "{:.6g}"},
              {"rel_mse_unshadowed", "unshadowed", 11, "{:.4g}", "{:.6g}"}, {"visibility_share_pct", "vis share%", 11, "{:.0f}", "{:.4g}"},
              {"light_selection_share_pct", "sel share%", 11, "{:.0f}", "{:.4g}"},
-             {"", fmt::format("verdict (|z| > {:.2f}: 99.9%)", zCritical), 0, "{}", "{}", true, "  "}});
+             {"", fmt::format("verdict (|t| above its critical value, {:.3g}% two-sided)", 100.0 * significance), 0, "{}", "{}", true, "  "}});
     for (const BiasRow& r : rows) {
         const double lossSe = refMean > 0.0 ? 100.0 * r.stderr / refMean : 0.0;
-        t.add({r.label, std::uint64_t(r.seeds), std::uint64_t(r.history), r.meanError, r.stderr, r.z, r.energyLossPct, lossSe,
+        t.add({r.label, std::uint64_t(r.seeds), std::uint64_t(r.history), r.meanError, r.stderr, r.z, r.seedSd, r.dof, r.critical,
+               r.energyLossPct, lossSe,
                fmt::format("{:>8.3f} +- {:<5.3f}", r.energyLossPct, lossSe), r.biased, r.detectablePct, r.secondsPerRender,
                r.secondsPerFrame, r.relMse, r.relMseUnshadowed, 100.0 * (r.relMse - r.relMseUnshadowed) / r.relMse,
                100.0 * r.relMseUnshadowed / r.relMse,
@@ -428,16 +430,16 @@ void runBias(const BiasArgs& a) {
                                  {"frame", frame}, {"history", a.history}, {"z_critical", a.zCritical},
                                  {"reference_mean", ref.mean}, {"reference_mean_stderr", ref.meanStderr},
                                  {"settings", settingsToToml(scene)}, {"rows", table.json()}, {"reuse", reuse}});
-    // Red bars: BIASED (|z| above the critical value); the title says what was measured.
+    // Red bars: BIASED (|t| above its critical value); the title says what was measured.
     const std::string script = fmt::format(
         "set datafile separator ','\nset style fill solid 0.5\nset boxwidth 0.6\nset grid ytics\n"
-        "set title {2}\nset ylabel 'energy loss % (bars: {0:.2f} standard errors)'\nset xtics rotate by -30\nset key off\n"
-        "plot {1} skip 1 using 0:($9 == 1 ? NaN : $7):xtic(1) with boxes lc rgb '#4682b4', "
-        "{1} skip 1 using 0:($9 == 1 ? $7 : NaN) with boxes lc rgb '#d62728', "
-        "{1} skip 1 using 0:7:($8*{0}) with yerrorbars lc rgb 'black' pt 0\n",
-        a.zCritical, gnuplotQuote(prefix + ".csv"),
-        gnuplotQuote(fmt::format("bias of {} frame {}, {} seeds (red: BIASED, |z| > {:.2f})",
-                                 std::filesystem::path(scene.scenePath).filename().string(), frame, a.seeds, a.zCritical)));
+        "set title {1}\nset ylabel 'energy loss % (bars: the critical |t| in standard errors)'\nset xtics rotate by -30\nset key off\n"
+        "plot {0} skip 1 using 0:($12 == 1 ? NaN : $10):xtic(1) with boxes lc rgb '#4682b4', "
+        "{0} skip 1 using 0:($12 == 1 ? $10 : NaN) with boxes lc rgb '#d62728', "
+        "{0} skip 1 using 0:10:($11*$9) with yerrorbars lc rgb 'black' pt 0\n",
+        gnuplotQuote(prefix + ".csv"),
+        gnuplotQuote(fmt::format("bias of {} frame {}, {} seeds (red: BIASED, |t| above its critical value)",
+                                 std::filesystem::path(scene.scenePath).filename().string(), frame, a.seeds)));
     plotPng(prefix + ".png", script);
     fmt::print("bias: {}.csv, {}.png, {}.json, bias maps {}.<estimator>.exr (.z.png)\n", prefix, prefix, prefix, prefix);
 }
@@ -462,7 +464,7 @@ void addBiasCommand(CLI::App& app) {
                     "visible against it; its relMSE is light selection's error, the rest visibility's share (one per --reference, "
                     "the same crops)")
         ->allow_extra_args(false);
-    cmd->add_option("--z", args->zCritical, "Two-sided critical |z| for the verdict (3.29: 99.9%)")->check(finiteIn(0.0, 1e6));
+    cmd->add_option("--z", args->zCritical, "The verdict's significance, as the normal's two-sided critical |z| (3.29: 99.9%); the test keeps it with Student's t at the seeds' degrees of freedom")->check(finiteIn(0.0, 1e6));
     cmd->add_option("--gpu-frames", args->gpuFrames,
                     "Read each seed's frame from the OptiX twin's .gpuframe files instead of rendering it: a pattern "
                     "with {estimator} (the spec, file-safe) and {seed} (render.seed + k)");

@@ -30,6 +30,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "accretion/analysis/bias_test.h"
 #include "accretion/analysis/experiment.h"
 #include "accretion/core/atomic_file.h"
 #include "accretion/core/error.h"
@@ -301,6 +302,7 @@ constexpr const char* verdictName(BiasVerdict v) {
 /// smallest energy bias its seeds detect 4 times in 5).
 struct ErrorRow {
     double relMse = 0.0, z = 0.0, energyLossPct = 0.0, cpuSecondsPerFrame = 0.0, detectablePct = 0.0;
+    double seedSd = 0.0, referenceMean = 0.0, referenceStderr = 0.0, zCritical = 0.0;  ///< bias's test: what more seeds would see
     double visibilitySharePct = NAN;  ///< --anatomy: the share of relMSE that every light visible removes
     std::uint32_t seeds = 0;
     BiasVerdict verdict = BiasVerdict::unknown;
@@ -345,6 +347,10 @@ ErrorRow measureErrorSeeds(TuneContext& t, const LightingChoice& o, std::uint32_
     e.energyLossPct = r.at("energy_loss_pct").get<double>();
     e.cpuSecondsPerFrame = r.at("seconds_per_frame").get<double>();
     e.detectablePct = r.at("detectable_bias_pct").get<double>();
+    e.seedSd = r.at("seed_sd").get<double>();
+    e.referenceMean = j.at("reference_mean").get<double>();
+    e.referenceStderr = j.at("reference_mean_stderr").get<double>();
+    e.zCritical = j.at("z_critical").get<double>();
     e.seeds = seeds;
     if (j.contains("reuse") && j.at("reuse").contains(spec)) e.reuse = j.at("reuse").at(spec);
     if (!t.unshadowedReferences.empty()) e.visibilitySharePct = r.at("visibility_share_pct").get<double>();
@@ -355,15 +361,16 @@ ErrorRow measureErrorSeeds(TuneContext& t, const LightingChoice& o, std::uint32_
 }
 
 /// The error with --seeds; where a bias of --bias-bound could hide in it,
-/// again with the seeds that would see one (the bound falls as 1/sqrt(seeds)),
+/// again with the fewest seeds whose test would see one (Student's t: the
+/// bound falls faster than 1/sqrt(seeds) while the degrees of freedom grow),
 /// up to --max-seeds; past that the verdict stays "unknown", with its bound.
 ErrorRow measureError(TuneContext& t, const LightingChoice& o) {
     const ErrorRow first = measureErrorSeeds(t, o, t.args.seeds);
     if (first.verdict != BiasVerdict::unknown || !std::isfinite(first.detectablePct)) return first;
-    const double ratio = first.detectablePct / t.args.biasBoundPct;
-    const double needed = std::ceil(double(t.args.seeds) * ratio * ratio * 1.1);  // 10% spare: the bound is itself measured
-    if (needed > double(t.args.maxSeeds)) return first;
-    return measureErrorSeeds(t, o, static_cast<std::uint32_t>(needed));
+    // 10% spare on the variance: the seeds' spread is itself measured.
+    const std::uint32_t needed = seedsToDetect(first.seedSd * std::sqrt(1.1), first.seeds, first.referenceStderr, first.zCritical,
+                                               t.args.biasBoundPct / 100.0 * first.referenceMean, t.args.maxSeeds);
+    return needed ? measureErrorSeeds(t, o, needed) : first;
 }
 
 /// The references of the error measurements, one per crop: given, or
@@ -642,7 +649,7 @@ void plotTune(const std::string& prefix, const TuneArgs& a, const Settings& scen
         "set arrow from {4},graph 0 to {4},graph 1 nohead dt 2 lc rgb 'gray40'\n"
         "set label 'budget' at {4},graph 0.95 right offset -0.5,0 tc rgb 'gray40'\n{6}"
         "plot {5} skip 1 using 2:($7 == 0 ? $3 : NaN) with points pt 7 lc rgb 'gray60' title 'configurations', "
-        "{5} skip 1 using 2:($7 != 0 ? $3 : NaN) with points pt 2 ps 1.5 lc rgb 'red' title 'biased (|z| > 3.29)', "
+        "{5} skip 1 using 2:($7 != 0 ? $3 : NaN) with points pt 2 ps 1.5 lc rgb 'red' title 'biased (|t| above its critical value, 99.9%)', "
         "{5} skip 1 using 2:($8 != 0 ? $3 : NaN) with points pt 6 ps 2 lc rgb 'blue' title 'Pareto front'\n",
         gnuplotQuote(fmt::format("{} ({} particles) at {}x{}: budget {:g} ms", scene.sceneName, particles,
                                  scene.camera.width, scene.camera.height, a.budgetMs)),

@@ -11,6 +11,7 @@
 
 #include "accretion/counters/gpu_layouts.h"
 #include "accretion/scene/estimator_table.h"
+#include "accretion/scene/scene_parser.h"
 
 namespace accretion {
 namespace {
@@ -107,56 +108,111 @@ void cropLayers(FrameImage& img, const PixelWindow& rendered) {
     for (Heatmap& h : img.heatmaps) cut(h.values);
 }
 
+/// The lanes' settings with their own parts (seed, crop, crop margin) set
+/// to the first lane's: equal where the lanes share everything else.
+std::string sharedPart(Settings s, const Settings& first) {
+    s.render.seed = first.render.seed;
+    s.render.crop = first.render.crop;
+    s.restir.crop_margin = first.restir.crop_margin;
+    return settingsToToml(s);
+}
+
 }  // namespace
 
+struct FrameRenderer::FrameGeometry {
+    CameraPose pose;
+    Camera world;                         ///< the whole image's, in frame coordinates
+    Particles loaded;                     ///< this frame's, unless the scene is static
+    const Particles* particles = nullptr; ///< loaded or the static ones
+    AliasTable powerTable;
+    LightTree lightTree;
+};
+
 FrameRenderer::FrameRenderer(const Settings& settings, ParticleSource source, RenderOptions options)
-    : settings_(settings), cameras_(settings.camera), plan_(planFrame(settings, FrameFacts{})), source_(std::move(source)), options_(options),
-      device_(std::make_unique<EmbreeDevice>()),
-      bvh_(newBvh(*device_, settings)) {
-    if (estimatorInfo(settings_.render.estimator).reuse) restir_ = std::make_unique<Restir>(settings_, plan_.keepHistory);
+    : FrameRenderer(std::vector<Settings>{settings}, std::move(source), options) {}
+
+FrameRenderer::FrameRenderer(std::vector<Settings> lanes, ParticleSource source, RenderOptions options)
+    : cameras_(lanes.at(0).camera), source_(std::move(source)), options_(options), device_(std::make_unique<EmbreeDevice>()),
+      bvh_(newBvh(*device_, lanes.at(0))) {
+    for (std::size_t k = 1; k < lanes.size(); ++k)
+        if (sharedPart(lanes[k], lanes[0]) != sharedPart(lanes[0], lanes[0]))
+            throw std::invalid_argument("FrameRenderer: lanes differ in more than render.seed, render.crop and restir.crop_margin");
+    for (Settings& s : lanes) {
+        Lane lane{std::move(s), {}, nullptr};
+        lane.plan = planFrame(lane.settings, FrameFacts{});
+        if (lanes_.size() > 0 && lane.plan.counting)
+            throw std::invalid_argument("FrameRenderer: gpu.counters counts one view's work; it takes one lane");
+        if (estimatorInfo(lane.settings.render.estimator).reuse)
+            lane.restir = std::make_unique<Restir>(lane.settings, lane.plan.keepHistory);
+        lanes_.push_back(std::move(lane));
+    }
 }
 
 FrameRenderer::~FrameRenderer() = default;
 
-const Particles& FrameRenderer::prepareGeometry(std::uint32_t frame, const Camera& camera, FrameStats& stats,
-                                                Particles& loaded) {
+void FrameRenderer::prepareFrame(std::uint32_t frame, FrameGeometry& g, FrameStats& stats) {
+    // Frame coordinates: the world less an origin at the frame's camera, so
+    // that precision does not depend on where the scene is (docs/MODEL.md
+    // section 3). Geometry that persists across frames (a static scene,
+    // refit and partial builds) keeps the origin of its first build.
+    const Settings& settings = lanes_[0].settings;
+    const FramePlan& run = lanes_[0].plan;  // the run-wide decisions, the same in every lane
+    g.pose = cameras_.pose(frame);
+    const Camera world = Camera::fromPose(g.pose, settings.camera.width, settings.camera.height);
+    if (!built_ || !(run.staticGeometry || run.updateInPlace)) origin_ = world.position;
+    g.world = world.rebased(origin_);
+    stats.origin = origin_;
+
     // A static scene loads its particles and builds its BVH once for all
     // frames; the plan of this frame needs the particles (do they emit?).
     FrameFacts facts;
     facts.geometryBuilt = built_ && !options_.rebuildStatic;
-    facts.historyAvailable = restir_ && restir_->hasHistory();
-    if (plan_.loadsParticles(facts)) {  // the run's plan: this frame's is made once its particles are known
+    if (run.loadsParticles(facts)) {  // the run's plan: this frame's is made once its particles are known
         auto t = stats.timer.scope(Pass::loadParticles);
-        loaded = source_.frame(frame);
-        for (Vec3& p : loaded.position) p -= origin_;
-        if (plan_.staticGeometry) staticParticles_ = std::move(loaded);
+        g.loaded = source_.frame(frame);
+        for (Vec3& p : g.loaded.position) p -= origin_;
+        if (run.staticGeometry) staticParticles_ = std::move(g.loaded);
     }
-    const Particles& particles = plan_.staticGeometry ? staticParticles_ : loaded;
+    g.particles = run.staticGeometry ? &staticParticles_ : &g.loaded;
+    const Particles& particles = *g.particles;
     facts.emissive = emissive(particles);
-    plan_ = planFrame(settings_, facts);
+    for (Lane& lane : lanes_) {
+        facts.historyAvailable = lane.restir && lane.restir->hasHistory();
+        lane.plan = planFrame(lane.settings, facts);
+    }
+    const FramePlan& plan = lanes_[0].plan;
     stats.particles = particles.size();
-    if (plan_.buildClusters) {
+    if (plan.buildClusters) {
         auto t = stats.timer.scope(Pass::buildClusters);
-        if (plan_.previousBvh) {  // double buffer: last frame's BVH stays valid
+        if (plan.previousBvh) {  // double buffer: last frame's BVH stays valid
             std::swap(bvh_, previousBvh_);
-            if (!bvh_) bvh_ = newBvh(*device_, settings_);
+            if (!bvh_) bvh_ = newBvh(*device_, settings);
         }
-        bvh_->build(particles, camera);
+        bvh_->build(particles, g.world);
         built_ = true;
     }
     stats.bvh = bvh_->stats();
-    if (!plan_.buildClusters) {
+    if (!plan.buildClusters) {
         stats.bvh.built = false;
         stats.bvh.rebuiltClusters = 0;
         stats.bvh.clusterSeconds = stats.bvh.blasSeconds = stats.bvh.tlasSeconds = 0.0;
     }
-    return particles;
+    if (plan.sampler != LightSamplerKind::none) {
+        auto t = stats.timer.scope(Pass::buildLightSampler);
+        if (plan.sampler == LightSamplerKind::power) g.powerTable = buildPowerTable(particles);
+        if (plan.sampler == LightSamplerKind::tree) g.lightTree = LightTree(particles, settings.shading);
+        stats.lightTreeNodes = g.lightTree.nodeCount();
+    }
 }
 
-void FrameRenderer::lightFrame(std::uint32_t frame, const Camera& camera, const Particles& particles, const GBuffer& gbuffer,
-                               const AliasTable* powerTable, const LightTree* lightTree, const LightingSession* session,
-                               PixelTrace* trace, FrameImage& img, FrameStats& stats) {
-    const FramePlan& plan = plan_;
+void FrameRenderer::lightFrame(Lane& lane, std::uint32_t frame, const Camera& camera, const FrameGeometry& g,
+                               const GBuffer& gbuffer, const LightingSession* session, PixelTrace* trace, FrameImage& img,
+                               FrameStats& stats) {
+    const FramePlan& plan = lane.plan;
+    const Settings& settings = lane.settings;
+    const Particles& particles = *g.particles;
+    const AliasTable* powerTable = plan.sampler == LightSamplerKind::power ? &g.powerTable : nullptr;
+    const LightTree* lightTree = plan.sampler == LightSamplerKind::tree ? &g.lightTree : nullptr;
     const std::size_t pixels = gbuffer.texels.size();
     if (!plan.lighting) {  // nothing lights the scene: Lr = 0
         img.lighting.Lr.assign(pixels, Vec3(0.0f));
@@ -165,20 +221,20 @@ void FrameRenderer::lightFrame(std::uint32_t frame, const Camera& camera, const 
         img.lighting.rejected.assign(pixels, 0.0f);
         return;
     }
-    const std::uint32_t nearLights = plan.chooseNearLights ? chooseFrameNearLights(frame, img.camera, particles, lightTree, stats) : 0u;
+    const std::uint32_t nearLights = plan.chooseNearLights ? chooseFrameNearLights(lane, frame, g, stats) : 0u;
     auto t = stats.timer.scope(Pass::estimateLighting);
     if (plan.restir) {
-        RestirInputs in{*bvh_, particles, gbuffer, camera, settings_, plan, frame, powerTable, lightTree,
+        RestirInputs in{*bvh_, particles, gbuffer, camera, settings, plan, frame, powerTable, lightTree,
                         plan.previousBvh ? previousBvh_.get() : nullptr, plan.counting ? &img.counters : nullptr, trace};
-        stats.lighting = restir_->render(in, img.lighting, img.reservoirs, stats.timer, stats.nonFinite, stats.reuse);
-        stats.reservoirBytes = restir_->reservoirBytes();
+        stats.lighting = lane.restir->render(in, img.lighting, img.reservoirs, stats.timer, stats.nonFinite, stats.reuse);
+        stats.reservoirBytes = lane.restir->reservoirBytes();
         if (img.lighting.rejected.empty()) img.lighting.rejected.assign(pixels, 0.0f);
         return;
     }
-    LightingInputs in{*bvh_, particles, gbuffer, settings_.shading, settings_.render, frame, powerTable, lightTree,
+    LightingInputs in{*bvh_, particles, gbuffer, settings.shading, settings.render, frame, powerTable, lightTree,
                       plan.counting ? &img.counters.add(Pass::estimateLighting, camera.width, camera.height) : nullptr, trace};
     in.nearLights = nearLights;
-    const LightingPlan lp = planLighting(settings_.render, camera.height, session ? session->shard : Shard{});
+    const LightingPlan lp = planLighting(settings.render, camera.height, session ? session->shard : Shard{});
     // Progress by work: the hit pixels of the rows (exact) or the chunks
     // (samples) still to run, as the sweep counts them.
     const Accumulation* resume = session ? session->resume : nullptr;
@@ -208,90 +264,104 @@ void FrameRenderer::lightFrame(std::uint32_t frame, const Camera& camera, const 
     if (stats.lighting.nonFinite) stats.nonFinite[Pass::estimateLighting] = stats.lighting.nonFinite;
 }
 
-std::uint32_t FrameRenderer::chooseFrameNearLights(std::uint32_t frame, const CameraPose& pose, const Particles& particles,
-                                                   const LightTree* lightTree, FrameStats& stats) {
+std::uint32_t FrameRenderer::chooseFrameNearLights(const Lane& lane, std::uint32_t frame, const FrameGeometry& g,
+                                                   FrameStats& stats) {
     auto t = stats.timer.scope(Pass::chooseNearLights);
     // The pilot's image: the frame's view at 64 pixels across, whatever the
     // resolution or crop, so that every part of one image gets one k.
+    const Settings& settings = lane.settings;
     constexpr std::uint32_t kWidth = 64;
     const std::uint32_t height = std::max(1u, static_cast<std::uint32_t>(std::lround(
-        double(kWidth) * settings_.camera.height / settings_.camera.width)));
-    const Camera camera = Camera::fromPose(pose, kWidth, height).rebased(origin_);
+        double(kWidth) * settings.camera.height / settings.camera.width)));
+    const Camera camera = Camera::fromPose(g.pose, kWidth, height).rebased(origin_);
     GBuffer gbuffer;
-    traceGBuffer(*bvh_, particles, camera, settings_.shading.model, gbuffer);
-    const LightingInputs pilot{*bvh_, particles, gbuffer, settings_.shading, settings_.render, frame, nullptr, lightTree};
+    traceGBuffer(*bvh_, *g.particles, camera, settings.shading.model, gbuffer);
+    const LightTree* lightTree = lane.plan.sampler == LightSamplerKind::tree ? &g.lightTree : nullptr;
+    const LightingInputs pilot{*bvh_, *g.particles, gbuffer, settings.shading, settings.render, frame, nullptr, lightTree};
     stats.nearLights = chooseNearLights(pilot);
     return stats.nearLights.k;
 }
 
-FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const LightingSession* session, PixelTrace* trace) {
-    const auto start = std::chrono::steady_clock::now();
-    stats.frame = frame;
-    // Frame coordinates: the world less an origin at the frame's camera, so
-    // that precision does not depend on where the scene is (docs/MODEL.md
-    // section 3). Geometry that persists across frames (a static scene,
-    // refit and partial builds) keeps the origin of its first build.
-    const CameraPose pose = cameras_.pose(frame);
-    const Camera world = Camera::fromPose(pose, settings_.camera.width, settings_.camera.height);
-    const bool persistent = plan_.staticGeometry || plan_.updateInPlace;
-    if (!built_ || !persistent) origin_ = world.position;
-    // The frame's image: the whole, or restir's window of it (plan.frameWindow).
-    const PixelWindow fw = plan_.frameWindow;
-    const Camera camera = fw.isWhole(world.width, world.height)
-                              ? world.rebased(origin_)
-                              : world.rebased(origin_).window(fw.x0, fw.y0, fw.width(), fw.height());
-    stats.origin = origin_;
+FrameImage FrameRenderer::renderLane(Lane& lane, std::uint32_t frame, const FrameGeometry& g, FrameStats& stats,
+                                     const LightingSession* session, PixelTrace* trace) {
+    const FramePlan& plan = lane.plan;
+    const Settings& settings = lane.settings;
+    const Particles& particles = *g.particles;
     PassTimer& timer = stats.timer;
-
-    Particles loaded;
-    const Particles& particles = prepareGeometry(frame, camera, stats, loaded);
-    const FramePlan& plan = plan_;
+    // The lane's image: the whole, or restir's window of it (plan.frameWindow).
+    const PixelWindow fw = plan.frameWindow;
+    const bool whole = fw.isWhole(g.world.width, g.world.height);
+    const Camera camera = whole ? g.world : g.world.window(fw.x0, fw.y0, fw.width(), fw.height());
     FrameImage img;
-    img.camera = pose;
+    img.camera = g.pose;
     if (plan.counting) recordClusterBuild(*bvh_, particles, img.counters);
-
-    AliasTable powerTable;
-    LightTree lightTree;
-    if (plan.sampler != LightSamplerKind::none) {
-        auto t = timer.scope(Pass::buildLightSampler);
-        if (plan.sampler == LightSamplerKind::power) powerTable = buildPowerTable(particles);
-        if (plan.sampler == LightSamplerKind::tree) lightTree = LightTree(particles, settings_.shading);
-        stats.lightTreeNodes = lightTree.nodeCount();
-    }
 
     // A crop traces, lights and holds only its window, each pixel as in the
     // whole image: every estimator but restir lights a pixel from its own
     // streams alone. restir and counting mode render everything (FramePlan::traced).
-    img.window = PixelWindow::of(settings_);
+    img.window = PixelWindow::of(settings);
     const PixelWindow& traced = plan.traced;
     GBuffer gbuffer;
     {
         auto t = timer.scope(Pass::traceGBuffer);
         PassCounters* pc = plan.counting ? &img.counters.add(Pass::traceGBuffer, camera.width, camera.height) : nullptr;
-        stats.primaryRays = traceGBuffer(*bvh_, particles, camera, settings_.shading.model, gbuffer, pc, &traced);
+        stats.primaryRays = traceGBuffer(*bvh_, particles, camera, settings.shading.model, gbuffer, pc, &traced);
     }
     img.width = camera.width;
     img.height = camera.height;
-    lightFrame(frame, camera, particles, gbuffer, plan.sampler == LightSamplerKind::power ? &powerTable : nullptr,
-               plan.sampler == LightSamplerKind::tree ? &lightTree : nullptr, session, trace, img, stats);
+    lightFrame(lane, frame, camera, g, gbuffer, session, trace, img, stats);
     {
         auto t = timer.scope(Pass::composeImage);
-        composeImage(gbuffer, particles, settings_.shading, img, stats);
+        composeImage(gbuffer, particles, settings.shading, img, stats);
         if (plan.counting) recordCompose(gbuffer, particles, *bvh_, img.counters.add(Pass::composeImage, img.width, img.height));
     }
     if (plan.counting) {
         img.counters.accel = bvh_->accelCounters();
         img.heatmaps = counterHeatmaps(img.counters, img.width, img.height);
     }
-    if (camera.isWindow()) {  // the layers are the window's: cut to render.crop, in the image's coordinates
+    if (!whole) {  // the layers are the window's: cut to render.crop, in the image's coordinates
         cropLayers(img, fw);
-        img.width = world.width;
-        img.height = world.height;
+        img.width = g.world.width;
+        img.height = g.world.height;
     } else if (traced != img.window) {
         cropLayers(img, PixelWindow::whole(img.width, img.height));
     }
+    return img;
+}
+
+FrameImage FrameRenderer::render(std::uint32_t frame, FrameStats& stats, const LightingSession* session, PixelTrace* trace) {
+    if (lanes_.size() != 1) throw std::logic_error("FrameRenderer::render: one lane; renderLanes renders several");
+    const auto start = std::chrono::steady_clock::now();
+    stats.frame = frame;
+    FrameGeometry g;
+    prepareFrame(frame, g, stats);
+    FrameImage img = renderLane(lanes_[0], frame, g, stats, session, trace);
     stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return img;
+}
+
+std::vector<FrameImage> FrameRenderer::renderLanes(std::uint32_t frame, FrameStats& shared, std::vector<FrameStats>& laneStats) {
+    auto since = [](auto start) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+    const auto start = std::chrono::steady_clock::now();
+    shared.frame = frame;
+    FrameGeometry g;
+    prepareFrame(frame, g, shared);
+    laneStats.assign(lanes_.size(), FrameStats{});
+    std::vector<FrameImage> images;
+    images.reserve(lanes_.size());
+    for (std::size_t k = 0; k < lanes_.size(); ++k) {
+        const auto laneStart = std::chrono::steady_clock::now();
+        FrameStats& s = laneStats[k];
+        s.frame = frame;
+        s.origin = shared.origin;
+        s.particles = shared.particles;
+        s.bvh = shared.bvh;
+        s.lightTreeNodes = shared.lightTreeNodes;
+        images.push_back(renderLane(lanes_[k], frame, g, s, nullptr, nullptr));
+        s.seconds = since(laneStart);
+    }
+    shared.seconds = since(start);
+    return images;
 }
 
 }  // namespace accretion

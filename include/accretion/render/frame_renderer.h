@@ -76,38 +76,64 @@ struct RenderOptions {
 /// (loadParticles, buildClusters, buildLightSampler, traceGBuffer,
 /// estimateLighting or the restir passes, composeImage) and decides nothing
 /// else. Keeps the Embree device and BVH across frames (refit needs them).
+///
+/// Lanes: several settings of one scene that differ only in render.seed,
+/// render.crop and restir.crop_margin (the seeds and crops of an
+/// experiment). Each frame's particles, BVH and light sampler are built once;
+/// each lane traces and lights its own view of them, restir with its own
+/// history, and gets the image a renderer of its settings alone would give.
 class FrameRenderer {
 public:
     FrameRenderer(const Settings& settings, ParticleSource source, RenderOptions options = {});
+    /// Throws std::invalid_argument where the lanes differ in anything but
+    /// their seed and crop, or count GPU work (gpu.counters: one BVH's counts).
+    FrameRenderer(std::vector<Settings> lanes, ParticleSource source, RenderOptions options = {});
     ~FrameRenderer();
 
-    /// Render one frame; the passes' times go to stats.timer. With a trace
-    /// (render --pixel), the lighting of pixel trace->px is recorded in it.
+    /// Render one frame of the one lane; the passes' times go to stats.timer.
+    /// With a trace (render --pixel), the lighting of pixel trace->px is recorded in it.
     FrameImage render(std::uint32_t frame, FrameStats& stats, const LightingSession* session = nullptr,
                       PixelTrace* trace = nullptr);
 
-    const Settings& settings() const { return settings_; }
+    /// Render one frame of every lane: the geometry's passes (loadParticles,
+    /// buildClusters, buildLightSampler) timed in `shared`, each lane's own in
+    /// laneStats[k] (resized to the lanes).
+    std::vector<FrameImage> renderLanes(std::uint32_t frame, FrameStats& shared, std::vector<FrameStats>& laneStats);
+
+    std::size_t lanes() const { return lanes_.size(); }
+    const Settings& settings() const { return lanes_[0].settings; }
     /// The BVH of the last frame rendered.
     const ParticleBvh& bvh() const { return *bvh_; }
-    /// The plan of the last frame rendered (before the first: of the first frame, as far as the settings tell).
-    const FramePlan& plan() const { return plan_; }
+    /// The plan of the last frame rendered (before the first: of the first
+    /// frame, as far as the settings tell); the first lane's.
+    const FramePlan& plan() const { return lanes_[0].plan; }
 
 private:
-    /// loadParticles and buildClusters as this frame's plan says; plans the
-    /// frame (the plan needs to know whether the particles emit).
-    const Particles& prepareGeometry(std::uint32_t frame, const Camera& camera, FrameStats& stats, Particles& loaded);
+    /// One view of the frame: its settings, this frame's plan, its restir history.
+    struct Lane {
+        Settings settings;
+        FramePlan plan;
+        std::unique_ptr<Restir> restir;
+    };
+    /// What every lane of a frame shares: the camera, the particles and the light sampler.
+    struct FrameGeometry;
+
+    /// The frame's camera and origin, loadParticles and buildClusters as the
+    /// plan says, and buildLightSampler; plans each lane's frame (the plan
+    /// needs to know whether the particles emit).
+    void prepareFrame(std::uint32_t frame, FrameGeometry& g, FrameStats& stats);
+    /// traceGBuffer, lighting and composeImage of one lane's view.
+    FrameImage renderLane(Lane& lane, std::uint32_t frame, const FrameGeometry& g, FrameStats& stats,
+                          const LightingSession* session, PixelTrace* trace);
     /// chooseNearLights: split's k for this frame (render.near_lights = 0),
     /// from a pilot on the frame's view at 64 pixels across.
-    std::uint32_t chooseFrameNearLights(std::uint32_t frame, const CameraPose& pose, const Particles& particles,
-                                        const LightTree* lightTree, FrameStats& stats);
+    std::uint32_t chooseFrameNearLights(const Lane& lane, std::uint32_t frame, const FrameGeometry& g, FrameStats& stats);
     /// estimateLighting (the restir passes for restir) into img.lighting, or Lr = 0 unlit.
-    void lightFrame(std::uint32_t frame, const Camera& camera, const Particles& particles, const GBuffer& gbuffer,
-                    const AliasTable* powerTable, const LightTree* lightTree, const LightingSession* session,
-                    PixelTrace* trace, FrameImage& img, FrameStats& stats);
+    void lightFrame(Lane& lane, std::uint32_t frame, const Camera& camera, const FrameGeometry& g, const GBuffer& gbuffer,
+                    const LightingSession* session, PixelTrace* trace, FrameImage& img, FrameStats& stats);
 
-    Settings settings_;
+    std::vector<Lane> lanes_;
     CameraTrack cameras_;  ///< every frame's camera: the path, or the engine's file
-    FramePlan plan_;             ///< the last frame's
     ParticleSource source_;
     Particles staticParticles_;  ///< static scenes: loaded once
     bool built_ = false;         ///< the BVH has been built once
@@ -116,7 +142,6 @@ private:
     std::unique_ptr<EmbreeDevice> device_;
     std::unique_ptr<ParticleBvh> bvh_;
     std::unique_ptr<ParticleBvh> previousBvh_;  ///< last frame's, when needsPreviousBvh()
-    std::unique_ptr<Restir> restir_;  ///< restir: history across frames
 };
 
 }  // namespace accretion
