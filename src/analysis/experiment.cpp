@@ -115,4 +115,41 @@ ExperimentRender renderForExperiment(const Settings& settings, const ParticleSou
     return r;
 }
 
+std::vector<ExperimentRender> renderLanesForExperiment(std::vector<Settings> lanes, const ParticleSource& source,
+                                                       std::uint32_t frame, std::uint32_t history) {
+    const std::uint32_t first =
+        estimatorInfo(lanes.at(0).render.estimator).reuse ? frame - std::min(frame, history) : frame;
+    for (Settings& run : lanes) {  // the frames rendered, so that the pass plan keeps restir's history
+        run.render.frame_start = first;
+        run.render.frames = frame - first + 1;
+    }
+    const std::size_t n = lanes.size();
+    FrameRenderer renderer(std::move(lanes), source, RenderOptions{true});
+    std::vector<ExperimentRender> r(n);
+    std::vector<double> own(n, 0.0);
+    const auto start = std::chrono::steady_clock::now();
+    for (std::uint32_t f = first;; ++f) {  // to `frame` inclusive, which may be the last 32-bit number
+        FrameStats shared;
+        std::vector<FrameStats> stats;
+        std::vector<FrameImage> images = renderer.renderLanes(f, shared, stats);
+        double lanesSeconds = 0.0;
+        for (const FrameStats& s : stats) lanesSeconds += s.seconds;
+        const double geometrySeconds = std::max(0.0, shared.seconds - lanesSeconds) / double(n);
+        for (std::size_t k = 0; k < n; ++k) {
+            own[k] += stats[k].seconds + geometrySeconds;
+            if (f != frame) continue;
+            r[k].image = std::move(images[k]);
+            r[k].frameSeconds = stats[k].seconds + geometrySeconds;
+            r[k].stats = std::move(stats[k]);
+        }
+        if (f == frame) break;
+    }
+    // Each lane's share of the wall time: its own passes and an even share of the rest.
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    double sum = 0.0;
+    for (double s : own) sum += s;
+    for (std::size_t k = 0; k < n; ++k) r[k].totalSeconds = sum > 0.0 ? wall * own[k] / sum : wall / double(n);
+    return r;
+}
+
 }  // namespace accretion

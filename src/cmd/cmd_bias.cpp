@@ -215,26 +215,53 @@ ExperimentRender readGpuRender(const std::string& file, const Settings& s, std::
     return r;
 }
 
-/// One seed's Lr over the reference's crops (crop after crop, as
-/// ref.rgb): each crop rendered alone, restir with --crop-margin around it
-/// (restir.crop_margin); the measured frames' times and reuse summed.
-ExperimentRender renderCrops(const BiasArgs& a, const Settings& s, const ParticleSource& source, std::uint32_t frame,
-                             std::uint32_t history, const BiasReference& ref) {
-    if (ref.whole()) return renderForExperiment(s, source, frame, history);
-    ExperimentRender all;
-    all.image.lighting.Lr.reserve(ref.rgb.size());
-    for (const PixelWindow& w : ref.crops) {
-        Settings c = s;
-        c.render.crop = {double(w.x0), double(w.x1), double(w.y0), double(w.y1)};
-        if (estimatorInfo(c.render.estimator).reuse) c.restir.crop_margin = a.cropMargin;
-        ExperimentRender r = renderForExperiment(c, source, frame, history);
-        const std::vector<Vec3>& lr = r.image.lighting.Lr;
-        all.image.lighting.Lr.insert(all.image.lighting.Lr.end(), lr.begin(), lr.end());
-        all.frameSeconds += r.frameSeconds;
-        all.totalSeconds += r.totalSeconds;
-        for (const auto& [pass, counts] : r.stats.reuse) all.stats.reuse[pass] += counts;
+/// Seeds first .. first + count - 1 of one spec over the reference's crops:
+/// one lane per seed and crop (restir with --crop-margin around each crop:
+/// restir.crop_margin) on each frame's geometry, built once for all of them
+/// (renderLanesForExperiment). Each seed's Lr crop after crop (as ref.rgb),
+/// its times and reuse summed over its crops.
+std::vector<ExperimentRender> renderSeeds(const BiasArgs& a, const Settings& s, const ParticleSource& source, std::uint32_t frame,
+                                          std::uint32_t history, const BiasReference& ref, std::uint32_t first, std::uint32_t count) {
+    std::vector<Settings> lanes;
+    for (std::uint32_t k = 0; k < count; ++k) {
+        Settings seed = s;
+        seed.render.seed = s.render.seed + first + k;
+        if (ref.whole()) lanes.push_back(seed);
+        for (const PixelWindow& w : ref.whole() ? std::vector<PixelWindow>{} : ref.crops) {
+            Settings c = seed;
+            c.render.crop = {double(w.x0), double(w.x1), double(w.y0), double(w.y1)};
+            if (estimatorInfo(c.render.estimator).reuse) c.restir.crop_margin = a.cropMargin;
+            lanes.push_back(std::move(c));
+        }
     }
-    return all;
+    const std::size_t perSeed = lanes.size() / count;
+    std::vector<ExperimentRender> rendered = renderLanesForExperiment(std::move(lanes), source, frame, history);
+    std::vector<ExperimentRender> seeds(count);
+    for (std::uint32_t k = 0; k < count; ++k) {
+        ExperimentRender& all = seeds[k];
+        all.image.lighting.Lr.reserve(ref.rgb.size());
+        for (std::size_t c = 0; c < perSeed; ++c) {
+            ExperimentRender& r = rendered[k * perSeed + c];
+            const std::vector<Vec3>& lr = r.image.lighting.Lr;
+            all.image.lighting.Lr.insert(all.image.lighting.Lr.end(), lr.begin(), lr.end());
+            all.frameSeconds += r.frameSeconds;
+            all.totalSeconds += r.totalSeconds;
+            for (const auto& [pass, counts] : r.stats.reuse) all.stats.reuse[pass] += counts;
+        }
+    }
+    return seeds;
+}
+
+/// How many seeds render side by side: their lanes' pixels (each crop with
+/// its margin, or the whole image) up to about four 1080p frames, whose
+/// restir histories they keep.
+std::uint32_t seedsPerBatch(const BiasArgs& a, const BiasReference& ref) {
+    constexpr double kLanePixels = 4.0 * 1920.0 * 1080.0;
+    double perSeed = 0.0;
+    const double image = double(ref.width) * ref.height;
+    for (const PixelWindow& w : ref.crops)
+        perSeed += std::min(image, double(w.width() + 2 * a.cropMargin + 16) * double(w.height() + 2 * a.cropMargin + 16));
+    return static_cast<std::uint32_t>(std::clamp(std::floor(kLanePixels / std::max(perSeed, 1.0)), 1.0, double(a.seeds)));
 }
 
 /// One estimator over the seeds: its row, and its bias map at prefix.<estimator>.exr.
@@ -248,13 +275,7 @@ BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vec
     double e1 = 0.0, e2 = 0.0, seconds = 0.0, frameSeconds = 0.0, relMse = 0.0;
     PassReuse reuse;
     Progress progress("bias " + spec.label + " (seeds)", a.seeds, a.quiet);
-    for (std::uint32_t k = 0; k < a.seeds; ++k) {
-        Settings s = specBase;
-        s.render.seed = specBase.render.seed + k;
-        const ExperimentRender r = a.gpuFrames.empty()
-                                       ? renderCrops(a, s, source, frame, history, ref)
-                                       : readGpuRender(gpuFramePath(a.gpuFrames, biasMapName(spec), s.render.seed), s, frame,
-                                                       ref, a.strict);
+    auto add = [&](const ExperimentRender& r) {
         seconds += r.totalSeconds;
         for (const auto& [pass, counts] : r.stats.reuse) reuse[pass] += counts;
         frameSeconds += a.gpuFrames.empty() ? r.frameSeconds : r.totalSeconds;
@@ -271,6 +292,18 @@ BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vec
         e1 += e;
         e2 += e * e;
         progress.advance(1);
+    };
+    if (!a.gpuFrames.empty()) {
+        for (std::uint32_t k = 0; k < a.seeds; ++k) {
+            Settings s = specBase;
+            s.render.seed = specBase.render.seed + k;
+            add(readGpuRender(gpuFramePath(a.gpuFrames, biasMapName(spec), s.render.seed), s, frame, ref, a.strict));
+        }
+    } else {
+        const std::uint32_t batch = seedsPerBatch(a, ref);
+        for (std::uint32_t k = 0; k < a.seeds; k += batch)
+            for (const ExperimentRender& r : renderSeeds(a, specBase, source, frame, history, ref, k, std::min(batch, a.seeds - k)))
+                add(r);
     }
     progress.finish();
     const double S = a.seeds;

@@ -360,17 +360,18 @@ ErrorRow measureErrorSeeds(TuneContext& t, const LightingChoice& o, std::uint32_
     return e;
 }
 
-/// The error with --seeds; where a bias of --bias-bound could hide in it,
-/// again with the fewest seeds whose test would see one (Student's t: the
-/// bound falls faster than 1/sqrt(seeds) while the degrees of freedom grow),
-/// up to --max-seeds; past that the verdict stays "unknown", with its bound.
-ErrorRow measureError(TuneContext& t, const LightingChoice& o) {
-    const ErrorRow first = measureErrorSeeds(t, o, t.args.seeds);
+/// The error again with the fewest seeds whose test would see a bias of
+/// --bias-bound (Student's t: the bound falls faster than 1/sqrt(seeds)
+/// while the degrees of freedom grow), up to --max-seeds; past that the
+/// first measurement stands, its verdict "unknown" with its bound.
+ErrorRow measureMoreSeeds(TuneContext& t, const LightingChoice& o, const ErrorRow& first) {
     if (first.verdict != BiasVerdict::unknown || !std::isfinite(first.detectablePct)) return first;
     // 10% spare on the variance: the seeds' spread is itself measured.
     const std::uint32_t needed = seedsToDetect(first.seedSd * std::sqrt(1.1), first.seeds, first.referenceStderr, first.zCritical,
                                                t.args.biasBoundPct / 100.0 * first.referenceMean, t.args.maxSeeds);
-    return needed ? measureErrorSeeds(t, o, needed) : first;
+    if (!needed) return first;
+    ++t.steps;  // a measurement the plan did not count
+    return measureErrorSeeds(t, o, needed);
 }
 
 /// The references of the error measurements, one per crop: given, or
@@ -493,24 +494,6 @@ struct PricedGeometry {
     std::map<Pass, double> ms;
 };
 
-/// The lighting choices on the chosen geometry: error on the CPU, GPU time
-/// priced; the Pareto front marked, sorted by time.
-std::vector<ParetoPoint> measureLighting(TuneContext& t, const GeometryChoice& chosen, const std::vector<LightingChoice>& lighting) {
-    std::vector<ParetoPoint> points;
-    for (const LightingChoice& l : lighting) {
-        ParetoPoint p{l};
-        std::vector<std::string> defines = chosen.defines();
-        const std::vector<std::string> own = l.defines();
-        defines.insert(defines.end(), own.begin(), own.end());
-        p.ms = total(predictMs(t, defines, l.label()));
-        p.error = measureError(t, l);
-        points.push_back(std::move(p));
-    }
-    markFront(points);
-    std::sort(points.begin(), points.end(), [](const ParetoPoint& p, const ParetoPoint& q) { return p.ms < q.ms; });
-    return points;
-}
-
 /// The recommendation: under the budget (and --max-error), never biased
 /// unless allowed; a configuration whose seeds could see a bias of
 /// --bias-bound before one they could not (which is recommended only with
@@ -529,6 +512,57 @@ const ParetoPoint* recommend(const TuneArgs& a, const std::vector<ParetoPoint>& 
         if (!best || better(p, *best)) best = &p;
     }
     return best;
+}
+
+/// Seeds where the recommendation needs them: in the order the
+/// recommendation ranks the eligible configurations (under the budget and
+/// --max-error, not found biased; by error, or by time with --max-error), each
+/// whose bias is unknown is measured again with the seeds that would see
+/// --bias-bound (measureMoreSeeds), until one is verified unbiased: nothing
+/// ranked after it can be recommended before it, so its seeds would be spent
+/// for nothing. Each configuration gets more seeds at most once; the others
+/// keep their "bias unknown (bound X%)".
+void verifyCandidates(TuneContext& t, std::vector<ParetoPoint>& points) {
+    const TuneArgs& a = t.args;
+    std::vector<bool> tried(points.size(), false);
+    for (;;) {
+        std::vector<std::size_t> order;
+        for (std::size_t k = 0; k < points.size(); ++k) {
+            const ParetoPoint& p = points[k];
+            if (p.ms > a.budgetMs || (p.error.biased() && !a.allowBiased)) continue;
+            if (a.maxError && p.error.relMse > *a.maxError) continue;
+            order.push_back(k);
+        }
+        std::stable_sort(order.begin(), order.end(), [&](std::size_t i, std::size_t j) {
+            return a.maxError ? points[i].ms < points[j].ms : points[i].error.relMse < points[j].error.relMse;
+        });
+        const auto next = std::find_if(order.begin(), order.end(), [&](std::size_t k) {
+            return points[k].error.verdict == BiasVerdict::unbiased || (points[k].error.verdict == BiasVerdict::unknown && !tried[k]);
+        });
+        if (next == order.end() || points[*next].error.verdict == BiasVerdict::unbiased) return;
+        tried[*next] = true;
+        points[*next].error = measureMoreSeeds(t, points[*next].lighting, points[*next].error);
+    }
+}
+
+/// The lighting choices on the chosen geometry: error on the CPU (--seeds,
+/// then more where the recommendation needs them), GPU time priced; the
+/// Pareto front marked, sorted by time.
+std::vector<ParetoPoint> measureLighting(TuneContext& t, const GeometryChoice& chosen, const std::vector<LightingChoice>& lighting) {
+    std::vector<ParetoPoint> points;
+    for (const LightingChoice& l : lighting) {
+        ParetoPoint p{l};
+        std::vector<std::string> defines = chosen.defines();
+        const std::vector<std::string> own = l.defines();
+        defines.insert(defines.end(), own.begin(), own.end());
+        p.ms = total(predictMs(t, defines, l.label()));
+        p.error = measureErrorSeeds(t, l, t.args.seeds);
+        points.push_back(std::move(p));
+    }
+    verifyCandidates(t, points);
+    markFront(points);
+    std::sort(points.begin(), points.end(), [](const ParetoPoint& p, const ParetoPoint& q) { return p.ms < q.ms; });
+    return points;
 }
 
 /// What tune found, as its report, CSV, JSON and plot read it.

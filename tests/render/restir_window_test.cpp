@@ -80,3 +80,58 @@ TEST_CASE("restir on a crop and its margin renders the crop as the whole frame d
     s.restir.crop_margin = 0;  // the crop alone: its edge's neighbours and history beyond it are off-screen
     CHECK(differing(whole, lastFrame(s, 3), s.camera.width) > 0);
 }
+
+TEST_CASE("Lanes on one frame's geometry give each lane the image of its own renderer", "[render][restir][window][lanes]") {
+    // Two seeds by two crops (and the whole frame) of restir with temporal
+    // and spatial reuse over 4 frames, and ris: each lane bit for bit what a
+    // renderer of its settings alone gives, its history its own.
+    const EstimatorKind kind = GENERATE(EstimatorKind::restir, EstimatorKind::ris);
+    INFO(enumName(kind));
+    Settings s = test::smallDiskSettings();
+    s.camera.width = 96;
+    s.camera.height = 64;
+    s.render.estimator = kind;
+    s.render.source = LightSource::tree;
+    s.render.candidates = 4;
+    s.render.samples = 2;
+    s.render.frames = 4;
+    s.restir.spatial_neighbours = 3;
+    s.restir.spatial_radius = 4.0;
+    std::vector<Settings> lanes;
+    for (std::uint64_t seed : {5u, 9u}) {
+        Settings l = s;
+        l.render.seed = seed;
+        lanes.push_back(l);  // the whole frame
+        for (const PixelWindow& w : {PixelWindow{8, 40, 8, 32}, PixelWindow{50, 90, 30, 60}}) {
+            l.render.crop = {double(w.x0), double(w.x1), double(w.y0), double(w.y1)};
+            l.restir.crop_margin = kind == EstimatorKind::restir ? 8.0 : -1.0;
+            lanes.push_back(l);
+        }
+    }
+    FrameRenderer renderer(lanes, ParticleSource(s), RenderOptions{true});
+    std::vector<FrameImage> images;
+    for (std::uint32_t f = 0; f < 4; ++f) {
+        FrameStats shared;
+        std::vector<FrameStats> stats;
+        images = renderer.renderLanes(f, shared, stats);
+        REQUIRE(stats.size() == lanes.size());
+        CHECK(shared.particles > 0);
+    }
+    REQUIRE(images.size() == lanes.size());
+    std::size_t lit = 0;
+    for (std::size_t k = 0; k < lanes.size(); ++k) {
+        INFO("lane " << k);
+        const FrameImage alone = lastFrame(lanes[k], 4);
+        REQUIRE(images[k].window == alone.window);
+        CHECK(images[k].lighting.Lr == alone.lighting.Lr);
+        CHECK(images[k].particle == alone.particle);
+        for (const Vec3& v : alone.lighting.Lr) lit += v.x > 0.0f;
+    }
+    CHECK(lit > 100);
+    CHECK(images[0].lighting.Lr != images[3].lighting.Lr);  // the seeds differ
+
+    // Lanes share everything but their seed and crop.
+    Settings other = lanes[1];
+    other.render.candidates = 8;
+    CHECK_THROWS_AS(FrameRenderer(std::vector<Settings>{lanes[0], other}, ParticleSource(s)), std::invalid_argument);
+}

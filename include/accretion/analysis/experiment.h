@@ -71,4 +71,12 @@ std::uint32_t historyBefore(const HistoryChoice& history, const Settings& settin
 ExperimentRender renderForExperiment(const Settings& settings, const ParticleSource& source, std::uint32_t frame,
                                      std::uint32_t history);
 
+/// The same for several lanes of one scene (settings that differ only in
+/// render.seed, render.crop and restir.crop_margin: FrameRenderer's lanes),
+/// each frame's geometry built once for all of them. Each lane's image is
+/// the one renderForExperiment gives it; its times are its own passes plus
+/// an even share of the geometry's, and its stats its own passes'.
+std::vector<ExperimentRender> renderLanesForExperiment(std::vector<Settings> lanes, const ParticleSource& source,
+                                                       std::uint32_t frame, std::uint32_t history);
+
 }  // namespace accretion
