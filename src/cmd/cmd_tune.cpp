@@ -53,7 +53,7 @@ namespace {
 struct TuneArgs : SceneArgs {
     double budgetMs = 0.0;
     std::optional<double> maxError;
-    std::uint32_t seeds = 16;
+    std::uint32_t seeds = 4;  ///< every configuration's first measurement; more where they decide the answer (verifyCandidates)
     std::optional<std::uint32_t> frame;  ///< default: render.frame_start + the steady state's history
     std::string errorCrops = "4x2";     ///< strata of the frame, one crop each: COLUMNSxROWS
     std::string cropSize = "160x90";    ///< each crop's size at the scene's resolution
@@ -65,7 +65,7 @@ struct TuneArgs : SceneArgs {
     bool allowBiased = false;
     bool anatomy = false;          ///< also the error with every light visible: visibility's share
     double biasBoundPct = 1.0;     ///< the energy bias a verdict of "unbiased" must be able to see
-    std::uint32_t maxSeeds = 64;   ///< the most seeds tune spends on one configuration to see it
+    std::uint32_t maxSeeds = 48;   ///< the most seeds tune spends on one configuration to see it
 };
 
 /// One point of the space: its label and the settings it overrides.
@@ -751,7 +751,7 @@ void addTuneCommand(CLI::App& app) {
     cmd->remove_option(cmd->get_option("--frames"));  // tune measures one frame: --frame
     cmd->add_option("--budget-ms", args->budgetMs, "GPU time budget of a frame, ms (the cost model's prediction)")->required();
     cmd->add_option("--max-error", args->maxError, "Recommend the fastest configuration with relMSE at most this (on the crops)");
-    cmd->add_option("--seeds", args->seeds, "Seeds per lighting configuration for its error and bias")->check(CLI::Range(2u, 100000u));
+    cmd->add_option("--seeds", args->seeds, "Seeds of every lighting configuration's first error and bias measurement (more where they decide the recommendation, up to --max-seeds)")->check(CLI::Range(2u, 100000u));
     cmd->add_option("--frame", args->frame,
                     "The measured frame, after the history that brings temporal reuse to steady state (ceil(restir.m_cap) "
                     "frames, at least 8; default: render.frame_start + that history)");
