@@ -464,15 +464,18 @@ void runBias(const BiasArgs& a) {
                                  {"reference_mean", ref.mean}, {"reference_mean_stderr", ref.meanStderr},
                                  {"settings", settingsToToml(scene)}, {"rows", table.json()}, {"reuse", reuse}});
     // Red bars: BIASED (|t| above its critical value); the title says what was measured.
+    const std::size_t biased = table.csvColumn("biased"), loss = table.csvColumn("energy_loss_pct"),
+                      lossSe = table.csvColumn("energy_loss_stderr_pct"), critical = table.csvColumn("t_critical");
     const std::string script = fmt::format(
         "set datafile separator ','\nset style fill solid 0.5\nset boxwidth 0.6\nset grid ytics\n"
         "set title {1}\nset ylabel 'energy loss % (bars: the critical |t| in standard errors)'\nset xtics rotate by -30\nset key off\n"
-        "plot {0} skip 1 using 0:($12 == 1 ? NaN : $10):xtic(1) with boxes lc rgb '#4682b4', "
-        "{0} skip 1 using 0:($12 == 1 ? $10 : NaN) with boxes lc rgb '#d62728', "
-        "{0} skip 1 using 0:10:($11*$9) with yerrorbars lc rgb 'black' pt 0\n",
+        "plot {0} skip 1 using 0:(${2} == 1 ? NaN : ${3}):xtic(1) with boxes lc rgb '#4682b4', "
+        "{0} skip 1 using 0:(${2} == 1 ? ${3} : NaN) with boxes lc rgb '#d62728', "
+        "{0} skip 1 using 0:{3}:(${4}*${5}) with yerrorbars lc rgb 'black' pt 0\n",
         gnuplotQuote(prefix + ".csv"),
         gnuplotQuote(fmt::format("bias of {} frame {}, {} seeds (red: BIASED, |t| above its critical value)",
-                                 std::filesystem::path(scene.scenePath).filename().string(), frame, a.seeds)));
+                                 std::filesystem::path(scene.scenePath).filename().string(), frame, a.seeds)),
+        biased, loss, lossSe, critical);
     plotPng(prefix + ".png", script);
     fmt::print("bias: {}.csv, {}.png, {}.json, bias maps {}.<estimator>.exr (.z.png)\n", prefix, prefix, prefix, prefix);
 }

@@ -673,24 +673,35 @@ void writeTuneJson(const std::string& prefix, const TuneArgs& a, const Settings&
                                  {"lighting", lt.json()}, {"reuse", reuse}, {"recommended", recommended}, {"time", spentJson(t)}});
 }
 
-/// PREFIX.png: the configurations' error against predicted GPU ms, the front and the budget.
-void plotTune(const std::string& prefix, const TuneArgs& a, const Settings& scene, std::size_t particles, const TuneResult& r) {
+/// PREFIX.png: the configurations' error against predicted GPU ms by bias
+/// verdict, the front and the budget; the columns found by their keys in `lt`.
+void plotTune(const std::string& prefix, const TuneArgs& a, const Settings& scene, std::size_t particles, const TuneResult& r,
+              const Table& lt) {
     const std::string csv = gnuplotQuote(prefix + ".csv");
     const ParetoPoint* best = r.best;
+    double maxMs = a.budgetMs;
+    for (const ParetoPoint& p : r.points) maxMs = std::max(maxMs, p.ms);
+    const std::size_t ms = lt.csvColumn("gpu_ms"), err = lt.csvColumn("rel_mse"), verdict = lt.csvColumn("bias_verdict"),
+                      front = lt.csvColumn("front");
+    auto points = [&](const char* which, const char* style, const char* title) {
+        return fmt::format("{} skip 1 using {}:(strcol({}) eq '{}' ? ${} : NaN) with points {} title '{}'", csv, ms, verdict, which, err,
+                           style, title);
+    };
     const std::string script = fmt::format(
-        "set datafile separator ','\nset logscale y\nset grid\nset key top right\n"
-        "set title {0}\nset xlabel 'predicted GPU ms per frame ({1}; calibrated cost model)'\nset ylabel 'relMSE on {2} ({3} seeds)'\n"
+        "set datafile separator ','\nset logscale y\nset grid\nset key top right\nset xrange [0:{7}]\n"
+        "set title {0}\nset xlabel 'predicted GPU ms per frame ({1}; calibrated cost model)'\nset ylabel 'relMSE on {2} ({3}+ seeds)'\n"
         "set arrow from {4},graph 0 to {4},graph 1 nohead dt 2 lc rgb 'gray40'\n"
-        "set label 'budget' at {4},graph 0.95 right offset -0.5,0 tc rgb 'gray40'\n{6}"
-        "plot {5} skip 1 using 2:($7 == 0 ? $3 : NaN) with points pt 7 lc rgb 'gray60' title 'configurations', "
-        "{5} skip 1 using 2:($7 != 0 ? $3 : NaN) with points pt 2 ps 1.5 lc rgb 'red' title 'biased (|t| above its critical value, 99.9%)', "
-        "{5} skip 1 using 2:($8 != 0 ? $3 : NaN) with points pt 6 ps 2 lc rgb 'blue' title 'Pareto front'\n",
+        "set label 'budget' at {4},graph 0.05 right offset -0.5,0 tc rgb 'gray40'\n{6}"
+        "plot {8}, {9}, {10}, {5} skip 1 using {11}:(${12} != 0 ? ${13} : NaN) with points pt 6 ps 2 lc rgb 'blue' title 'Pareto front'\n",
         gnuplotQuote(fmt::format("{} ({} particles) at {}x{}: budget {:g} ms", scene.sceneName, particles,
                                  scene.camera.width, scene.camera.height, a.budgetMs)),
         r.chosen->choice.label(), fmt::format("{} crops of {}", a.errorCrops, a.cropSize), a.seeds, a.budgetMs, csv,
         best ? fmt::format("set label 'recommended' at {},{} point pt 3 ps 3 lc rgb 'dark-green' offset 1,1 tc rgb 'dark-green'\n", best->ms,
                            best->error.relMse)
-             : std::string());
+             : std::string(),
+        1.08 * maxMs, points("unbiased", "pt 7 ps 1.3 lc rgb 'dark-green'", fmt::format("unbiased to {:g}%", a.biasBoundPct).c_str()),
+        points("unknown", "pt 7 lc rgb 'gray60'", "bias unknown"),
+        points("biased", "pt 2 ps 1.5 lc rgb 'red'", "biased (|t| above its critical value, 99.9%)"), ms, front, err);
     plotPng(prefix + ".png", script);
 }
 
@@ -736,7 +747,7 @@ void runTune(const TuneArgs& a) {
     printTune(a, scene, t, r, gt, lt);
     writeFileAtomic(prefix + ".csv", lt.csv());
     writeTuneJson(prefix, a, scene, t, r, gt, lt);
-    plotTune(prefix, a, scene, particles, r);
+    plotTune(prefix, a, scene, particles, r, lt);
     fmt::print("tune: {}.csv, {}.json, {}.png (cache {})\n", prefix, prefix, prefix, t.cache.string());
 }
 

@@ -44,6 +44,16 @@ std::string Table::console() const {
     return out;
 }
 
+std::size_t Table::csvColumn(std::string_view key) const {
+    std::size_t n = 0;
+    for (const Column& c : columns_) {
+        if (c.key.empty()) continue;
+        ++n;
+        if (c.key == key) return n;
+    }
+    throw std::logic_error("Table::csvColumn: no column " + std::string(key));
+}
+
 std::string Table::csv() const {
     std::string out;
     for (const Column& c : columns_)

@@ -38,6 +38,9 @@ public:
     std::string console() const;
     /// CSV with a header line (columns with a key; a flag is 1 or 0).
     std::string csv() const;
+    /// The 1-based column of `key` in csv() (as gnuplot's `using` counts);
+    /// throws std::logic_error where no column has that key.
+    std::size_t csvColumn(std::string_view key) const;
     /// An array of objects keyed by the column keys (a non-finite number is null).
     nlohmann::json json() const;
     /// "header value" lines of the first row (a one-row report).
