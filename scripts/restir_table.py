@@ -96,7 +96,7 @@ def measure(scene, seeds, out):
         uniform_at_t = u["rel_mse"] * u["seconds_per_frame"] / t
         table.append({"spec": spec, "source": src, "correction": bc, "visibility_reuse": vis,
                       "rel_mse": b["rel_mse"], "cpu_ms": 1e3 * t, "gain_vs_uniform": uniform_at_t / b["rel_mse"],
-                      "z": b["z"], "energy_loss_pct": b["energy_loss_pct"],
+                      "t": b["t"], "energy_loss_pct": b["energy_loss_pct"],
                       "energy_loss_stderr_pct": b["energy_loss_stderr_pct"], "biased": b["biased"],
                       "gpu_ms": c["predicted_ms"],
                       "gpu_lighting_ms": sum(p["predicted_ms"] for p in c["passes"] if p["pass"] in LIGHTING),
@@ -109,13 +109,13 @@ def markdown(m):
     u = m["uniform"]
     lines = [f"**{m['scene']}** (320x180, frame 1 after 1 history frame, {m['seeds']} seeds; uniform Monte Carlo at 16 spp: "
              f"relMSE {u['rel_mse']:.3g} in {1e3 * u['seconds_per_frame']:.0f} ms)", "",
-             "| source | bias correction | vis. reuse | relMSE | CPU ms | gain vs uniform at equal time | bias z | energy loss % | GPU ms: frame / lighting / presampling |",
+             "| source | bias correction | vis. reuse | relMSE | CPU ms | gain vs uniform at equal time | bias t | energy loss % | GPU ms: frame / lighting / presampling |",
              "|---|---|---|---|---|---|---|---|---|"]
     for r in m["rows"]:
         corr = r["correction"] + ("+vis" if r["correction"] == "basic" and r["visibility_reuse"] else "")
         flag = " **biased**" if r["biased"] else ""
         lines.append(f"| {r['source']} | {corr} | {'on' if r['visibility_reuse'] else 'off'} | {r['rel_mse']:.3g} | "
-                     f"{r['cpu_ms']:.0f} | {r['gain_vs_uniform']:.2f}x | {r['z']:.1f}{flag} | "
+                     f"{r['cpu_ms']:.0f} | {r['gain_vs_uniform']:.2f}x | {r['t']:.1f}{flag} | "
                      f"{r['energy_loss_pct']:.2f} +- {r['energy_loss_stderr_pct']:.2f} | "
                      f"{r['gpu_ms']:.2f} / {r['gpu_lighting_ms']:.3f} / {r['gpu_presample_ms']:.3f} |")
     unbiased = [r for r in m["rows"] if not r["biased"] and r["correction"] != "none"]

@@ -92,14 +92,25 @@ std::uint32_t historyBefore(const HistoryChoice& history, const Settings& settin
     return h;
 }
 
+namespace {
+
+/// Set the frames rendered to `frame`'s history and `frame` (restir's
+/// history frames first, so that the pass plan keeps its history; none
+/// without reuse); returns the first frame rendered.
+std::uint32_t renderFramesUpTo(Settings& run, std::uint32_t frame, std::uint32_t history) {
+    const std::uint32_t first = estimatorInfo(run.render.estimator).reuse ? frame - std::min(frame, history) : frame;
+    run.render.frame_start = first;
+    run.render.frames = frame - first + 1;
+    return first;
+}
+
+}  // namespace
+
 ExperimentRender renderForExperiment(const Settings& settings, const ParticleSource& source, std::uint32_t frame,
                                      std::uint32_t history) {
     ExperimentRender r;
-    const std::uint32_t first =
-        estimatorInfo(settings.render.estimator).reuse ? frame - std::min(frame, history) : frame;
-    Settings run = settings;  // the frames rendered, so that the pass plan keeps restir's history
-    run.render.frame_start = first;
-    run.render.frames = frame - first + 1;
+    Settings run = settings;
+    const std::uint32_t first = renderFramesUpTo(run, frame, history);
     FrameRenderer renderer(run, source, RenderOptions{true});
     const auto start = std::chrono::steady_clock::now();
     for (std::uint32_t f = first;; ++f) {  // to `frame` inclusive, which may be the last 32-bit number
@@ -117,12 +128,8 @@ ExperimentRender renderForExperiment(const Settings& settings, const ParticleSou
 
 std::vector<ExperimentRender> renderLanesForExperiment(std::vector<Settings> lanes, const ParticleSource& source,
                                                        std::uint32_t frame, std::uint32_t history) {
-    const std::uint32_t first =
-        estimatorInfo(lanes.at(0).render.estimator).reuse ? frame - std::min(frame, history) : frame;
-    for (Settings& run : lanes) {  // the frames rendered, so that the pass plan keeps restir's history
-        run.render.frame_start = first;
-        run.render.frames = frame - first + 1;
-    }
+    std::uint32_t first = frame;
+    for (Settings& run : lanes) first = renderFramesUpTo(run, frame, history);
     const std::size_t n = lanes.size();
     FrameRenderer renderer(std::move(lanes), source, RenderOptions{true});
     std::vector<ExperimentRender> r(n);

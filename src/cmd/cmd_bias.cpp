@@ -55,7 +55,7 @@ struct BiasRow {
     std::uint32_t history = 0;  ///< frames rendered before the measured one
     double meanError = 0.0;    ///< mean over seeds of the image-mean signed error (x - ref)
     double stderr = 0.0;       ///< its standard error (seeds and reference noise)
-    double z = 0.0;            ///< meanError / stderr: Student's t with `dof` degrees of freedom
+    double t = 0.0;            ///< meanError / stderr: Student's t with `dof` degrees of freedom
     double seedSd = 0.0;       ///< the seeds' sample standard deviation of the image-mean signed error
     double dof = 0.0;          ///< Welch-Satterthwaite's, from the seeds' spread and the reference's
     double critical = 0.0;     ///< the two-sided critical |t| at --z's significance
@@ -320,14 +320,14 @@ BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vec
     // No spread at all (a deterministic estimator against an exact
     // reference): any difference beyond float summation is a bias, not noise.
     const double tiny = 1e-6 * std::max(std::fabs(ref.mean), 1e-30);
-    row.z = row.stderr > 0.0 ? row.meanError / row.stderr
+    row.t = row.stderr > 0.0 ? row.meanError / row.stderr
           : std::fabs(row.meanError) > tiny ? std::copysign(std::numeric_limits<double>::infinity(), row.meanError)
                                             : 0.0;
     row.energyLossPct = ref.mean > 0.0 ? -100.0 * row.meanError / ref.mean : 0.0;
     row.secondsPerRender = seconds / S;
     row.relMse = relMse / S;
     row.secondsPerFrame = frameSeconds / S;
-    row.biased = std::fabs(row.z) > row.critical;
+    row.biased = std::fabs(row.t) > row.critical;
     row.detectablePct = ref.mean > 0.0 ? 100.0 * test.detectable / ref.mean : std::numeric_limits<double>::infinity();
     row.map = biasMap(s1, s2, S, ref);
     row.reuse = std::move(reuse);
@@ -357,7 +357,7 @@ Table biasTable(const std::vector<BiasRow>& rows, double refMean, double zCritic
     const double significance = 1.0 - 2.0 * (1.0 - normalCdf(zCritical));
     auto hidden = [](const char* key, const char* csv) { return Column{key, "", 0, "{}", csv, false}; };
     Table t({{"estimator", "estimator", -28}, {"seeds", "seeds", 6}, {"history_frames", "hist", 5}, {"mean_signed_error", "mean error", 13, "{:.5g}", "{:.8g}"},
-             {"stderr", "stderr", 11, "{:.3g}", "{:.8g}"}, {"z", "t", 8, "{:.2f}", "{:.5g}"},
+             {"stderr", "stderr", 11, "{:.3g}", "{:.8g}"}, {"t", "t", 8, "{:.2f}", "{:.5g}"},
              hidden("seed_sd", "{:.8g}"), {"dof", "dof", 6, "{:.3g}", "{:.6g}"}, {"t_critical", "|t| >", 6, "{:.2f}", "{:.6g}"},
              hidden("energy_loss_pct", "{:.6g}"), hidden("energy_loss_stderr_pct", "{:.6g}"), {"", "energy loss %", 15},
              hidden("biased", "{}"), hidden("detectable_bias_pct", "{:.4g}"), {"seconds_per_render", "s/render", 9, "{:.3f}", "{:.6g}"},
@@ -367,7 +367,7 @@ Table biasTable(const std::vector<BiasRow>& rows, double refMean, double zCritic
              {"", fmt::format("verdict (|t| above its critical value, {:.3g}% two-sided)", 100.0 * significance), 0, "{}", "{}", true, "  "}});
     for (const BiasRow& r : rows) {
         const double lossSe = refMean > 0.0 ? 100.0 * r.stderr / refMean : 0.0;
-        t.add({r.label, std::uint64_t(r.seeds), std::uint64_t(r.history), r.meanError, r.stderr, r.z, r.seedSd, r.dof, r.critical,
+        t.add({r.label, std::uint64_t(r.seeds), std::uint64_t(r.history), r.meanError, r.stderr, r.t, r.seedSd, r.dof, r.critical,
                r.energyLossPct, lossSe,
                fmt::format("{:>8.3f} +- {:<5.3f}", r.energyLossPct, lossSe), r.biased, r.detectablePct, r.secondsPerRender,
                r.secondsPerFrame, r.relMse, r.relMseUnshadowed, 100.0 * (r.relMse - r.relMseUnshadowed) / r.relMse,

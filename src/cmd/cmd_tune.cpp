@@ -298,10 +298,10 @@ constexpr const char* verdictName(BiasVerdict v) {
 }
 
 /// One lighting configuration's error: bias's row (relMSE of one frame less
-/// the reference's noise, the mean signed error's z, the energy loss, the
+/// the reference's noise, the mean signed error's t statistic, the energy loss, the
 /// smallest energy bias its seeds detect 4 times in 5).
 struct ErrorRow {
-    double relMse = 0.0, z = 0.0, energyLossPct = 0.0, cpuSecondsPerFrame = 0.0, detectablePct = 0.0;
+    double relMse = 0.0, t = 0.0, energyLossPct = 0.0, cpuSecondsPerFrame = 0.0, detectablePct = 0.0;
     double seedSd = 0.0, referenceMean = 0.0, referenceStderr = 0.0, zCritical = 0.0;  ///< bias's test: what more seeds would see
     double visibilitySharePct = NAN;  ///< --anatomy: the share of relMSE that every light visible removes
     std::uint32_t seeds = 0;
@@ -343,7 +343,7 @@ ErrorRow measureErrorSeeds(TuneContext& t, const LightingChoice& o, std::uint32_
     const nlohmann::json& r = j.at("rows").at(0);
     ErrorRow e;
     e.relMse = r.at("rel_mse").get<double>();
-    e.z = r.at("z").get<double>();
+    e.t = r.at("t").get<double>();
     e.energyLossPct = r.at("energy_loss_pct").get<double>();
     e.cpuSecondsPerFrame = r.at("seconds_per_frame").get<double>();
     e.detectablePct = r.at("detectable_bias_pct").get<double>();
@@ -586,7 +586,7 @@ Table geometryTable(const TuneResult& r) {
 
 Table lightingTable(const TuneArgs& a, const TuneResult& r) {
     Table lt({{"lighting", "lighting (on the chosen geometry)", -36}, {"gpu_ms", "GPU ms", 9, "{:.3f}", "{:.6g}"},
-              {"rel_mse", "relMSE", 10, "{:.4g}", "{:.6g}"}, {"z", "bias z", 7, "{:.1f}", "{:.5g}"},
+              {"rel_mse", "relMSE", 10, "{:.4g}", "{:.6g}"}, {"t", "bias t", 7, "{:.1f}", "{:.5g}"},
               {"energy_loss_pct", "loss %", 7, "{:.1f}", "{:.5g}"}, {"detectable_bias_pct", "bound %", 8, "{:.2g}", "{:.5g}"},
               {"seeds", "seeds", 6}, {"temporal_kept_pct", "temp kept%", 10, "{:.0f}", "{:.4g}"},
               {"spatial_kept_pct", "spat kept%", 10, "{:.0f}", "{:.4g}"}, {"spatial_other_particle_pct", "of them other%", 14, "{:.0f}", "{:.4g}"},
@@ -599,7 +599,7 @@ Table lightingTable(const TuneArgs& a, const TuneResult& r) {
         const std::string bias = p.error.label();
         const double temporalKept = p.error.kept("temporalResampling").first;
         const auto [spatialKept, spatialOther] = p.error.kept("spatialResampling");
-        lt.add({p.lighting.label(), p.ms, p.error.relMse, p.error.z, p.error.energyLossPct, p.error.detectablePct,
+        lt.add({p.lighting.label(), p.ms, p.error.relMse, p.error.t, p.error.energyLossPct, p.error.detectablePct,
                 std::uint64_t(p.error.seeds), temporalKept, spatialKept, spatialOther, p.error.visibilitySharePct,
                 100.0 - p.error.visibilitySharePct,
                 p.error.cpuSecondsPerFrame, p.error.biased(), std::string(verdictName(p.error.verdict)),

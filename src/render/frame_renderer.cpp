@@ -134,8 +134,9 @@ FrameRenderer::FrameRenderer(const Settings& settings, ParticleSource source, Re
 FrameRenderer::FrameRenderer(std::vector<Settings> lanes, ParticleSource source, RenderOptions options)
     : cameras_(lanes.at(0).camera), source_(std::move(source)), options_(options), device_(std::make_unique<EmbreeDevice>()),
       bvh_(newBvh(*device_, lanes.at(0))) {
+    const std::string shared = sharedPart(lanes.at(0), lanes[0]);
     for (std::size_t k = 1; k < lanes.size(); ++k)
-        if (sharedPart(lanes[k], lanes[0]) != sharedPart(lanes[0], lanes[0]))
+        if (sharedPart(lanes[k], lanes[0]) != shared)
             throw std::invalid_argument("FrameRenderer: lanes differ in more than render.seed, render.crop and restir.crop_margin");
     for (Settings& s : lanes) {
         Lane lane{std::move(s), {}, nullptr};
