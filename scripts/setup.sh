@@ -7,7 +7,7 @@ packages=(
   libopenexr-dev libpng-dev libfreetype-dev libopenimageio-dev openimageio-tools
   catch2 libtomlplusplus-dev nlohmann-json3-dev libcli11-dev libfmt-dev
   libpcg-cpp-dev libeigen3-dev libbenchmark-dev gnuplot-nox clang parallel fonts-dejavu-core
-  python3 python3-venv
+  python3 python3-venv locales
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -1,8 +1,10 @@
 #include "child_process.h"
 
 #include <cerrno>
+#include <chrono>
 #include <cstring>
 #include <fstream>
+#include <thread>
 
 #include <fcntl.h>
 #include <spawn.h>
@@ -12,6 +14,7 @@
 #include <fmt/core.h>
 
 #include "accretion/core/error.h"
+#include "accretion/core/stop_signal.h"
 
 extern char** environ;
 
@@ -37,11 +40,20 @@ pid_t spawnSelf(const std::vector<std::string>& argv, const std::filesystem::pat
     return pid;
 }
 
-int runSelf(const std::vector<std::string>& argv, const std::filesystem::path& log) {
+void forwardStop(pid_t child, int signal) { ::kill(-child, signal); }
+
+int runSelf(const std::vector<std::string>& argv, const std::filesystem::path& log, const StopSignal* stop) {
     const pid_t pid = spawnSelf(argv, log);
-    int status = 0;
-    while (waitpid(pid, &status, 0) < 0)
-        if (errno != EINTR) throw InternalError(fmt::format("waiting for a child process: {}", std::strerror(errno)));
+    int status = 0, forwarded = 0;
+    for (;;) {
+        // Polled, not blocked on: a stop request is seen within 20 ms
+        // whenever it comes, and forwarded once; the child is then waited for.
+        if (stop && stop->pending() && !forwarded) forwardStop(pid, forwarded = stop->pending());
+        const pid_t r = waitpid(pid, &status, stop ? WNOHANG : 0);
+        if (r == pid) break;
+        if (r < 0 && errno != EINTR) throw InternalError(fmt::format("waiting for a child process: {}", std::strerror(errno)));
+        if (r == 0) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
     return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 

@@ -227,7 +227,7 @@ public:
             startJobs(stop);
             if (stop.pending() && !forwarded_) {  // the renders checkpoint and stop
                 forwarded_ = stop.pending();
-                for (const Running& r : running_) ::kill(r.pid, forwarded_);
+                for (const Running& r : running_) forwardStop(r.pid, forwarded_);
                 if (!args_.quiet)
                     fmt::print(stderr, "accretion batch: {}: stopping {} running job(s)\n", StopSignal::name(forwarded_), running_.size());
             }

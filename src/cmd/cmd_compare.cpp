@@ -20,6 +20,7 @@
 #include "accretion/core/error.h"
 #include "accretion/core/output_guard.h"
 #include "accretion/core/parse.h"
+#include "accretion/core/read_file.h"
 #include "accretion/io/exr_output.h"
 #include "accretion/io/false_colour.h"
 #include "accretion/io/plot.h"
@@ -236,12 +237,22 @@ void printWorstPixels(const Pair& p, const std::map<std::string, std::string>& a
     std::vector<std::string> candidates = {stem + ".settings.toml"};
     if (digits >= 4 && digits < stem.size() && std::string_view("._-").find(stem[stem.size() - digits - 1]) != std::string_view::npos)
         candidates.push_back(stem.substr(0, stem.size() - digits - 1) + ".settings.toml");
-    std::string scene;
-    for (const std::string& c : candidates)
-        if (scene.empty() && std::filesystem::exists(c)) scene = c;
-    if (scene.empty() && !attr("accretion:scene").empty())  // no settings file: the scene, without its -D overrides
+    // A settings file is the reference's only if its text is the settings
+    // the reference records: a later run to the same name rewrites it.
+    std::string scene, why = " (the reference names no scene to explain them)";
+    bool stale = false;
+    for (const std::string& c : candidates) {
+        if (!scene.empty() || !std::filesystem::exists(c)) continue;
+        if (!attr("accretion:settings").empty() && readWholeFile(c, "settings file") == attr("accretion:settings")) {
+            scene = c;
+        } else {
+            stale = true;
+            why = fmt::format(" ({} is not the settings the reference records: a later run rewrote it)", displayPath(c));
+        }
+    }
+    if (scene.empty() && !stale && !attr("accretion:scene").empty())  // no settings file: the scene, without its -D overrides
         scene = fmt::format("{} --estimator {} --seed {}", attr("accretion:scene"), attr("accretion:estimator"), attr("accretion:seed"));
-    fmt::print("worst pixels (relative squared error){}:\n", scene.empty() ? " (the reference names no scene to explain them)" : "");
+    fmt::print("worst pixels (relative squared error){}:\n", scene.empty() ? why : "");
     for (std::size_t k = 0; k < count; ++k) {
         const std::size_t q = worst[k].second;
         const int x = p.x0 + int(q % p.w), y = p.y0 + int(q / p.w);

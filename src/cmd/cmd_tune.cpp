@@ -32,11 +32,15 @@
 
 #include "accretion/analysis/bias_test.h"
 #include "accretion/analysis/experiment.h"
+#include "accretion/analysis/image_metrics.h"
+#include "accretion/analysis/view_check.h"
 #include "accretion/core/atomic_file.h"
 #include "accretion/core/error.h"
 #include "accretion/core/parse.h"
+#include "accretion/core/output_guard.h"
 #include "accretion/core/read_file.h"
 #include "accretion/core/rng.h"
+#include "accretion/core/stop_signal.h"
 #include "accretion/core/version.h"
 #include "accretion/gpu/cost_model.h"
 #include "accretion/io/plot.h"
@@ -190,6 +194,7 @@ std::string cacheKey(const std::string& text) {
 /// The search's fixed inputs: this build, the scene file and its overrides.
 struct TuneContext {
     const TuneArgs& args;
+    const Settings* scene = nullptr;  ///< the scene with tune's overrides
     std::filesystem::path cache;
     std::string sceneText;  ///< version + scene file + overrides: every cache key starts with it
     std::vector<PixelWindow> crops;  ///< where the error is measured: one crop per stratum of the frame
@@ -197,6 +202,7 @@ struct TuneContext {
     std::vector<std::string> unshadowedReferences;  ///< --anatomy: the references with shading.visibility = false
     std::uint32_t frame = 0;    ///< the measured frame
     std::uint32_t history = 0;  ///< frames before it: restir's steady state (steadyStateHistory)
+    const StopSignal* stop = nullptr;  ///< SIGINT and SIGTERM: forwarded to the running measurement, then tune stops
     /// The history of the GPU-time counts: the frame counted needs its
     /// temporal pass running, not a saturated M cap. Measured on disk_100k at
     /// 1080p (tree M=8, 5 neighbours, pairwise, one BLAS of boxes refitted,
@@ -219,9 +225,40 @@ struct TuneContext {
 enum class MeasureKind { reference, gpuTime, error };
 constexpr std::array<const char*, 3> kMeasureKindNames = {"references", "GPU time (cost)", "error (bias)"};
 
+/// A cached or fresh measurement read back by `read`: what it cannot read
+/// (a truncated file, another command's output, JSON of another form) is
+/// the user's error naming the file, which stays where it is.
+template <class Read>
+auto readMeasurement(const std::filesystem::path& file, const std::string& what, Read&& read) -> decltype(read()) {
+    auto fail = [&](const char* why) {
+        return InputError(fmt::format("tune: {} ({}) cannot be read: {}; delete it and run tune again to measure it again",
+                                      displayPath(file), what, why));
+    };
+    try {
+        return read();
+    } catch (const InputError& e) {
+        throw fail(e.what());
+    } catch (const nlohmann::json::exception& e) {
+        throw fail(e.what());
+    }
+}
+
+/// Stops tune at a stop request, after its running measurement stopped:
+/// every finished measurement stays in the cache, the same command resumes.
+void stopTune(const TuneContext& t, int signal, const std::string& what) {
+    removeStaleTemporaries(t.cache);  // a measurement stopped mid-write
+    std::size_t kept = 0;
+    for (const TuneContext::Spent& s : t.spent) kept += s.runs + s.cached;
+    fmt::print(stderr, "tune: {}: stopped at {}; the {} measurements before it are in {}: the same command resumes from them\n",
+               StopSignal::name(signal), what, kept, displayPath(t.cache));
+    throw Interrupted{signal};
+}
+
 /// Runs `argv` (this executable) unless `result` exists; its log beside it.
 /// Its wall time is kept beside the result (RESULT.seconds), so that a
-/// cached rerun still says what the measurement cost.
+/// cached rerun still says what the measurement cost. A measurement refused
+/// as the user's error (exit 1) is tune's user error, with the child's
+/// message; a stop request is forwarded to it (stopTune).
 void measure(TuneContext& t, MeasureKind kind, const std::vector<std::string>& argv, const std::filesystem::path& result,
              const std::string& what) {
     ++t.step;
@@ -234,10 +271,17 @@ void measure(TuneContext& t, MeasureKind kind, const std::vector<std::string>& a
             spent.cachedSeconds += parseNumber(readWholeFile(secondsFile.string(), "tune")).value_or(0.0);
         return;
     }
+    if (t.stop && t.stop->pending()) stopTune(t, t.stop->pending(), what);
     if (!t.args.quiet) fmt::print(stderr, "tune: [{}/{}] {}\n", t.step, t.steps, what);
     const std::filesystem::path log = result.string() + ".log";
     const auto start = std::chrono::steady_clock::now();
-    const int rc = runSelf(argv, log);
+    const int rc = runSelf(argv, log, t.stop);
+    if (t.stop && t.stop->pending()) stopTune(t, t.stop->pending(), what);
+    if (rc == 1) {  // the child's user error: "accretion: error: FILE: why"
+        std::string why = lastLine(log);
+        if (why.rfind("accretion: error: ", 0) == 0) why = why.substr(18);
+        throw InputError(fmt::format("tune: {} failed: {} (log {})", what, why, displayPath(log)));
+    }
     if (rc != 0 || !std::filesystem::exists(result))
         throw InternalError(fmt::format("tune: {} failed (exit {}): {} (log {})", what, rc, lastLine(log), log.string()));
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -274,9 +318,10 @@ std::map<Pass, double> predictMs(TuneContext& t, const std::vector<std::string>&
     std::vector<std::string> argv = sceneArgv(t, "cost", defines);
     argv.insert(argv.end(), {"--frames", fmt::format("{}:{}", t.frame, t.frame + 1), "--history", std::to_string(t.costHistory()), "--overhead", "0",
                              "--cluster-sizes", "", "--omm-levels", "", "--ser-keys", "hit", "-q", "-o", prefix.string() + ".json"});
-    measure(t, MeasureKind::gpuTime, argv, prefix.string() + ".csv", "GPU time of " + what);
+    const std::string csv = prefix.string() + ".csv";
+    measure(t, MeasureKind::gpuTime, argv, csv, "GPU time of " + what);
     std::map<Pass, double> ms;  // a pass's runs summed
-    for (CostRow& r : readCounterCsv(prefix.string() + ".csv")) {
+    for (CostRow& r : readMeasurement(csv, "GPU time of " + what, [&] { return readCounterCsv(csv); })) {
         r.features[CostFeature::cold_work] =
             coldWork(r.features[CostFeature::rays], r.features[CostFeature::bytes], r.workingSetBytes, t.coefficients.cacheBytes);
         ms[r.pass.pass] += t.coefficients.predictMs(r.pass.pass, r.features);
@@ -323,23 +368,11 @@ struct ErrorRow {
     }
 };
 
-ErrorRow measureErrorSeeds(TuneContext& t, const LightingChoice& o, std::uint32_t seeds) {
-    std::string spec = "restir";
-    for (const std::string& d : o.defines())
-        if (d != "render.estimator=restir") spec += ":" + d;
-    std::string key = t.sceneText + fmt::format("\nbias {} seeds {} frame {} history {} crop margin {}", spec, seeds, t.frame,
-                                                t.history, t.args.cropMargin);
-    for (const std::string& r : t.references) key += "\nreference " + cacheKey(readWholeFile(r, "tune"));
-    for (const std::string& r : t.unshadowedReferences) key += "\nunshadowed " + cacheKey(readWholeFile(r, "tune"));
-    const std::filesystem::path prefix = t.cache / (cacheKey(key) + ".bias");
-    std::vector<std::string> argv = sceneArgv(t, "bias", {});
-    for (const std::string& r : t.references) argv.insert(argv.end(), {"--reference", r});
-    for (const std::string& r : t.unshadowedReferences) argv.insert(argv.end(), {"--unshadowed-reference", r});
-    argv.insert(argv.end(), {"--crop-margin", std::to_string(t.args.cropMargin), "--estimators", spec, "--seeds",
-                             std::to_string(seeds), "--frame", std::to_string(t.frame), "--history", std::to_string(t.history), "-q",
-                             "-o", prefix.string()});
-    measure(t, MeasureKind::error, argv, prefix.string() + ".json", fmt::format("error of {} ({} seeds)", o.label(), seeds));
-    const nlohmann::json j = nlohmann::json::parse(readWholeFile(prefix.string() + ".json", "tune"));
+/// bias's JSON of one configuration as tune's row: an object of bias's form
+/// for this estimator (a JSON of another form throws nlohmann's exception).
+ErrorRow readErrorRow(const TuneContext& t, const std::string& spec, std::uint32_t seeds, const nlohmann::json& j) {
+    if (j.at("command") != "bias" || j.at("rows").size() != 1 || j.at("rows").at(0).at("estimator") != spec)
+        throw InputError(fmt::format("not bias's measurement of {}", spec));
     const nlohmann::json& r = j.at("rows").at(0);
     ErrorRow e;
     e.relMse = r.at("rel_mse").get<double>();
@@ -360,6 +393,26 @@ ErrorRow measureErrorSeeds(TuneContext& t, const LightingChoice& o, std::uint32_
     return e;
 }
 
+ErrorRow measureErrorSeeds(TuneContext& t, const LightingChoice& o, std::uint32_t seeds) {
+    std::string spec = "restir";
+    for (const std::string& d : o.defines())
+        if (d != "render.estimator=restir") spec += ":" + d;
+    std::string key = t.sceneText + fmt::format("\nbias {} seeds {} frame {} history {} crop margin {}", spec, seeds, t.frame,
+                                                t.history, t.args.cropMargin);
+    for (const std::string& r : t.references) key += "\nreference " + cacheKey(readWholeFile(r, "tune"));
+    for (const std::string& r : t.unshadowedReferences) key += "\nunshadowed " + cacheKey(readWholeFile(r, "tune"));
+    const std::filesystem::path prefix = t.cache / (cacheKey(key) + ".bias");
+    std::vector<std::string> argv = sceneArgv(t, "bias", {});
+    for (const std::string& r : t.references) argv.insert(argv.end(), {"--reference", r});
+    for (const std::string& r : t.unshadowedReferences) argv.insert(argv.end(), {"--unshadowed-reference", r});
+    argv.insert(argv.end(), {"--crop-margin", std::to_string(t.args.cropMargin), "--estimators", spec, "--seeds",
+                             std::to_string(seeds), "--frame", std::to_string(t.frame), "--history", std::to_string(t.history), "-q",
+                             "-o", prefix.string()});
+    const std::string file = prefix.string() + ".json", what = fmt::format("error of {} ({} seeds)", o.label(), seeds);
+    measure(t, MeasureKind::error, argv, file, what);
+    return readMeasurement(file, what, [&] { return readErrorRow(t, spec, seeds, nlohmann::json::parse(readWholeFile(file, "tune"))); });
+}
+
 /// The error again with the fewest seeds whose test would see a bias of
 /// --bias-bound (Student's t: the bound falls faster than 1/sqrt(seeds)
 /// while the degrees of freedom grow), up to --max-seeds; past that the
@@ -372,6 +425,21 @@ ErrorRow measureMoreSeeds(TuneContext& t, const LightingChoice& o, const ErrorRo
     if (!needed) return first;
     ++t.steps;  // a measurement the plan did not count
     return measureErrorSeeds(t, o, needed);
+}
+
+/// A reference of the measured frame, crop `w` of the scene's view: its
+/// size, data window and view (frame and scene-defining settings), its
+/// pixels readable (InputError naming the file).
+void checkReference(const TuneContext& t, const std::string& file, const PixelWindow& w) {
+    const RgbLayer image = readExrLayer(file, "Lr");
+    if (image.width != t.scene->camera.width || image.height != t.scene->camera.height)
+        throw InputError(fmt::format("{}: reference of a {}x{} view, the scene renders {}x{}", file, image.width, image.height,
+                                     t.scene->camera.width, t.scene->camera.height));
+    if (image.x0 != int(w.x0) || image.y0 != int(w.y0) || image.dataWidth != w.width() || image.dataHeight != w.height())
+        throw InputError(fmt::format("{}: reference of pixels [{}, {}) x [{}, {}), its crop is [{}, {}) x [{}, {})", file, image.x0,
+                                     std::int64_t(image.x0) + image.dataWidth, image.y0, std::int64_t(image.y0) + image.dataHeight,
+                                     w.x0, w.x1, w.y0, w.y1));
+    requireSceneView(readExrAttributes(file), file, FileRole::reference, *t.scene, t.frame, false);
 }
 
 /// The references of the error measurements, one per crop: given, or
@@ -390,10 +458,13 @@ std::vector<std::string> ensureReferences(TuneContext& t, std::size_t particles,
         std::vector<std::string> defines = {"render.crop=" + crop};
         if (!visibility) defines.push_back("shading.visibility=false");
         std::vector<std::string> argv = sceneArgv(t, "render", defines);
+        // --resume: a reference stopped by a signal left its checkpoint; the next tune continues it.
         argv.insert(argv.end(), {"--estimator", exact ? "exact" : "split", "--frames", fmt::format("{}:{}", t.frame, t.frame + 1),
-                                 "-o", file.string(), "--quiet"});
+                                 "-o", file.string(), "--quiet", "--resume"});
         if (!exact) argv.insert(argv.end(), {"--spp", std::to_string(t.args.referenceSpp)});
-        measure(t, MeasureKind::reference, argv, file, fmt::format("reference ({}, crop {}{})", how, crop, unshadowed));
+        const std::string what = fmt::format("reference ({}, crop {}{})", how, crop, unshadowed);
+        measure(t, MeasureKind::reference, argv, file, what);
+        readMeasurement(file, what, [&] { checkReference(t, file.string(), w); });
         files.push_back(file.string());
     }
     return files;
@@ -467,25 +538,70 @@ TuneContext checkTuneArgs(const TuneArgs& a) {
     return t;
 }
 
-/// The search's context, its command line checked (checkTuneArgs): its
-/// outputs guarded, its cache and calibration, before any measurement.
+/// The nearest existing folder at or above `p` ("." for a relative path
+/// with none): what creating `p` would build on.
+std::filesystem::path existingAncestor(std::filesystem::path p) {
+    while (!p.empty() && !std::filesystem::exists(p)) p = p.parent_path();
+    return p.empty() ? std::filesystem::path(".") : p;
+}
+
+/// -o: a prefix of file names (PREFIX.csv, .json, .png), not a folder, in
+/// a folder that is or can be made (none of its parents a file).
+void checkPrefix(const std::string& prefix, const char* option) {
+    const std::filesystem::path p(prefix);
+    const std::string name = p.filename().string();
+    if (name.empty() || name == "." || name == ".." || std::filesystem::is_directory(p)) {
+        std::string folder = prefix;
+        while (folder.size() > 1 && folder.back() == '/') folder.pop_back();
+        throw InputError(fmt::format("command line {} {}: expected a prefix of file names, not a folder ({}/NAME writes NAME.csv, "
+                                     "NAME.json and NAME.png there)", option, prefix, folder.empty() ? "." : folder));
+    }
+    if (const std::filesystem::path up = existingAncestor(p.parent_path()); !std::filesystem::is_directory(up))
+        throw InputError(fmt::format("command line {} {}: {} is a file, not a folder", option, prefix, displayPath(up)));
+}
+
+/// --cache: a folder, or one that can be made (none of its parents a file).
+void checkFolder(const std::filesystem::path& folder, const char* option) {
+    if (const std::filesystem::path up = existingAncestor(folder); !std::filesystem::is_directory(up))
+        throw InputError(fmt::format("command line {} {}: {} is {}, not a folder", option, folder.string(), displayPath(up),
+                                     up == folder ? "a file" : "a file above it"));
+}
+
+/// The search's context, its command line checked (checkTuneArgs): every
+/// input checked (the scene's particle and camera files over the frames
+/// tune renders, the given references) and its outputs and cache guarded
+/// before anything is made; then the cache key, which covers the scene's
+/// files by content, and the folders.
 void prepareTune(TuneContext& t, const Settings& scene, const std::string& prefix) {
     const TuneArgs& a = t.args;
+    t.scene = &scene;
     t.cache = a.cache.empty() ? std::filesystem::path("out") / "tune_cache" / scene.sceneName : std::filesystem::path(a.cache);
-    OutputGuard guard = sceneInputs(scene);
+    checkFolder(t.cache, "--cache");
+    checkPrefix(prefix, "-o");
+    const std::uint32_t first = t.frame - t.history, end = t.frame + 1;  // the history and the measured frame
+    OutputGuard guard = sceneInputs(scene, first, end);
     for (const std::string& r : a.references) guard.addInput(r);
     checkOutputs(guard, prefix, {".csv", ".json", ".png"}, "-o");
-    std::filesystem::create_directories(t.cache);
-    if (auto dir = std::filesystem::path(prefix).parent_path(); !dir.empty()) std::filesystem::create_directories(dir);
+    for (std::size_t k = 0; k < a.references.size(); ++k) {
+        if (!std::filesystem::is_regular_file(a.references[k]))
+            throw InputError(fmt::format("command line --reference {}: no such file", a.references[k]));
+        checkReference(t, a.references[k], t.crops[k]);
+    }
     t.coefficients = CostCoefficients::forSetting(scene.gpu.coefficients);
     if (!t.coefficients.calibrated)
         throw InputError("tune: gpu.coefficients = \"uncalibrated\": tune prices with a calibration (the committed one by default)");
-    // The cache key: this build, the scene and its overrides (but the
-    // calibration, which prices the cached counters here, not in them).
+    // The cache key: this build, the scene, its overrides and the files it
+    // reads by content (but the calibration, which prices the cached
+    // counters here, not in them).
     t.sceneText = std::string(version()) + "\n" + readWholeFile(a.scene, "tune");
     for (const std::string& d : a.defines)
         if (d.rfind("gpu.coefficients", 0) != 0) t.sceneText += "\n-D " + d;
     t.sceneText += "\n-D render.estimator=restir";  // sceneArgv's
+    std::vector<std::filesystem::path> inputs = ParticleSource(scene).checkFiles(first, end);
+    if (!scene.camera.file.empty()) inputs.emplace_back(scene.camera.file);
+    for (const std::filesystem::path& f : inputs) t.sceneText += "\ninput " + cacheKey(readWholeFile(f.string(), "tune"));
+    std::filesystem::create_directories(t.cache);
+    if (auto dir = std::filesystem::path(prefix).parent_path(); !dir.empty()) std::filesystem::create_directories(dir);
 }
 
 /// A geometry choice priced: its predicted GPU ms per pass at the scene's lighting.
@@ -711,8 +827,11 @@ void runTune(const TuneArgs& a) {
     TuneContext t = checkTuneArgs(a);
     // The engine's operating point: the frame after the history that brings
     // temporal reuse to its M cap (every lighting choice shares it).
-    t.frame = a.frame.value_or(scene.render.frame_start + steadyStateHistory(scene));
     t.history = steadyStateHistory(scene);
+    const std::uint64_t frame = a.frame ? *a.frame : std::uint64_t(scene.render.frame_start) + t.history;
+    if (frame >= 0xffffffffull)  // tune renders frame + 1's end
+        throw InputError(fmt::format("command line --frame {}: expected a frame from {} to 4294967294", frame, t.history));
+    t.frame = std::uint32_t(frame);
     if (t.history > t.frame)  // tune has no --history: its frame must come after the whole history
         throw InputError(fmt::format("command line --frame {}: tune measures restir at steady state, after {} history frames "
                                      "(temporal reuse to its M cap of {:g}, at least 8): measure frame {} or later",
@@ -725,6 +844,10 @@ void runTune(const TuneArgs& a) {
         throw InputError(fmt::format("command line --reference: {} given, one per crop of --error-crops {} ({})", a.references.size(),
                                      a.errorCrops, t.crops.size()));
     prepareTune(t, scene, prefix);
+    const OutputLock lock(t.cache / "tune.lock");  // one tune per cache: a measurement is made once
+    removeStaleTemporaries(t.cache);                 // what a measurement killed mid-write left
+    const StopSignal stop;                           // forwarded to the running measurement (measure)
+    t.stop = &stop;
     t.steps = geometry.size() + 2 * lighting.size() + (a.references.empty() ? t.crops.size() : 0) + (a.anatomy ? t.crops.size() : 0);
     const std::size_t particles = ParticleSource(scene).frame(t.frame).size();
     t.references = ensureReferences(t, particles);

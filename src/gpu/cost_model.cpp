@@ -233,16 +233,33 @@ double parseNumber(const std::string& s, const std::string& where) {
     return *v;
 }
 
-/// Rows of a CSV with a header; each row mapped by column name.
+/// Rows of a CSV with a header; each row mapped by column name. The header
+/// holds every `required` column, and no column but those and `optional`
+/// (a misspelt name is an error, not a column of zeros), each once.
 std::vector<std::pair<int, std::map<std::string, std::string>>> readCsv(const std::string& path,
-                                                                        const std::vector<std::string>& required) {
+                                                                        const std::vector<std::string>& required,
+                                                                        const std::vector<std::string>& optional = {}) {
     std::ifstream in = openInputFile(path, "CSV file");
     std::string line;
     if (!std::getline(in, line)) throw InputError(fmt::format("{}: empty file", path));
     const std::vector<std::string> header = splitCsv(std::string(withoutBom(line)), path + ":1");
+    if (header.size() == 1 && header[0].find(';') != std::string::npos)
+        throw InputError(fmt::format("{}:1: cells separated by ';' (a spreadsheet's export in a decimal-comma locale): expected "
+                                     "comma-separated cells with '.' decimals", path));
     for (const std::string& r : required)
         if (std::find(header.begin(), header.end(), r) == header.end())
             throw InputError(fmt::format("{}:1: missing column '{}'", path, r));
+    for (std::size_t k = 0; k < header.size(); ++k) {
+        const std::string& c = header[k];
+        if (std::find(header.begin(), header.begin() + std::ptrdiff_t(k), c) != header.begin() + std::ptrdiff_t(k))
+            throw InputError(fmt::format("{}:1: column '{}' twice", path, c));
+        if (std::find(required.begin(), required.end(), c) == required.end() &&
+            std::find(optional.begin(), optional.end(), c) == optional.end()) {
+            std::vector<std::string> known = required;
+            known.insert(known.end(), optional.begin(), optional.end());
+            throw InputError(fmt::format("{}:1: unknown column '{}' (known: {})", path, c, fmt::join(known, ", ")));
+        }
+    }
     std::vector<std::pair<int, std::map<std::string, std::string>>> rows;
     int lineNo = 1;
     while (std::getline(in, line)) {
@@ -263,11 +280,16 @@ std::vector<std::pair<int, std::map<std::string, std::string>>> readCsv(const st
 std::vector<CostRow> readCounterCsv(const std::string& path) {
     std::vector<std::string> required{"config", "pass"};
     for (std::size_t k = 0; k < kBaseCostFeatures; ++k) required.emplace_back(kCostFeatures[k]);
+    std::vector<std::string> optional{"working_set_bytes", "predicted_ms", "uncalibrated_ms"};
+    for (std::size_t k = kBaseCostFeatures; k < kCostFeatures.size(); ++k) optional.emplace_back(kCostFeatures[k]);
     std::vector<CostRow> rows;
-    for (auto& [lineNo, r] : readCsv(path, required)) {
+    for (auto& [lineNo, r] : readCsv(path, required, optional)) {
         const std::optional<PassRun> pass = parsePassRun(r["pass"]);
         if (!pass) throw InputError(fmt::format("{}:{}: pass '{}' is not a pass ({})", path, lineNo, r["pass"], knownPasses()));
-        CostRow row{r["config"], *pass, {}, 0.0};
+        CostRow row;
+        row.config = r["config"];
+        row.pass = *pass;
+        row.origin = fmt::format("{}:{}", path, lineNo);
         for (std::size_t k = 0; k < kCostFeatures.size(); ++k) {
             const auto cell = r.find(std::string(kCostFeatures[k]));
             if (cell == r.end()) continue;  // a later counter, absent from a CSV of the first form: 0
@@ -282,8 +304,17 @@ std::vector<CostRow> readCounterCsv(const std::string& path) {
 }
 
 void joinTimings(const std::string& path, std::vector<CostRow>& rows) {
+    std::map<std::pair<std::string, PassRun>, const CostRow*> counted;
+    for (const CostRow& row : rows)
+        if (const auto [it, fresh] = counted.emplace(std::make_pair(row.config, row.pass), &row); !fresh)
+            throw InputError(fmt::format("{}: a second counter row for config '{}' pass '{}' (the first: {}): a timing joins one row; "
+                                         "give each configuration its own `cost --config`", row.origin, row.config, row.pass.label(),
+                                         it->second->origin));
     std::map<std::pair<std::string, PassRun>, double> ms;
-    for (auto& [lineNo, r] : readCsv(path, {"config", "pass", "ms"})) {
+    // The twin's timing CSVs (accretion-optix --timings) carry what made each row beside it.
+    const std::vector<std::string> twinColumns = {"frames", "clusters", "triangles", "rebuilt_clusters", "blas_bytes",
+                                                  "blas_memory_bytes", "blas_enqueue_ms", "device", "version", "repeat"};
+    for (auto& [lineNo, r] : readCsv(path, {"config", "pass", "ms"}, twinColumns)) {
         const std::optional<PassRun> pass = parsePassRun(r["pass"]);
         if (!pass) throw InputError(fmt::format("{}:{}: pass '{}' is not a pass ({})", path, lineNo, r["pass"], knownPasses()));
         const auto key = std::make_pair(r["config"], *pass);

@@ -27,7 +27,8 @@ void append(std::string& out, const std::vector<T>& plane) {
     out.append(reinterpret_cast<const char*>(plane.data()), plane.size() * sizeof(T));
 }
 
-/// The planes in file order, each applied to `f` by `visit(name, plane)`.
+/// Every plane, each applied to `f` by `visit(name, plane)`, in the order
+/// accretion writes them (a file's header lists its own order).
 template <class Frame, class Visit>
 void forEachPlane(Frame& f, Visit&& visit) {
     visit("L", f.L);
@@ -126,6 +127,18 @@ GpuFrame readGpuFrame(const std::filesystem::path& file) {
     if (const auto m = f.metadata.find("frame"); m != f.metadata.end() && m->second != std::to_string(f.frame))
         throw InputError(fmt::format("{}: the header's frame {} disagrees with its metadata's frame {}", name, f.frame, m->second));
     const std::size_t n = std::size_t(f.width) * f.height;
+    // The header's plane list: known names, each once, Lr among them.
+    std::vector<std::string> known;
+    forEachPlane(f, [&](const char* what, const auto&) { known.emplace_back(what); });
+    for (std::size_t k = 0; k < planes.size(); ++k) {
+        if (std::find(known.begin(), known.end(), planes[k]) == known.end() ||
+            std::find(planes.begin(), planes.begin() + std::ptrdiff_t(k), planes[k]) != planes.begin() + std::ptrdiff_t(k))
+            throw InputError(fmt::format("{}: bad plane list: '{}' is {} (known planes: {}; each once, Lr required)", name, planes[k],
+                                         std::find(known.begin(), known.end(), planes[k]) == known.end() ? "no plane" : "listed twice",
+                                         fmt::join(known, ", ")));
+    }
+    if (std::find(planes.begin(), planes.end(), "Lr") == planes.end())
+        throw InputError(fmt::format("{}: bad plane list: no Lr (known planes: {}; each once, Lr required)", name, fmt::join(known, ", ")));
     // The planes' bytes, checked against the file before anything is allocated on the header's word.
     std::uint64_t need = 0;
     forEachPlane(f, [&](const char* what, const auto& plane) {
@@ -134,20 +147,14 @@ GpuFrame readGpuFrame(const std::filesystem::path& file) {
     if (const std::uint64_t have = bytesLeft(in); need != have)
         throw InputError(fmt::format("{}: the header's {}x{} planes ({}) take {} bytes, the file holds {}", name, f.width,
                                      f.height, fmt::join(planes, ", "), need, have));
-    auto read = [&](auto& plane, const char* what) {
-        plane.resize(n);
-        if (!in.read(reinterpret_cast<char*>(plane.data()), std::streamsize(n * sizeof(plane[0]))))
-            throw InputError(fmt::format("{}: truncated in plane {}", name, what));
-    };
-    std::size_t known = 0;
-    forEachPlane(f, [&](const char* what, auto& plane) {
-        if (std::find(planes.begin(), planes.end(), what) == planes.end()) return;
-        ++known;
-        read(plane, what);
-    });
-    if (known != planes.size() || f.Lr.empty())
-        throw InputError(fmt::format("{}: bad plane list (known planes: L, Le, Lr, normal, depth, particle, Lr_stderr, spp, "
-                                     "rejected; Lr required)", name));
+    // In the order the header lists them: that is the file's order.
+    for (const std::string& listed : planes)
+        forEachPlane(f, [&](const char* what, auto& plane) {
+            if (listed != what) return;
+            plane.resize(n);
+            if (!in.read(reinterpret_cast<char*>(plane.data()), std::streamsize(n * sizeof(plane[0]))))
+                throw InputError(fmt::format("{}: truncated in plane {}", name, what));
+        });
     return f;
 }
 

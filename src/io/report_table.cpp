@@ -4,6 +4,8 @@
 
 #include <fmt/format.h>
 
+#include "accretion/core/csv_cell.h"
+
 namespace accretion {
 namespace {
 
@@ -59,7 +61,7 @@ std::string Table::csv() const {
     for (const Column& c : columns_)
         if (!c.key.empty()) {
             if (!out.empty()) out += ',';
-            out += c.key;
+            out += csvCell(c.key);
         }
     out += "\n";
     for (const auto& row : rows_) {
@@ -69,7 +71,7 @@ std::string Table::csv() const {
             if (columns_[k].key.empty()) continue;
             const Cell& v = row[k];
             if (!first) line += ',';
-            line += std::holds_alternative<bool>(v) ? std::string(std::get<bool>(v) ? "1" : "0") : formatCell(columns_[k].csvSpec, v);
+            line += std::holds_alternative<bool>(v) ? std::string(std::get<bool>(v) ? "1" : "0") : csvCell(formatCell(columns_[k].csvSpec, v));
             first = false;
         }
         out += line + "\n";

@@ -62,4 +62,12 @@ void Accumulation::merge(const Accumulation& o) {
     }
 }
 
+std::uint32_t nextBandPixels(double pixelChunkSeconds, std::uint64_t span, std::uint32_t previous, std::uint32_t groupPixels,
+                             std::uint32_t cores, double bandSeconds) {
+    const double least = double(groupPixels) * std::max(cores, 1u);
+    if (!(pixelChunkSeconds > 0.0) || previous == 0) return std::uint32_t(least);
+    const double fit = bandSeconds / (pixelChunkSeconds * double(std::max<std::uint64_t>(span, 1)));
+    return std::uint32_t(std::clamp(std::min(fit, 4.0 * previous), least, 1e9));
+}
+
 }  // namespace accretion

@@ -405,6 +405,7 @@ LightingCounters run(const LightingInputs& in, const LightArrays& L, const Light
         return total;
     }
     double pixelChunkSeconds = 0.0;        // measured: the slowest pixel-chunk of a band so far
+    std::uint32_t previous = 0;            // the last band's pixels
     while (acc.nextChunk < plan.end) {
         const std::uint64_t c = acc.nextChunk;
         if (plan.exact) {
@@ -412,10 +413,8 @@ LightingCounters run(const LightingInputs& in, const LightArrays& L, const Light
             acc.nextChunk = c + 1;
         } else {
             const std::uint64_t span = plan.end - c;
-            // Pixels a band takes in kBandSeconds; at least enough for every core to have groups.
-            const double fit = pixelChunkSeconds > 0.0 ? kBandSeconds / (pixelChunkSeconds * double(span)) : 0.0;
-            const std::uint32_t least = 16u * kGroupPixels * std::uint32_t(tbb::this_task_arena::max_concurrency());
-            const std::uint32_t pixels = std::max(least, std::uint32_t(std::min(fit, 1e9)));
+            const std::uint32_t pixels = nextBandPixels(pixelChunkSeconds, span, previous, kGroupPixels,
+                                                        std::uint32_t(tbb::this_task_arena::max_concurrency()), kBandSeconds);
             const std::uint32_t row = std::max(acc.bandRows, w.y0), x0 = std::max(acc.bandCols, w.x0);
             PixelWindow band;
             if (x0 == w.x0 && pixels >= w.width())  // whole rows
@@ -424,6 +423,7 @@ LightingCounters run(const LightingInputs& in, const LightArrays& L, const Light
                 band = {x0, std::min(w.x1, x0 + pixels), row, row + 1};
             const auto start = std::chrono::steady_clock::now();
             total += sweep<M, P, Count>(in, L, plan, &acc, nullptr, c, plan.end, progress, band);
+            previous = std::max(previous, std::uint32_t(band.pixels()));  // the largest band so far
             const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
             pixelChunkSeconds = std::max(pixelChunkSeconds, seconds / (double(band.pixels()) * double(span)));
             if (band.x1 == w.x1) {

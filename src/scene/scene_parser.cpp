@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <toml++/toml.h>
 
@@ -326,6 +327,13 @@ void validateSampling(const Settings& s, const RuleFailure& fail) {
         if (s.render.crop.empty()) fail("restir.crop_margin", "is the margin of render.crop, which is not set");
         if (s.gpu.counters) fail("restir.crop_margin", "gpu.counters counts the GPU's dispatch, which is the whole frame");
     }
+    if (s.render.target_stderr > 0.0 && !estimatorInfo(s.render.estimator).adaptive) {
+        std::vector<std::string_view> adaptive;
+        for (const EstimatorInfo& e : kEstimators)
+            if (e.adaptive) adaptive.push_back(enumName(e.kind));
+        fail("render.target_stderr", fmt::format("render.estimator = \"{}\" does not sample adaptively (only {} do): leave "
+                                                 "target_stderr at 0", enumName(s.render.estimator), fmt::join(adaptive, ", ")));
+    }
     if (s.render.target_stderr > 0.0 && s.render.max_samples < s.render.samples)
         fail("render.max_samples", fmt::format("must be at least render.samples ({}) when target_stderr is set", s.render.samples));
 }
@@ -376,6 +384,14 @@ void validateLightingAndGeometry(const Settings& s, const RuleFailure& fail) {
         fail("gpu.omm", "opacity micromaps apply to disc-alpha billboards (geometry.alpha = \"disc\")");
     if (s.geometry.primitive == Primitive::sphere && s.geometry.alpha == AlphaMode::disc)
         fail("geometry.alpha", "disc alpha applies to billboards only (primitive = \"sphere\")");
+    // Designs no GPU builds, refused here for every command (cost would
+    // price them, the twin could not run them).
+    if (s.gpu.omm != OmmMode::off && s.geometry.layout == AccelLayout::aabbs)
+        fail("gpu.omm", "opacity micromaps are built over triangles; geometry.layout = \"aabbs\" holds procedural boxes, whose "
+                        "intersection program tests the disc itself");
+    if (s.geometry.layout == AccelLayout::instances && s.geometry.build != BuildPolicy::rebuild && s.geometry.build != BuildPolicy::refit)
+        fail("geometry.build", fmt::format("\"{}\" is a policy of cluster BLASes; geometry.layout = \"instances\" shares one BLAS "
+                                           "and rebuilds or refits its TLAS (rebuild or refit)", enumName(s.geometry.build)));
 }
 
 /// Cross-field rules, reported at the location of the offending key, in this order.

@@ -19,6 +19,7 @@
 
 #include "accretion/scene/estimator_table.h"
 #include "accretion/core/atomic_file.h"
+#include "accretion/core/csv_cell.h"
 #include "accretion/core/error.h"
 #include "accretion/core/median.h"
 #include "accretion/core/parse.h"
@@ -65,11 +66,8 @@ void requireSupported(const Settings& s, bool lighting) {
     if (g.primitive == Primitive::sphere && g.layout != AccelLayout::clusters)
         refuse(fmt::format("geometry.primitive = \"sphere\" with geometry.layout = \"{}\" (spheres: clusters)", enumName(g.layout)));
     if (g.primitive == Primitive::sphere && g.alpha != AlphaMode::opaque) refuse("geometry.alpha on spheres");
-    if (g.layout == AccelLayout::aabbs && s.gpu.omm != OmmMode::off && g.alpha == AlphaMode::disc)
-        refuse("gpu.omm with geometry.layout = \"aabbs\" (micromaps are for triangles)");
-    if (g.layout == AccelLayout::instances && g.build != BuildPolicy::rebuild && g.build != BuildPolicy::refit)
-        refuse(fmt::format("geometry.build = \"{}\" with geometry.layout = \"instances\" (rebuild or refit the TLAS)",
-                           enumName(g.build)));
+    // Micromaps on boxes and cluster policies on instances are no design at
+    // all: the scene's rules refuse them for every command (loadScene).
     const EstimatorKind e = s.render.estimator;
     if (lighting && !estimatorInfo(e).twin) refuse(fmt::format("render.estimator = \"{}\"", enumName(e)));
     if (lighting && estimatorInfo(e).reuse) {
@@ -552,7 +550,7 @@ void TwinRun::renderFrame(std::uint32_t frame, std::uint64_t seed) {
     }
     timingsCsv_ = "config,pass,ms\n";  // the last frame's
     if (!a_.config.empty())
-        for (const auto& [p, t] : calibrated) timingsCsv_ += fmt::format("{},{},{:.6f}\n", a_.config, p, t);
+        for (const auto& [p, t] : calibrated) timingsCsv_ += fmt::format("{},{},{:.6f}\n", csvCell(a_.config), p, t);
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     out.metadata = frameMetadata(s_, settingsToml_, frame, seed, "", wall);
     out.metadata.insert({{"lighting", a_.skipLighting ? "skipped" : std::string(enumName(s_.render.estimator))},

@@ -110,6 +110,9 @@ write("gpu_frame_negative.gpuframe", gpuframe({"frame": -1}))
 write("gpu_zero_camera.gpuframe", gpuframe({"camera": {"eye": [0, 0, 0], "forward": [0, 0, 0], "right": [0, 0, 0],
                                                        "up": [0, 0, 0], "tan_half_fov": 0, "jitter": [0, 0]}}))
 write("gpu_frame_disagrees.gpuframe", gpuframe({"frame": 3}))
+# A plane list that names a plane twice, or one no frame has: refused by name.
+write("gpu_plane_twice.gpuframe", gpuframe({}, planes=("Lr", "Lr")))
+write("gpu_plane_unknown.gpuframe", gpuframe({}, payload=b"\0" * 48, planes=("Lr", "albedo")))
 os.makedirs("gpu_a", exist_ok=True)
 os.makedirs("gpu_b", exist_ok=True)
 write("gpu_a/frame.gpuframe", gpuframe({}))

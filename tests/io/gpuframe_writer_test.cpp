@@ -3,6 +3,10 @@
 // reads: every plane bit for bit, the camera and metadata exactly.
 #include <catch2/catch.hpp>
 
+#include <clocale>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <random>
 
@@ -74,4 +78,44 @@ TEST_CASE("the engine's reference .gpuframe writer writes what accretion reads, 
     lr.depth.assign(5, 0.0f);
     CHECK_FALSE(accretion_engine::writeGpuFrame((dir / "bad.gpuframe").string(), lr));
     CHECK_FALSE(std::filesystem::exists(dir / "bad.gpuframe"));
+}
+
+TEST_CASE("the engine's .gpuframe writer writes the same header under a decimal-comma locale", "[io][gpu_frame]") {
+    // An engine that calls setlocale(LC_ALL, "") on a German desktop: printf
+    // writes 0,25 there, which is not JSON. The locale is compiled here from
+    // glibc's sources (the `locales` package), so no system locale is needed.
+    const auto dir = accretion::test::scratchDir("gpuframe_writer_locale");
+    std::string out;
+    REQUIRE(accretion::test::runCommand("localedef -i de_DE -f UTF-8 " + (dir / "de_DE.UTF-8").string(), out) == 0);
+    accretion_engine::GpuFrameOut f;
+    f.width = 2;
+    f.height = 1;
+    f.frame = 3;
+    f.tanHalfFov = 0.3249196962329063;
+    f.jitter[0] = 0.25;
+    f.jitter[1] = -0.125;
+    const double eye[3] = {1.5, 7.0, 17.25};
+    std::memcpy(f.eye, eye, sizeof eye);
+    f.Lr = {0.5f, 1.5f, 2.5f, 3.5f, 4.5f, 5.5f};
+    const auto file = (dir / "comma.gpuframe").string();
+    ::setenv("LOCPATH", dir.c_str(), 1);
+    const bool german = std::setlocale(LC_ALL, "de_DE.UTF-8") != nullptr;
+    char probe[16];
+    std::snprintf(probe, sizeof probe, "%.2f", 0.5);
+    const bool written = german && accretion_engine::writeGpuFrame(file, f);
+    std::setlocale(LC_ALL, "C");
+    ::unsetenv("LOCPATH");
+    REQUIRE(german);
+    CHECK(std::string(probe) == "0,50");  // the locale was in force while the frame was written
+    REQUIRE(written);
+    const accretion::GpuFrame g = accretion::readGpuFrame(file);
+    CHECK(g.camera.tanHalfFov == f.tanHalfFov);
+    CHECK(g.camera.jitterX == 0.25);
+    CHECK(g.camera.jitterY == -0.125);
+    CHECK(g.camera.eye == accretion::DVec3(1.5, 7.0, 17.25));
+    CHECK(sameBits(g.Lr, f.Lr));
+    // A camera that is not finite has no JSON form: refused, nothing written.
+    f.tanHalfFov = std::nan("");
+    CHECK_FALSE(accretion_engine::writeGpuFrame((dir / "nan.gpuframe").string(), f));
+    CHECK_FALSE(std::filesystem::exists(dir / "nan.gpuframe"));
 }

@@ -116,13 +116,15 @@ TEST_CASE("a crop holds its window alone, and its pixels, stopped and restarted,
     REQUIRE(renderer.plan().traced == w);
 
     // Stopped part-way (exact: after row 19, fifteen rows into the window; the
-    // others: after the first band), restarted from a copy of the sums.
+    // others: after the first band with a hit pixel done, the first bands
+    // being probes of a few pixels), restarted from a copy of the sums.
     Accumulation sums, saved;
     LightingSession session;
     session.result = &sums;
     int calls = 0;
     session.afterChunk = [&](const Accumulation& acc) {
-        if (++calls == (c.kind == EstimatorKind::exact ? 20 : 1)) {
+        const bool someDone = std::count(acc.n.begin(), acc.n.end(), 0u) < std::ptrdiff_t(acc.n.size());
+        if (c.kind == EstimatorKind::exact ? ++calls == 20 : someDone) {
             saved = acc;
             throw Interrupted{15};
         }
@@ -195,4 +197,20 @@ TEST_CASE("accumulation files round-trip and refuse corruption", "[io][accumulat
         INFO("size " << size);
         CHECK_THROWS_AS(readAccumulationFile(dir / "c.acc"), InputError);
     }
+}
+
+TEST_CASE("a Monte Carlo band is sized to the stop latency: a probe first, then what fits the band time", "[render][accumulation]") {
+    using accretion::nextBandPixels;
+    // Before any timing: one group of 8 pixels per core, whatever the samples.
+    CHECK(nextBandPixels(0.0, 8192, 0, 8, 2, 2.0) == 16);
+    CHECK(nextBandPixels(0.0, 8192, 0, 8, 16, 2.0) == 128);
+    // Measured: 1 ms per pixel and chunk over 100 chunks is 0.1 s a pixel:
+    // 20 pixels fill 2 s.
+    CHECK(nextBandPixels(1e-3, 100, 16, 8, 2, 2.0) == 20);
+    // Slower than a group per core in 2 s: one group per core still.
+    CHECK(nextBandPixels(1.0, 100, 16, 8, 2, 2.0) == 16);
+    // Fast pixels: at most 4x the largest band so far (a band of sky does not size one of disk).
+    CHECK(nextBandPixels(1e-9, 100, 16, 8, 2, 2.0) == 64);
+    CHECK(nextBandPixels(1e-9, 100, 1000, 8, 2, 2.0) == 4000);
+    CHECK(nextBandPixels(1e-6, 100, 1000000, 8, 2, 2.0) == 20000);
 }

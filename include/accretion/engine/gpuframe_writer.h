@@ -5,6 +5,8 @@
 // --gpu-frames`. tests/io/gpuframe_writer_test.cpp reads what it writes back
 // with accretion's own reader, plane for plane, bit for bit.
 #pragma once
+#include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -55,10 +57,19 @@ inline std::string jsonString(const std::string& s) {
     return out + "\"";
 }
 
+/// The shortest text that reads back as `v`, whatever the process's locale
+/// (printf's "%g" writes "0,5" under a decimal-comma LC_NUMERIC, which is
+/// not JSON). Non-finite values have no JSON form: the caller refuses them.
 inline std::string jsonNumber(double v) {
     char buf[32];
-    std::snprintf(buf, sizeof buf, "%.17g", v);
-    return buf;
+    const std::to_chars_result r = std::to_chars(buf, buf + sizeof buf, v);
+    return std::string(buf, r.ptr);
+}
+
+inline bool finite(const double* v, int n) {
+    for (int k = 0; k < n; ++k)
+        if (!std::isfinite(v[k])) return false;
+    return true;
 }
 
 inline std::string jsonVec(const double* v, int n) {
@@ -70,8 +81,9 @@ inline std::string jsonVec(const double* v, int n) {
 }  // namespace detail
 
 /// Writes `f` to `path` through `path`.tmp and a rename, so a reader never
-/// sees half a frame. Returns false (errno set) when a plane has the wrong
-/// size, Lr is missing, or the file cannot be written. Little-endian hosts.
+/// sees half a frame. Returns false when a plane has the wrong size, Lr is
+/// missing, the camera is not finite, or the file cannot be written (errno
+/// set). Little-endian hosts. The header is the same under any locale.
 inline bool writeGpuFrame(const std::string& path, const GpuFrameOut& f) {
     const std::size_t n = std::size_t(f.width) * f.height;
     struct Plane { const char* name; const void* data; std::size_t bytes, expected; };
@@ -82,6 +94,9 @@ inline bool writeGpuFrame(const std::string& path, const GpuFrameOut& f) {
         {"Lr_stderr", f.Lr_stderr.data(), f.Lr_stderr.size() * 4, 3 * n * 4},
         {"spp", f.spp.data(), f.spp.size() * 4, n * 4},         {"rejected", f.rejected.data(), f.rejected.size() * 4, n * 4}};
     if (n == 0 || f.Lr.empty()) return false;
+    if (!detail::finite(f.eye, 3) || !detail::finite(f.forward, 3) || !detail::finite(f.right, 3) || !detail::finite(f.up, 3) ||
+        !detail::finite(&f.tanHalfFov, 1) || !detail::finite(f.jitter, 2))
+        return false;
     std::string names;
     for (const Plane& p : planes) {
         if (p.bytes == 0) continue;

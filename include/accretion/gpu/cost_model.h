@@ -238,12 +238,18 @@ struct CostRow {
     CostFeatures features{};
     double measuredMs = 0.0;
     double workingSetBytes = 0.0;  ///< PassReport::workingSetBytes (cold_work is recomputed from it for a cache)
+    std::string origin;            ///< "FILE:LINE" of the counter row (readCounterCsv)
 };
 
-/// counters.csv as `accretion cost` writes it (config,pass,<features...>,working_set_bytes).
+/// counters.csv as `accretion cost` writes it (config,pass,<features...>,
+/// working_set_bytes,predicted_ms): a column of another name (a misspelt
+/// counter) and a second row of one (config, pass) are refused, naming the
+/// file and line.
 std::vector<CostRow> readCounterCsv(const std::string& path);
 /// timings.csv: config,pass,ms (one row per pass per configuration, as
-/// exported from Nsight); joined to the counters on (config, pass).
+/// exported from Nsight); joined to the counters on (config, pass). Two
+/// counter rows of one (config, pass), from one file or two, are refused:
+/// a timing must name the one row it times.
 void joinTimings(const std::string& path, std::vector<CostRow>& rows);
 
 struct Calibration {

@@ -42,6 +42,17 @@ struct LightingPlan {
     }
 };
 
+/// Monte Carlo sweeps: how many pixels the next band takes. A band runs
+/// every remaining chunk of its pixels at once, and a stop request or a due
+/// checkpoint waits for it, so it is sized to take about `bandSeconds`:
+/// from `pixelChunkSeconds`, the slowest wall time per pixel and chunk of
+/// the bands so far (0 before any), over `span` chunks. The first band is a
+/// probe of `groupPixels` per core (a frame at 65536 spp must not start with
+/// a band of many seconds); a band grows at most 4x over `previous` (a band
+/// of sky does not size one of disk); at least one group per core.
+std::uint32_t nextBandPixels(double pixelChunkSeconds, std::uint64_t span, std::uint32_t previous, std::uint32_t groupPixels,
+                             std::uint32_t cores, double bandSeconds);
+
 /// The chunks of a frame for `render` at `height` rows, restricted to `shard`
 /// (a contiguous range). Throws InputError when the shard cannot be cut
 /// (adaptive sampling, fewer chunks than shards).

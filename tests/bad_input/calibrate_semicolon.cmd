@@ -1,0 +1,1 @@
+calibrate counters_min.csv timings_semicolon.csv -o calib_out/c.json

@@ -1,0 +1,1 @@
+import-gpu gpu_plane_twice.gpuframe -o import_out

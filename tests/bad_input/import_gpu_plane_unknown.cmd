@@ -1,0 +1,1 @@
+import-gpu gpu_plane_unknown.gpuframe -o import_out
