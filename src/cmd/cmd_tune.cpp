@@ -249,8 +249,8 @@ void stopTune(const TuneContext& t, int signal, const std::string& what) {
     removeStaleTemporaries(t.cache);  // a measurement stopped mid-write
     std::size_t kept = 0;
     for (const TuneContext::Spent& s : t.spent) kept += s.runs + s.cached;
-    fmt::print(stderr, "tune: {}: stopped at {}; the {} measurements before it are in {}: the same command resumes from them\n",
-               StopSignal::name(signal), what, kept, displayPath(t.cache));
+    fmt::print(stderr, "tune: {}: stopped at {}; what was measured before it ({} of {}) stays in {}: the same command resumes from it\n",
+               StopSignal::name(signal), what, kept, t.steps, displayPath(t.cache));
     throw Interrupted{signal};
 }
 
@@ -427,19 +427,19 @@ ErrorRow measureMoreSeeds(TuneContext& t, const LightingChoice& o, const ErrorRo
     return measureErrorSeeds(t, o, needed);
 }
 
-/// A reference of the measured frame, crop `w` of the scene's view: its
+/// A reference of `frame`, crop `w` of the scene's view: its
 /// size, data window and view (frame and scene-defining settings), its
 /// pixels readable (InputError naming the file).
-void checkReference(const TuneContext& t, const std::string& file, const PixelWindow& w) {
+void checkReference(const Settings& scene, std::uint32_t frame, const std::string& file, const PixelWindow& w) {
     const RgbLayer image = readExrLayer(file, "Lr");
-    if (image.width != t.scene->camera.width || image.height != t.scene->camera.height)
+    if (image.width != scene.camera.width || image.height != scene.camera.height)
         throw InputError(fmt::format("{}: reference of a {}x{} view, the scene renders {}x{}", file, image.width, image.height,
-                                     t.scene->camera.width, t.scene->camera.height));
+                                     scene.camera.width, scene.camera.height));
     if (image.x0 != int(w.x0) || image.y0 != int(w.y0) || image.dataWidth != w.width() || image.dataHeight != w.height())
         throw InputError(fmt::format("{}: reference of pixels [{}, {}) x [{}, {}), its crop is [{}, {}) x [{}, {})", file, image.x0,
                                      std::int64_t(image.x0) + image.dataWidth, image.y0, std::int64_t(image.y0) + image.dataHeight,
                                      w.x0, w.x1, w.y0, w.y1));
-    requireSceneView(readExrAttributes(file), file, FileRole::reference, *t.scene, t.frame, false);
+    requireSceneView(readExrAttributes(file), file, FileRole::reference, scene, frame, false);
 }
 
 /// The references of the error measurements, one per crop: given, or
@@ -458,13 +458,16 @@ std::vector<std::string> ensureReferences(TuneContext& t, std::size_t particles,
         std::vector<std::string> defines = {"render.crop=" + crop};
         if (!visibility) defines.push_back("shading.visibility=false");
         std::vector<std::string> argv = sceneArgv(t, "render", defines);
-        // --resume: a reference stopped by a signal left its checkpoint; the next tune continues it.
+        // --resume: a reference stopped by a signal left its checkpoint; the
+        // next tune continues it (its log says so: not --quiet).
         argv.insert(argv.end(), {"--estimator", exact ? "exact" : "split", "--frames", fmt::format("{}:{}", t.frame, t.frame + 1),
-                                 "-o", file.string(), "--quiet", "--resume"});
+                                 "-o", file.string(), "--resume"});
         if (!exact) argv.insert(argv.end(), {"--spp", std::to_string(t.args.referenceSpp)});
         const std::string what = fmt::format("reference ({}, crop {}{})", how, crop, unshadowed);
         measure(t, MeasureKind::reference, argv, file, what);
-        readMeasurement(file, what, [&] { checkReference(t, file.string(), w); });
+        Settings rendered = *t.scene;
+        rendered.shading.visibility = visibility;
+        readMeasurement(file, what, [&] { checkReference(rendered, t.frame, file.string(), w); });
         files.push_back(file.string());
     }
     return files;
@@ -585,7 +588,7 @@ void prepareTune(TuneContext& t, const Settings& scene, const std::string& prefi
     for (std::size_t k = 0; k < a.references.size(); ++k) {
         if (!std::filesystem::is_regular_file(a.references[k]))
             throw InputError(fmt::format("command line --reference {}: no such file", a.references[k]));
-        checkReference(t, a.references[k], t.crops[k]);
+        checkReference(scene, t.frame, a.references[k], t.crops[k]);
     }
     t.coefficients = CostCoefficients::forSetting(scene.gpu.coefficients);
     if (!t.coefficients.calibrated)

@@ -220,3 +220,22 @@ TEST_CASE("compare's worst pixels are ready-to-run render --pixel commands that 
     INFO(explained);
     CHECK_THAT(explained, Contains("pixel (" + xy + ", " + pixel.substr(pixel.find(',') + 1) + ") of frame 0, exact estimator"));
 }
+
+TEST_CASE("compare's worst pixels never name a settings file that a later run rewrote", "[cli][compare]") {
+    const auto dir = scratchDir("compare_worst_stale");
+    std::string out;
+    // ref.0000.exr and its ref.settings.toml, then a later run of the same
+    // {frame} name at another field of view: it rewrites ref.settings.toml.
+    const std::string ref = (dir / "ref.{frame}.exr").string();
+    REQUIRE(runCommand(kBin + " render " + tinyScene() + " --quiet --estimator exact --frames 0:1 -o " + ref, out) == 0);
+    REQUIRE(runCommand(kBin + " render " + tinyScene() + " --quiet --estimator uniform --spp 1 -o " + (dir / "x.exr").string(), out) ==
+            0);
+    const std::string compare = kBin + " compare " + (dir / "x.exr").string() + " " + (dir / "ref.0000.exr").string() + " --flip none";
+    REQUIRE(runCommand(compare, out) == 0);
+    CHECK_THAT(out, Contains("accretion render " + (dir / "ref.settings.toml").string()));
+    REQUIRE(runCommand(kBin + " render " + tinyScene() + " --quiet --estimator exact --frames 1:2 -D camera.fov=30 -o " + ref, out) == 0);
+    REQUIRE(runCommand(compare, out) == 0);
+    INFO(out);
+    CHECK(out.find("accretion render ") == std::string::npos);  // a command would render another view
+    CHECK_THAT(out, Contains("ref.settings.toml is not the settings the reference records: a later run rewrote it"));
+}

@@ -555,3 +555,22 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
     CHECK_FALSE(std::filesystem::exists(dir / "bad_cache"));
     CHECK_FALSE(std::filesystem::exists(dir / "bad.json"));
 }
+
+TEST_CASE("a configuration label with commas and quotes stays one CSV cell from cost to calibrate", "[cli][gpu]") {
+    const auto dir = accretion::test::scratchDir("gpu_config_comma");
+    std::string out;
+    const std::string label = "tree, M=8 \\\"hd\\\"";  // as the shell passes it: tree, M=8 "hd"
+    REQUIRE(runCommand(kBin + " cost " + tinyScene() + " -D render.estimator=\\\"restir\\\" --frames 2 --overhead 0 --omm-levels \"\" "
+                           "--cluster-sizes \"\" -q --config \"" + label +
+                           "\" -o " + (dir / "c.json").string(), out) == 0);
+    const std::vector<CostRow> rows = readCounterCsv((dir / "c.csv").string());
+    REQUIRE(rows.size() >= 3);
+    for (const CostRow& r : rows) CHECK(r.config == "tree, M=8 \"hd\"");
+    // calibrate joins the label as a spreadsheet quotes it.
+    std::string timings = "config,pass,ms\n";
+    for (const CostRow& r : rows) timings += "\"tree, M=8 \"\"hd\"\"\"," + r.pass.label() + "," + std::to_string(0.01 + r.features[0] * 1e-6) + "\n";
+    std::ofstream(dir / "t.csv") << timings;
+    REQUIRE(runCommand(kBin + " calibrate " + (dir / "c.csv").string() + " " + (dir / "t.csv").string() + " -o " + (dir / "k.json").string(),
+                       out) == 0);
+    CHECK_THAT(out, Contains("fitted on " + std::to_string(rows.size()) + " timed passes"));
+}

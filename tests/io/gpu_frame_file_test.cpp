@@ -2,10 +2,12 @@
 // import-gpu's EXR read back with OpenImageIO.
 #include <catch2/catch.hpp>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
 #include <OpenImageIO/imageio.h>
+#include <nlohmann/json.hpp>
 
 #include "accretion/core/error.h"
 #include "accretion/io/gpu_frame_file.h"
@@ -150,4 +152,30 @@ TEST_CASE("a Monte Carlo GPU frame keeps its standard error, spp and rejections 
         CHECK(px[k * spec.nchannels + spp] == f.spp[k]);
         CHECK(px[k * spec.nchannels + rej] == f.rejected[k]);
     }
+}
+
+TEST_CASE("a GPU frame's planes are read in the order its header lists them", "[io][gpu]") {
+    // An engine that writes Lr first and lists it first: its Lr is Lr, not L.
+    const auto dir = scratchDir("gpu_frame_order");
+    const GpuFrame f = sampleFrame();
+    writeGpuFrame(dir / "f.gpuframe", f);
+    std::ifstream in(dir / "f.gpuframe", std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::uint64_t length = 0;
+    std::memcpy(&length, bytes.data() + 8, 8);
+    nlohmann::json header = nlohmann::json::parse(bytes.substr(16, length));
+    REQUIRE(header["planes"] == nlohmann::json({"L", "Le", "Lr", "normal", "depth", "particle"}));
+    header["planes"] = {"Lr", "L", "Le", "normal", "depth", "particle"};
+    const std::string text = header.dump();
+    const std::uint64_t newLength = text.size();
+    const std::size_t planes = 16 + length, rgb = 15 * 12;  // L, Le, Lr: 15 pixels of 3 floats each
+    std::string reordered = bytes.substr(0, 8) + std::string(reinterpret_cast<const char*>(&newLength), 8) + text +
+                            bytes.substr(planes + 2 * rgb, rgb) + bytes.substr(planes, 2 * rgb) + bytes.substr(planes + 3 * rgb);
+    std::ofstream(dir / "lr_first.gpuframe", std::ios::binary) << reordered;
+    const GpuFrame g = readGpuFrame(dir / "lr_first.gpuframe");
+    CHECK(g.Lr == f.Lr);
+    CHECK(g.L == f.L);
+    CHECK(g.Le == f.Le);
+    CHECK(g.normal == f.normal);
+    CHECK(g.particle == f.particle);
 }
