@@ -131,6 +131,10 @@ write("cams_bom_comma.json", b'\xef\xbb\xbf{"frames": [{"frame": 0, "eye": [0, 1
 write("cams_overflow.json", '{"frames": [\n  {"frame": 0, "eye": [0, 1, 1e400], "look_at": [0, 0, 0]}\n]}\n')
 write("cams_far.csv", "frame,eye_x,eye_y,eye_z,look_at_x,look_at_y,look_at_z\n0,0,1e300,5e300,0,0,0\n")
 write("cams_units.csv", "# jitter_units = NDCs\nframe,eye_x,eye_y,eye_z,look_at_x,look_at_y,look_at_z\n0,0,1,5,0,0,0\n")
+# A camera file of frames 4..30: tune checks the frames it renders (its
+# history and the measured frame), not the scene's first frame.
+write("cams_4_30.csv", "frame,eye_x,eye_y,eye_z,look_at_x,look_at_y,look_at_z\n" +
+      "".join(f"{k},0,1,5,0,0,0\n" for k in range(4, 31)))
 write("coef_unknown.json", '{"coefficients_ns": {"threads": 1, "warp_steps": 1, "rays": 1, "blas_entries": 1, '
                            '"any_hits": 1, "bytes": 1, "blas_entires": 1}}\n')
 shutil.copy("half.exr", "seqimg.0000.exr")
