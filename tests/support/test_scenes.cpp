@@ -38,10 +38,11 @@ Settings smallDiskSettings() {
     return s;
 }
 
-DiskLights::DiskLights(ShadingModel model)
-    : settings([model] {
+DiskLights::DiskLights(ShadingModel model, std::uint32_t count)
+    : settings([model, count] {
           Settings s = smallDiskSettings();
           s.shading.model = model;
+          if (count > 0) s.particles.count = count;
           return s;
       }()),
       particles(ParticleSource(settings).frame(0)),

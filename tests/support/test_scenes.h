@@ -19,7 +19,8 @@ Settings smallDiskSettings();
 
 /// The small disk shaded with `model`: frame 0's particles and their light tree.
 struct DiskLights {
-    explicit DiskLights(ShadingModel model);
+    /// smallDiskSettings' disk, or `count` particles of it (0: its own count).
+    explicit DiskLights(ShadingModel model, std::uint32_t count = 0);
     Settings settings;
     Particles particles;
     LightTree tree;

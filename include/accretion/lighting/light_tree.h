@@ -1,5 +1,7 @@
 #pragma once
+#include <algorithm>
 #include <cstdint>
+#include <iterator>
 #include <utility>
 #include <vector>
 
@@ -21,6 +23,31 @@ namespace accretion {
 /// the receiver (power x cosine bound / squared distance bound), so every
 /// light whose term is non-zero has a non-zero pdf: the estimator is
 /// unbiased. The receiver's own particle gets importance 0 (i != j).
+/// One receiver's descent importances, kept for all its draws: the M
+/// candidates drawn at one shading point descend through the same upper
+/// levels, and each level's two children cost three square roots and a box
+/// test. Direct-mapped on the node index (a collision recomputes); a value
+/// is what descentImportance computes for that node, so the draws are those
+/// of LightTreeDirect bit for bit (tests/lighting/light_tree_test.cpp). On
+/// the CPU only: the GPU's candidate thread keeps no table.
+class LightTreeMemo {
+public:
+    LightTreeMemo() { std::fill(std::begin(node_), std::end(node_), kEmpty); }
+    float operator()(const LightTreeView& tree, std::uint32_t n, const ShadingPoint& sp) {
+        const std::uint32_t s = (n * 0x9e3779b1u) >> (32 - kBits);  // Fibonacci hashing onto the slots
+        if (node_[s] != n) {
+            node_[s] = n;
+            value_[s] = tree.descentImportance(n, tree.nodes[n].power, sp);
+        }
+        return value_[s];
+    }
+
+private:
+    static constexpr std::uint32_t kBits = 7, kEmpty = 0xffffffffu;
+    std::uint32_t node_[1u << kBits];
+    float value_[1u << kBits];
+};
+
 class LightTree {
 public:
     LightTree() = default;
@@ -30,6 +57,9 @@ public:
     /// Draw a light for the receiver: one uniform per level down to a node of
     /// at most kExactBelow lights, then one among its leaves (LightTreeView::sample).
     LightSample sample(const ShadingPoint& sp, Rng& rng) const { return view().sample(sp, rng); }
+    /// The same draw, the receiver's importances recalled from `memo` (one
+    /// memo per shading point, for all its draws).
+    LightSample sample(const ShadingPoint& sp, Rng& rng, LightTreeMemo& memo) const { return view().sample(sp, rng, memo); }
     /// Probability that sample() returns light i at this receiver.
     float pdf(const ShadingPoint& sp, std::uint32_t i) const;
 

@@ -44,6 +44,16 @@ ACC_HD inline std::uint32_t pickLeaf(const float* importance, std::uint32_t coun
     return k;
 }
 
+struct LightTreeView;
+
+/// The importance sample() weighs a child by, computed where it is asked
+/// for (descentImportance at the node's own power): the GPU's way, and the
+/// CPU's for a single draw. LightTreeMemo (light_tree.h) gives the same
+/// values from a receiver's table for many draws.
+struct LightTreeDirect {
+    ACC_HD float operator()(const LightTreeView& tree, std::uint32_t n, const ShadingPoint& sp) const;
+};
+
 struct LightTreeView {
     static constexpr std::uint32_t kExactBelow = LightTreeSmallNode::kCapacity;
     const LightTreeNode* nodes = nullptr;
@@ -149,16 +159,17 @@ struct LightTreeView {
     /// Draw a light for the receiver: one uniform per level down to a node of
     /// at most kExactBelow lights, then one among its leaves in proportion to
     /// their importances (the binary descent below it with exact sums gives
-    /// each the same probability, at one uniform).
-    template <class R>
-    ACC_HD LightSample sample(const ShadingPoint& sp, R& rng) const {
+    /// each the same probability, at one uniform). `importanceOf(tree, n, sp)`
+    /// gives descentImportance(n, nodes[n].power, sp), computed or recalled.
+    template <class R, class Importance = LightTreeDirect>
+    ACC_HD LightSample sample(const ShadingPoint& sp, R& rng, Importance&& importanceOf = Importance{}) const {
         if (nodeCount == 0) return {kNoLightSample, 0.0f};
         std::uint32_t n = 0;
         float pdf = 1.0f;
         while (nodes[n].count > kExactBelow) {
             const std::uint32_t c = nodes[n].child;
-            const float a = descentImportance(c, nodes[c].power, sp);
-            const float b = descentImportance(c + 1, nodes[c + 1].power, sp);
+            const float a = importanceOf(*this, c, sp);
+            const float b = importanceOf(*this, c + 1, sp);
             const float u = rng.uniform();
             if (!(a + b > 0.0f)) return {kNoLightSample, 0.0f};
             const float pa = a / (a + b);
@@ -182,5 +193,9 @@ struct LightTreeView {
         return {nodes[n].child, pdf};
     }
 };
+
+ACC_HD inline float LightTreeDirect::operator()(const LightTreeView& tree, std::uint32_t n, const ShadingPoint& sp) const {
+    return tree.descentImportance(n, tree.nodes[n].power, sp);
+}
 
 }  // namespace accretion

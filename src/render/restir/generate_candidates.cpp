@@ -25,16 +25,20 @@ struct CpuSource {
         return 1u + (S == LightSource::power ? 1u : 0u) + (S == LightSource::tree ? f.in.lightTree->depth() : 0u) + (presampled ? 1u : 0u);
     }
 
+    struct NoMemo {};
     struct Drawer {
         const FrameContext& f;
         const ShadingPoint& sp;
         std::uint32_t tile;
         std::int64_t cell;
+        /// tree: the receiver's descent importances, shared by its candidates.
+        mutable std::conditional_t<S == LightSource::tree, LightTreeMemo, NoMemo> memo{};
         /// A ReGIR slot's pdf is 1 / W (W its unbiased 1 / p_src), so its
         /// weight p_hat / pdf is p_hat W.
         LightSample sample(Rng& g) const {
             if constexpr (S == LightSource::regir) return cell >= 0 ? f.regir->sample(std::uint32_t(cell), g) : f.tiles->sample(tile, g);
             else if constexpr (S == LightSource::tiles) return f.tiles->sample(tile, g);
+            else if constexpr (S == LightSource::tree) return f.in.lightTree->sample(sp, g, memo);
             else return CandidateSampler<S>{f.L, f.in.powerTable, f.in.lightTree}.sample(sp, g);
         }
     };
