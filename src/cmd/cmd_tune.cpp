@@ -200,6 +200,7 @@ struct TuneContext {
     std::vector<PixelWindow> crops;  ///< where the error is measured: one crop per stratum of the frame
     std::vector<std::string> references;           ///< one per crop
     std::vector<std::string> unshadowedReferences;  ///< --anatomy: the references with shading.visibility = false
+    std::string referencesKey;  ///< the references' contents, hashed once: part of every error measurement's key
     std::uint32_t frame = 0;    ///< the measured frame
     std::uint32_t history = 0;  ///< frames before it: restir's steady state (steadyStateHistory)
     const StopSignal* stop = nullptr;  ///< SIGINT and SIGTERM: forwarded to the running measurement, then tune stops
@@ -399,8 +400,7 @@ ErrorRow measureErrorSeeds(TuneContext& t, const LightingChoice& o, std::uint32_
         if (d != "render.estimator=restir") spec += ":" + d;
     std::string key = t.sceneText + fmt::format("\nbias {} seeds {} frame {} history {} crop margin {}", spec, seeds, t.frame,
                                                 t.history, t.args.cropMargin);
-    for (const std::string& r : t.references) key += "\nreference " + cacheKey(readWholeFile(r, "tune"));
-    for (const std::string& r : t.unshadowedReferences) key += "\nunshadowed " + cacheKey(readWholeFile(r, "tune"));
+    key += t.referencesKey;
     const std::filesystem::path prefix = t.cache / (cacheKey(key) + ".bias");
     std::vector<std::string> argv = sceneArgv(t, "bias", {});
     for (const std::string& r : t.references) argv.insert(argv.end(), {"--reference", r});
@@ -855,6 +855,8 @@ void runTune(const TuneArgs& a) {
     const std::size_t particles = ParticleSource(scene).frame(t.frame).size();
     t.references = ensureReferences(t, particles);
     if (a.anatomy) t.unshadowedReferences = ensureReferences(t, particles, false);
+    for (const std::string& r : t.references) t.referencesKey += "\nreference " + cacheKey(readWholeFile(r, "tune"));
+    for (const std::string& r : t.unshadowedReferences) t.referencesKey += "\nunshadowed " + cacheKey(readWholeFile(r, "tune"));
 
     // Geometry: the same image whatever it is; the fastest predicted frame.
     TuneResult r;

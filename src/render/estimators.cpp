@@ -405,7 +405,7 @@ LightingCounters run(const LightingInputs& in, const LightArrays& L, const Light
         return total;
     }
     double pixelChunkSeconds = 0.0;        // measured: the slowest pixel-chunk of a band so far
-    std::uint32_t previous = 0;            // the last band's pixels
+    std::uint32_t previous = 0;            // the largest band's pixels so far
     while (acc.nextChunk < plan.end) {
         const std::uint64_t c = acc.nextChunk;
         if (plan.exact) {
@@ -423,7 +423,7 @@ LightingCounters run(const LightingInputs& in, const LightArrays& L, const Light
                 band = {x0, std::min(w.x1, x0 + pixels), row, row + 1};
             const auto start = std::chrono::steady_clock::now();
             total += sweep<M, P, Count>(in, L, plan, &acc, nullptr, c, plan.end, progress, band);
-            previous = std::max(previous, std::uint32_t(band.pixels()));  // the largest band so far
+            previous = std::max(previous, std::uint32_t(band.pixels()));
             const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
             pixelChunkSeconds = std::max(pixelChunkSeconds, seconds / (double(band.pixels()) * double(span)));
             if (band.x1 == w.x1) {
