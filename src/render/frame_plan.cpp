@@ -56,6 +56,9 @@ void planPasses(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
     plan.temporal = plan.restir && plan.keepHistory && facts.historyAvailable;
     plan.spatialIterations = plan.restir && s.restir.spatial_neighbours > 0 ? s.restir.spatial_iterations : 0;
     plan.upsample = plan.restir && float(s.restir.resolution_scale) < 1.0f;
+    plan.particleTexels = plan.restir && s.render.estimator == EstimatorKind::particle_restir;
+    plan.traceShadowRays = plan.restir && (!plan.particleTexels || s.restir.pixel_shading == PixelShading::interpolate ||
+                                           (s.restir.visibility_reuse && plan.shadowRays));
 }
 
 /// The plan as lines, with what each step does or why it is skipped.
@@ -111,18 +114,34 @@ void describe(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
              plan.presampleRegir ? fmt::format("{}^3 cells x {} reservoirs of {} tile candidates", r.regir_cells,
                                                r.regir_lights_per_cell, r.regir_build_samples)
              : dark ? noLight : fmt::format("source {}: no ReGIR grid", enumName(s.render.source)));
+        const bool particles = est == EstimatorKind::particle_restir;
+        const std::string texels = fmt::format("{0}x{0} texels x {1} reservoirs", r.texels, r.texel_rays);
+        if (particles)
+            step(Pass::gatherParticleTexels, dark ? noLight : fmt::format("the visible particles in Morton order, {} each", texels));
         step(Pass::generateCandidates,
-             dark ? noLight : fmt::format("{} candidates from {}", s.render.candidates, enumName(s.render.source)));
+             dark ? noLight : fmt::format("{} candidates from {}{}", s.render.candidates, enumName(s.render.source),
+                                          particles ? " per particle texel" : ""));
         step(Pass::temporalResampling,
-             plan.temporal ? "reprojection through particle motion"
+             plan.temporal ? (particles ? "the same texel of the same particle (by id)" : "reprojection through particle motion")
              : dark ? noLight : !s.restir.temporal ? "temporal off: no history buffers or motion"
              : !manyFrames ? "one frame: no history buffers or motion" : "first frame: no history yet");
         step(Pass::spatialResampling,
-             plan.spatialIterations ? fmt::format("{} neighbours x {}", s.restir.spatial_neighbours, s.restir.spatial_iterations)
+             plan.spatialIterations ? fmt::format("{} neighbours x {}{}", s.restir.spatial_neighbours, s.restir.spatial_iterations,
+                                                  particles ? fmt::format(" among the {} visible particles either side in world (Morton) order",
+                                                                          r.world_neighbours)
+                                                            : "")
                                     : (dark ? noLight : "no neighbours"));
         step(Pass::traceShadowRays,
-             plan.shadowRays ? "one shadow ray per pixel"
-             : dark ? noLight : "visibility off: the kept sample shaded with V = 1, no shadow rays");
+             dark ? noLight
+             : !plan.traceShadowRays ? "pixel_shading resample: each pixel traces its own (shadeParticlePixels), the texels none"
+             : plan.shadowRays ? (particles ? "one shadow ray per particle texel and reservoir" : "one shadow ray per pixel")
+                               : "visibility off: the kept sample shaded with V = 1, no shadow rays");
+        if (particles)
+            step(Pass::shadeParticlePixels,
+                 dark ? noLight
+                 : r.pixel_shading == PixelShading::interpolate
+                     ? "interpolate: bilinear over the pixel's particle's texels' Lr (biased)"
+                     : "resample: the particle's bilinear texels' samples at the pixel's point, its own shadow ray (unbiased)");
         step(Pass::upsampleLighting,
              plan.upsample ? fmt::format("lighting at scale {}", s.restir.resolution_scale) : "full-resolution lighting");
     } else {
@@ -180,7 +199,9 @@ bool FramePlan::runs(Pass pass) const {
     case Pass::generateCandidates: return restir;
     case Pass::temporalResampling: return temporal;
     case Pass::spatialResampling: return spatialIterations > 0;
-    case Pass::traceShadowRays: return restir;
+    case Pass::gatherParticleTexels: return particleTexels;
+    case Pass::traceShadowRays: return traceShadowRays;
+    case Pass::shadeParticlePixels: return particleTexels;
     case Pass::upsampleLighting: return upsample;
     case Pass::composeImage: return true;
     case Pass::writeOutputs: return true;

@@ -322,6 +322,14 @@ void validateSampling(const Settings& s, const RuleFailure& fail) {
                                             "0 <= y0 < y1 <= height; x1 and y1 are past the window)",
                                             c[0], c[1], c[2], c[3], s.camera.width, s.camera.height));
     }
+    if (s.render.estimator == EstimatorKind::particle_restir) {
+        const std::uint32_t t = s.restir.texels;
+        if (t != 1 && t != 2 && t != 4) fail("restir.texels", fmt::format("texels per billboard side are 1, 2 or 4 (got {})", t));
+        if (s.geometry.primitive == Primitive::sphere)
+            fail("render.estimator", "particle_restir's texels lie on the billboards: geometry.primitive = sphere has none");
+        if (s.restir.resolution_scale < 1.0)
+            fail("restir.resolution_scale", "particle_restir lights the particles' texels, not a reduced image: leave it at 1");
+    }
     if (const double m = s.restir.crop_margin; m != -1.0) {
         if (m < 0.0 || m != std::floor(m)) fail("restir.crop_margin", fmt::format("a number of pixels, or -1 for the whole frame (got {})", m));
         if (s.render.crop.empty()) fail("restir.crop_margin", "is the margin of render.crop, which is not set");

@@ -68,6 +68,12 @@ struct FramePlan {
     bool temporal = false;        ///< temporalResampling
     std::uint32_t spatialIterations = 0;  ///< spatialResampling runs
     bool upsample = false;        ///< upsampleLighting (restir at reduced resolution)
+    /// particle_restir: gatherParticleTexels and shadeParticlePixels around
+    /// the reservoir passes, which run on the texels.
+    bool particleTexels = false;
+    /// traceShadowRays runs: restir's pixels, particle_restir's texels when
+    /// the pixels interpolate their Lr (or visibility reuse needs their V).
+    bool traceShadowRays = false;
     std::vector<PlannedStep> steps;
 
     /// Whether a frame with these facts loads (and builds) its particles: the

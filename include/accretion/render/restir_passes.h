@@ -69,7 +69,23 @@ struct ReuseParams {
     /// the whole). A texel's streams are keyed by its index in the whole
     /// grid, so a window draws each texel's numbers as the whole frame does.
     std::uint32_t wholeWidth = 0, originX = 0, originY = 0;
-    ACC_HD std::uint64_t streamKey(std::size_t px) const {
+    /// particle_restir (particle_restir_passes.h): the grid is the visible
+    /// particles' billboard texels, texelsPerParticle() consecutive texels a
+    /// particle (texelLayers layers of texelSide x texelSide), in its slot.
+    std::uint32_t texelSide = 0;       ///< texels per billboard side (0: the grid is the image's pixels)
+    std::uint32_t texelLayers = 1;     ///< restir.texel_rays: independent reservoirs per texel
+    std::uint32_t worldNeighbours = 8; ///< restir.world_neighbours: slots either side spatial reuse draws from
+    std::uint32_t visible = 0;         ///< visible particles (slots) this frame
+    ACC_HD std::uint32_t texelsPerParticle() const { return texelSide * texelSide * texelLayers; }
+    /// The streams of texel px showing g: a pixel's by its place in the
+    /// whole grid; a particle texel's by its particle and its place on it,
+    /// so that it draws the same numbers whatever else is visible.
+    ACC_HD std::uint64_t streamKey(std::size_t px, const GBufferTexel& g) const {
+        if (texelSide != 0) return (std::uint64_t(1) << 62) | (std::uint64_t(g.particle) * texelsPerParticle() + px % texelsPerParticle());
+        return pixelKey(px);
+    }
+    /// Texel px of a grid of pixels by its place in the whole grid.
+    ACC_HD std::uint64_t pixelKey(std::size_t px) const {
         if (wholeWidth == 0) return px;
         return (std::uint64_t(px / width) + originY) * wholeWidth + px % width + originX;
     }
@@ -92,6 +108,11 @@ inline ReuseParams reuseParams(const Settings& s, std::uint32_t frame, std::uint
     p.candidates = s.render.candidates;
     p.neighbours = s.restir.spatial_neighbours;
     p.radius = std::max(1.0f, float(s.restir.spatial_radius) * scale);
+    if (s.render.estimator == EstimatorKind::particle_restir) {
+        p.texelSide = s.restir.texels;
+        p.texelLayers = s.restir.texel_rays;
+        p.worldNeighbours = s.restir.world_neighbours;
+    }
     return p;
 }
 
@@ -122,7 +143,7 @@ ACC_HD_BODY void generateCandidatesTexel(B& b, const Source& source, std::size_t
     rec.gather(M * source.gathers());
     rec.write(b.reservoirBytes());
     const ShadingPoint sp = b.shadingPoint(g);
-    typename B::Rng rng(p.streamKey(px), p.frame, RngPass::restirCandidates, p.seed);
+    typename B::Rng rng(p.streamKey(px, g), p.frame, RngPass::restirCandidates, p.seed);
     const auto drawer = source.at(sp, x, y, rng);
     Reservoir r;
     if (!resampleCandidates(
@@ -185,7 +206,7 @@ ACC_HD_BODY void temporalResamplingTexel(B& b, std::size_t px) {
     prev.M = capHistoryM(prev.M, cur.M, p.mCap);
     if (prev.M != historyM) b.historyCapped();
     offers.addHistory(prev, q);
-    typename B::Rng rng(p.streamKey(px), p.frame, RngPass::restirTemporal, p.seed);
+    typename B::Rng rng(p.streamKey(px, g), p.frame, RngPass::restirTemporal, p.seed);
     b.keep(px, sanitizeReservoir(offers.combine(rng), [&] { return b.reject(px); }));
 }
 
@@ -205,7 +226,7 @@ ACC_HD_BODY void spatialResamplingTexel(B& b, std::size_t px, std::uint32_t x, s
     rec.read(R + gpu_layout::kParticleRecord);
     rec.gather(1);
     rec.write(R);
-    typename B::Rng rng(p.streamKey(px) ^ (std::uint64_t(iteration) << 40), p.frame, RngPass::restirSpatial, p.seed);
+    typename B::Rng rng(p.streamKey(px, g) ^ (std::uint64_t(iteration) << 40), p.frame, RngPass::restirSpatial, p.seed);
     auto offers = b.template offers<kMaxOffers>();
     offers.addCurrent(b.input(px), g);
     for (std::uint32_t s = 0; s < p.neighbours; ++s) {

@@ -29,7 +29,7 @@ struct EstimatorInfo {
     std::string_view summary;
 };
 
-inline constexpr std::array<EstimatorInfo, 7> kEstimators = {{
+inline constexpr std::array<EstimatorInfo, 8> kEstimators = {{
     {EstimatorKind::exact, true, LightSamplerKind::none, false, false, true, false, true, false,
      "every light i != j with its shadow ray: the reference"},
     {EstimatorKind::uniform, false, LightSamplerKind::none, false, false, true, true, true, false,
@@ -44,6 +44,8 @@ inline constexpr std::array<EstimatorInfo, 7> kEstimators = {{
      "S lights drawn from the light tree at the receiver, with the standard error"},
     {EstimatorKind::split, false, LightSamplerKind::tree, false, false, true, true, false, true,
      "the nearest lights summed, the far ones drawn from the light tree"},
+    {EstimatorKind::particle_restir, false, LightSamplerKind::none, true, true, false, false, true, false,
+     "ReSTIR DI on the visible particles' billboard texels (history by particle id, world-space neighbours); pixels interpolate or resample them"},
 }};
 
 constexpr bool estimatorTableMatchesEnum() {

@@ -41,7 +41,8 @@ enum class BuildPolicy { rebuild, refit, fast_trace, partial };
 enum class AccelLayout { clusters, instances, aabbs };
 enum class CpuLayout { fastest, gpu };
 enum class ShadingModel { lambert, sphere, isotropic };
-enum class EstimatorKind { exact, uniform, power, ris, restir, tree, split };
+enum class EstimatorKind { exact, uniform, power, ris, restir, tree, split, particle_restir };
+enum class PixelShading { interpolate, resample };
 enum class BiasCorrection { none, basic, pairwise };
 enum class ReservoirLayout { full, packed };
 enum class LightSource { uniform, power, tree, tiles, regir };
@@ -61,7 +62,8 @@ ACC_ENUM_NAMES(BuildPolicy, "rebuild", "refit", "fast_trace", "partial");
 ACC_ENUM_NAMES(AccelLayout, "clusters", "instances", "aabbs");
 ACC_ENUM_NAMES(CpuLayout, "fastest", "gpu");
 ACC_ENUM_NAMES(ShadingModel, "lambert", "sphere", "isotropic");
-ACC_ENUM_NAMES(EstimatorKind, "exact", "uniform", "power", "ris", "restir", "tree", "split");
+ACC_ENUM_NAMES(EstimatorKind, "exact", "uniform", "power", "ris", "restir", "tree", "split", "particle_restir");
+ACC_ENUM_NAMES(PixelShading, "interpolate", "resample");
 ACC_ENUM_NAMES(BiasCorrection, "none", "basic", "pairwise");
 ACC_ENUM_NAMES(ReservoirLayout, "full", "packed");
 ACC_ENUM_NAMES(LightSource, "uniform", "power", "tree", "tiles", "regir");
@@ -298,6 +300,12 @@ struct RestirSettings {
     std::uint32_t regir_lights_per_cell = 512; ///< regir: reservoirs per cell (RTXDI LightsPerCell)
     std::uint32_t regir_build_samples = 8;   ///< regir: candidates per cell reservoir (RTXDI regirNumBuildSamples)
     double regir_jitter = 1.0;               ///< regir: receiver jitter in cells (RTXDI regirSamplingJitter)
+    // particle_restir (docs/MODEL.md section 4b): reservoirs on the visible
+    // particles' billboards, not on the pixels.
+    std::uint32_t texels = 1;                ///< particle_restir: texels per billboard side (1: one reservoir a particle, 2: 2x2, 4: 4x4)
+    std::uint32_t texel_rays = 1;            ///< particle_restir: independent reservoirs (one shadow ray each) per texel
+    PixelShading pixel_shading = PixelShading::interpolate; ///< particle_restir: how a pixel reads its particle's texels
+    std::uint32_t world_neighbours = 8;      ///< particle_restir: spatial reuse draws among this many visible particles either side in Morton order
 
     template <class V> void visit(V& v) {
         v.field("temporal", temporal, "temporal reuse through particle motion and the previous camera");
@@ -323,6 +331,10 @@ struct RestirSettings {
         v.field("regir_lights_per_cell", regir_lights_per_cell, "render.source = regir: light reservoirs per cell (RTXDI LightsPerCell)", Range{1, 65536});
         v.field("regir_build_samples", regir_build_samples, "render.source = regir: tile candidates per cell reservoir, resampled by the cell's target (RTXDI regirNumBuildSamples)", Range{1, 1024});
         v.field("regir_jitter", regir_jitter, "render.source = regir: receiver position jitter in cells before the cell lookup (RTXDI regirSamplingJitter)", Range{0.0, 8.0});
+        v.field("texels", texels, "particle_restir: texels per billboard side, each with its reservoirs (1, 2 or 4)", Range{1, 4});
+        v.field("texel_rays", texel_rays, "particle_restir: independent reservoirs per texel, each traced with its own shadow ray (K)", Range{1, 8});
+        v.field("pixel_shading", pixel_shading, "particle_restir: interpolate (bilinear over the particle's texels' Lr: biased) or resample (the pixel resamples its particle's texels' samples at its own point and traces its own shadow ray: unbiased)");
+        v.field("world_neighbours", world_neighbours, "particle_restir: spatial reuse draws its neighbours among this many visible particles either side of the texel's in Morton order (world space)", Range{1, 1024});
     }
 };
 

@@ -19,6 +19,7 @@ inline ReuseParams reuseParams(const FrameContext& f) {
     p.wholeWidth = f.wholeWidth;
     p.originX = f.originX;
     p.originY = f.originY;
+    if (f.texels) p.visible = f.texels->visible();
     return p;
 }
 
@@ -28,6 +29,7 @@ struct CpuBuffers {
     const std::vector<StoredReservoir>* in = nullptr;
     std::vector<StoredReservoir>* out = nullptr;
     std::vector<Vec3>* Lr = nullptr;
+    const std::vector<Vec3>* texelLr = nullptr;  ///< particle_restir's pixels: the texels' Lr (their reservoirs are `in`)
 };
 
 /// One CPU pass's bridge, made per texel on the thread that runs it.
@@ -110,6 +112,23 @@ public:
     bool dropOccludedCandidates() const { return f_.rs.candidate_visibility && f_.shadows; }
     bool visibilityReuse() const { return f_.rs.visibility_reuse; }
     void writeLr(std::size_t px, const Vec3& Lr) { (*io_.Lr)[px] = Lr; }
+
+    // particle_restir (particle_restir_passes.h).
+    bool historyTexelOf(std::uint32_t j, std::uint32_t sub, std::size_t& q) const {
+        const std::vector<std::uint32_t>& slots = f_.prev->slotOf;
+        if (j >= slots.size() || slots[j] == kNoSlot) return false;
+        q = std::size_t(slots[j]) * p_.texelsPerParticle() + sub;
+        return true;
+    }
+    const GBufferTexel& pixel(std::size_t px) const { return f_.lg.texels[px]; }
+    std::uint32_t slotOf(std::uint32_t j) const { return f_.texels->slotOf[j]; }
+    Vec2 pixelUv(const GBufferTexel& g) const {
+        return billboardUv(g.local, f_.in.particles.radius[g.particle], f_.in.bvh.frame(g.particle));
+    }
+    const GBufferTexel& gridTexel(std::size_t q) const { return f_.texels->grid.texels[q]; }
+    const StoredReservoir& gridReservoir(std::size_t q) const { return (*io_.in)[q]; }
+    const Vec3& gridLr(std::size_t q) const { return (*io_.texelLr)[q]; }
+    void writePixelLr(std::size_t px, const Vec3& Lr) { (*io_.Lr)[px] = Lr; }
 
 private:
     const FrameContext& f_;

@@ -2,6 +2,7 @@
 #include "accretion/render/restir.h"
 
 #include "accretion/core/error.h"
+#include "accretion/render/particle_texels.h"
 #include "accretion/render/upsample_pixel.h"
 #include "restir_pass.h"
 
@@ -42,25 +43,60 @@ LightingCounters runPasses(restir::FrameContext& f, std::vector<StoredReservoir>
         add(Pass::generateCandidates, restir::generateCandidates(f, a));
     }
     snapshot({Pass::generateCandidates}, a);
+    const bool particles = plan.particleTexels;  // history by id, world neighbours
     if (plan.temporal) {
         auto t = timer.scope(Pass::temporalResampling);
-        add(Pass::temporalResampling, restir::temporalResampling(f, a, b));
+        add(Pass::temporalResampling, particles ? restir::temporalResamplingById(f, a, b) : restir::temporalResampling(f, a, b));
         std::swap(a, b);
         snapshot({Pass::temporalResampling}, a);
     }
     if (plan.spatialIterations > 0) {
         auto t = timer.scope(Pass::spatialResampling);
         for (std::uint32_t it = 0; it < plan.spatialIterations; ++it) {
-            add(Pass::spatialResampling, restir::spatialResampling(f, it, a, b));
+            add(Pass::spatialResampling, particles ? restir::spatialResamplingWorld(f, it, a, b) : restir::spatialResampling(f, it, a, b));
             std::swap(a, b);
             snapshot({Pass::spatialResampling, it + 1}, a);
         }
     }
-    {
+    if (plan.traceShadowRays) {
         auto t = timer.scope(Pass::traceShadowRays);
         add(Pass::traceShadowRays, restir::traceShadowRays(f, a, lowLr));
     }
     return total;
+}
+
+/// Counting mode: gatherParticleTexels's per-pixel work (the G-buffer texel
+/// read, the particle's visible flag written).
+void recordGather(const RestirInputs& in, PassCounters& pc) {
+    const GBuffer& g = in.gbuffer;
+    for (std::size_t px = 0; px < g.texels.size(); ++px) {
+        ThreadCounters& t = pc.threads[px];
+        recordTexel(t, g.texels[px], in.particles, in.bvh, gpu_layout::kGBufferTexel);
+        if (g.texels[px].hit()) t.bytesWritten += 1;
+    }
+}
+
+/// particle_restir's reservoir AOVs: each hit pixel's spp and the reservoir
+/// of its particle's first texel.
+void writeTexelAovs(const GBuffer& full, const ParticleTexels& texels, const std::vector<StoredReservoir>& a,
+                    const std::vector<std::uint32_t>& pixelRejected, LightingImage& out, ReservoirImage& aov) {
+    const std::size_t pixels = full.texels.size();
+    aov.W.assign(pixels, 0.0f);
+    aov.M.assign(pixels, 0.0f);
+    aov.light.assign(pixels, kNoLight);
+    aov.p_hat.assign(pixels, 0.0f);
+    out.rejected.assign(pixels, 0.0f);
+    for (std::size_t px = 0; px < pixels; ++px) {
+        const GBufferTexel& g = full.texels[px];
+        if (!g.hit()) continue;
+        out.spp[px] = 1.0f;
+        out.rejected[px] = float(pixelRejected[px]);
+        const StoredReservoir& r = a[std::size_t(texels.slotOf[g.particle]) * texels.perParticle()];
+        aov.W[px] = r.W;
+        aov.M[px] = float(r.M);
+        aov.light[px] = r.W > 0.0f ? r.y : kNoLight;
+        aov.p_hat[px] = r.p_hat;
+    }
 }
 
 /// The lighting grid at resolution_scale: each texel the G-buffer texel of
@@ -130,25 +166,35 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
         reduced = reduceToLightingGrid(full, scale);
         lg = &reduced;
     }
+    ParticleTexels texels;  // particle_restir: the lighting grid is the visible particles' texels
+    if (in.plan.particleTexels) {
+        auto t = timer.scope(Pass::gatherParticleTexels);
+        texels = gatherParticleTexels(full, in.particles, in.bvh, in.camera, in.settings);
+        if (in.counters) recordGather(in, in.counters->add(Pass::gatherParticleTexels, full.width, full.height));
+        lg = &texels.grid;
+    }
     const std::size_t lpixels = std::size_t(lg->width) * lg->height;
     const LightArrays L(in.particles, in.settings.shading);
     const FramePlan& plan = in.plan;
     ACC_CHECK(plan.restir);
     ACC_CHECK((plan.sampler == LightSamplerKind::power) == (in.powerTable != nullptr));  // candidates from the planned source
     ACC_CHECK((plan.sampler == LightSamplerKind::tree) == (in.lightTree != nullptr));
-    ACC_CHECK(!plan.temporal || (history_ && history_->gbuffer.width == lg->width && history_->gbuffer.height == lg->height));
+    ACC_CHECK(!plan.temporal || (history_ && (plan.particleTexels || (history_->gbuffer.width == lg->width &&
+                                                                        history_->gbuffer.height == lg->height))));
     const History* prev = plan.temporal ? history_.get() : nullptr;
     std::vector<std::uint32_t> lowRejected(lpixels, 0);
-    restir::FrameContext f{in, rs_, codec_, *lg, L, prev, lg == &full ? 1.0f : float(lg->width) / float(full.width),
+    restir::FrameContext f{in, rs_, codec_, *lg, L, prev, lg == &reduced ? float(lg->width) / float(full.width) : 1.0f,
                    VisibilityOptions::from(in.settings.render), plan.shadowRays, in.counters,
                    lowRejected.data()};
+    if (plan.particleTexels) f.texels = &texels;
 
-    if (in.camera.isWindow()) {  // restir.crop_margin: the frame's window, each texel keyed by its place in the whole grid
+    if (in.camera.isWindow() && !plan.particleTexels) {  // restir.crop_margin: the frame's window, each texel keyed by its place in the whole grid
         f.originX = std::uint32_t(in.camera.pixelX0 * f.scale);
         f.originY = std::uint32_t(in.camera.pixelY0 * f.scale);
         f.wholeWidth = lg == &full ? in.camera.imageWidth : lightingGridExtent(in.camera.imageWidth, scale);
     }
-    if (!in.settings.render.crop.empty()) {  // reuse is counted over render.crop's texels, not the rest rendered for it
+    // particle_restir's texels are keyed by particle: their reuse is counted whatever render.crop.
+    if (!in.settings.render.crop.empty() && !plan.particleTexels) {  // reuse is counted over render.crop's texels, not the rest rendered for it
         const PixelWindow crop = PixelWindow::of(in.settings);
         const auto at = [&](std::uint32_t v, float o) { return std::uint32_t(std::max(0.0f, (float(v) - o) * f.scale)); };
         f.counted = {at(crop.x0, in.camera.pixelX0), at(crop.x1, in.camera.pixelX0), at(crop.y0, in.camera.pixelY0),
@@ -166,23 +212,41 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
         const auto x = std::uint32_t(in.trace->px % in.camera.imageWidth) - std::uint32_t(in.camera.pixelX0);
         const auto y = std::uint32_t(in.trace->px / in.camera.imageWidth) - std::uint32_t(in.camera.pixelY0);
         ACC_CHECK(x < full.width && y < full.height);
-        traced = texelOf(x, y);
+        const GBufferTexel& g = full.at(x + full.window.x0, y + full.window.y0);
+        traced = !plan.particleTexels ? texelOf(x, y) : g.hit() ? std::size_t(texels.slotOf[g.particle]) * texels.perParticle() : 0;
     }
     LightingCounters counters = runPasses(f, a, b, lowLr, timer, rejected, reuse, traced);
 
-    if (!plan.upsample) {
+    if (plan.particleTexels) {  // the pixels from their particles' texels, each as restir keys a pixel
+        auto t = timer.scope(Pass::shadeParticlePixels);
+        RestirSettings pixelRs = rs_;  // no canonical sample at the pixel: pairwise MIS has nothing to weigh against
+        if (pixelRs.bias_correction == BiasCorrection::pairwise) pixelRs.bias_correction = BiasCorrection::basic;
+        std::vector<std::uint32_t> pixelRejected(pixels, 0);
+        restir::FrameContext fp{in, pixelRs, codec_, full, L, prev, 1.0f, f.vis, plan.shadowRays, in.counters, pixelRejected.data()};
+        fp.texels = &texels;
+        if (in.camera.isWindow()) {
+            fp.originX = std::uint32_t(in.camera.pixelX0);
+            fp.originY = std::uint32_t(in.camera.pixelY0);
+            fp.wholeWidth = in.camera.imageWidth;
+        }
+        const LightingCounters c = restir::shadeParticlePixels(fp, a, lowLr, out.Lr);
+        counters += c;
+        if (c.nonFinite) rejected[Pass::shadeParticlePixels] += c.nonFinite;
+        writeTexelAovs(full, texels, a, pixelRejected, out, aov);
+    } else if (!plan.upsample) {
         out.Lr = lowLr;
     } else {
         auto t = timer.scope(Pass::upsampleLighting);
         restir::upsampleLighting(full, *lg, in.particles, lowLr, f.scale, rs_, out.Lr);
         if (in.counters) restir::recordUpsample(in, *lg, in.counters->add(Pass::upsampleLighting, full.width, full.height));
     }
-    writeReservoirAovs(full, a, lowRejected, texelOf, out, aov);
+    if (!plan.particleTexels) writeReservoirAovs(full, a, lowRejected, texelOf, out, aov);
 
     // History for the next frame.
     if (!keepHistory_) return counters;
     auto h = std::make_shared<History>();
     h->gbuffer = *lg;
+    h->slotOf = std::move(texels.slotOf);
     h->particles = in.particles;
     h->lights = LightArrays(h->particles, in.settings.shading);
     h->camera = in.camera;

@@ -17,6 +17,7 @@
 #include "accretion/lighting/regir_grid.h"
 #include "accretion/lighting/reservoir.h"
 #include "accretion/lighting/shading.h"
+#include "accretion/render/particle_texels.h"
 #include "accretion/render/restir.h"
 #include "accretion/render/visibility.h"
 
@@ -29,6 +30,8 @@ struct Restir::History {
     LightArrays lights;                     ///< views of `particles`
     Camera camera;
     std::vector<StoredReservoir> reservoirs;
+    /// particle_restir: the slot of each particle visible last frame (kNoSlot otherwise).
+    std::vector<std::uint32_t> slotOf;
 };
 
 namespace restir {
@@ -98,6 +101,9 @@ struct FrameContext {
     PixelWindow counted{0, ~0u, 0, ~0u};
     const LightTiles* tiles = nullptr;  ///< render.source tiles or regir: this frame's presampled tiles
     const RegirGrid* regir = nullptr;   ///< render.source regir: this frame's grid
+    /// particle_restir: this frame's particle texels (lg is their grid, or
+    /// the image's G-buffer in shadeParticlePixels).
+    const ParticleTexels* texels = nullptr;
 
     /// Count a non-finite value at px; true if the policy discards the reservoir.
     bool reject(std::size_t px, LightingCounters& c) const {
@@ -157,6 +163,15 @@ LightingCounters temporalResampling(const FrameContext& f, const std::vector<Sto
 LightingCounters spatialResampling(const FrameContext& f, std::uint32_t iteration, const std::vector<StoredReservoir>& cur,
                                    std::vector<StoredReservoir>& out);
 LightingCounters traceShadowRays(const FrameContext& f, std::vector<StoredReservoir>& res, std::vector<Vec3>& Lr);
+// particle_restir's own passes (particle_space.cpp): temporal reuse by
+// particle id, spatial reuse among world neighbours, and the pixels read
+// from the texels (f.lg the image's G-buffer, f.texels the texels).
+LightingCounters temporalResamplingById(const FrameContext& f, const std::vector<StoredReservoir>& cur,
+                                        std::vector<StoredReservoir>& out);
+LightingCounters spatialResamplingWorld(const FrameContext& f, std::uint32_t iteration, const std::vector<StoredReservoir>& cur,
+                                        std::vector<StoredReservoir>& out);
+LightingCounters shadeParticlePixels(const FrameContext& f, const std::vector<StoredReservoir>& texelReservoirs,
+                                     const std::vector<Vec3>& texelLr, std::vector<Vec3>& Lr);
 void upsampleLighting(const GBuffer& full, const GBuffer& lg, const Particles& particles, const std::vector<Vec3>& lowLr,
                       float scale, const RestirSettings& rs, std::vector<Vec3>& Lr);
 /// Counting mode: upsampleLighting's per-pixel work.

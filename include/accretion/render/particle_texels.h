@@ -1,0 +1,120 @@
+#pragma once
+// The lighting grid of particle_restir (docs/MODEL.md section 4b): texels on
+// the billboards of the particles the frame sees, not pixels. Each visible
+// particle has a slot; its texelsPerParticle() texels are consecutive in the
+// grid (layer by layer, each layer side x side texels at uv centres
+// ((i + 0.5) / side, (j + 0.5) / side)). Slots follow the particles' Morton
+// order in world space, so that the slots either side of one hold its world
+// neighbours (spatial reuse) and a warp's texels lie close together. The
+// helpers marked ACC_HD are the CPU's and the twin's alike.
+#include <cstdint>
+#include <vector>
+
+#include "accretion/core/math.h"
+#include "accretion/geometry/billboard.h"
+#include "accretion/geometry/camera.h"
+#include "accretion/render/gbuffer.h"
+#include "accretion/scene/settings.h"
+
+namespace accretion {
+
+class ParticleBvh;
+struct Particles;
+
+inline constexpr std::uint32_t kNoSlot = 0xffffffffu;
+
+/// The grid's width: 8 texels a row, so that an 8x8 thread group is 64
+/// consecutive texels and a warp 32 (a 1D launch over the texels).
+inline constexpr std::uint32_t kTexelRowWidth = 8;
+
+/// 21 bits per axis of a point in [0, 1]^3, interleaved (z y x, x lowest).
+ACC_HD inline std::uint64_t mortonKey(const Vec3& unit) {
+    auto spread = [](std::uint64_t v) {
+        v &= 0x1fffff;
+        v = (v | v << 32) & 0x1f00000000ffffull;
+        v = (v | v << 16) & 0x1f0000ff0000ffull;
+        v = (v | v << 8) & 0x100f00f00f00f00full;
+        v = (v | v << 4) & 0x10c30c30c30c30c3ull;
+        v = (v | v << 2) & 0x1249249249249249ull;
+        return v;
+    };
+    auto q = [](float c) {
+        const float s = c * 2097151.0f;
+        return std::uint64_t(s > 0.0f ? (s < 2097151.0f ? s : 2097151.0f) : 0.0f);
+    };
+    return spread(q(unit.x)) | spread(q(unit.y)) << 1 | spread(q(unit.z)) << 2;
+}
+
+/// The uv centre of texel `sub` (its place in a layer: row-major) of a side x side billboard grid.
+ACC_HD inline Vec2 texelUv(std::uint32_t sub, std::uint32_t side) {
+    return Vec2((float(sub % side) + 0.5f) / float(side), (float(sub / side) + 0.5f) / float(side));
+}
+
+/// The receiver at billboard uv of particle j (at p, radius r, frame f) as
+/// the camera sees it: the point p + (2u - 1) r right + (2v - 1) r up, the
+/// billboard's normal towards the camera (the impostor's at uv for the
+/// sphere model), its camera-space depth; what billboardTexel gives a pixel
+/// ray through that point.
+ACC_HD inline GBufferTexel billboardPointTexel(const Camera& camera, std::uint32_t j, const Vec3& p, float r,
+                                               const BillboardFrame& f, Vec2 uv, ShadingModel model) {
+    GBufferTexel g;
+    g.particle = j;
+    const DVec3 R(f.right), U(f.up);
+    g.local = Vec3((2.0 * double(uv.x) - 1.0) * double(r) * R + (2.0 * double(uv.y) - 1.0) * double(r) * U);
+    g.geomNormal = glm::normalize(f.normal());
+    if (glm::dot(g.geomNormal, (p + g.local) - camera.position) > 0.0f) g.geomNormal = -g.geomNormal;
+    g.normal = model == ShadingModel::sphere ? impostorNormal(f, uv) : g.geomNormal;
+    g.depth = glm::dot((p + g.local) - camera.position, camera.forward);
+    return g;
+}
+
+/// The billboard uv of a pixel's receiver on particle j (radius r, frame f): inverse of billboardPointTexel.
+ACC_HD inline Vec2 billboardUv(const Vec3& local, float r, const BillboardFrame& f) {
+    const float inv = 0.5f / r;
+    return Vec2(0.5f + glm::dot(local, f.right) * inv, 0.5f + glm::dot(local, f.up) * inv);
+}
+
+/// Bilinear interpolation over a side x side texel grid at uv: the (up to)
+/// four texels sub[k] of a layer and their weights w[k] (sum 1), clamped at
+/// the billboard's edges. Returns how many (1 for side 1).
+ACC_HD inline std::uint32_t bilinearTexels(Vec2 uv, std::uint32_t side, std::uint32_t sub[4], float w[4]) {
+    if (side == 1) {
+        sub[0] = 0;
+        w[0] = 1.0f;
+        return 1;
+    }
+    const float last = float(side - 1);
+    const float tx = glm::clamp(uv.x * float(side) - 0.5f, 0.0f, last), ty = glm::clamp(uv.y * float(side) - 0.5f, 0.0f, last);
+    const std::uint32_t x0 = std::uint32_t(tx) < side - 1 ? std::uint32_t(tx) : side - 2;
+    const std::uint32_t y0 = std::uint32_t(ty) < side - 1 ? std::uint32_t(ty) : side - 2;
+    const float fx = tx - float(x0), fy = ty - float(y0);
+    sub[0] = y0 * side + x0;
+    sub[1] = sub[0] + 1;
+    sub[2] = sub[0] + side;
+    sub[3] = sub[2] + 1;
+    w[0] = (1.0f - fx) * (1.0f - fy);
+    w[1] = fx * (1.0f - fy);
+    w[2] = (1.0f - fx) * fy;
+    w[3] = fx * fy;
+    return 4;
+}
+
+/// A frame's particle texels (gatherParticleTexels): the slots, and the
+/// texels as a G-buffer kTexelRowWidth wide (the last row's tail misses).
+struct ParticleTexels {
+    std::uint32_t side = 1, layers = 1;
+    std::vector<std::uint32_t> particleOf;  ///< slot -> particle
+    std::vector<std::uint32_t> slotOf;      ///< particle -> slot, kNoSlot when not visible
+    GBuffer grid;
+    std::uint32_t perParticle() const { return side * side * layers; }
+    std::uint32_t visible() const { return static_cast<std::uint32_t>(particleOf.size()); }
+    std::size_t texels() const { return std::size_t(visible()) * perParticle(); }
+};
+
+/// gatherParticleTexels: the particles some pixel of `gbuffer` sees, in
+/// Morton order of their positions over the bounds of the visible ones
+/// (ties by id), and their texels on the billboards `bvh` holds for the camera.
+ParticleTexels gatherParticleTexels(const GBuffer& gbuffer, const Particles& particles, const ParticleBvh& bvh,
+                                    const Camera& camera, const Settings& settings);
+
+}  // namespace accretion

@@ -1,0 +1,73 @@
+// gatherParticleTexels: particle_restir's lighting grid from the frame's G-buffer.
+#include "accretion/render/particle_texels.h"
+
+#include <algorithm>
+#include <utility>
+
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
+#include "accretion/geometry/particle_bvh.h"
+#include "accretion/particles/particles.h"
+
+namespace accretion {
+
+ParticleTexels gatherParticleTexels(const GBuffer& gbuffer, const Particles& particles, const ParticleBvh& bvh,
+                                    const Camera& camera, const Settings& settings) {
+    ParticleTexels t;
+    t.side = settings.restir.texels;
+    t.layers = settings.restir.texel_rays;
+    const std::size_t n = particles.size();
+
+    // The particles some pixel sees.
+    std::vector<std::uint8_t> seen(n, 0);
+    for (const GBufferTexel& g : gbuffer.texels)
+        if (g.hit()) seen[g.particle] = 1;
+    std::vector<std::uint32_t> visible;
+    Vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+    for (std::uint32_t j = 0; j < n; ++j)
+        if (seen[j]) {
+            visible.push_back(j);
+            lo = glm::min(lo, particles.position[j]);
+            hi = glm::max(hi, particles.position[j]);
+        }
+
+    // Morton order over the visible particles' bounds (a cube, so that the
+    // order's cells are cubes), ties by id.
+    const Vec3 extent = hi - lo;
+    const float edge = std::max({extent.x, extent.y, extent.z});
+    const float inv = edge > 0.0f ? 1.0f / edge : 0.0f;
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(visible.size());
+    tbb::parallel_for(std::size_t(0), visible.size(), [&](std::size_t k) {
+        const std::uint32_t j = visible[k];
+        keyed[k] = {mortonKey((particles.position[j] - lo) * inv), j};
+    });
+    tbb::parallel_sort(keyed.begin(), keyed.end());
+
+    t.particleOf.resize(keyed.size());
+    t.slotOf.assign(n, kNoSlot);
+    for (std::uint32_t v = 0; v < keyed.size(); ++v) {
+        t.particleOf[v] = keyed[v].second;
+        t.slotOf[keyed[v].second] = v;
+    }
+
+    // The texels, kTexelRowWidth a row.
+    const std::uint32_t per = t.perParticle(), perLayer = t.side * t.side;
+    const std::size_t count = t.texels();
+    t.grid.width = kTexelRowWidth;
+    t.grid.height = std::uint32_t((count + kTexelRowWidth - 1) / kTexelRowWidth);
+    t.grid.window = PixelWindow::whole(t.grid.width, t.grid.height);
+    t.grid.texels.assign(std::size_t(t.grid.width) * t.grid.height, GBufferTexel{});
+    const ShadingModel model = settings.shading.model;
+    tbb::parallel_for(std::uint32_t(0), t.visible(), [&](std::uint32_t v) {
+        const std::uint32_t j = t.particleOf[v];
+        const BillboardFrame& f = bvh.frame(j);
+        for (std::uint32_t s = 0; s < perLayer; ++s) {
+            const GBufferTexel g = billboardPointTexel(camera, j, particles.position[j], particles.radius[j], f, texelUv(s, t.side), model);
+            for (std::uint32_t k = 0; k < t.layers; ++k) t.grid.texels[std::size_t(v) * per + k * perLayer + s] = g;
+        }
+    });
+    return t;
+}
+
+}  // namespace accretion

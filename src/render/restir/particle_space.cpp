@@ -1,0 +1,42 @@
+// particle_restir's own passes on the CPU: the bodies of
+// particle_restir_passes.h over the CPU's bridge. generateCandidates and
+// traceShadowRays run on the texels as restir's do.
+#include "accretion/render/particle_restir_passes.h"
+#include "cpu_bridge.h"
+
+namespace accretion::restir {
+
+/// Temporal reuse by particle id: last frame's reservoir of the same texel.
+LightingCounters temporalResamplingById(const FrameContext& f, const std::vector<StoredReservoir>& cur,
+                                        std::vector<StoredReservoir>& out) {
+    return dispatchKernel(f, [&]<ShadingModel SM, Primitive P, bool Count>() {
+        return forEachTexel<SM, P, Count>(f, Pass::temporalResampling, CpuBuffers{&cur, &out},
+                                          [&](auto& b, std::size_t px, std::uint32_t, std::uint32_t) { temporalByIdTexel(b, px); });
+    });
+}
+
+/// Spatial reuse among the texels of the world neighbours (Morton order).
+LightingCounters spatialResamplingWorld(const FrameContext& f, std::uint32_t iteration, const std::vector<StoredReservoir>& cur,
+                                        std::vector<StoredReservoir>& out) {
+    return dispatchKernel(f, [&]<ShadingModel SM, Primitive P, bool Count>() {
+        return forEachTexel<SM, P, Count>(f, Pass::spatialResampling, CpuBuffers{&cur, &out},
+                                          [&](auto& b, std::size_t px, std::uint32_t, std::uint32_t) {
+                                              spatialWorldTexel(b, px, iteration);
+                                          });
+    });
+}
+
+/// The pixels from their particles' texels (restir.pixel_shading).
+LightingCounters shadeParticlePixels(const FrameContext& f, const std::vector<StoredReservoir>& texelReservoirs,
+                                     const std::vector<Vec3>& texelLr, std::vector<Vec3>& Lr) {
+    const bool resample = f.rs.pixel_shading == PixelShading::resample;
+    return dispatchKernel(f, [&]<ShadingModel SM, Primitive P, bool Count>() {
+        return forEachTexel<SM, P, Count>(f, Pass::shadeParticlePixels, CpuBuffers{&texelReservoirs, nullptr, &Lr, &texelLr},
+                                          [&](auto& b, std::size_t px, std::uint32_t, std::uint32_t) {
+                                              if (resample) resamplePixel(b, px);
+                                              else interpolatePixel(b, px);
+                                          });
+    });
+}
+
+}  // namespace accretion::restir
