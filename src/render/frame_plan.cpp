@@ -59,6 +59,8 @@ void planPasses(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
     plan.particleTexels = plan.restir && s.render.estimator == EstimatorKind::particle_restir;
     plan.traceShadowRays = plan.restir && (!plan.particleTexels || s.restir.pixel_shading == PixelShading::interpolate ||
                                            (s.restir.visibility_reuse && plan.shadowRays));
+    plan.texelHistory = plan.particleTexels && plan.temporal && s.restir.pixel_shading == PixelShading::interpolate &&
+                        s.restir.texel_history > 0.0;
 }
 
 /// The plan as lines, with what each step does or why it is skipped.
@@ -134,7 +136,9 @@ void describe(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
         step(Pass::traceShadowRays,
              dark ? noLight
              : !plan.traceShadowRays ? "pixel_shading resample: each pixel traces its own (shadeParticlePixels), the texels none"
-             : plan.shadowRays ? (particles ? "one shadow ray per particle texel and reservoir" : "one shadow ray per pixel")
+             : plan.shadowRays ? (particles ? fmt::format("one shadow ray per particle texel and reservoir{}",
+                                                          plan.texelHistory ? fmt::format(", Lr averaged with last frame's (h = {})", r.texel_history) : "")
+                                            : "one shadow ray per pixel")
                                : "visibility off: the kept sample shaded with V = 1, no shadow rays");
         if (particles)
             step(Pass::shadeParticlePixels,

@@ -329,6 +329,8 @@ void validateSampling(const Settings& s, const RuleFailure& fail) {
             fail("render.estimator", "particle_restir's texels lie on the billboards: geometry.primitive = sphere has none");
         if (s.restir.resolution_scale < 1.0)
             fail("restir.resolution_scale", "particle_restir lights the particles' texels, not a reduced image: leave it at 1");
+        if (s.restir.texel_history > 0.0 && (s.restir.pixel_shading != PixelShading::interpolate || !s.restir.temporal))
+            fail("restir.texel_history", "averages the texels' Lr over frames: it needs pixel_shading = interpolate and restir.temporal");
     }
     if (const double m = s.restir.crop_margin; m != -1.0) {
         if (m < 0.0 || m != std::floor(m)) fail("restir.crop_margin", fmt::format("a number of pixels, or -1 for the whole frame (got {})", m));

@@ -74,6 +74,9 @@ struct FramePlan {
     /// traceShadowRays runs: restir's pixels, particle_restir's texels when
     /// the pixels interpolate their Lr (or visibility reuse needs their V).
     bool traceShadowRays = false;
+    /// particle_restir with restir.texel_history: the texels' Lr averaged
+    /// with last frame's (in traceShadowRays, whose kernel it ends).
+    bool texelHistory = false;
     std::vector<PlannedStep> steps;
 
     /// Whether a frame with these facts loads (and builds) its particles: the

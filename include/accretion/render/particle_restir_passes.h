@@ -14,6 +14,7 @@
 //            Vec2 pixelUv(g)                   the billboard uv of a pixel's receiver
 //            GBufferTexel gridTexel(q), StoredReservoir gridReservoir(q), Vec3 gridLr(q)
 //            void writePixelLr(px, Lr)
+//   texel_history: Vec3 historyLr(q)         last frame's Lr of texel q (after its own average)
 //
 // In the pixel pass, texel(px), input(px) and recorder(px, g) are the
 // pixel's, and the offers combine with bias correction basic (there is no
@@ -24,8 +25,9 @@
 namespace accretion::restir {
 
 /// The most texels a pixel resamples: the four bilinear texels of each of
-/// up to 8 layers, plus its own empty canonical reservoir.
-inline constexpr std::uint32_t kMaxPixelOffers = 33;
+/// up to 16 layers (restir.texel_rays), plus its own empty canonical reservoir.
+inline constexpr std::uint32_t kMaxPixelOffers = 65;
+static_assert(kMaxPixelOffers <= kMaxOffers, "the pixel's offers fit combineReservoirs' arrays");
 
 /// particle_restir's temporalResampling at texel px: last frame's reservoir
 /// of the same texel of the same particle (no reprojection: the id is the
@@ -119,6 +121,23 @@ ACC_HD_BODY void spatialWorldTexel(B& b, std::size_t px, std::uint32_t iteration
         offers.addCurrent(b.input(q), gn);
     }
     b.keep(px, sanitizeReservoir(offers.combine(rng), [&] { return b.reject(px); }));
+}
+
+/// traceShadowRays's last step with restir.texel_history h: texel px's Lr
+/// becomes (1 - h) x this frame's + h x its own last frame's (the same
+/// texel of the same particle), an exponential average over frames. Reads
+/// gridLr(px), writes writeLr(px).
+template <class B>
+ACC_HD_BODY void accumulateTexelLr(B& b, std::size_t px) {
+    const ReuseParams& p = b.params();
+    const GBufferTexel g = b.texel(px);
+    if (!g.hit()) return;
+    auto&& rec = b.recorder(px, g);
+    std::size_t q = 0;
+    if (!b.historyTexelOf(g.particle, std::uint32_t(px % p.texelsPerParticle()), q)) return;
+    rec.read(4 + gpu_layout::kRadiance);
+    rec.gather(1);
+    b.writeLr(px, (1.0f - p.texelHistory) * b.gridLr(px) + p.texelHistory * b.historyLr(q));
 }
 
 /// The texels pixel g reads and their weights: the bilinear four (one for

@@ -76,6 +76,7 @@ struct ReuseParams {
     std::uint32_t texelLayers = 1;     ///< restir.texel_rays: independent reservoirs per texel
     std::uint32_t worldNeighbours = 8; ///< restir.world_neighbours: slots either side spatial reuse draws from
     std::uint32_t visible = 0;         ///< visible particles (slots) this frame
+    float texelHistory = 0.0f;         ///< restir.texel_history: weight of a texel's last Lr
     ACC_HD std::uint32_t texelsPerParticle() const { return texelSide * texelSide * texelLayers; }
     /// The streams of texel px showing g: a pixel's by its place in the
     /// whole grid; a particle texel's by its particle and its place on it,
@@ -112,6 +113,7 @@ inline ReuseParams reuseParams(const Settings& s, std::uint32_t frame, std::uint
         p.texelSide = s.restir.texels;
         p.texelLayers = s.restir.texel_rays;
         p.worldNeighbours = s.restir.world_neighbours;
+        p.texelHistory = float(s.restir.texel_history);
     }
     return p;
 }

@@ -306,6 +306,7 @@ struct RestirSettings {
     std::uint32_t texel_rays = 1;            ///< particle_restir: independent reservoirs (one shadow ray each) per texel
     PixelShading pixel_shading = PixelShading::interpolate; ///< particle_restir: how a pixel reads its particle's texels
     std::uint32_t world_neighbours = 8;      ///< particle_restir: spatial reuse draws among this many visible particles either side in Morton order
+    double texel_history = 0.0;              ///< particle_restir, interpolate: weight of a texel's last Lr in its new one (0: none)
 
     template <class V> void visit(V& v) {
         v.field("temporal", temporal, "temporal reuse through particle motion and the previous camera");
@@ -332,8 +333,9 @@ struct RestirSettings {
         v.field("regir_build_samples", regir_build_samples, "render.source = regir: tile candidates per cell reservoir, resampled by the cell's target (RTXDI regirNumBuildSamples)", Range{1, 1024});
         v.field("regir_jitter", regir_jitter, "render.source = regir: receiver position jitter in cells before the cell lookup (RTXDI regirSamplingJitter)", Range{0.0, 8.0});
         v.field("texels", texels, "particle_restir: texels per billboard side, each with its reservoirs (1, 2 or 4)", Range{1, 4});
-        v.field("texel_rays", texel_rays, "particle_restir: independent reservoirs per texel, each traced with its own shadow ray (K)", Range{1, 8});
+        v.field("texel_rays", texel_rays, "particle_restir: independent reservoirs per texel, each traced with its own shadow ray (K)", Range{1, 16});
         v.field("pixel_shading", pixel_shading, "particle_restir: interpolate (bilinear over the particle's texels' Lr: biased) or resample (the pixel resamples its particle's texels' samples at its own point and traces its own shadow ray: unbiased)");
+        v.field("texel_history", texel_history, "particle_restir with pixel_shading interpolate: a texel's Lr is (1 - h) x this frame's + h x its own last frame's, found by particle id (an exponential average: biased where the light changes)", Range{0.0, 0.99});
         v.field("world_neighbours", world_neighbours, "particle_restir: spatial reuse draws its neighbours among this many visible particles either side of the texel's in Morton order (world space)", Range{1, 1024});
     }
 };

@@ -128,6 +128,7 @@ public:
     const GBufferTexel& gridTexel(std::size_t q) const { return f_.texels->grid.texels[q]; }
     const StoredReservoir& gridReservoir(std::size_t q) const { return (*io_.in)[q]; }
     const Vec3& gridLr(std::size_t q) const { return (*io_.texelLr)[q]; }
+    const Vec3& historyLr(std::size_t q) const { return f_.prev->texelLr[q]; }
     void writePixelLr(std::size_t px, const Vec3& Lr) { (*io_.Lr)[px] = Lr; }
 
 private:

@@ -26,6 +26,14 @@ LightingCounters spatialResamplingWorld(const FrameContext& f, std::uint32_t ite
     });
 }
 
+LightingCounters accumulateTexelLr(const FrameContext& f, std::vector<Vec3>& texelLr) {
+    return dispatchKernel(f, [&]<ShadingModel SM, Primitive P, bool Count>() {
+        // Counted with traceShadowRays, whose kernel it ends on the GPU.
+        return forEachTexel<SM, P, false>(f, Pass::traceShadowRays, CpuBuffers{nullptr, nullptr, &texelLr, &texelLr},
+                                          [&](auto& b, std::size_t px, std::uint32_t, std::uint32_t) { accumulateTexelLr(b, px); });
+    });
+}
+
 /// The pixels from their particles' texels (restir.pixel_shading).
 LightingCounters shadeParticlePixels(const FrameContext& f, const std::vector<StoredReservoir>& texelReservoirs,
                                      const std::vector<Vec3>& texelLr, std::vector<Vec3>& Lr) {

@@ -61,6 +61,7 @@ LightingCounters runPasses(restir::FrameContext& f, std::vector<StoredReservoir>
     if (plan.traceShadowRays) {
         auto t = timer.scope(Pass::traceShadowRays);
         add(Pass::traceShadowRays, restir::traceShadowRays(f, a, lowLr));
+        if (plan.texelHistory) restir::accumulateTexelLr(f, lowLr);
     }
     return total;
 }
@@ -247,6 +248,7 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
     auto h = std::make_shared<History>();
     h->gbuffer = *lg;
     h->slotOf = std::move(texels.slotOf);
+    if (plan.particleTexels && rs_.texel_history > 0.0) h->texelLr = lowLr;
     h->particles = in.particles;
     h->lights = LightArrays(h->particles, in.settings.shading);
     h->camera = in.camera;

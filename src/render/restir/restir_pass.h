@@ -32,6 +32,7 @@ struct Restir::History {
     std::vector<StoredReservoir> reservoirs;
     /// particle_restir: the slot of each particle visible last frame (kNoSlot otherwise).
     std::vector<std::uint32_t> slotOf;
+    std::vector<Vec3> texelLr;  ///< particle_restir with texel_history: each texel's Lr (after its average)
 };
 
 namespace restir {
@@ -170,6 +171,8 @@ LightingCounters temporalResamplingById(const FrameContext& f, const std::vector
                                         std::vector<StoredReservoir>& out);
 LightingCounters spatialResamplingWorld(const FrameContext& f, std::uint32_t iteration, const std::vector<StoredReservoir>& cur,
                                         std::vector<StoredReservoir>& out);
+/// restir.texel_history: each texel's Lr averaged with its own last frame's (in place).
+LightingCounters accumulateTexelLr(const FrameContext& f, std::vector<Vec3>& texelLr);
 LightingCounters shadeParticlePixels(const FrameContext& f, const std::vector<StoredReservoir>& texelReservoirs,
                                      const std::vector<Vec3>& texelLr, std::vector<Vec3>& Lr);
 void upsampleLighting(const GBuffer& full, const GBuffer& lg, const Particles& particles, const std::vector<Vec3>& lowLr,
