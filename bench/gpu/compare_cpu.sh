@@ -85,6 +85,11 @@ restir_case basic_omm4 basic_omm4 "${disc[@]}" -D gpu.omm=4state -D gpu.omm_leve
 restir_case basic_omm4_traverse basic_omm4
 restir_case restir_power restir_power -D render.source=power
 restir_case restir_tree restir_tree -D render.source=tree
+# particle_restir (run.sh designs): the texels' reservoirs and the pixels read from them.
+restir_case prt_interp prt_interp -D render.estimator=particle_restir -D restir.bias_correction=pairwise
+restir_case prt_resample prt_resample -D render.estimator=particle_restir -D restir.bias_correction=pairwise -D restir.pixel_shading=resample
+restir_case prt_2x2_k2 prt_2x2_k2 -D render.estimator=particle_restir -D restir.texels=2 -D restir.texel_rays=2
+restir_case prt_history prt_history -D render.estimator=particle_restir -D restir.texel_rays=4 -D restir.texel_history=0.5 -D restir.spatial_neighbours=0
 
 # uniform and power (one frame): Lr, its standard error and the samples taken.
 declare -A sampled=(

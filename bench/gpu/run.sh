@@ -1,7 +1,7 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine, from the repository root:
 #   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
-#                                      layout_images layouts streams front identity shared_core ab
+#                                      layout_images layouts streams front identity shared_core ab designs
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -248,6 +248,23 @@ step_streams() {
             done
         done
     done
+}
+
+# The designs of issue 46 (bench/gpu/designs.txt: restir per pixel and
+# particle_restir per particle texel at 100K and 1M, 1080p), timed as the
+# layouts are (frame 1 after a history frame, 5 timed runs); and
+# particle_restir's frames on quickstart at 320x180 (frames 0-2) for the
+# per-pixel comparison with the CPU (compare_cpu.sh).
+step_designs() {
+    local q=scenes/quickstart.toml small="-D camera.width=320 -D camera.height=180 -D render.estimator=particle_restir"
+    local t="$W/designs/images"
+    mkdir -p "$t"
+    one() { local name=$1; shift; $BIN $q $small --frames 0:3 --repeat 1 -q -o "$t/$name.{frame}.exr" "$@" || echo "designs: $name failed"; }
+    one prt_interp -D restir.bias_correction=pairwise
+    one prt_resample -D restir.bias_correction=pairwise -D restir.pixel_shading=resample
+    one prt_2x2_k2 -D restir.texels=2 -D restir.texel_rays=2
+    one prt_history -D restir.texel_rays=4 -D restir.texel_history=0.5 -D restir.spatial_neighbours=0
+    time_configs designs bench/gpu/designs.txt 5
 }
 
 # The configurations on tune's Pareto fronts (bench/gpu/front.txt, written

@@ -25,7 +25,7 @@ void printEstimators() {
     for (const EstimatorInfo& e : kEstimators)
         fmt::print("| `{}` | {} | {} | {} | {} | {} | {} | {} |\n", enumName(e.kind), e.summary,
                    e.resampling ? "render.source's" : samplerName(e.sampler), yesNo(e.resampling), yesNo(e.reuse),
-                   e.unbiased ? "yes" : "with a bias correction", yesNo(e.adaptive), yesNo(e.twin));
+                   e.unbiased ? std::string_view("yes") : e.unbiasedWhen, yesNo(e.adaptive), yesNo(e.twin));
 }
 
 }  // namespace

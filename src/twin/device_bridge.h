@@ -1,7 +1,7 @@
 #pragma once
 // The twin's bridge of the shared pass bodies (accretion/render/restir_passes.h):
 // the launch's buffers, nothing counted, the reservoirs stored as they are.
-#include "accretion/render/restir_passes.h"
+#include "accretion/render/particle_restir_passes.h"
 #include "launch_params.h"
 #include "restir_device.h"
 
@@ -104,6 +104,25 @@ public:
     __device__ bool dropOccludedCandidates() const { return false; }
     __device__ bool visibilityReuse() const { return p_.restir.visibilityReuse; }
     __device__ void writeLr(std::size_t px, const Vec3& Lr) const { p_.restir.Lr[px] = Lr; }
+
+    // particle_restir (particle_restir_passes.h).
+    __device__ bool historyTexelOf(std::uint32_t j, std::uint32_t sub, std::size_t& q) const {
+        const RestirParams& rp = p_.restir;
+        if (j >= rp.prevSlotCount || rp.prevSlotOf[j] == kNoSlot) return false;
+        q = std::size_t(rp.prevSlotOf[j]) * rp.reuse.texelsPerParticle() + sub;
+        return true;
+    }
+    __device__ GBufferTexel pixel(std::size_t px) const { return p_.gbuffer[px]; }
+    __device__ std::uint32_t slotOf(std::uint32_t j) const { return p_.restir.slotOf[j]; }
+    __device__ Vec2 pixelUv(const GBufferTexel& g) const {
+        return billboardUv(g.local, p_.radius[g.particle], p_.frames[g.particle]);
+    }
+    __device__ GBufferTexel gridTexel(std::size_t q) const { return p_.restir.gbuffer[q]; }
+    __device__ StoredReservoir gridReservoir(std::size_t q) const { return in_[q]; }
+    __device__ Vec3 gridLr(std::size_t q) const { return p_.restir.Lr[q]; }
+    __device__ Vec3 historyLr(std::size_t q) const { return p_.restir.prevTexelLr[q]; }
+    __device__ void writePixelLr(std::size_t px, const Vec3& Lr) const { p_.Lr[px] = Lr; }
+    __device__ std::uint32_t clusterOf(std::uint32_t i) const { return p_.restir.particleCluster[i]; }
 
 private:
     const LaunchParams& p_;

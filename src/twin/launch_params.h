@@ -78,6 +78,12 @@ struct RestirParams {
     const StoredReservoir* prevReservoirs = nullptr;
     Camera prevCamera;
     const std::uint32_t* particleCluster = nullptr; ///< BLAS of each particle (SER hint)
+    // particle_restir: the lighting grid (gbuffer, Lr, reuse) is the visible
+    // particles' texels (particle_texels.h); the pixels read them at the end.
+    const std::uint32_t* slotOf = nullptr;      ///< particle -> slot this frame (kNoSlot: not visible)
+    const std::uint32_t* prevSlotOf = nullptr;  ///< last frame's
+    std::uint32_t prevSlotCount = 0;            ///< particles prevSlotOf holds
+    const Vec3* prevTexelLr = nullptr;          ///< restir.texel_history: last frame's texel Lr
 };
 
 struct LaunchParams {

@@ -198,7 +198,27 @@ __device__ void shade() {
     }
 }
 
+/// particle_restir's shadeParticlePixels, resample: the pixel resamples its
+/// particle's texels (restir.in) at its own point and traces its own shadow ray.
+template <ShadingModel SM>
+__device__ void resampleParticlePixel() {
+    const uint3 idx = optixGetLaunchIndex();
+    const std::size_t px = std::size_t(idx.y) * params.camera.width + idx.x;
+    LaunchCounters c;
+    DeviceBridge<SM, OptixShadowRays<false>> b(params, false, OptixShadowRays<false>{&c}, &c);
+    restir::resamplePixel(b, px);
+    addCounters(c);
+}
+
 }  // namespace
+
+extern "C" __global__ void __raygen__shadeParticlePixels() {
+    switch (params.model) {
+    case ShadingModel::lambert: resampleParticlePixel<ShadingModel::lambert>(); break;
+    case ShadingModel::sphere: resampleParticlePixel<ShadingModel::sphere>(); break;
+    case ShadingModel::isotropic: resampleParticlePixel<ShadingModel::isotropic>(); break;
+    }
+}
 
 extern "C" __global__ void __raygen__shade() { shade<false>(); }
 extern "C" __global__ void __raygen__shadeTraverse() { shade<true>(); }

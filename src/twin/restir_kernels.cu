@@ -50,6 +50,31 @@ __global__ void spatialResamplingKernel(const __grid_constant__ LaunchParams p, 
     });
 }
 
+// particle_restir's own passes (particle_restir_passes.h), on the texels.
+template <ShadingModel SM>
+__global__ void temporalByIdKernel(const __grid_constant__ LaunchParams p) {
+    onTexel<SM>(p, [&](auto& b, std::size_t px, std::uint32_t, std::uint32_t) { restir::temporalByIdTexel(b, px); });
+}
+
+template <ShadingModel SM>
+__global__ void spatialWorldKernel(const __grid_constant__ LaunchParams p, std::uint32_t iteration) {
+    onTexel<SM>(p, [&](auto& b, std::size_t px, std::uint32_t, std::uint32_t) { restir::spatialWorldTexel(b, px, iteration); });
+}
+
+template <ShadingModel SM>
+__global__ void accumulateTexelLrKernel(const __grid_constant__ LaunchParams p) {
+    onTexel<SM>(p, [&](auto& b, std::size_t px, std::uint32_t, std::uint32_t) { restir::accumulateTexelLr(b, px); });
+}
+
+/// shadeParticlePixels, interpolate: one thread per image pixel.
+template <ShadingModel SM>
+__global__ void interpolatePixelsKernel(const __grid_constant__ LaunchParams p) {
+    const std::uint32_t x = blockIdx.x * blockDim.x + threadIdx.x, y = blockIdx.y * blockDim.y + threadIdx.y;
+    if (x >= p.camera.width || y >= p.camera.height) return;
+    DeviceBridge<SM> b(p);
+    restir::interpolatePixel(b, std::size_t(y) * p.camera.width + x);
+}
+
 dim3 blocks(const LaunchParams& p) { return dim3((p.restir.reuse.width + 7) / 8, (p.restir.reuse.height + 7) / 8); }
 const dim3 kGroup(8, 8);
 
@@ -100,6 +125,23 @@ void generateCandidates(const LaunchParams& p, cudaStream_t stream) {
 
 void temporalResampling(const LaunchParams& p, cudaStream_t stream) {
     byModel(p.model, [&]<ShadingModel SM>() { temporalResamplingKernel<SM><<<blocks(p), kGroup, 0, stream>>>(p); });
+}
+
+void temporalResamplingById(const LaunchParams& p, cudaStream_t stream) {
+    byModel(p.model, [&]<ShadingModel SM>() { temporalByIdKernel<SM><<<blocks(p), kGroup, 0, stream>>>(p); });
+}
+
+void spatialResamplingWorld(const LaunchParams& p, std::uint32_t iteration, cudaStream_t stream) {
+    byModel(p.model, [&]<ShadingModel SM>() { spatialWorldKernel<SM><<<blocks(p), kGroup, 0, stream>>>(p, iteration); });
+}
+
+void accumulateTexelLr(const LaunchParams& p, cudaStream_t stream) {
+    byModel(p.model, [&]<ShadingModel SM>() { accumulateTexelLrKernel<SM><<<blocks(p), kGroup, 0, stream>>>(p); });
+}
+
+void interpolatePixels(const LaunchParams& p, cudaStream_t stream) {
+    const dim3 b((p.camera.width + 7) / 8, (p.camera.height + 7) / 8);
+    byModel(p.model, [&]<ShadingModel SM>() { interpolatePixelsKernel<SM><<<b, kGroup, 0, stream>>>(p); });
 }
 
 void spatialResampling(const LaunchParams& p, std::uint32_t iteration, cudaStream_t stream) {

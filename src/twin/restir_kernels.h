@@ -12,6 +12,14 @@ namespace accretion::twin {
 void generateCandidates(const LaunchParams& p, cudaStream_t stream);
 void temporalResampling(const LaunchParams& p, cudaStream_t stream);
 void spatialResampling(const LaunchParams& p, std::uint32_t iteration, cudaStream_t stream);
+/// particle_restir on the texels (p.restir's grid): temporal reuse by id,
+/// spatial reuse among world neighbours, restir.texel_history's average;
+/// and shadeParticlePixels' interpolate over the image (resample is the
+/// raygen shadeParticlePixels: it traces).
+void temporalResamplingById(const LaunchParams& p, cudaStream_t stream);
+void spatialResamplingWorld(const LaunchParams& p, std::uint32_t iteration, cudaStream_t stream);
+void accumulateTexelLr(const LaunchParams& p, cudaStream_t stream);
+void interpolatePixels(const LaunchParams& p, cudaStream_t stream);
 /// restir.resolution_scale < 1: the lighting grid's G-buffer from the image's
 /// (p.restir.reuse.width x height texels into `grid`), and upsampleLighting (the
 /// CPU's bilateral rule, upsamplePixel) from p.restir.Lr into p.Lr.

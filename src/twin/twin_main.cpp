@@ -37,6 +37,7 @@
 #include "accretion/render/upsample_pixel.h"
 #include "accretion/scene/scene_parser.h"
 #include "launch_params.h"
+#include "gather_particle_texels.h"
 #include "optix_pipeline.h"
 #include "particle_accel.h"
 #include "restir_kernels.h"
@@ -86,7 +87,9 @@ struct FrameBuffers {
     // restir: two reservoir buffers, rejections, the BLAS of each particle,
     // and the previous frame (temporal reuse).
     DeviceBuffer resA, resB, rejected, particleCluster;
-    DeviceBuffer gridGbuffer, gridLr;  // restir.resolution_scale < 1: the lighting grid
+    DeviceBuffer gridGbuffer, gridLr;  // restir.resolution_scale < 1 or particle_restir: the lighting grid
+    DeviceBuffer gatherFlags, gatherIds, gatherSortedIds, gatherKeys, gatherSortedKeys, gatherCount, gatherTemp, slotOf;  // particle_restir
+    DeviceBuffer prevSlotOf, prevTexelLr;
     DeviceBuffer prevPosition, prevEmission, prevAlbedo, prevDmin2, prevGbuffer, prevReservoirs;
     DeviceBuffer aliasProb, aliasAlias, aliasPmf;  // power: the alias table
     DeviceBuffer treeNodes;                       // tree: the light tree's nodes
@@ -147,7 +150,8 @@ private:
     AccelOptions accelOptions_;
     const bool omm_;
     Raygen shade_ = Raygen::shade;
-    std::uint32_t gridW_, gridH_;  ///< restir's lighting grid (resolution_scale)
+    std::uint32_t gridW_, gridH_;  ///< restir's lighting grid (resolution_scale; particle_restir: this frame's texels)
+    MortonFrame morton_;           ///< particle_restir: the Morton cube of this frame's particles
     std::string device_;
     std::unique_ptr<TwinPipeline> pipeline_;
     cudaStream_t stream_{};
@@ -270,6 +274,7 @@ void TwinRun::uploadParticles(const Particles& particles, const Camera& camera) 
     buf_.emission.upload(particles.emission);
     buf_.albedo.upload(particles.albedo);
     buf_.radius.upload(particles.radius);
+    if (runPlan_.particleTexels) morton_ = mortonFrame(particles.position.data(), n);
     buf_.dmin2.upload(dmin2);
     buf_.frames.upload(frames);
 }
@@ -355,6 +360,9 @@ LaunchParams TwinRun::launchParams(const FramePlan& plan, const Camera& camera, 
         rp.prevGbuffer = buf_.prevGbuffer.as<GBufferTexel>();
         rp.prevReservoirs = buf_.prevReservoirs.as<StoredReservoir>();
         rp.prevCamera = prevCamera_;
+        rp.prevSlotOf = buf_.prevSlotOf.as<std::uint32_t>();
+        rp.prevSlotCount = plan.temporal ? prevCount_ : 0;
+        rp.prevTexelLr = buf_.prevTexelLr.as<Vec3>();
     }
     return lp;
 }
@@ -366,8 +374,42 @@ LaunchParams TwinRun::launchParams(const FramePlan& plan, const Camera& camera, 
 /// Returns the final reservoirs (the next frame's history).
 StoredReservoir* TwinRun::runRestir(const FramePlan& plan, LaunchParams& lp) {
     RestirParams& rp = lp.restir;
-    const std::size_t pixels = std::size_t(rp.reuse.width) * rp.reuse.height;
     GpuTimer& timer = *timer_;
+    if (plan.particleTexels) {  // the lighting grid: the visible particles' texels, kTexelRowWidth a row
+        GpuScope t(timer, Pass::gatherParticleTexels);
+        const RestirSettings& rs = s_.restir;
+        const std::uint32_t n = lp.particleCount;
+        buf_.gatherFlags.reserve(n);
+        for (DeviceBuffer* b : {&buf_.gatherIds, &buf_.gatherSortedIds, &buf_.slotOf}) b->reserve(n * sizeof(std::uint32_t));
+        for (DeviceBuffer* b : {&buf_.gatherKeys, &buf_.gatherSortedKeys}) b->reserve(n * sizeof(std::uint64_t));
+        buf_.gatherCount.reserve(sizeof(std::uint32_t));
+        buf_.gatherTemp.reserve(gatherTempBytes(n));
+        const GatherArrays arrays{buf_.gatherFlags.as<std::uint8_t>(), buf_.gatherIds.as<std::uint32_t>(),
+                                  buf_.gatherSortedIds.as<std::uint32_t>(), buf_.gatherCount.as<std::uint32_t>(),
+                                  buf_.slotOf.as<std::uint32_t>(), buf_.gatherKeys.as<std::uint64_t>(),
+                                  buf_.gatherSortedKeys.as<std::uint64_t>(), buf_.gatherTemp.as<void>(), buf_.gatherTemp.bytes()};
+        const std::uint32_t visible = findVisibleParticles(lp, morton_, arrays, stream_);
+        const std::size_t texels = std::size_t(visible) * rp.reuse.texelsPerParticle();
+        gridW_ = kTexelRowWidth;
+        gridH_ = std::max(1u, std::uint32_t((texels + kTexelRowWidth - 1) / kTexelRowWidth));  // one row of misses when none is seen
+        const std::size_t grid = std::size_t(gridW_) * gridH_;
+        buf_.gridGbuffer.reserve(grid * sizeof(GBufferTexel));
+        writeParticleTexels(lp, arrays.sortedIds, visible, rs.texels, rs.texel_rays, std::size_t(gridW_) * gridH_,
+                            buf_.gridGbuffer.as<GBufferTexel>(), stream_);
+        buf_.resA.reserve(grid * sizeof(StoredReservoir));
+        buf_.resB.reserve(grid * sizeof(StoredReservoir));
+        buf_.gridLr.reserve(grid * sizeof(Vec3));
+        buf_.rejected.reserve(std::max(grid, std::size_t(W_) * H_) * sizeof(std::uint32_t));
+        rp.reuse.width = gridW_;
+        rp.reuse.height = gridH_;
+        rp.reuse.visible = visible;
+        rp.gbuffer = buf_.gridGbuffer.as<GBufferTexel>();
+        rp.Lr = buf_.gridLr.as<Vec3>();
+        rp.rejected = buf_.rejected.as<std::uint32_t>();
+        rp.slotOf = buf_.slotOf.as<std::uint32_t>();
+    }
+    const std::size_t pixels = std::max(std::size_t(rp.reuse.width) * rp.reuse.height,
+                                        plan.particleTexels ? std::size_t(W_) * H_ : std::size_t(0));
     if (plan.upsample) {
         GpuScope t(timer, Pass::upsampleLighting, "reduceGBuffer");
         reduceGBuffer(lp, buf_.gridGbuffer.as<GBufferTexel>(), stream_);
@@ -385,7 +427,8 @@ StoredReservoir* TwinRun::runRestir(const FramePlan& plan, LaunchParams& lp) {
         GpuScope t(timer, Pass::temporalResampling);
         rp.in = a;
         rp.out = b;
-        temporalResampling(lp, stream_);
+        if (plan.particleTexels) temporalResamplingById(lp, stream_);
+        else temporalResampling(lp, stream_);
         std::swap(a, b);
     }
     const std::uint32_t iterations = plan.spatialIterations;
@@ -394,16 +437,31 @@ StoredReservoir* TwinRun::runRestir(const FramePlan& plan, LaunchParams& lp) {
         for (std::uint32_t it = 0; it < iterations; ++it) {
             rp.in = a;
             rp.out = b;
-            spatialResampling(lp, it, stream_);
+            if (plan.particleTexels) spatialResamplingWorld(lp, it, stream_);
+            else spatialResampling(lp, it, stream_);
             std::swap(a, b);
         }
     }
-    {
+    if (plan.traceShadowRays) {
         GpuScope t(timer, Pass::traceShadowRays);
         rp.in = nullptr;
         rp.out = a;
         CUDA_CHECK(cudaMemcpyAsync(buf_.params.as<void>(), &lp, sizeof lp, cudaMemcpyHostToDevice, stream_));
         pipeline_->launch(shade_, buf_.params.address(), sizeof lp, rp.reuse.width, rp.reuse.height, stream_);
+        if (plan.texelHistory) accumulateTexelLr(lp, stream_);
+    }
+    if (plan.particleTexels) {  // the pixels from their particles' texels
+        GpuScope t(timer, Pass::shadeParticlePixels);
+        rp.in = a;
+        if (s_.restir.pixel_shading == PixelShading::interpolate) {
+            interpolatePixels(lp, stream_);
+        } else {
+            const BiasCorrection chain = rp.bias;  // no canonical sample at the pixel: basic for pairwise (the CPU's rule)
+            if (rp.bias == BiasCorrection::pairwise) rp.bias = BiasCorrection::basic;
+            CUDA_CHECK(cudaMemcpyAsync(buf_.params.as<void>(), &lp, sizeof lp, cudaMemcpyHostToDevice, stream_));
+            pipeline_->launch(Raygen::shadeParticlePixels, buf_.params.address(), sizeof lp, W_, H_, stream_);
+            rp.bias = chain;
+        }
     }
     if (plan.upsample) {
         GpuScope t(timer, Pass::upsampleLighting);
@@ -469,11 +527,16 @@ void TwinRun::keepHistory(const Camera& camera, std::size_t n, const StoredReser
         return;
     }
     const std::size_t gridPixels = std::size_t(gridW_) * gridH_;
+    if (runPlan_.particleTexels) {  // the slots by id, and the texels' Lr for texel_history
+        copyDevice(buf_.prevSlotOf, buf_.slotOf, n * sizeof(std::uint32_t), stream_);
+        if (s_.restir.texel_history > 0.0) copyDevice(buf_.prevTexelLr, buf_.gridLr, gridPixels * sizeof(Vec3), stream_);
+    }
     copyDevice(buf_.prevPosition, buf_.position, n * sizeof(Vec3), stream_);
     copyDevice(buf_.prevEmission, buf_.emission, n * sizeof(Vec3), stream_);
     copyDevice(buf_.prevAlbedo, buf_.albedo, n * sizeof(Vec3), stream_);
     copyDevice(buf_.prevDmin2, buf_.dmin2, n * sizeof(float), stream_);
-    copyDevice(buf_.prevGbuffer, runPlan_.upsample ? buf_.gridGbuffer : buf_.gbuffer, gridPixels * sizeof(GBufferTexel), stream_);
+    copyDevice(buf_.prevGbuffer, runPlan_.upsample || runPlan_.particleTexels ? buf_.gridGbuffer : buf_.gbuffer,
+               gridPixels * sizeof(GBufferTexel), stream_);
     buf_.prevReservoirs.reserve(gridPixels * sizeof(StoredReservoir));
     CUDA_CHECK(cudaMemcpyAsync(buf_.prevReservoirs.as<void>(), finalReservoirs, gridPixels * sizeof(StoredReservoir),
                                cudaMemcpyDeviceToDevice, stream_));

@@ -8,18 +8,16 @@
 // neighbours (spatial reuse) and a warp's texels lie close together. The
 // helpers marked ACC_HD are the CPU's and the twin's alike.
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "accretion/core/math.h"
 #include "accretion/geometry/billboard.h"
 #include "accretion/geometry/camera.h"
-#include "accretion/render/gbuffer.h"
+#include "accretion/render/gbuffer_texel.h"
 #include "accretion/scene/settings.h"
 
 namespace accretion {
-
-class ParticleBvh;
-struct Particles;
 
 inline constexpr std::uint32_t kNoSlot = 0xffffffffu;
 
@@ -43,6 +41,24 @@ ACC_HD inline std::uint64_t mortonKey(const Vec3& unit) {
         return std::uint64_t(s > 0.0f ? (s < 2097151.0f ? s : 2097151.0f) : 0.0f);
     };
     return spread(q(unit.x)) | spread(q(unit.y)) << 1 | spread(q(unit.z)) << 2;
+}
+
+/// The cube Morton keys are taken over: the particles' bounds, its edge the longest side.
+struct MortonFrame {
+    Vec3 lo{0.0f};
+    float inv = 0.0f;  ///< 1 / edge (0 for one point)
+    ACC_HD std::uint64_t key(const Vec3& p) const { return mortonKey((p - lo) * inv); }
+};
+inline MortonFrame mortonFrame(const Vec3* position, std::size_t n) {
+    Vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+    for (std::size_t j = 0; j < n; ++j) {
+        lo = glm::min(lo, position[j]);
+        hi = glm::max(hi, position[j]);
+    }
+    if (n == 0) return {};
+    const Vec3 e = hi - lo;
+    const float edge = e.x > e.y ? (e.x > e.z ? e.x : e.z) : (e.y > e.z ? e.y : e.z);
+    return {lo, edge > 0.0f ? 1.0f / edge : 0.0f};
 }
 
 /// The uv centre of texel `sub` (its place in a layer: row-major) of a side x side billboard grid.
@@ -98,23 +114,5 @@ ACC_HD inline std::uint32_t bilinearTexels(Vec2 uv, std::uint32_t side, std::uin
     w[3] = fx * fy;
     return 4;
 }
-
-/// A frame's particle texels (gatherParticleTexels): the slots, and the
-/// texels as a G-buffer kTexelRowWidth wide (the last row's tail misses).
-struct ParticleTexels {
-    std::uint32_t side = 1, layers = 1;
-    std::vector<std::uint32_t> particleOf;  ///< slot -> particle
-    std::vector<std::uint32_t> slotOf;      ///< particle -> slot, kNoSlot when not visible
-    GBuffer grid;
-    std::uint32_t perParticle() const { return side * side * layers; }
-    std::uint32_t visible() const { return static_cast<std::uint32_t>(particleOf.size()); }
-    std::size_t texels() const { return std::size_t(visible()) * perParticle(); }
-};
-
-/// gatherParticleTexels: the particles some pixel of `gbuffer` sees, in
-/// Morton order of their positions over the bounds of the visible ones
-/// (ties by id), and their texels on the billboards `bvh` holds for the camera.
-ParticleTexels gatherParticleTexels(const GBuffer& gbuffer, const Particles& particles, const ParticleBvh& bvh,
-                                    const Camera& camera, const Settings& settings);
 
 }  // namespace accretion

@@ -27,6 +27,8 @@ struct EstimatorInfo {
     bool twin;                ///< accretion-optix runs it
     bool nearField;           ///< sums each pixel's nearest render.near_lights lights exactly (0: the pilot chooses them)
     std::string_view summary;
+    /// When it is unbiased, where not always (`accretion estimators`).
+    std::string_view unbiasedWhen = "with a bias correction";
 };
 
 inline constexpr std::array<EstimatorInfo, 8> kEstimators = {{
@@ -45,7 +47,8 @@ inline constexpr std::array<EstimatorInfo, 8> kEstimators = {{
     {EstimatorKind::split, false, LightSamplerKind::tree, false, false, true, true, false, true,
      "the nearest lights summed, the far ones drawn from the light tree"},
     {EstimatorKind::particle_restir, false, LightSamplerKind::none, true, true, false, false, true, false,
-     "ReSTIR DI on the visible particles' billboard texels (history by particle id, world-space neighbours); pixels interpolate or resample them"},
+     "ReSTIR DI on the visible particles' billboard texels (history by particle id, world-space neighbours); pixels interpolate or resample them",
+     "pixel_shading resample, with a bias correction (interpolate: no)"},
 }};
 
 constexpr bool estimatorTableMatchesEnum() {

@@ -2,7 +2,7 @@
 #include "accretion/render/restir.h"
 
 #include "accretion/core/error.h"
-#include "accretion/render/particle_texels.h"
+#include "accretion/render/particle_texel_grid.h"
 #include "accretion/render/upsample_pixel.h"
 #include "restir_pass.h"
 

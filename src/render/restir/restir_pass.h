@@ -17,7 +17,7 @@
 #include "accretion/lighting/regir_grid.h"
 #include "accretion/lighting/reservoir.h"
 #include "accretion/lighting/shading.h"
-#include "accretion/render/particle_texels.h"
+#include "accretion/render/particle_texel_grid.h"
 #include "accretion/render/restir.h"
 #include "accretion/render/visibility.h"
 

@@ -1,5 +1,5 @@
 // gatherParticleTexels: particle_restir's lighting grid from the frame's G-buffer.
-#include "accretion/render/particle_texels.h"
+#include "accretion/render/particle_texel_grid.h"
 
 #include <algorithm>
 #include <utility>
@@ -24,23 +24,15 @@ ParticleTexels gatherParticleTexels(const GBuffer& gbuffer, const Particles& par
     for (const GBufferTexel& g : gbuffer.texels)
         if (g.hit()) seen[g.particle] = 1;
     std::vector<std::uint32_t> visible;
-    Vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
     for (std::uint32_t j = 0; j < n; ++j)
-        if (seen[j]) {
-            visible.push_back(j);
-            lo = glm::min(lo, particles.position[j]);
-            hi = glm::max(hi, particles.position[j]);
-        }
+        if (seen[j]) visible.push_back(j);
 
-    // Morton order over the visible particles' bounds (a cube, so that the
-    // order's cells are cubes), ties by id.
-    const Vec3 extent = hi - lo;
-    const float edge = std::max({extent.x, extent.y, extent.z});
-    const float inv = edge > 0.0f ? 1.0f / edge : 0.0f;
+    // Morton order over the particles' bounding cube, ties by id.
+    const MortonFrame frame = mortonFrame(particles.position.data(), n);
     std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(visible.size());
     tbb::parallel_for(std::size_t(0), visible.size(), [&](std::size_t k) {
         const std::uint32_t j = visible[k];
-        keyed[k] = {mortonKey((particles.position[j] - lo) * inv), j};
+        keyed[k] = {frame.key(particles.position[j]), j};
     });
     tbb::parallel_sort(keyed.begin(), keyed.end());
 

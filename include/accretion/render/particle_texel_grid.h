@@ -1,0 +1,29 @@
+#pragma once
+// particle_restir's lighting grid on the CPU: the slots and texels of a
+// frame (particle_texels.h has the rules the CPU and the twin share).
+#include <cstdint>
+#include <vector>
+
+#include "accretion/render/gbuffer.h"
+#include "accretion/render/particle_texels.h"
+
+namespace accretion {
+
+/// A frame's particle texels (gatherParticleTexels): the slots, and the
+/// texels as a G-buffer kTexelRowWidth wide (the last row's tail misses).
+struct ParticleTexels {
+    std::uint32_t side = 1, layers = 1;
+    std::vector<std::uint32_t> particleOf;  ///< slot -> particle
+    std::vector<std::uint32_t> slotOf;      ///< particle -> slot, kNoSlot when not visible
+    GBuffer grid;
+    std::uint32_t perParticle() const { return side * side * layers; }
+    std::uint32_t visible() const { return static_cast<std::uint32_t>(particleOf.size()); }
+    std::size_t texels() const { return std::size_t(visible()) * perParticle(); }
+};
+
+/// gatherParticleTexels: the particles some pixel of `gbuffer` sees, in
+/// Morton order of their positions over the particles' bounding cube (ties by id), and their texels on the billboards `bvh` holds for the camera.
+ParticleTexels gatherParticleTexels(const GBuffer& gbuffer, const Particles& particles, const ParticleBvh& bvh,
+                                    const Camera& camera, const Settings& settings);
+
+}  // namespace accretion
