@@ -15,36 +15,7 @@ A=${ACCRETION:-build/accretion}
 scene=scenes/disk_100k.toml
 D=(-D camera.width=1920 -D camera.height=1080 -D particles.count=$n)
 mkdir -p "$out"
-# tune's crops (cmd_tune.cpp errorCrops), printed by tune itself would need a
-# whole search: the same strata and hash here.
-crops=$(python3 - <<'PY'
-M = (1 << 64) - 1
-def mix64(x):
-    x = (x + 0x9e3779b97f4a7c15) & M
-    x = ((x ^ (x >> 30)) * 0xbf58476d1ce4e5b9) & M
-    x = ((x ^ (x >> 27)) * 0x94d049bb133111eb) & M
-    return x ^ (x >> 31)
-cols, rows, cw, ch, W, H = 4, 2, 160, 90, 1920, 1080
-sw, sh = W // cols, H // rows
-for r in range(rows):
-    for c in range(cols):
-        h = mix64((0x9e3779b97f4a7c15 * (r * cols + c + 1)) & M)
-        x0 = c * sw + (h & 0xffffffff) % (sw - cw + 1)
-        y0 = r * sh + (h >> 32) % (sh - ch + 1)
-        print(f"[{x0},{x0 + cw},{y0},{y0 + ch}]")
-PY
-)
-refs=() unshadowed=() k=0
-for c in $crops; do
-    for vis in true false; do
-        f=$out/ref$k.$vis.exr
-        [ -f "$f" ] || "$A" render $scene "${D[@]}" -D "render.crop=$c" -D shading.visibility=$vis --estimator split --spp 1024 \
-            --frames 20:21 -o "$f" --quiet > /dev/null
-    done
-    refs+=(--reference "$out/ref$k.true.exr")
-    unshadowed+=(--unshadowed-reference "$out/ref$k.false.exr")
-    k=$((k + 1))
-done
+source bench/operating_point_refs.sh
 run() {  # NAME SPEC
     local t0=$SECONDS
     "$A" bias $scene "${D[@]}" "${refs[@]}" "${unshadowed[@]}" --frame 20 --seeds "$seeds" --estimators "$2" -q -o "$out/$1" \

@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# The error of issue 46's designs at the engine's operating point, measured
+# as bench/operating_point.sh measures restir's (its crops and its split
+# references at 1024 spp, made here when absent): disk_100k (or PARTICLES)
+# at 1920x1080, frame 20 after 20 history frames, tune's eight 160x90 crops,
+# SEEDS seeds; each bias run beside the GPU ms the twin measured for the
+# same configuration (bench/gpu/results/designs.csv). The configurations
+# are bench/gpu/designs.txt's lighting (the geometry changes the time, not
+# the image).
+#   bash bench/designs.sh [PARTICLES] [SEEDS] [OUT] [NAME...]   (100000, 8, bench/results/operating_point_<N>; all)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+n=${1:-100000} seeds=${2:-8} out=${3:-bench/results/operating_point_$n}
+shift $(($# < 3 ? $# : 3))
+A=${ACCRETION:-build/accretion}
+scene=scenes/disk_100k.toml
+D=(-D camera.width=1920 -D camera.height=1080 -D particles.count=$n)
+mkdir -p "$out"
+source bench/operating_point_refs.sh
+suffix=$([ "$n" = 1000000 ] && echo 1m || echo 100k)
+: >> "$out/times.txt"
+# designs.txt's lines of this size: name, then the lighting overrides as a bias spec.
+grep -v '^#' bench/gpu/designs.txt | sed 's/ *#.*//' | grep "_$suffix " | while read -r name args; do
+    base=${name%_"$suffix"}
+    if [ $# -gt 0 ] && [[ " $* " != *" $base "* ]]; then continue; fi
+    spec=$(python3 - "$args" <<'PY'
+import sys
+words = sys.argv[1].split()
+kv = [words[i + 1] for i in range(0, len(words), 2) if words[i] == "-D"]
+lighting = [x for x in kv if x.split("=")[0].split(".")[0] in ("render", "restir")]
+est = next((x.split("=")[1] for x in lighting if x.startswith("render.estimator=")), "restir")
+print(":".join([est] + [x for x in lighting if not x.startswith("render.estimator=")]))
+PY
+)
+    t0=$SECONDS
+    "$A" bias $scene "${D[@]}" "${refs[@]}" "${unshadowed[@]}" --frame 20 --seeds "$seeds" --estimators "$spec" -q \
+        -o "$out/design_$base" > "$out/design_$base.txt"
+    echo "design_$base: $((SECONDS - t0)) s ($seeds seeds)" | tee -a "$out/times.txt"
+done
+echo "commit $(git rev-parse --short=10 HEAD), $(nproc) cores: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)" >> "$out/times.txt"
+python3 scripts/operating_point_table.py "$out" > "$out/table.md"
+cat "$out/table.md"
