@@ -43,7 +43,8 @@ TEST_CASE("bit-identical EXR for 1 and 2 threads", "[cli][determinism]") {
     const auto dir = accretion::test::scratchDir("threads");
     // restir: three frames of temporal + spatial reuse (pairwise, packed
     // reservoirs, reduced resolution); tree: adaptive sampling.
-    const std::string estimator = GENERATE("exact", "power", "uniform", "ris", "tree", "split", "restir");
+    const std::string estimator = GENERATE("exact", "power", "uniform", "ris", "tree", "split", "restir", "particle_restir");
+    const bool reuse = estimator == std::string("restir") || estimator == std::string("particle_restir");
     std::string extra = " --spp 8";
     if (estimator == std::string("tree")) extra += " --target-stderr 5% -D render.max_samples=64";
     // split: k from the pilot (threads work on one cache each); more lights than the near field holds.
@@ -51,8 +52,12 @@ TEST_CASE("bit-identical EXR for 1 and 2 threads", "[cli][determinism]") {
     if (estimator == std::string("restir"))
         extra = " -D render.frames=3 -D restir.bias_correction=\"pairwise\" -D restir.layout=\"packed\""
                 " -D restir.resolution_scale=0.5 -D particles.gm=40";
-    const std::string last = estimator == std::string("restir") ? ".0002.exr" : ".exr";
-    const std::string pattern = estimator == std::string("restir") ? ".{frame}.exr" : ".exr";
+    // particle_restir: texels 2x2 with 2 layers, world neighbours, the pixels resampling them.
+    if (estimator == std::string("particle_restir"))
+        extra = " -D render.frames=3 -D restir.texels=2 -D restir.texel_rays=2 -D restir.pixel_shading=\"resample\""
+                " -D particles.gm=40";
+    const std::string last = reuse ? ".0002.exr" : ".exr";
+    const std::string pattern = reuse ? ".{frame}.exr" : ".exr";
     std::string out;
     for (int t : {1, 2}) {
         const std::string cmd = smallQuickstart() + " --estimator " + estimator + extra + " --threads " +
