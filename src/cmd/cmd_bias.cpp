@@ -176,12 +176,17 @@ std::vector<FloatChannel> biasMap(const std::vector<DVec3>& s1, const std::vecto
     return ch;
 }
 
-/// The <estimator> of prefix.<estimator>.exr: the spec's label, file-safe.
+/// The <estimator> of prefix.<estimator>.exr: the spec's label, file-safe;
+/// a label over 120 characters is cut to 100 and an FNV-1a hash of the
+/// whole (a file name stays under the system's 255 bytes, and unique).
 std::string biasMapName(const EstimatorSpec& spec) {
     std::string safe = spec.label;
     for (char& c : safe)
         if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
-    return safe;
+    if (safe.size() <= 120) return safe;
+    std::uint64_t h = 1469598103934665603ull;
+    for (unsigned char c : spec.label) h = (h ^ c) * 1099511628211ull;
+    return fmt::format("{}_{:016x}", safe.substr(0, 100), h);
 }
 
 /// --gpu-frames: the pattern's {estimator} and {seed} filled in.

@@ -23,6 +23,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <memory>
 #include <optional>
 
@@ -119,10 +120,19 @@ std::vector<GeometryChoice> geometryChoices(const Settings& s) {
     return out;
 }
 
-/// A lighting choice of restir: candidate source and count, spatial
-/// neighbours and iterations, bias correction, visibility reuse (with
-/// basic, V tested at the neighbours too: unbiased; pairwise cannot) and
-/// the lighting resolution.
+/// The design a lighting choice runs: restir per pixel, or particle_restir
+/// per particle texel (texels per side, reservoirs a texel, how the pixels
+/// read them).
+struct Design {
+    EstimatorKind estimator = EstimatorKind::restir;
+    std::uint32_t texels = 1, texelRays = 1;
+    PixelShading shading = PixelShading::interpolate;
+};
+
+/// A lighting choice: its design (restir or particle_restir), candidate
+/// source and count, spatial neighbours and iterations, bias correction,
+/// visibility reuse (with basic, V tested at the neighbours too: unbiased;
+/// pairwise cannot) and the lighting resolution (restir).
 struct LightingChoice {
     LightSource source = LightSource::power;
     std::uint32_t candidates = 8;
@@ -130,13 +140,31 @@ struct LightingChoice {
     BiasCorrection bias = BiasCorrection::basic;
     bool visibilityReuse = false;
     double scale = 1.0;
+    Design design{};
 
+    bool particles() const { return design.estimator == EstimatorKind::particle_restir; }
     std::string label() const {
+        if (particles())
+            return fmt::format("particles {} M={} {}x{}xK{} nb={}x{} {}{} {}", enumName(source), candidates, design.texels,
+                               design.texels, design.texelRays, neighbours, iterations, enumName(bias), visibilityReuse ? "+vis" : "",
+                               enumName(design.shading));
         return fmt::format("{} M={} nb={}x{} {}{} {:g}x", enumName(source), candidates, neighbours, iterations, enumName(bias),
                            visibilityReuse ? "+vis" : "", scale);
     }
     /// As -D overrides of the measurements' child processes (and their cache keys).
     std::vector<std::string> defines() const {
+        std::vector<std::string> d = restirDefines();
+        if (particles()) {
+            d.front() = "render.estimator=particle_restir";
+            d.push_back(fmt::format("restir.texels={}", design.texels));
+            d.push_back(fmt::format("restir.texel_rays={}", design.texelRays));
+            d.push_back(fmt::format("restir.pixel_shading={}", enumName(design.shading)));
+        }
+        return d;
+    }
+
+private:
+    std::vector<std::string> restirDefines() const {
         return {"render.estimator=restir",
                 fmt::format("render.source={}", enumName(source)),
                 fmt::format("render.candidates={}", candidates),
@@ -149,8 +177,8 @@ struct LightingChoice {
     }
 };
 
-/// The lighting choices of `space`: quick, 34 points around the GPU team's
-/// settings; full, the whole grid (1080 points: hours).
+/// The lighting choices of `space`: quick, 34 restir points around the GPU
+/// team's settings and 8 of particle_restir; full, the whole grids (hours).
 std::vector<LightingChoice> lightingChoices(const std::string& space) {
     struct Axes {
         std::vector<LightSource> sources;
@@ -181,6 +209,26 @@ std::vector<LightingChoice> lightingChoices(const std::string& space) {
         out.push_back({LightSource::tree, 16, 5, 1, none, false, 1.0});
         out.push_back({LightSource::tree, 16, 5, 1, pairwise, true, 1.0});
     }
+    // particle_restir (docs/designs.md): tree candidates, temporal reuse by
+    // id, the pixels interpolating K reservoirs a particle; beside them its
+    // unbiased form (the pixels resample), world neighbours and 2x2 texels.
+    const auto particles = [](std::uint32_t texels, std::uint32_t rays, PixelShading shading = PixelShading::interpolate) {
+        return Design{EstimatorKind::particle_restir, texels, rays, shading};
+    };
+    std::vector<LightingChoice> designs;
+    for (const auto& [m, k] : std::vector<std::pair<std::uint32_t, std::uint32_t>>{{8, 4}, {4, 8}, {8, 8}, {4, 16}, {8, 16}})
+        designs.push_back({LightSource::tree, m, 0, 1, pairwise, false, 1.0, particles(1, k)});
+    designs.push_back({LightSource::tree, 8, 5, 1, pairwise, false, 1.0, particles(1, 4)});
+    designs.push_back({LightSource::tree, 8, 0, 1, pairwise, false, 1.0, particles(2, 2)});
+    designs.push_back({LightSource::tree, 32, 0, 1, pairwise, false, 1.0, particles(1, 4, PixelShading::resample)});
+    if (space == "full")
+        for (std::uint32_t m : x.candidates)
+            for (std::uint32_t k : {2u, 4u, 8u, 16u})
+                for (const auto& [nb, it] : x.spatial)
+                    for (const BiasCorrection bc : x.corrections)
+                        for (const PixelShading sh : {PixelShading::interpolate, PixelShading::resample})
+                            designs.push_back({LightSource::tree, m, nb, it, bc, false, 1.0, particles(1, k, sh)});
+    out.insert(out.end(), designs.begin(), designs.end());
     return out;
 }
 
@@ -395,9 +443,9 @@ ErrorRow readErrorRow(const TuneContext& t, const std::string& spec, std::uint32
 }
 
 ErrorRow measureErrorSeeds(TuneContext& t, const LightingChoice& o, std::uint32_t seeds) {
-    std::string spec = "restir";
+    std::string spec(enumName(o.design.estimator));  // restir's specs as before: their cache keys hold
     for (const std::string& d : o.defines())
-        if (d != "render.estimator=restir") spec += ":" + d;
+        if (!d.starts_with("render.estimator=")) spec += ":" + d;
     std::string key = t.sceneText + fmt::format("\nbias {} seeds {} frame {} history {} crop margin {}", spec, seeds, t.frame,
                                                 t.history, t.args.cropMargin);
     key += t.referencesKey;
@@ -728,6 +776,18 @@ Table lightingTable(const TuneArgs& a, const TuneResult& r) {
     return lt;
 }
 
+/// Per design (restir, particle_restir), its point of lowest relMSE under
+/// the budget (biased points only with --allow-biased).
+std::map<std::string, const ParetoPoint*> bestPerDesign(const TuneArgs& a, const TuneResult& r) {
+    std::map<std::string, const ParetoPoint*> best;
+    for (const ParetoPoint& p : r.points) {
+        if (p.ms > a.budgetMs || (p.error.biased() && !a.allowBiased)) continue;
+        const ParetoPoint*& b = best[std::string(enumName(p.lighting.design.estimator))];
+        if (!b || p.error.relMse < b->error.relMse) b = &p;
+    }
+    return best;
+}
+
 /// The tables and the verdict on stdout.
 void printTune(const TuneArgs& a, const Settings& scene, const TuneContext& t, const TuneResult& r, const Table& gt, const Table& lt) {
     fmt::print("{}\n{}", gt.console(), lt.console());
@@ -749,7 +809,11 @@ void printTune(const TuneArgs& a, const Settings& scene, const TuneContext& t, c
                    a.maxError ? fmt::format(" and relMSE {:g}", *a.maxError) : "", chosen.label(), best->lighting.label(), best->ms,
                    best->error.relMse, best->error.seeds,
                    best->error.label().empty() ? fmt::format("unbiased to {:.2g}%", best->error.detectablePct) : best->error.label());
-    else
+    // Which design and why: each design's lowest error under the budget (biased ones aside unless allowed).
+    for (const auto& [design, p] : bestPerDesign(a, r))
+        fmt::print("  best {} under {:g} ms: {} at {:.3f} ms, relMSE {:.4g}{}\n", design, a.budgetMs, p->lighting.label(), p->ms,
+                   p->error.relMse, p == r.best ? " (recommended)" : "");
+    if (!r.best)
         fmt::print("no {}configuration is under {:g} ms{}\n", a.allowBiased ? "" : "unbiased ", a.budgetMs,
                    a.maxError ? fmt::format(" with relMSE <= {:g}", *a.maxError) : "");
     std::string spent;
@@ -776,8 +840,11 @@ void writeTuneJson(const std::string& prefix, const TuneArgs& a, const Settings&
         recommended = {{"geometry", chosen.label()}, {"lighting", best->lighting.label()}, {"defines", defines}, {"gpu_ms", best->ms},
                        {"rel_mse", best->error.relMse}, {"biased", best->error.biased()},
                        {"bias_verdict", verdictName(best->error.verdict)}, {"detectable_bias_pct", best->error.detectablePct},
-                       {"seeds", best->error.seeds}};
+                       {"seeds", best->error.seeds}, {"design", enumName(best->lighting.design.estimator)}};
     }
+    nlohmann::json designs = nlohmann::json::object();  // each design's best under the budget
+    for (const auto& [design, p] : bestPerDesign(a, r))
+        designs[design] = {{"lighting", p->lighting.label()}, {"gpu_ms", p->ms}, {"rel_mse", p->error.relMse}};
     nlohmann::json reuse = nlohmann::json::object();  // per lighting configuration, per pass: the offers by outcome
     for (const ParetoPoint& p : r.points)
         if (!p.error.reuse.is_null()) reuse[p.lighting.label()] = p.error.reuse;
@@ -789,7 +856,7 @@ void writeTuneJson(const std::string& prefix, const TuneArgs& a, const Settings&
                                  {"unshadowed_references", t.unshadowedReferences},
                                  {"space", a.space}, {"coefficients", t.coefficients.source}, {"geometry", gt.json()},
                                  {"fastest_triangle_geometry", r.triangles->choice.label()}, {"chosen_geometry", chosen.label()},
-                                 {"lighting", lt.json()}, {"reuse", reuse}, {"recommended", recommended}, {"time", spentJson(t)}});
+                                 {"lighting", lt.json()}, {"reuse", reuse}, {"recommended", recommended}, {"best_per_design", designs}, {"time", spentJson(t)}});
 }
 
 /// PREFIX.png: the configurations' error against predicted GPU ms by bias
@@ -900,7 +967,7 @@ void addTuneCommand(CLI::App& app) {
     cmd->add_option("--crop-size", args->cropSize, "Each crop's size in pixels, WIDTHxHEIGHT");
     cmd->add_option("--crop-margin", args->cropMargin, "The pixels around each crop that restir renders for its reuse (restir.crop_margin)")
         ->check(CLI::Range(0u, 16384u));
-    cmd->add_option("--space", args->space, "quick (34 lighting configurations) or full (1080: hours)");
+    cmd->add_option("--space", args->space, "quick (34 restir and 8 particle_restir configurations) or full (1080 and 488: hours)");
     cmd->add_option("--reference", args->references,
                     "Reference EXRs of --frame, one per crop in stratum order, row by row (default: rendered once, exact up to 20K "
                     "particles, else split)")
