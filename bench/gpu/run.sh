@@ -210,17 +210,17 @@ step_layout_images() {
 # LAYOUT_LIST another list (bench/gpu/layouts_refit.txt); REPEAT the timed runs
 # per frame (3; a pass's time is their median).
 # Times the "name -D overrides..." lines of list $2 (comments and blank lines
-# skipped), each on disk_100k's restir frame 1 after a history frame, $3
-# timed runs per frame, into $W/$1; with parts i/n ($4), the i-th of n parts.
+# skipped), each on disk_100k's (or scene $5's) restir frame 1 after a history
+# frame, $3 timed runs per frame, into $W/$1; with parts i/n ($4), the i-th of n parts.
 time_configs() {
-    local t="$W/$1" list=$2 repeat=$3 part=${4:-1/1} k=0
+    local t="$W/$1" list=$2 repeat=$3 part=${4:-1/1} scene=${5:-scenes/disk_100k.toml} k=0
     mkdir -p "$t"
     grep -v '^#' "$list" | sed 's/ *#.*//' | while read -r name args; do
         [ -z "$name" ] && continue
         k=$((k + 1))
         [ $(((k - 1) % ${part#*/})) -eq $((${part%/*} - 1)) ] || continue
         # shellcheck disable=SC2086  # the overrides are words
-        timeout 120 $BIN scenes/disk_100k.toml -D render.estimator=restir $args --frames 0:2 --repeat "$repeat" -q \
+        timeout 120 $BIN "$scene" -D render.estimator=restir $args --frames 0:2 --repeat "$repeat" -q \
             -o "$t/$name.{frame}.exr" --timings "$t/$name.timings.csv" --config "$name" < /dev/null \
             || echo "$1: $name failed"
         rm -f "$t"/*.gpuframe
@@ -265,6 +265,9 @@ step_designs() {
     one prt_2x2_k2 -D restir.texels=2 -D restir.texel_rays=2
     one prt_history -D restir.texel_rays=4 -D restir.texel_history=0.5 -D restir.spatial_neighbours=0
     time_configs designs bench/gpu/designs.txt 5
+    # The flattened cluster from raw buffers (made here: they are not committed).
+    python3 scenes/cluster/make_cluster.py 3
+    time_configs designs/cluster bench/gpu/designs_cluster.txt 5 1/1 scenes/cluster_150k.toml
 }
 
 # The configurations on tune's Pareto fronts (bench/gpu/front.txt, written
