@@ -11,55 +11,11 @@
 #include "accretion/geometry/billboard.h"
 #include "accretion/render/frame_renderer.h"
 #include "accretion/render/particle_texel_grid.h"
-#include "support/oracle.h"
+#include "support/seed_sums.h"
 #include "support/statistics.h"
 #include "support/test_scenes.h"
 
 using namespace accretion;
-
-namespace {
-
-double texelLrSum(const FrameImage& img) {
-    double s = 0.0;
-    for (const Vec3& v : img.lighting.Lr) s += double(v.x) + v.y + v.z;
-    return s;
-}
-
-/// Mean and standard error over `seeds` histories of the last of `frames` frames' image sum.
-std::pair<double, double> particleRestirSums(Settings s, std::uint32_t frames, std::uint32_t seeds) {
-    s.render.estimator = EstimatorKind::particle_restir;
-    s.render.frames = frames;
-    const ParticleSource source(s);
-    double s1 = 0.0, s2 = 0.0;
-    for (std::uint32_t seed = 0; seed < seeds; ++seed) {
-        s.render.seed = 2000 + seed;
-        FrameRenderer renderer(s, source, RenderOptions{true});
-        FrameImage img;
-        for (std::uint32_t f = 0; f < frames; ++f) {
-            FrameStats stats;
-            img = renderer.render(f, stats);
-        }
-        const double x = texelLrSum(img);
-        s1 += x;
-        s2 += x * x;
-    }
-    const double mean = s1 / seeds;
-    return {mean, std::sqrt(std::max(0.0, (s2 / seeds - mean * mean) / (seeds - 1.0)))};
-}
-
-/// The oracle's image sum at `frame` of an orbiting camera (restir_test.cpp's pose).
-double oracleLrSum(Settings s, std::uint32_t frame) {
-    const double a = double(frame) * s.camera.orbit_speed * 3.14159265358979323846 / 180.0;
-    const glm::dvec3 t(s.camera.look_at), d = glm::dvec3(s.camera.position) - t;
-    s.camera.position = Vec3(t + glm::dvec3(std::cos(a) * d.x + std::sin(a) * d.z, d.y, -std::sin(a) * d.x + std::cos(a) * d.z));
-    s.camera.path = CameraPath::static_pose;
-    const test::OracleImage o = test::oracleRender(s, ParticleSource(s).frame(frame));
-    double sum = 0.0;
-    for (const glm::dvec3& v : o.Lr) sum += v.x + v.y + v.z;
-    return sum;
-}
-
-}  // namespace
 
 TEST_CASE("bilinearTexels: weights sum to 1, reproduce a linear function inside, clamp at the edges", "[particle_restir]") {
     for (const std::uint32_t side : {1u, 2u, 4u}) {
@@ -196,8 +152,8 @@ TEST_CASE("particle_restir resampled at the pixels agrees with the oracle", "[pa
     s.restir.spatial_neighbours = 3;
     s.restir.world_neighbours = 4;
     const std::uint32_t frames = 4, seeds = test::statisticalSeeds(biased ? 50 : 200);
-    const double oracle = oracleLrSum(s, frames - 1);
-    const auto [mean, stderr] = particleRestirSums(s, frames, seeds);
+    const double oracle = test::oracleImageSum(s, frames - 1);
+    const auto [mean, stderr] = test::seedImageSums(s, EstimatorKind::particle_restir, frames, seeds, 2000);
     const double z = (mean - oracle) / stderr;
     INFO("oracle " << oracle << ", particle_restir " << mean << " +- " << stderr << ", z " << z);
     if (biased) {

@@ -10,6 +10,7 @@
 
 #include "accretion/render/frame_renderer.h"
 #include "support/oracle.h"
+#include "support/seed_sums.h"
 #include "support/statistics.h"
 #include "support/test_scenes.h"
 
@@ -17,61 +18,11 @@ using namespace accretion;
 
 namespace {
 
-double lrSum(const FrameImage& img) {
-    double s = 0.0;
-    for (const Vec3& v : img.lighting.Lr) s += double(v.x) + v.y + v.z;
-    return s;
-}
-
-struct SeedStats {
-    double mean = 0.0, stderr = 0.0;
-};
-
-/// Image sum of the last of `frames` restir frames, over `seeds` histories.
-SeedStats restirSums(Settings s, std::uint32_t frames, std::uint32_t seeds) {
-    s.render.estimator = EstimatorKind::restir;
-    s.render.frames = frames;  // the pass plan keeps the history for more than one frame
-    const ParticleSource source(s);  // copies share the generator's tables
-    double s1 = 0.0, s2 = 0.0;
-    for (std::uint32_t seed = 0; seed < seeds; ++seed) {
-        s.render.seed = 1000 + seed;
-        FrameRenderer renderer(s, source, RenderOptions{true});
-        FrameImage img;
-        for (std::uint32_t f = 0; f < frames; ++f) {
-            FrameStats stats;
-            img = renderer.render(f, stats);
-        }
-        const double x = lrSum(img);
-        s1 += x;
-        s2 += x * x;
-    }
-    SeedStats r;
-    r.mean = s1 / seeds;
-    r.stderr = std::sqrt(std::max(0.0, (s2 / seeds - r.mean * r.mean) / (seeds - 1.0)));
-    return r;
-}
-
 double exactSum(Settings s, std::uint32_t frame) {
     s.render.estimator = EstimatorKind::exact;
     FrameRenderer renderer(s, ParticleSource(s), RenderOptions{true});
     FrameStats stats;
-    return lrSum(renderer.render(frame, stats));
-}
-
-/// The oracle's image sum at `frame`: the camera pose of the orbit computed
-/// here (a rotation of the eye about the y axis through look_at), the
-/// particles of that frame from the generator.
-double oracleSum(Settings s, std::uint32_t frame) {
-    if (s.camera.path == CameraPath::orbit) {
-        const double a = double(frame) * s.camera.orbit_speed * 3.14159265358979323846 / 180.0;
-        const glm::dvec3 t(s.camera.look_at), d = glm::dvec3(s.camera.position) - t;
-        s.camera.position = Vec3(t + glm::dvec3(std::cos(a) * d.x + std::sin(a) * d.z, d.y, -std::sin(a) * d.x + std::cos(a) * d.z));
-        s.camera.path = CameraPath::static_pose;
-    }
-    const test::OracleImage o = test::oracleRender(s, ParticleSource(s).frame(frame));
-    double sum = 0.0;
-    for (const glm::dvec3& v : o.Lr) sum += v.x + v.y + v.z;
-    return sum;
+    return test::imageLrSum(renderer.render(frame, stats));
 }
 
 Settings restirScene(bool animated) {
@@ -116,8 +67,8 @@ TEST_CASE("restir with basic or pairwise correction agrees with the oracle and e
     // sum: a 5% bias is still seen, checked below); the biased modes lose
     // 25-30% of the energy (z of -70 to -110 at 300 seeds), which 50 seeds show.
     const std::uint32_t frames = 4, seeds = test::statisticalSeeds(mode.biased ? 50 : 200);
-    const double exact = exactSum(s, frames - 1), oracle = oracleSum(s, frames - 1);
-    const SeedStats r = restirSums(s, frames, seeds);
+    const double exact = exactSum(s, frames - 1), oracle = test::oracleImageSum(s, frames - 1);
+    const test::SeedSums r = test::seedImageSums(s, EstimatorKind::restir, frames, seeds, 1000);
     const double z = (r.mean - oracle) / r.stderr;
     INFO("oracle " << oracle << ", exact " << exact << ", restir " << r.mean << " +- " << r.stderr << ", z " << z);
     // exact is the oracle's image to float rounding (tests/render/oracle_test.cpp).
@@ -154,8 +105,8 @@ TEST_CASE("restir with candidates by power, from the light tree, light tiles or 
     // 200 seeds: the largest standard error of the eight (regir, basic) is
     // about 0.7% of the sum, so a 5% bias is still seen (checked below).
     const std::uint32_t frames = 3, seeds = test::statisticalSeeds(200);
-    const double oracle = oracleSum(s, frames - 1);
-    const SeedStats r = restirSums(s, frames, seeds);
+    const double oracle = test::oracleImageSum(s, frames - 1);
+    const test::SeedSums r = test::seedImageSums(s, EstimatorKind::restir, frames, seeds, 1000);
     const double z = (r.mean - oracle) / r.stderr;
     INFO("oracle " << oracle << ", restir " << r.mean << " +- " << r.stderr << ", z " << z);
     CHECK(std::fabs(z) < 4.4);

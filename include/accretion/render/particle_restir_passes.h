@@ -54,15 +54,7 @@ ACC_HD_BODY void temporalByIdTexel(B& b, std::size_t px) {
     b.reuse(ReuseOutcome::sameParticle);
     rec.read(R + gpu_layout::kGBufferTexel + gpu_layout::kParticleRecord);  // the previous reservoir, texel and light
     rec.gather(1);
-    auto offers = b.template offers<2>();
-    offers.addCurrent(cur, g);
-    StoredReservoir prev = b.historyReservoir(q);
-    const std::uint32_t historyM = prev.M;
-    prev.M = capHistoryM(prev.M, cur.M, p.mCap);
-    if (prev.M != historyM) b.historyCapped();
-    offers.addHistory(prev, q);
-    typename B::Rng rng(p.streamKey(px, g), p.frame, RngPass::restirTemporal, p.seed);
-    b.keep(px, sanitizeReservoir(offers.combine(rng), [&] { return b.reject(px); }));
+    combineWithHistory(b, px, g, cur, q);
 }
 
 /// The texel of particle_restir's spatial neighbour s of texel px: a slot
@@ -91,36 +83,13 @@ ACC_HD bool drawWorldNeighbour(RngT& rng, const ReuseParams& p, std::size_t px, 
 template <class B>
 ACC_HD_BODY void spatialWorldTexel(B& b, std::size_t px, std::uint32_t iteration) {
     const ReuseParams& p = b.params();
-    const GBufferTexel g = b.texel(px);
-    auto&& rec = b.recorder(px, g);
-    b.output(px, b.input(px));
-    if (!g.hit()) return;
-    const std::uint32_t R = b.reservoirBytes();
-    rec.trip(p.neighbours);
-    rec.read(R + gpu_layout::kParticleRecord);
-    rec.gather(1);
-    rec.write(R);
-    typename B::Rng rng(p.streamKey(px, g) ^ (std::uint64_t(iteration) << 40), p.frame, RngPass::restirSpatial, p.seed);
-    auto offers = b.template offers<kMaxOffers>();
-    offers.addCurrent(b.input(px), g);
-    for (std::uint32_t s = 0; s < p.neighbours; ++s) {
-        std::size_t q;
-        if (!drawWorldNeighbour(rng, p, px, q)) {
-            b.reuse(ReuseOutcome::offScreen);
-            continue;
-        }
-        const GBufferTexel gn = b.texel(q);
-        rec.read(gpu_layout::kGBufferTexel);
-        const ReuseOutcome o = glm::dot(g.normal, gn.normal) < p.normalThreshold ? ReuseOutcome::normal
-                               : gn.particle == g.particle                         ? ReuseOutcome::sameParticle
-                                                                                   : ReuseOutcome::otherParticle;
-        b.reuse(o);
-        if (!kept(o)) continue;
-        rec.read(R + gpu_layout::kParticleRecord);
-        rec.gather(1);
-        offers.addCurrent(b.input(q), gn);
-    }
-    b.keep(px, sanitizeReservoir(offers.combine(rng), [&] { return b.reject(px); }));
+    resampleNeighbours(
+        b, px, iteration, [&](typename B::Rng& rng, std::size_t& q) { return drawWorldNeighbour(rng, p, px, q); },
+        [&](const GBufferTexel& g, const GBufferTexel& gn) {
+            return glm::dot(g.normal, gn.normal) < p.normalThreshold ? ReuseOutcome::normal
+                   : gn.particle == g.particle                         ? ReuseOutcome::sameParticle
+                                                                       : ReuseOutcome::otherParticle;
+        });
 }
 
 /// traceShadowRays's last step with restir.texel_history h: texel px's Lr
@@ -159,19 +128,27 @@ ACC_HD std::uint32_t pixelTexels(const B& b, const GBufferTexel& g, std::size_t 
     return n;
 }
 
+/// shadeParticlePixels' start at pixel px showing g: Lr = 0 written, and
+/// for a hit the texels it reads (pixelTexels); returns how many (0 on a miss).
+template <class B, class Rec>
+ACC_HD_BODY std::uint32_t beginPixel(B& b, std::size_t px, const GBufferTexel& g, Rec& rec, std::size_t q[kMaxPixelOffers],
+                                     float w[kMaxPixelOffers]) {
+    b.writePixelLr(px, Vec3(0.0f));
+    rec.write(gpu_layout::kRadiance);
+    return g.hit() ? pixelTexels(b, g, q, w) : 0u;
+}
+
 /// shadeParticlePixels, interpolate: the pixel's Lr is its particle's
 /// texels' Lr, bilinear at its uv and averaged over the layers (biased: the
 /// light at the texels, not at the pixel's point).
 template <class B>
 ACC_HD_BODY void interpolatePixel(B& b, std::size_t px) {
-    b.writePixelLr(px, Vec3(0.0f));
     const GBufferTexel g = b.pixel(px);
     auto&& rec = b.recorder(px, g);
-    rec.write(gpu_layout::kRadiance);
-    if (!g.hit()) return;
     std::size_t q[kMaxPixelOffers];
     float w[kMaxPixelOffers];
-    const std::uint32_t n = pixelTexels(b, g, q, w);
+    const std::uint32_t n = beginPixel(b, px, g, rec, q, w);
+    if (n == 0) return;
     rec.read(4 + n * gpu_layout::kRadiance);  // the slot, the texels' Lr
     rec.gather(1);
     Vec3 Lr(0.0f);
@@ -187,14 +164,12 @@ ACC_HD_BODY void interpolatePixel(B& b, std::size_t px) {
 template <class B>
 ACC_HD_BODY void resamplePixel(B& b, std::size_t px) {
     const ReuseParams& p = b.params();
-    b.writePixelLr(px, Vec3(0.0f));
     const GBufferTexel g = b.pixel(px);
     auto&& rec = b.recorder(px, g);
-    rec.write(gpu_layout::kRadiance);
-    if (!g.hit()) return;
     std::size_t q[kMaxPixelOffers];
     float w[kMaxPixelOffers];
-    const std::uint32_t n = pixelTexels(b, g, q, w);
+    const std::uint32_t n = beginPixel(b, px, g, rec, q, w);
+    if (n == 0) return;
     const std::uint32_t R = b.reservoirBytes();
     rec.trip(n);
     rec.read(4 + n * (R + gpu_layout::kGBufferTexel + gpu_layout::kParticleRecord));
@@ -207,17 +182,10 @@ ACC_HD_BODY void resamplePixel(B& b, std::size_t px) {
     if (!(r.W > 0.0f)) return;
     rec.read(gpu_layout::kParticleRecord);
     if constexpr (std::decay_t<decltype(rec)>::on) rec.hint(b.clusterOf(r.y));
-    const ShadingPoint sp = b.shadingPoint(g);
-    LightTerm t;
-    b.countLightTerm();
-    if (!b.lightTerm(sp, r.y, t)) return;
-    bool seen = true;
-    if (b.shadows()) {
-        rec.trip();
-        seen = b.visible(sp, r.y, t, rec);
-    }
+    Shade shade;
     Vec3 Lr(0.0f);
-    switch (shadeSample(t, r.W, seen, Lr)) {
+    if (!shadeKeptSample(b, b.shadingPoint(g), r, rec, shade, Lr)) return;
+    switch (shade) {
     case Shade::lit: b.writePixelLr(px, Lr); break;
     case Shade::occluded: b.occluded(); break;
     case Shade::overflow: b.reject(px); break;

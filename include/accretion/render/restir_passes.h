@@ -162,6 +162,42 @@ ACC_HD_BODY void generateCandidatesTexel(B& b, const Source& source, std::size_t
     b.keep(px, StoredReservoir::of(r));
 }
 
+/// temporalResampling's step once texel px (showing g, this frame's
+/// reservoir cur) has found its history, last frame's reservoir at q: that
+/// reservoir's M capped at m_cap x M, the two combined
+/// (restir.bias_correction) and kept at px. restir's reprojection and
+/// particle_restir's id both end here.
+template <class B>
+ACC_HD_BODY void combineWithHistory(B& b, std::size_t px, const GBufferTexel& g, const StoredReservoir& cur, std::size_t q) {
+    const ReuseParams& p = b.params();
+    auto offers = b.template offers<2>();
+    offers.addCurrent(cur, g);
+    StoredReservoir prev = b.historyReservoir(q);
+    const std::uint32_t historyM = prev.M;
+    prev.M = capHistoryM(prev.M, cur.M, p.mCap);
+    if (prev.M != historyM) b.historyCapped();
+    offers.addHistory(prev, q);
+    typename B::Rng rng(p.streamKey(px, g), p.frame, RngPass::restirTemporal, p.seed);
+    b.keep(px, sanitizeReservoir(offers.combine(rng), [&] { return b.reject(px); }));
+}
+
+/// The kept sample r shaded at sp: its light term (counted), its shadow ray
+/// when shadows are on (traced and counted on rec), and Lr = f I G V W by
+/// shadeSample's outcome. False when the light term is zero (Lr stays 0).
+template <class B, class Rec>
+ACC_HD_BODY bool shadeKeptSample(B& b, const ShadingPoint& sp, const StoredReservoir& r, Rec& rec, Shade& shade, Vec3& Lr) {
+    LightTerm t;
+    b.countLightTerm();
+    if (!b.lightTerm(sp, r.y, t)) return false;
+    bool seen = true;
+    if (b.shadows()) {
+        rec.trip();
+        seen = b.visible(sp, r.y, t, rec);
+    }
+    shade = shadeSample(t, r.W, seen, Lr);
+    return true;
+}
+
 /// temporalResampling at texel px: the surface point where it was last frame
 /// (moved back by its particle's motion), projected with the previous camera
 /// onto the previous lighting grid; rejected on another particle, normal or
@@ -201,23 +237,17 @@ ACC_HD_BODY void temporalResamplingTexel(B& b, std::size_t px) {
     if (!kept(o)) return;
     rec.read(R + gpu_layout::kParticleRecord);  // the previous reservoir and its light
     rec.gather(1);
-    auto offers = b.template offers<2>();
-    offers.addCurrent(cur, g);
-    StoredReservoir prev = b.historyReservoir(q);
-    const std::uint32_t historyM = prev.M;
-    prev.M = capHistoryM(prev.M, cur.M, p.mCap);
-    if (prev.M != historyM) b.historyCapped();
-    offers.addHistory(prev, q);
-    typename B::Rng rng(p.streamKey(px, g), p.frame, RngPass::restirTemporal, p.seed);
-    b.keep(px, sanitizeReservoir(offers.combine(rng), [&] { return b.reject(px); }));
+    combineWithHistory(b, px, g, cur, q);
 }
 
-/// spatialResampling at texel (x, y) = px, iteration `iteration`: k
-/// neighbours uniform in a disc of the radius (drawNeighbour), rejected off
-/// the grid, on a miss, or on normal and depth; combined with this texel's
-/// reservoir (restir.bias_correction).
-template <class B>
-ACC_HD_BODY void spatialResamplingTexel(B& b, std::size_t px, std::uint32_t x, std::uint32_t y, std::uint32_t iteration) {
+/// A spatial pass's body at texel px, iteration `iteration`: this texel's
+/// reservoir and p.neighbours neighbours, each drawn by draw(rng, q) (false:
+/// off the grid, or this texel) and judged by outcome(g, gn) (kept or
+/// refused, and why), combined (restir.bias_correction) and kept at px.
+/// restir's disc of pixels and particle_restir's world neighbours differ
+/// only in those two.
+template <class B, class Draw, class Outcome>
+ACC_HD_BODY void resampleNeighbours(B& b, std::size_t px, std::uint32_t iteration, Draw&& draw, Outcome&& outcome) {
     const ReuseParams& p = b.params();
     const GBufferTexel g = b.texel(px);
     auto&& rec = b.recorder(px, g);
@@ -233,17 +263,13 @@ ACC_HD_BODY void spatialResamplingTexel(B& b, std::size_t px, std::uint32_t x, s
     offers.addCurrent(b.input(px), g);
     for (std::uint32_t s = 0; s < p.neighbours; ++s) {
         std::size_t q;
-        if (!drawNeighbour(rng, p.radius, x, y, p.width, p.height, q)) {
+        if (!draw(rng, q)) {
             b.reuse(ReuseOutcome::offScreen);
             continue;
         }
         const GBufferTexel gn = b.texel(q);
         rec.read(gpu_layout::kGBufferTexel);
-        const ReuseOutcome o = !gn.hit() ? ReuseOutcome::miss
-                                         : resampling::surfaceOutcome(g.normal, g.depth, gn.normal, gn.depth, p.normalThreshold,
-                                                                      p.depthThreshold,
-                                                                      gn.particle == g.particle ? ReuseOutcome::sameParticle
-                                                                                                : ReuseOutcome::otherParticle);
+        const ReuseOutcome o = outcome(g, gn);
         b.reuse(o);
         if (!kept(o)) continue;
         rec.read(R + gpu_layout::kParticleRecord);
@@ -251,6 +277,24 @@ ACC_HD_BODY void spatialResamplingTexel(B& b, std::size_t px, std::uint32_t x, s
         offers.addCurrent(b.input(q), gn);
     }
     b.keep(px, sanitizeReservoir(offers.combine(rng), [&] { return b.reject(px); }));
+}
+
+/// spatialResampling at texel (x, y) = px, iteration `iteration`: k
+/// neighbours uniform in a disc of the radius (drawNeighbour), rejected off
+/// the grid, on a miss, or on normal and depth; combined with this texel's
+/// reservoir (restir.bias_correction).
+template <class B>
+ACC_HD_BODY void spatialResamplingTexel(B& b, std::size_t px, std::uint32_t x, std::uint32_t y, std::uint32_t iteration) {
+    const ReuseParams& p = b.params();
+    resampleNeighbours(
+        b, px, iteration,
+        [&](typename B::Rng& rng, std::size_t& q) { return drawNeighbour(rng, p.radius, x, y, p.width, p.height, q); },
+        [&](const GBufferTexel& g, const GBufferTexel& gn) {
+            return !gn.hit() ? ReuseOutcome::miss
+                             : resampling::surfaceOutcome(g.normal, g.depth, gn.normal, gn.depth, p.normalThreshold, p.depthThreshold,
+                                                          gn.particle == g.particle ? ReuseOutcome::sameParticle
+                                                                                    : ReuseOutcome::otherParticle);
+        });
 }
 
 /// traceShadowRays at texel px: one shadow ray for the kept sample, Lr =
@@ -272,17 +316,10 @@ ACC_HD_BODY void traceShadowRayTexel(B& b, std::size_t px) {
     rec.read(gpu_layout::kParticleRecord);
     rec.gather(1);
     if constexpr (std::decay_t<decltype(rec)>::on) rec.hint(b.clusterOf(r.y));
-    const ShadingPoint sp = b.shadingPoint(g);
-    LightTerm t;
-    b.countLightTerm();
-    if (!b.lightTerm(sp, r.y, t)) return;
-    bool seen = true;
-    if (b.shadows()) {
-        rec.trip();
-        seen = b.visible(sp, r.y, t, rec);
-    }
+    Shade shade;
     Vec3 Lr(0.0f);
-    switch (shadeSample(t, r.W, seen, Lr)) {
+    if (!shadeKeptSample(b, b.shadingPoint(g), r, rec, shade, Lr)) return;
+    switch (shade) {
     case Shade::lit: b.writeLr(px, Lr); break;
     case Shade::occluded:
         b.occluded();
