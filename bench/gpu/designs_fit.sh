@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The cost model with the designs in its data: the sweep's counters and
 # H100 timings (results/sweep_*.csv) and the designs' (designs_cost.sh's
-# cost CSVs of the 100K configurations, results/designs.csv's H100 rows),
+# cost CSVs of the 100K and cluster_150k configurations, results/designs.csv's
+# H100 rows),
 # fitted per pass on half the configurations and predicting the other half
 # (`calibrate --holdout 0.5`, split seeds 1-3); each run's report in OUT.
 #   bash bench/gpu/designs_fit.sh COST_DIR [OUT]   (OUT: bench/gpu/results/designs_fit)
@@ -16,11 +17,11 @@ trap 'rm -rf "$T"' EXIT
   python3 -c '
 import csv
 for r in csv.DictReader(open("bench/gpu/results/designs.csv")):
-    if "H100" in r["gpu"] and r["pass"] != "frame" and r["config"].endswith("_100k"):
+    if "H100" in r["gpu"] and r["pass"] != "frame" and r["config"].endswith(("_100k", "_cluster")):
         print(",".join((r["config"], r["pass"], r["ms"])))'
 } > "$T/timings.csv"
 for seed in 1 2 3; do
-    "$A" calibrate bench/gpu/results/sweep_counters.csv "$costs"/cost_*_100k.csv "$T/timings.csv" --form per_pass --holdout 0.5 \
+    "$A" calibrate bench/gpu/results/sweep_counters.csv "$costs"/cost_*_100k.csv "$costs"/cost_*_cluster.csv "$T/timings.csv" --form per_pass --holdout 0.5 \
         --split-seed $seed -o "$T/c$seed.json" | sed -n '/^held out/,$p' | grep -v '^coefficients:' > "$out/holdout_seed$seed.txt"
 done
 cat "$out"/holdout_seed*.txt
