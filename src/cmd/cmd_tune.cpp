@@ -64,6 +64,7 @@ struct TuneArgs : SceneArgs {
     std::string cropSize = "160x90";    ///< each crop's size at the scene's resolution
     std::uint32_t cropMargin = 32;      ///< the pixels around a crop restir renders for its reuse
     std::string space = "quick";
+    std::vector<std::string> designs{"restir", "particle_restir"};
     std::vector<std::string> references;  ///< --reference: one per crop
     std::uint32_t referenceSpp = 1024;
     std::string out, cache;
@@ -229,6 +230,21 @@ std::vector<LightingChoice> lightingChoices(const std::string& space) {
                         for (const PixelShading sh : {PixelShading::interpolate, PixelShading::resample})
                             designs.push_back({LightSource::tree, m, nb, it, bc, false, 1.0, particles(1, k, sh)});
     out.insert(out.end(), designs.begin(), designs.end());
+    return out;
+}
+
+/// The choices of the designs named by --designs (restir, particle_restir).
+std::vector<LightingChoice> designChoices(const std::vector<LightingChoice>& all, const std::vector<std::string>& designs) {
+    std::vector<LightingChoice> out;
+    for (const std::string& d : designs) {
+        EstimatorKind kind{};
+        if (!parseEnum(d, kind) || (kind != EstimatorKind::restir && kind != EstimatorKind::particle_restir))
+            throw InputError(fmt::format("command line --designs {}: expected restir or particle_restir", d));
+        if (std::count(designs.begin(), designs.end(), d) > 1)
+            throw InputError(fmt::format("command line --designs {}: named twice", d));
+        for (const LightingChoice& c : all)
+            if (c.design.estimator == kind) out.push_back(c);
+    }
     return out;
 }
 
@@ -907,7 +923,7 @@ void runTune(const TuneArgs& a) {
                                      "(temporal reuse to its M cap of {:g}, at least 8): measure frame {} or later",
                                      t.frame, t.history, scene.restir.m_cap, t.history));
     const std::vector<GeometryChoice> geometry = geometryChoices(scene);
-    const std::vector<LightingChoice> lighting = lightingChoices(a.space);
+    const std::vector<LightingChoice> lighting = designChoices(lightingChoices(a.space), a.designs);
     const std::string prefix = a.out.empty() ? "out/" + scene.sceneName + ".tune" : a.out;
     t.crops = errorCrops(a, scene);
     if (!a.references.empty() && a.references.size() != t.crops.size())  // before anything is made
@@ -967,6 +983,8 @@ void addTuneCommand(CLI::App& app) {
     cmd->add_option("--crop-size", args->cropSize, "Each crop's size in pixels, WIDTHxHEIGHT");
     cmd->add_option("--crop-margin", args->cropMargin, "The pixels around each crop that restir renders for its reuse (restir.crop_margin)")
         ->check(CLI::Range(0u, 16384u));
+    cmd->add_option("--designs", args->designs, "the designs searched: restir (per pixel), particle_restir (per particle texel); both by default")
+        ->delimiter(',');
     cmd->add_option("--space", args->space, "quick (34 restir and 8 particle_restir configurations) or full (1080 and 488: hours)");
     cmd->add_option("--reference", args->references,
                     "Reference EXRs of --frame, one per crop in stratum order, row by row (default: rendered once, exact up to 20K "

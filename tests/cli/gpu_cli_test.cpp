@@ -538,10 +538,13 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
     // --anatomy: each configuration again with every light visible, against
     // a reference without visibility that tune renders once: visibility's
     // share of the error, mostly between 0 and 100% (one shadow ray a pixel
-    // is noise of its own).
-    REQUIRE(runCommand(cmd + " --anatomy -q", out) == 0);
+    // is noise of its own). --designs restir: restir's 34 alone (the
+    // particle designs' anatomy is bench/designs.sh's).
+    REQUIRE(runCommand(cmd + " --anatomy --designs restir -q", out) == 0);
     const nlohmann::json an = nlohmann::json::parse(slurp(dir / "t.json"));
     CHECK(an["unshadowed_references"].size() == 4);
+    CHECK(an.at("lighting").size() == 34);
+    CHECK_FALSE(an.at("best_per_design").contains("particle_restir"));
     std::vector<double> shares;
     for (const auto& p : an.at("lighting")) shares.push_back(p["visibility_share_pct"].get<double>());
     std::sort(shares.begin(), shares.end());
@@ -558,6 +561,8 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
     CHECK_THAT(out, Contains("--crop-size 32x24: a crop must fit its stratum, 24x16"));
     CHECK(runCommand(kBin + " tune " + tinyScene() + " --budget-ms 5 --space huge -o " + (dir / "bad").string(), out) == 1);
     CHECK_THAT(out, Contains("--space huge"));
+    CHECK(runCommand(kBin + " tune " + tinyScene() + " --budget-ms 5 --designs restir,voxels -o " + (dir / "bad").string(), out) == 1);
+    CHECK_THAT(out, Contains("--designs voxels: expected restir or particle_restir"));
     CHECK(runCommand(kBin + " tune " + tinyScene() + " --budget-ms 5 --error-crops 2x2 --crop-size 32x24 --reference " +
                          (dir / "t.csv").string() + " --cache " + (dir / "bad_cache").string() + " -o " + (dir / "bad").string(), out) == 1);
     CHECK_THAT(out, Contains("--reference: 1 given, one per crop of --error-crops 2x2 (4)"));
