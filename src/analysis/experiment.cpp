@@ -60,8 +60,10 @@ Settings specSettings(const std::filesystem::path& scene, const std::vector<std:
 }
 
 std::uint32_t steadyStateHistory(const Settings& settings) {
-    if (!estimatorInfo(settings.render.estimator).reuse || !settings.restir.temporal) return 0;
     constexpr std::uint32_t kAtLeast = 8;
+    if (estimatorInfo(settings.render.estimator).worldCache)  // the cells' running mean to its cap
+        return settings.voxel.history > 1.0 ? std::max(kAtLeast, static_cast<std::uint32_t>(std::ceil(settings.voxel.history))) : 0;
+    if (!estimatorInfo(settings.render.estimator).reuse || !settings.restir.temporal) return 0;
     return std::max(kAtLeast, static_cast<std::uint32_t>(std::ceil(settings.restir.m_cap)));
 }
 

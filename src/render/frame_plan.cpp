@@ -26,7 +26,7 @@ PixelWindow restirWindow(const Settings& s) {
 void planRun(const Settings& s, FramePlan& plan) {
     const bool staticCamera = s.camera.path == CameraPath::static_pose ||
                               (s.camera.path == CameraPath::orbit && s.camera.orbit_speed == 0.0);
-    const bool restir = estimatorInfo(s.render.estimator).reuse;
+    const bool restir = estimatorInfo(s.render.estimator).reuse && !estimatorInfo(s.render.estimator).worldCache;
     plan.staticGeometry = staticParticles(s.particles) && staticCamera;
     plan.updateInPlace = s.geometry.build == BuildPolicy::refit || s.geometry.build == BuildPolicy::partial;
     plan.alphaFilter = s.geometry.primitive == Primitive::billboard && s.geometry.alpha == AlphaMode::disc;
@@ -50,7 +50,8 @@ void planPasses(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
     if (plan.lighting) plan.sampler = samplerFor(s.render);  // tiles and the ReGIR grid are drawn from the power table
     plan.chooseNearLights = plan.lighting && est.nearField && s.render.near_lights == 0;
     const LightSourceInfo& source = sourceInfo(s.render.source);
-    plan.restir = plan.lighting && est.reuse;
+    plan.restir = plan.lighting && est.reuse && !est.worldCache;
+    plan.voxelCache = plan.lighting && est.worldCache;
     plan.presampleTiles = plan.restir && source.presampled;
     plan.presampleRegir = plan.restir && source.regirGrid;
     plan.temporal = plan.restir && plan.keepHistory && facts.historyAvailable;
@@ -66,7 +67,7 @@ void planPasses(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
 /// The plan as lines, with what each step does or why it is skipped.
 void describe(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
     const EstimatorKind est = s.render.estimator;
-    const bool restir = estimatorInfo(est).reuse;
+    const bool restir = estimatorInfo(est).reuse && !estimatorInfo(est).worldCache;
     const bool manyFrames = s.render.frames > 1;
     auto step = [&](Pass pass, std::string why) { plan.steps.push_back({pass, {}, true, std::move(why)}); };
     auto work = [&](std::string name, bool runs, std::string why) {
@@ -106,7 +107,8 @@ void describe(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
              ? std::string("one primary ray per pixel")
              : fmt::format("one primary ray per pixel of render.crop's {}x{} window", plan.traced.width(), plan.traced.height()));
     step(Pass::estimateLighting,
-         dark ? noLight : restir ? "the restir passes below" : std::string(enumName(est)));
+         dark ? noLight : restir ? "the restir passes below"
+         : estimatorInfo(est).worldCache ? "the voxel cache's passes below" : std::string(enumName(est)));
     if (restir) {
         const RestirSettings& r = s.restir;
         step(Pass::presampleLightTiles,
@@ -148,6 +150,16 @@ void describe(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
                      : "resample: the particle's bilinear texels' samples at the pixel's point, its own shadow ray (unbiased)");
         step(Pass::upsampleLighting,
              plan.upsample ? fmt::format("lighting at scale {}", s.restir.resolution_scale) : "full-resolution lighting");
+    } else if (estimatorInfo(est).worldCache) {
+        const VoxelSettings& v = s.voxel;
+        step(Pass::updateVoxelCache,
+             dark ? noLight
+                  : fmt::format("{} cells along the longest side, those the particles reach: {} lights from {} each, {}, averaged "
+                                "over up to {:g} frames", v.cells, v.rays, enumName(s.render.source),
+                                plan.shadowRays ? "one shadow ray each" : "visibility off (V = 1)", v.history));
+        step(Pass::shadeVoxelPixels,
+             dark ? noLight : fmt::format("trilinear over the 8 cells around the pixel's point, its own light taken out, basis {}",
+                                          enumName(v.basis)));
     } else {
         work("shadow rays", plan.shadowRays,
              plan.shadowRays ? "V by occlusion queries" : (dark ? noLight : "visibility off: no shadow rays"));
@@ -176,7 +188,7 @@ bool emissive(const Particles& particles) {
 }
 
 bool needsPreviousBvh(const Settings& s) {
-    return estimatorInfo(s.render.estimator).reuse && s.restir.temporal &&
+    return estimatorInfo(s.render.estimator).reuse && !estimatorInfo(s.render.estimator).worldCache && s.restir.temporal &&
            s.restir.bias_correction == BiasCorrection::basic && s.restir.basic_visibility &&
            (s.restir.visibility_reuse || s.restir.candidate_visibility) &&
            (s.geometry.build == BuildPolicy::rebuild || s.geometry.build == BuildPolicy::fast_trace);
@@ -206,6 +218,8 @@ bool FramePlan::runs(Pass pass) const {
     case Pass::gatherParticleTexels: return particleTexels;
     case Pass::traceShadowRays: return traceShadowRays;
     case Pass::shadeParticlePixels: return particleTexels;
+    case Pass::updateVoxelCache: return voxelCache;
+    case Pass::shadeVoxelPixels: return voxelCache;
     case Pass::upsampleLighting: return upsample;
     case Pass::composeImage: return true;
     case Pass::writeOutputs: return true;

@@ -143,8 +143,9 @@ FrameRenderer::FrameRenderer(std::vector<Settings> lanes, ParticleSource source,
         lane.plan = planFrame(lane.settings, FrameFacts{});
         if (lanes_.size() > 0 && lane.plan.counting)
             throw std::invalid_argument("FrameRenderer: gpu.counters counts one view's work; it takes one lane");
-        if (estimatorInfo(lane.settings.render.estimator).reuse)
-            lane.restir = std::make_unique<Restir>(lane.settings, lane.plan.keepHistory);
+        const EstimatorInfo& e = estimatorInfo(lane.settings.render.estimator);
+        if (e.worldCache) lane.voxel = std::make_unique<VoxelCache>(lane.settings);
+        else if (e.reuse) lane.restir = std::make_unique<Restir>(lane.settings, lane.plan.keepHistory);
         lanes_.push_back(std::move(lane));
     }
 }
@@ -224,6 +225,12 @@ void FrameRenderer::lightFrame(Lane& lane, std::uint32_t frame, const Camera& ca
     }
     const std::uint32_t nearLights = plan.chooseNearLights ? chooseFrameNearLights(lane, frame, g, stats) : 0u;
     auto t = stats.timer.scope(Pass::estimateLighting);
+    if (plan.voxelCache) {
+        VoxelInputs in{*bvh_, particles, gbuffer, camera, settings, plan, frame, powerTable, lightTree, origin_,
+                       plan.counting ? &img.counters : nullptr};
+        stats.lighting = lane.voxel->render(in, img.lighting, stats.timer);
+        return;
+    }
     if (plan.restir) {
         RestirInputs in{*bvh_, particles, gbuffer, camera, settings, plan, frame, powerTable, lightTree,
                         plan.previousBvh ? previousBvh_.get() : nullptr, plan.counting ? &img.counters : nullptr, trace};

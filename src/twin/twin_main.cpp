@@ -71,7 +71,7 @@ void requireSupported(const Settings& s, bool lighting) {
     // all: the scene's rules refuse them for every command (loadScene).
     const EstimatorKind e = s.render.estimator;
     if (lighting && !estimatorInfo(e).twin) refuse(fmt::format("render.estimator = \"{}\"", enumName(e)));
-    if (lighting && estimatorInfo(e).reuse) {
+    if (lighting && estimatorInfo(e).reuse && !estimatorInfo(e).worldCache) {
         const RestirSettings& r = s.restir;
         if (!sourceInfo(s.render.source).twin) refuse(fmt::format("render.source = \"{}\"", enumName(s.render.source)));
         if (r.layout != ReservoirLayout::full) refuse("restir.layout = \"packed\"");

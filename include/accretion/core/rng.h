@@ -18,6 +18,7 @@ enum class RngPass : std::uint32_t {
     presampleRegir = 7,    ///< ReGIR grid: one slot's RIS (and a slot group's tile)
     tileSelection = 8,     ///< light tiles: the tile of a pixel block
     nearLightPilot = 9,    ///< split: the far samples of the pilot that picks k
+    voxelCache = 10,       ///< voxel_cache: a cell's light draws
 };
 
 /// 64-bit finaliser (SplitMix64), a bijection with good avalanche.

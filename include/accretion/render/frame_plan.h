@@ -77,6 +77,8 @@ struct FramePlan {
     /// particle_restir with restir.texel_history: the texels' Lr averaged
     /// with last frame's (in traceShadowRays, whose kernel it ends).
     bool texelHistory = false;
+    /// voxel_cache: updateVoxelCache and shadeVoxelPixels instead of restir's passes.
+    bool voxelCache = false;
     std::vector<PlannedStep> steps;
 
     /// Whether a frame with these facts loads (and builds) its particles: the

@@ -16,7 +16,7 @@
 #include "accretion/render/gbuffer.h"
 #include "accretion/render/frame_plan.h"
 #include "accretion/render/pixel_window.h"
-#include "accretion/render/restir.h"
+#include "accretion/render/voxel_cache.h"
 #include "accretion/scene/settings.h"
 
 namespace accretion {
@@ -114,6 +114,7 @@ private:
         Settings settings;
         FramePlan plan;
         std::unique_ptr<Restir> restir;
+        std::unique_ptr<VoxelCache> voxel;  ///< voxel_cache: the world's cells, kept from frame to frame
     };
     /// What every lane of a frame shares: the camera, the particles and the light sampler.
     struct FrameGeometry;

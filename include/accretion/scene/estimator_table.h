@@ -21,7 +21,7 @@ struct EstimatorInfo {
     bool sums;                ///< sums every light (exact): no samples, no standard error
     LightSamplerKind sampler; ///< the light sampler it draws from itself (ris and restir: their render.source's)
     bool resampling;          ///< draws render.candidates candidates from render.source, keeps one by RIS
-    bool reuse;               ///< reservoirs reused across pixels and frames: restir's passes and history
+    bool reuse;               ///< state reused across pixels and frames (restir's reservoirs, the voxel cache): history frames first, one estimate a pixel
     bool unbiased;            ///< converges to exact whatever its settings (restir: only with a bias correction)
     bool adaptive;            ///< render.target_stderr stops each pixel at its error
     bool twin;                ///< accretion-optix runs it
@@ -29,9 +29,11 @@ struct EstimatorInfo {
     std::string_view summary;
     /// When it is unbiased, where not always (`accretion estimators`).
     std::string_view unbiasedWhen = "with a bias correction";
+    /// Lit from a world-space cache (VoxelCache's passes), not restir's reservoirs.
+    bool worldCache = false;
 };
 
-inline constexpr std::array<EstimatorInfo, 8> kEstimators = {{
+inline constexpr std::array<EstimatorInfo, 9> kEstimators = {{
     {EstimatorKind::exact, true, LightSamplerKind::none, false, false, true, false, true, false,
      "every light i != j with its shadow ray: the reference"},
     {EstimatorKind::uniform, false, LightSamplerKind::none, false, false, true, true, true, false,
@@ -49,6 +51,9 @@ inline constexpr std::array<EstimatorInfo, 8> kEstimators = {{
     {EstimatorKind::particle_restir, false, LightSamplerKind::none, true, true, false, false, true, false,
      "ReSTIR DI on the visible particles' billboard texels (history by particle id, world-space neighbours); pixels interpolate or resample them",
      "pixel_shading resample, with a bias correction (interpolate: no)"},
+    {EstimatorKind::voxel_cache, false, LightSamplerKind::none, false, true, false, false, true, false,
+     "seed 004's voxel radiance cache: lights from render.source at each occupied cell's centre, one shadow ray each, averaged over frames; pixels read it trilinearly",
+     "never (the light at the cells' centres, in an L1 or cosine basis)", true},
 }};
 
 constexpr bool estimatorTableMatchesEnum() {
@@ -124,7 +129,7 @@ template <class Fn> decltype(auto) withLightSource(LightSource kind, Fn&& fn) {
 /// its render.source's.
 constexpr LightSamplerKind samplerFor(const RenderSettings& render) {
     const EstimatorInfo& e = estimatorInfo(render.estimator);
-    return e.resampling ? sourceInfo(render.source).sampler : e.sampler;
+    return e.resampling || e.worldCache ? sourceInfo(render.source).sampler : e.sampler;
 }
 
 /// Whether render.crop traces, lights and holds its window alone (each pixel

@@ -41,8 +41,9 @@ enum class BuildPolicy { rebuild, refit, fast_trace, partial };
 enum class AccelLayout { clusters, instances, aabbs };
 enum class CpuLayout { fastest, gpu };
 enum class ShadingModel { lambert, sphere, isotropic };
-enum class EstimatorKind { exact, uniform, power, ris, restir, tree, split, particle_restir };
+enum class EstimatorKind { exact, uniform, power, ris, restir, tree, split, particle_restir, voxel_cache };
 enum class PixelShading { interpolate, resample };
+enum class VoxelBasis { l1, camera };
 enum class BiasCorrection { none, basic, pairwise };
 enum class ReservoirLayout { full, packed };
 enum class LightSource { uniform, power, tree, tiles, regir };
@@ -62,8 +63,9 @@ ACC_ENUM_NAMES(BuildPolicy, "rebuild", "refit", "fast_trace", "partial");
 ACC_ENUM_NAMES(AccelLayout, "clusters", "instances", "aabbs");
 ACC_ENUM_NAMES(CpuLayout, "fastest", "gpu");
 ACC_ENUM_NAMES(ShadingModel, "lambert", "sphere", "isotropic");
-ACC_ENUM_NAMES(EstimatorKind, "exact", "uniform", "power", "ris", "restir", "tree", "split", "particle_restir");
+ACC_ENUM_NAMES(EstimatorKind, "exact", "uniform", "power", "ris", "restir", "tree", "split", "particle_restir", "voxel_cache");
 ACC_ENUM_NAMES(PixelShading, "interpolate", "resample");
+ACC_ENUM_NAMES(VoxelBasis, "l1", "camera");
 ACC_ENUM_NAMES(BiasCorrection, "none", "basic", "pairwise");
 ACC_ENUM_NAMES(ReservoirLayout, "full", "packed");
 ACC_ENUM_NAMES(LightSource, "uniform", "power", "tree", "tiles", "regir");
@@ -340,6 +342,23 @@ struct RestirSettings {
     }
 };
 
+/// [voxel]: seed 004's voxel radiance cache (docs/MODEL.md section 4b,
+/// docs/designs.md): a world-space grid over the particles whose cells hold
+/// the light arriving at their centres, updated every frame from a ray
+/// budget and read by the pixels by trilinear lookup.
+struct VoxelSettings {
+    std::uint32_t cells = 64;      ///< cells along the longest side of the particles' bounds
+    std::uint32_t rays = 8;        ///< light samples (one shadow ray each) per occupied cell and frame
+    double history = 16.0;         ///< frames a cell averages, at most (1: this frame's rays alone)
+    VoxelBasis basis = VoxelBasis::l1; ///< the cell's directional basis
+    template <class V> void visit(V& v) {
+        v.field("cells", cells, "voxel_cache: cells along the longest side of the particles' bounding box (cubic cells)", Range{1, 1024});
+        v.field("rays", rays, "voxel_cache: lights drawn by power per occupied cell and frame, one shadow ray each from the cell's centre", Range{1, 1024});
+        v.field("history", history, "voxel_cache: a cell's value is the mean of its last min(n, history) frames' (a running mean, then exponential with weight 1/history)", Range{1.0, 1e6});
+        v.field("basis", basis, "voxel_cache: l1 (the incident light's L1 moments: any normal, the clamped cosine by its L1 convolution) or camera (the cosine lobe toward the camera from the cell's centre: billboards)");
+    }
+};
+
 /// An SER sort key as the settings hold it: its components, most
 /// significant first ("hit,type" in a scene file).
 struct SerKeySpec {
@@ -403,6 +422,7 @@ struct Settings {
     ShadingSettings shading;
     RenderSettings render;
     RestirSettings restir;
+    VoxelSettings voxel;
     GpuSettings gpu;
 
     std::string sceneName = "scene"; ///< stem of the scene file
@@ -415,6 +435,7 @@ struct Settings {
         v.section("shading", shading);
         v.section("render", render);
         v.section("restir", restir);
+        v.section("voxel", voxel);
         v.section("gpu", gpu);
     }
 };

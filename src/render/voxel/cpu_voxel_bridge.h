@@ -1,0 +1,138 @@
+#pragma once
+// The CPU's bridge of the voxel cache's pass bodies
+// (accretion/render/voxel_cache_passes.h): the frame's cells, Embree for
+// shadow rays, the thread records of counting mode. Internal to
+// src/render/voxel/.
+#include <cstdint>
+#include <vector>
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include "accretion/counters/gpu_layouts.h"
+#include <algorithm>
+#include <bit>
+
+#include "accretion/lighting/light_arrays.h"
+#include "accretion/lighting/light_tree_view.h"
+#include "accretion/lighting/source_pmf.h"
+#include "accretion/render/visibility.h"
+#include "accretion/render/voxel_cache.h"
+
+namespace accretion::voxel {
+
+/// What both CPU passes read and write.
+struct CpuFrame {
+    const VoxelInputs& in;
+    const VoxelParams& params;
+    const LightArrays& L;
+    SourcePmf source;                        ///< render.source uniform or power
+    LightTreeView tree;                      ///< render.source tree: the light tree, its importance without the cosine (nodes null otherwise)
+    VisibilityOptions vis;
+    bool shadows = true;                     ///< plan.shadowRays
+    const std::vector<std::uint8_t>& occupied;
+    const std::vector<VoxelCell>& cells;     ///< read
+    std::vector<VoxelCell>* written = nullptr;  ///< updateVoxelCache's output
+    std::vector<Vec3>* Lr = nullptr;            ///< shadeVoxelPixels' output
+};
+
+/// One cell's or pixel's bridge, with its thread record in counting mode.
+template <Primitive P, bool Count>
+class CpuVoxelBridge {
+public:
+    CpuVoxelBridge(const CpuFrame& f, ThreadCounters* t, LightingCounters& c) : f_(f), rec_(t), c_(c) {}
+
+    const VoxelParams& params() const { return f_.params; }
+    bool occupied(std::uint32_t c) {
+        rec_.read(1);
+        return f_.occupied[c] != 0;
+    }
+    VoxelCell cell(std::uint32_t c) {
+        rec_.read(sizeof(VoxelCell));
+        rec_.gather(1);
+        return f_.cells[c];
+    }
+    void writeCell(std::uint32_t c, const VoxelCell& v) {
+        rec_.write(sizeof(VoxelCell));
+        (*f_.written)[c] = v;
+    }
+    LightSample sampleLight(const ShadingPoint& sp, PortableRng& rng) {
+        rec_.trip();
+        if (f_.tree.nodes) {
+            const LightSample s = f_.tree.sample(sp, rng);
+            if constexpr (Count) {  // a node pair per level, then the light's record
+                const std::uint32_t levels = std::bit_width(std::max(1u, f_.L.count)) ;
+                rec_.gather(levels + 1);
+                rec_.read(2 * levels * gpu_layout::kLightTreeNode + gpu_layout::kParticleRecord);
+            }
+            return s;
+        }
+        rec_.gather(f_.source.power ? 2 : 1);  // the alias entry, then the light's record
+        rec_.read((f_.source.power ? gpu_layout::kAliasEntry : 0u) + gpu_layout::kParticleRecord);
+        return f_.source.sample(rng);
+    }
+    bool cellTerm(const ShadingPoint& sp, std::uint32_t i, LightTerm& t) {
+        ++c_.lightTerms;
+        return f_.L.term<ShadingModel::isotropic>(sp, i, t);
+    }
+    bool shadows() const { return f_.shadows; }
+    bool visible(const ShadingPoint& sp, std::uint32_t i, const LightTerm& t) {
+        RayCounters rc;
+        const bool seen = accretion::visible<P>(f_.in.bvh, f_.vis, sp, i, f_.L.position[i], f_.L.radius[i], t, rec_.rayCounters(rc));
+        if constexpr (Count) rec_.ray(rc);
+        ++c_.shadowRays;
+        c_.shadowOccluded += !seen;
+        return seen;
+    }
+    GBufferTexel pixel(std::size_t px) {
+        const GBufferTexel& g = f_.in.gbuffer.texels[px];
+        if constexpr (Count) {
+            rec_.read(gpu_layout::kGBufferTexel);
+            if (g.hit()) rec_.shade(true, f_.in.particles.type[g.particle], f_.in.bvh.clusterOf(g.particle));
+        }
+        return g;
+    }
+    ShadingPoint shadingPoint(const GBufferTexel& g) const { return accretion::shadingPoint(g, f_.in.particles); }
+    void writePixelLr(std::size_t px, const Vec3& Lr) {
+        rec_.write(gpu_layout::kRadiance);
+        (*f_.Lr)[px] = Lr;
+    }
+
+private:
+    const CpuFrame& f_;
+    Recorder<Count> rec_;
+    LightingCounters& c_;
+};
+
+/// Runs body(bridge, item) over items [0, n) on every core, each with its
+/// own bridge (and, counting, the thread record `pc->threads[item]`);
+/// returns the threads' counters summed.
+template <Primitive P, bool Count, class Body>
+LightingCounters forEachItem(const CpuFrame& f, std::size_t n, PassCounters* pc, Body&& body) {
+    tbb::enumerable_thread_specific<LightingCounters> counters;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& r) {
+        LightingCounters& c = counters.local();
+        for (std::size_t k = r.begin(); k != r.end(); ++k) {
+            CpuVoxelBridge<P, Count> b(f, Count ? &pc->threads[k] : nullptr, c);
+            body(b, k);
+        }
+    });
+    LightingCounters total;
+    for (const LightingCounters& c : counters) total += c;
+    return total;
+}
+
+/// fn.template operator()<P, Count>() for the frame's primitive and counting mode.
+template <class Fn>
+LightingCounters dispatchVoxel(const CpuFrame& f, Fn&& fn) {
+    const bool spheres = f.in.bvh.settings().primitive == Primitive::sphere;
+    if (f.in.counters)
+        return spheres ? fn.template operator()<Primitive::sphere, true>() : fn.template operator()<Primitive::billboard, true>();
+    return spheres ? fn.template operator()<Primitive::sphere, false>() : fn.template operator()<Primitive::billboard, false>();
+}
+
+// The passes (one file each).
+LightingCounters updateVoxelCache(const CpuFrame& f);
+LightingCounters shadeVoxelPixels(const CpuFrame& f);
+
+}  // namespace accretion::voxel
