@@ -43,8 +43,9 @@ TEST_CASE("bit-identical EXR for 1 and 2 threads", "[cli][determinism]") {
     const auto dir = accretion::test::scratchDir("threads");
     // restir: three frames of temporal + spatial reuse (pairwise, packed
     // reservoirs, reduced resolution); tree: adaptive sampling.
-    const std::string estimator = GENERATE("exact", "power", "uniform", "ris", "tree", "split", "restir", "particle_restir");
-    const bool reuse = estimator == std::string("restir") || estimator == std::string("particle_restir");
+    const std::string estimator = GENERATE("exact", "power", "uniform", "ris", "tree", "split", "restir", "particle_restir", "voxel_cache");
+    const bool reuse = estimator == std::string("restir") || estimator == std::string("particle_restir") ||
+                       estimator == std::string("voxel_cache");
     std::string extra = " --spp 8";
     if (estimator == std::string("tree")) extra += " --target-stderr 5% -D render.max_samples=64";
     // split: k from the pilot (threads work on one cache each); more lights than the near field holds.
@@ -56,6 +57,9 @@ TEST_CASE("bit-identical EXR for 1 and 2 threads", "[cli][determinism]") {
     if (estimator == std::string("particle_restir"))
         extra = " -D render.frames=3 -D restir.texels=2 -D restir.texel_rays=2 -D restir.pixel_shading=\"resample\""
                 " -D particles.gm=40";
+    // voxel_cache: three frames of the cells' running mean, lights from the tree.
+    if (estimator == std::string("voxel_cache"))
+        extra = " -D render.frames=3 -D render.source=\"tree\" -D voxel.cells=16 -D particles.gm=40";
     const std::string last = reuse ? ".0002.exr" : ".exr";
     const std::string pattern = reuse ? ".{frame}.exr" : ".exr";
     std::string out;
