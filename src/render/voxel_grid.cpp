@@ -80,14 +80,14 @@ std::vector<std::uint8_t> occupiedCells(const voxel::VoxelGrid& grid, const Part
 }
 
 voxel::VoxelParams voxelParams(const Settings& s, const VoxelPlacement& placement, const Vec3& origin, const Camera& camera,
-                               std::uint32_t frame) {
+                               std::uint32_t frame, std::uint64_t seed) {
     voxel::VoxelParams p;
     p.grid = placement.inFrame(origin);
     p.rays = s.voxel.rays;
     p.history = float(s.voxel.history);
     p.basis = s.voxel.basis;
     p.frame = frame;
-    p.seed = s.render.seed;
+    p.seed = seed;
     p.camera = camera.position;
     p.facesPlane = s.geometry.orientation == Orientation::view_plane;
     p.planeNormal = -camera.forward;

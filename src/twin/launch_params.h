@@ -13,6 +13,7 @@
 #include "accretion/geometry/camera.h"
 #include "accretion/render/gbuffer_texel.h"
 #include "accretion/render/restir_passes.h"
+#include "accretion/render/voxel_cache_passes.h"
 #include "accretion/render/shadow_query.h"
 #include "accretion/scene/settings.h"
 
@@ -86,6 +87,17 @@ struct RestirParams {
     const Vec3* prevTexelLr = nullptr;          ///< restir.texel_history: last frame's texel Lr
 };
 
+/// voxel_cache (voxel_cache_passes.h) as the CPU's VoxelCache runs it: the
+/// cells read (last frame's in updateVoxelCache, this frame's in
+/// shadeVoxelPixels) and written, double-buffered so that a timed pass
+/// run again computes the same cells.
+struct VoxelLaunch {
+    voxel::VoxelParams params;
+    const std::uint8_t* occupied = nullptr;  ///< per cell: a particle reaches it
+    const voxel::VoxelCell* read = nullptr;
+    voxel::VoxelCell* write = nullptr;
+};
+
 struct LaunchParams {
     OptixTraversableHandle tlas = 0;
     Camera camera;                       ///< frame coordinates (origin at the first camera)
@@ -118,6 +130,7 @@ struct LaunchParams {
     LightTreeView tree;                  ///< render.source = "tree": the CPU's light tree (nodes null otherwise)
     SamplingParams sampling;
     RestirParams restir;
+    VoxelLaunch voxel;
 
     // Outputs.
     GBufferTexel* gbuffer = nullptr;     ///< width x height

@@ -18,6 +18,7 @@
 #include "accretion/render/shadow_query.h"
 #include "launch_params.h"
 #include "device_bridge.h"
+#include "voxel_device.h"
 #include "restir_device.h"
 
 using namespace accretion;
@@ -211,6 +212,17 @@ __device__ void resampleParticlePixel() {
 }
 
 }  // namespace
+
+/// voxel_cache's updateVoxelCache: voxel_cache_passes.h's body at cell
+/// (y nx + x) of the grid, with OptiX's shadow rays.
+extern "C" __global__ void __raygen__updateVoxelCache() {
+    const uint3 idx = optixGetLaunchIndex();
+    const std::uint32_t c = idx.y * params.voxel.params.grid.nx + idx.x;
+    LaunchCounters counters;
+    VoxelBridge<OptixShadowRays<false>> b(params, OptixShadowRays<false>{&counters}, &counters);
+    voxel::updateVoxelCell(b, c);
+    addCounters(counters);
+}
 
 extern "C" __global__ void __raygen__shadeParticlePixels() {
     switch (params.model) {

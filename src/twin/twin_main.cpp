@@ -40,7 +40,9 @@
 #include "gather_particle_texels.h"
 #include "optix_pipeline.h"
 #include "particle_accel.h"
+#include "accretion/render/voxel_grid.h"
 #include "restir_kernels.h"
+#include "voxel_kernels.h"
 
 #ifndef ACCRETION_TWIN_PROGRAMS
 #define ACCRETION_TWIN_PROGRAMS "programs.optixir"
@@ -94,6 +96,7 @@ struct FrameBuffers {
     DeviceBuffer aliasProb, aliasAlias, aliasPmf;  // power: the alias table
     DeviceBuffer treeNodes;                       // tree: the light tree's nodes
     DeviceBuffer Lr_stderr, spp, rejectedSamples;  // uniform / power
+    DeviceBuffer voxelCells[2], voxelOccupied;      // voxel_cache: last frame's cells and this frame's; the reached cells
 };
 
 void copyDevice(DeviceBuffer& to, const DeviceBuffer& from, std::size_t bytes, cudaStream_t stream) {
@@ -118,6 +121,7 @@ public:
     void restart() {
         history_ = built_ = false;
         prevCount_ = 0;
+        voxelPlacement_ = VoxelPlacement{};
     }
     /// Render, time and write one frame (a .gpuframe and its stats record).
     void renderFrame(std::uint32_t frame, std::uint64_t seed);
@@ -132,6 +136,8 @@ private:
     LaunchParams launchParams(const FramePlan& plan, const Camera& camera, const Particles& particles,
                               std::uint32_t frame, std::uint64_t seed);
     StoredReservoir* runRestir(const FramePlan& plan, LaunchParams& lp);
+    void placeVoxels(const Particles& particles);
+    void runVoxelCache(LaunchParams& lp);
     StepTimes runPasses(const FramePlan& plan, LaunchParams& lp, const Clusters& clusters, bool recluster,
                         LaunchCounters& counters, StoredReservoir*& finalReservoirs);
     void keepHistory(const Camera& camera, std::size_t particleCount, const StoredReservoir* finalReservoirs);
@@ -164,6 +170,8 @@ private:
     std::uint32_t prevCount_ = 0;
     Clusters clusters_;
     Vec3 origin_{0.0f};
+    VoxelPlacement voxelPlacement_;  ///< voxel_cache: where its grid lies (the CPU's VoxelCache's rule)
+    unsigned voxelLast_ = 0;         ///< voxel_cache: buf_.voxelCells[voxelLast_] holds last frame's cells
     Particles particles_;  ///< this frame's, rebased to origin_
     std::map<std::uint32_t, Particles> loaded_;  ///< --seeds: each frame's particles, loaded once
     nlohmann::json stats_;
@@ -179,7 +187,8 @@ FrameFacts planningFacts(const Args& a) {
 TwinRun::TwinRun(const Args& a, const Settings& settings)
     : a_(a), s_(settings), settingsToml_(settingsToToml(settings)), source_(settings), cameras_(settings.camera),
       W_(settings.camera.width), H_(settings.camera.height), runPlan_(planFrame(settings, planningFacts(a))),
-      sampling_(!a.skipLighting && !estimatorInfo(settings.render.estimator).sums && !estimatorInfo(settings.render.estimator).resampling),
+      sampling_(!a.skipLighting && !estimatorInfo(settings.render.estimator).sums && !estimatorInfo(settings.render.estimator).resampling &&
+                !estimatorInfo(settings.render.estimator).reuse),
       lightingPlan_(planLighting(settings.render, H_)),
       omm_(settings.geometry.alpha == AlphaMode::disc && settings.gpu.omm != OmmMode::off) {
     if (a.shadowRays == "traverse" || a.shadowRays == "reorder") shade_ = Raygen::shadeTraverse;
@@ -341,6 +350,7 @@ LaunchParams TwinRun::launchParams(const FramePlan& plan, const Camera& camera, 
         sp.spp = buf_.spp.as<float>();
         sp.rejected = buf_.rejectedSamples.as<std::uint32_t>();
     }
+    if (plan.voxelCache) lp.voxel.params = voxelParams(s_, voxelPlacement_, origin_, camera, frame, seed);
     if (plan.restir) {
         RestirParams& rp = lp.restir;
         const RestirSettings& rs = s_.restir;
@@ -471,6 +481,45 @@ StoredReservoir* TwinRun::runRestir(const FramePlan& plan, LaunchParams& lp) {
     return a;
 }
 
+/// voxel_cache's grid: kept while it holds the particles, else placed again
+/// and its cells emptied (the CPU's VoxelCache::render).
+void TwinRun::placeVoxels(const Particles& particles) {
+    if (voxelPlacement_.holds(particles, origin_)) return;
+    voxelPlacement_ = placeVoxelGrid(particles, origin_, s_.voxel.cells);
+    const std::size_t cells = voxelPlacement_.cells();
+    for (DeviceBuffer& b : buf_.voxelCells) {
+        b.reserve(cells * sizeof(voxel::VoxelCell));
+        CUDA_CHECK(cudaMemsetAsync(b.as<void>(), 0, cells * sizeof(voxel::VoxelCell), stream_));
+    }
+    buf_.voxelOccupied.reserve(cells);
+    voxelLast_ = 0;
+}
+
+/// voxel_cache's passes (the CPU's VoxelCache::render): updateVoxelCache
+/// (the reached cells marked, then a raygen per cell reading last frame's
+/// cells and writing this frame's) and shadeVoxelPixels (a kernel per
+/// pixel). Run again, they compute the same cells: last frame's stay.
+void TwinRun::runVoxelCache(LaunchParams& lp) {
+    VoxelLaunch& v = lp.voxel;
+    const voxel::VoxelGrid& grid = v.params.grid;
+    voxel::VoxelCell* next = buf_.voxelCells[voxelLast_ ^ 1u].as<voxel::VoxelCell>();
+    {
+        GpuScope t(*timer_, Pass::updateVoxelCache);
+        markVoxelCells(lp, buf_.voxelOccupied.as<std::uint8_t>(), grid.count(), stream_);
+        v.occupied = buf_.voxelOccupied.as<std::uint8_t>();
+        v.read = buf_.voxelCells[voxelLast_].as<voxel::VoxelCell>();
+        v.write = next;
+        CUDA_CHECK(cudaMemcpyAsync(buf_.params.as<void>(), &lp, sizeof lp, cudaMemcpyHostToDevice, stream_));
+        pipeline_->launch(Raygen::updateVoxelCache, buf_.params.address(), sizeof lp, grid.nx, grid.ny * grid.nz, stream_);
+    }
+    {
+        GpuScope t(*timer_, Pass::shadeVoxelPixels);
+        v.read = next;
+        shadeVoxelPixels(lp, stream_);
+    }
+    CUDA_CHECK(cudaGetLastError());
+}
+
 /// The frame's passes: one counting run (its atomics would be timed too),
 /// then `repeat` timed runs when repeat > 1. A rebuild runs in every run;
 /// so does a refit (of positions that have not moved since the first run:
@@ -500,6 +549,8 @@ StepTimes TwinRun::runPasses(const FramePlan& plan, LaunchParams& lp, const Clus
         }
         if (plan.restir) {
             finalReservoirs = runRestir(plan, lp);
+        } else if (plan.voxelCache) {
+            runVoxelCache(lp);
         } else if (plan.lighting) {
             GpuScope s(*timer_, Pass::estimateLighting);
             pipeline_->launch(sampling_ ? Raygen::sample : Raygen::exact, buf_.params.address(), sizeof lp, W_, H_, stream_);
@@ -596,11 +647,13 @@ void TwinRun::renderFrame(std::uint32_t frame, std::uint64_t seed) {
     if (recluster) clusters_ = clusters;
     uploadClusterHint(particles, recluster, frame == s_.render.frame_start);
 
+    if (plan.voxelCache) placeVoxels(particles);
     LaunchParams lp = launchParams(plan, camera, particles, frame, seed);
     LaunchCounters counters{};
     StoredReservoir* finalReservoirs = nullptr;
     const StepTimes ms = runPasses(plan, lp, clusters, recluster, counters, finalReservoirs);
     built_ = true;
+    if (plan.voxelCache) voxelLast_ ^= 1u;  // this frame's cells are the next one's last
     keepHistory(camera, n, finalReservoirs);
 
     std::size_t hits = 0, nonFinite = 0;

@@ -25,6 +25,7 @@
 #include "accretion/render/restir_passes.h"
 #include "accretion/render/sample_sums.h"
 #include "accretion/render/restir_steps.h"
+#include "accretion/render/voxel_cache_passes.h"
 
 namespace {
 
@@ -313,6 +314,72 @@ ACC_HD void loopCase(int k, const PassInputs* variants, Out& o) {
     o = Out{{lo(sums.sum.x), lo(sums.sum.y), lo(sums.sum.z), lo(sums.sumSq.x), lo(sums.sumSq.y), lo(sums.sumSq.z), sums.n, 2u}};
 }
 
+// ---------------------------------------------------------------- the voxel cache
+// voxel_cache_passes.h's bodies over a bridge of plain arrays, on the
+// passes' lights: a grid over them, every third cell unoccupied, last
+// frame's cells a fixed function of the cell; lights uniform from the
+// cell's stream, visibility a fixed function of (cell, light). Case k <
+// kVoxelCells updates cell k; the rest shade each texel of the passes' grid
+// in l1 and camera (lambert) and isotropic.
+
+constexpr std::uint32_t kVoxelNx = 20, kVoxelNy = 8, kVoxelNz = 14;
+constexpr int kVoxelCells = int(kVoxelNx * kVoxelNy * kVoxelNz);
+constexpr int kVoxelCases = kVoxelCells + 3 * int(kGridW * kGridH);
+
+struct VoxelCheckBridge {
+    const PassInputs& in;
+    const voxel::VoxelParams& p;
+    voxel::VoxelCell* written;
+    Vec3* Lr;
+    ACC_HD const voxel::VoxelParams& params() const { return p; }
+    ACC_HD bool occupied(std::uint32_t c) const { return c % 3u != 0u; }
+    ACC_HD voxel::VoxelCell cell(std::uint32_t c) const {
+        voxel::VoxelCell v;
+        v.A = Vec3(float(c % 7u), float(c % 5u), float(c % 3u)) * 0.5f;
+        v.Bx = Vec3(0.1f * float(c % 11u) - 0.5f);
+        v.By = Vec3(0.05f * float(c % 13u));
+        v.Bz = Vec3(-0.02f * float(c % 17u));
+        v.C = 0.3f * v.A;
+        v.frames = float(c % 4u);
+        return v;
+    }
+    ACC_HD void writeCell(std::uint32_t, const voxel::VoxelCell& v) const { *written = v; }
+    ACC_HD LightSample sampleLight(const ShadingPoint&, PortableRng& g) const {
+        return {g.uniformInt(in.particles), 1.0f / float(in.particles)};
+    }
+    ACC_HD bool cellTerm(const ShadingPoint& sp, std::uint32_t i, LightTerm& t) const {
+        if (i >= in.particles) return false;
+        return evalLight<ShadingModel::isotropic>(sp, in.historyPositions[i], in.emission[i], 0.01f, t);
+    }
+    ACC_HD bool shadows() const { return true; }
+    ACC_HD bool visible(const ShadingPoint& sp, std::uint32_t i, const LightTerm&) const { return (bits(sp.x.x) ^ (i * 7u)) % 5u != 0u; }
+    ACC_HD GBufferTexel pixel(std::size_t px) const { return in.texels[px]; }
+    ACC_HD ShadingPoint shadingPoint(const GBufferTexel& g) const {
+        const Vec3 c = in.historyPositions[g.particle];
+        return {c + g.local, g.normal, g.geomNormal, Vec3(0.7f), g.particle, c, g.local};
+    }
+    ACC_HD void writePixelLr(std::size_t, const Vec3& v) const { *Lr = v; }
+};
+
+ACC_HD void voxelCase(int k, const PassInputs* variants, const voxel::VoxelParams* params, Out& o) {
+    const PassInputs& in = variants[0];
+    voxel::VoxelCell c;
+    Vec3 Lr(-1.0f);
+    if (k < kVoxelCells) {
+        VoxelCheckBridge b{in, params[0], &c, &Lr};
+        voxel::updateVoxelCell(b, std::uint32_t(k));
+        o = Out{{bits(c.A.x), bits(c.A.y), bits(c.A.z), bits(c.Bx.x), bits(c.By.y), bits(c.Bz.z), bits(c.C.x), bits(c.frames)}};
+        return;
+    }
+    const std::uint32_t texels = kGridW * kGridH;
+    const int variant = (k - kVoxelCells) / int(texels);
+    const std::size_t px = std::size_t(k - kVoxelCells) % texels;
+    VoxelCheckBridge b{in, params[variant == 1 ? 1 : 0], &c, &Lr};
+    if (variant == 2) voxel::shadeVoxelPixel<ShadingModel::isotropic>(b, px);
+    else voxel::shadeVoxelPixel<ShadingModel::lambert>(b, px);
+    o = Out{{bits(Lr.x), bits(Lr.y), bits(Lr.z), 3u, 0u, 0u, 0u, 0u}};
+}
+
 // ---------------------------------------------------------------- the hosts
 
 struct Inputs {
@@ -321,11 +388,12 @@ struct Inputs {
     StoredReservoir* offers;
     float* shades;
     PassInputs* passes;  ///< none, basic, pairwise
+    voxel::VoxelParams* voxel;  ///< l1, camera
 };
 
-enum class Step { neighbours, reprojections, caps, candidates, combines, shades, passes, loops };
+enum class Step { neighbours, reprojections, caps, candidates, combines, shades, passes, loops, voxels };
 constexpr Step kSteps[] = {Step::neighbours, Step::reprojections, Step::caps, Step::candidates, Step::combines, Step::shades,
-                           Step::passes, Step::loops};
+                           Step::passes, Step::loops, Step::voxels};
 
 ACC_HD int caseCount(Step s) {
     switch (s) {
@@ -337,6 +405,7 @@ ACC_HD int caseCount(Step s) {
         case Step::shades: return kShades;
         case Step::passes: return kPassCases;
         case Step::loops: return kLoopCases;
+        case Step::voxels: return kVoxelCases;
     }
     return 0;
 }
@@ -351,6 +420,7 @@ ACC_HD void runCase(Step s, int k, const Inputs& in, Out& o) {
         case Step::shades: shadeCase(k, in.shades, o); break;
         case Step::passes: passCase(k, in.passes, o); break;
         case Step::loops: loopCase(k, in.passes, o); break;
+        case Step::voxels: voxelCase(k, in.passes, in.voxel, o); break;
     }
 }
 
@@ -369,6 +439,7 @@ const char* stepName(Step s) {
         case Step::shades: return "shadeSample/occludedReservoir";
         case Step::passes: return "the pass bodies (restir_passes.h)";
         case Step::loops: return "exact and uniform loops (light_estimates.h)";
+        case Step::voxels: return "the voxel cache's bodies (voxel_cache_passes.h)";
     }
     return "?";
 }
@@ -494,9 +565,26 @@ int main() {
         devicePasses.push_back({params, bias, dGrid, dCurrent, dHistory, dCentres, texels, gridCam, dEmission});
     }
 
+    // The voxel grid over the passes' points (depth 20-30 before the camera
+    // at z = 30), in l1 and camera bases.
+    std::vector<voxel::VoxelParams> voxels(2);
+    for (int b = 0; b < 2; ++b) {
+        voxel::VoxelParams& v = voxels[b];
+        v.grid.lower = Vec3(-12.0f, -4.0f, -2.0f);
+        v.grid.cellSize = 1.2f;
+        v.grid.invCellSize = 1.0f / 1.2f;
+        v.grid.nx = kVoxelNx, v.grid.ny = kVoxelNy, v.grid.nz = kVoxelNz;
+        v.rays = 6;
+        v.history = 3.0f;
+        v.basis = b == 0 ? VoxelBasis::l1 : VoxelBasis::camera;
+        v.frame = 4;
+        v.seed = 13;
+        v.camera = gridCam.position;
+        v.facesPlane = false;
+    }
     const Inputs host{Camera::lookAt(Vec3(0.0f, 7.0f, 17.0f), Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f), 45.0, 320, 180), points.data(),
-                      offers.data(), shades.data(), hostPasses.data()};
-    const Inputs device{host.cam, toDevice(points), toDevice(offers), toDevice(shades), toDevice(devicePasses)};
+                      offers.data(), shades.data(), hostPasses.data(), voxels.data()};
+    const Inputs device{host.cam, toDevice(points), toDevice(offers), toDevice(shades), toDevice(devicePasses), toDevice(voxels)};
 
     std::printf("shared_core_check: %s, CUDA %d.%d; host results from the host compiler, device results from sm_%d%d\n",
                 prop.name, CUDART_VERSION / 1000, (CUDART_VERSION % 1000) / 10, prop.major, prop.minor);

@@ -42,6 +42,6 @@ std::vector<std::uint8_t> occupiedCells(const voxel::VoxelGrid& grid, const Part
 /// The frame's VoxelParams (the grid in its coordinates, the settings, the
 /// camera): the CPU and the twin both make theirs here.
 voxel::VoxelParams voxelParams(const Settings& s, const VoxelPlacement& placement, const Vec3& origin, const Camera& camera,
-                               std::uint32_t frame);
+                               std::uint32_t frame, std::uint64_t seed);
 
 }  // namespace accretion

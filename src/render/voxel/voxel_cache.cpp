@@ -25,7 +25,7 @@ LightingCounters VoxelCache::render(const VoxelInputs& in, LightingImage& out, P
         ++placements_;
         cells_.assign(placement_.cells(), voxel::VoxelCell{});
     }
-    const voxel::VoxelParams params = voxelParams(in.settings, placement_, in.origin, in.camera, in.frame);
+    const voxel::VoxelParams params = voxelParams(in.settings, placement_, in.origin, in.camera, in.frame, in.settings.render.seed);
     const LightArrays L(in.particles, in.settings.shading);
     std::vector<voxel::VoxelCell> next(cells_.size());
     LightingCounters counters;
