@@ -90,6 +90,17 @@ restir_case prt_interp prt_interp -D render.estimator=particle_restir -D restir.
 restir_case prt_resample prt_resample -D render.estimator=particle_restir -D restir.bias_correction=pairwise -D restir.pixel_shading=resample
 restir_case prt_2x2_k2 prt_2x2_k2 -D render.estimator=particle_restir -D restir.texels=2 -D restir.texel_rays=2
 restir_case prt_history prt_history -D render.estimator=particle_restir -D restir.texel_rays=4 -D restir.texel_history=0.5 -D restir.spatial_neighbours=0
+# voxel_cache (run.sh voxels): the cells and the pixels read from them, frames 0-2.
+voxel_case() {
+    local gpu=$1
+    shift
+    [ -f "$T/$gpu.0000.exr" ] || return 0
+    cpu "$gpu" 0:3 -D render.estimator=voxel_cache "$@"
+    for f in 0 1 2; do compare "voxel_cache $gpu" $f "$T/$gpu.000$f.exr" "$T/cpu_$gpu.000$f.exr"; done
+}
+voxel_case vox_tree -D render.source=tree
+voxel_case vox_power_camera -D render.source=power -D voxel.basis=camera
+voxel_case vox_uniform_h1 -D render.source=uniform -D voxel.history=1 -D voxel.cells=16
 
 # uniform and power (one frame): Lr, its standard error and the samples taken.
 declare -A sampled=(

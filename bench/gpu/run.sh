@@ -1,7 +1,7 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine, from the repository root:
 #   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
-#                                      layout_images layouts streams front identity shared_core ab designs
+#                                      layout_images layouts streams front identity shared_core ab designs voxels
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -268,6 +268,23 @@ step_designs() {
     # The flattened cluster from raw buffers (made here: they are not committed).
     python3 scenes/cluster/make_cluster.py 3
     time_configs designs/cluster bench/gpu/designs_cluster.txt 5 1/1 scenes/cluster_150k.toml
+}
+
+# seed 004's voxel radiance cache (designs.txt's vox_ lines, 100K and 1M at
+# 1080p), timed as the designs are, beside today's recommendations and
+# particle_restir's best timed again in the same run; and its frames on
+# quickstart at 320x180 (frames 0-2) for the per-pixel comparison with the
+# CPU (compare_cpu.sh).
+step_voxels() {
+    local q=scenes/quickstart.toml small="-D camera.width=320 -D camera.height=180 -D render.estimator=voxel_cache"
+    local t="$W/voxels/images"
+    mkdir -p "$t"
+    one() { local name=$1; shift; $BIN $q $small --frames 0:3 --repeat 1 -q -o "$t/$name.{frame}.exr" "$@" || echo "voxels: $name failed"; }
+    one vox_tree -D render.source=tree
+    one vox_power_camera -D render.source=power -D voxel.basis=camera
+    one vox_uniform_h1 -D render.source=uniform -D voxel.history=1 -D voxel.cells=16
+    grep -E '^(vox_|restir_m32_t_basic_1x_100k|restir_m32_t_pairwise_05x_1m|prt_m8_k16_100k|prt_m8_k4_1m) ' bench/gpu/designs.txt > "$W/voxels.txt"
+    time_configs voxels "$W/voxels.txt" 5
 }
 
 # The configurations on tune's Pareto fronts (bench/gpu/front.txt, written

@@ -64,7 +64,7 @@ struct TuneArgs : SceneArgs {
     std::string cropSize = "160x90";    ///< each crop's size at the scene's resolution
     std::uint32_t cropMargin = 32;      ///< the pixels around a crop restir renders for its reuse
     std::string space = "quick";
-    std::vector<std::string> designs{"restir", "particle_restir"};
+    std::vector<std::string> designs{"restir", "particle_restir", "voxel_cache"};
     std::vector<std::string> references;  ///< --reference: one per crop
     std::uint32_t referenceSpp = 1024;
     std::string out, cache;
@@ -121,13 +121,16 @@ std::vector<GeometryChoice> geometryChoices(const Settings& s) {
     return out;
 }
 
-/// The design a lighting choice runs: restir per pixel, or particle_restir
+/// The design a lighting choice runs: restir per pixel, particle_restir
 /// per particle texel (texels per side, reservoirs a texel, how the pixels
-/// read them).
+/// read them), or voxel_cache in world cells (cells along the longest side,
+/// rays a cell, its basis).
 struct Design {
     EstimatorKind estimator = EstimatorKind::restir;
     std::uint32_t texels = 1, texelRays = 1;
     PixelShading shading = PixelShading::interpolate;
+    std::uint32_t cells = 64, cellRays = 8;
+    VoxelBasis basis = VoxelBasis::camera;
 };
 
 /// A lighting choice: its design (restir or particle_restir), candidate
@@ -144,7 +147,10 @@ struct LightingChoice {
     Design design{};
 
     bool particles() const { return design.estimator == EstimatorKind::particle_restir; }
+    bool voxels() const { return design.estimator == EstimatorKind::voxel_cache; }
     std::string label() const {
+        if (voxels())
+            return fmt::format("voxels {} cells={} rays={} {}", enumName(source), design.cells, design.cellRays, enumName(design.basis));
         if (particles())
             return fmt::format("particles {} M={} {}x{}xK{} nb={}x{} {}{} {}", enumName(source), candidates, design.texels,
                                design.texels, design.texelRays, neighbours, iterations, enumName(bias), visibilityReuse ? "+vis" : "",
@@ -154,6 +160,10 @@ struct LightingChoice {
     }
     /// As -D overrides of the measurements' child processes (and their cache keys).
     std::vector<std::string> defines() const {
+        if (voxels())  // the cache's own settings alone: restir's would only split its cache keys
+            return {"render.estimator=voxel_cache", fmt::format("render.source={}", enumName(source)),
+                    fmt::format("voxel.cells={}", design.cells), fmt::format("voxel.rays={}", design.cellRays),
+                    fmt::format("voxel.basis={}", enumName(design.basis))};
         std::vector<std::string> d = restirDefines();
         if (particles()) {
             d.front() = "render.estimator=particle_restir";
@@ -179,7 +189,8 @@ private:
 };
 
 /// The lighting choices of `space`: quick, 34 restir points around the GPU
-/// team's settings and 8 of particle_restir; full, the whole grids (hours).
+/// team's settings, 8 of particle_restir and 2 of voxel_cache; full, the
+/// whole grids (hours).
 std::vector<LightingChoice> lightingChoices(const std::string& space) {
     struct Axes {
         std::vector<LightSource> sources;
@@ -229,17 +240,33 @@ std::vector<LightingChoice> lightingChoices(const std::string& space) {
                     for (const BiasCorrection bc : x.corrections)
                         for (const PixelShading sh : {PixelShading::interpolate, PixelShading::resample})
                             designs.push_back({LightSource::tree, m, nb, it, bc, false, 1.0, particles(1, k, sh)});
+    // voxel_cache (seed 004's radiance cache): light-tree rays from the
+    // cells, the cosine lobe toward the camera (the billboards' normal).
+    const auto voxels = [](std::uint32_t cells, std::uint32_t rays, VoxelBasis basis) {
+        Design d{EstimatorKind::voxel_cache};
+        d.cells = cells, d.cellRays = rays, d.basis = basis;
+        return LightingChoice{LightSource::tree, 0, 0, 1, basic, false, 1.0, d};
+    };
+    designs.push_back(voxels(64, 8, VoxelBasis::camera));
+    designs.push_back(voxels(128, 16, VoxelBasis::camera));
+    if (space == "full")
+        for (std::uint32_t cells : {32u, 64u, 128u, 256u})
+            for (std::uint32_t rays : {4u, 8u, 16u, 32u})
+                for (const VoxelBasis basis : {VoxelBasis::l1, VoxelBasis::camera})
+                    if (!(rays == 8 && cells == 64 && basis == VoxelBasis::camera) && !(rays == 16 && cells == 128 && basis == VoxelBasis::camera))
+                        designs.push_back(voxels(cells, rays, basis));
     out.insert(out.end(), designs.begin(), designs.end());
     return out;
 }
 
-/// The choices of the designs named by --designs (restir, particle_restir).
+/// The choices of the designs named by --designs (restir, particle_restir, voxel_cache).
 std::vector<LightingChoice> designChoices(const std::vector<LightingChoice>& all, const std::vector<std::string>& designs) {
     std::vector<LightingChoice> out;
     for (const std::string& d : designs) {
         EstimatorKind kind{};
-        if (!parseEnum(d, kind) || (kind != EstimatorKind::restir && kind != EstimatorKind::particle_restir))
-            throw InputError(fmt::format("command line --designs {}: expected restir or particle_restir", d));
+        if (!parseEnum(d, kind) ||
+            (kind != EstimatorKind::restir && kind != EstimatorKind::particle_restir && kind != EstimatorKind::voxel_cache))
+            throw InputError(fmt::format("command line --designs {}: expected restir, particle_restir or voxel_cache", d));
         if (std::count(designs.begin(), designs.end(), d) > 1)
             throw InputError(fmt::format("command line --designs {}: named twice", d));
         for (const LightingChoice& c : all)
@@ -792,7 +819,7 @@ Table lightingTable(const TuneArgs& a, const TuneResult& r) {
     return lt;
 }
 
-/// Per design (restir, particle_restir), its point of lowest relMSE under
+/// Per design (restir, particle_restir, voxel_cache), its point of lowest relMSE under
 /// the budget (biased points only with --allow-biased).
 std::map<std::string, const ParetoPoint*> bestPerDesign(const TuneArgs& a, const TuneResult& r) {
     std::map<std::string, const ParetoPoint*> best;
@@ -983,9 +1010,9 @@ void addTuneCommand(CLI::App& app) {
     cmd->add_option("--crop-size", args->cropSize, "Each crop's size in pixels, WIDTHxHEIGHT");
     cmd->add_option("--crop-margin", args->cropMargin, "The pixels around each crop that restir renders for its reuse (restir.crop_margin)")
         ->check(CLI::Range(0u, 16384u));
-    cmd->add_option("--designs", args->designs, "the designs searched: restir (per pixel), particle_restir (per particle texel); both by default")
+    cmd->add_option("--designs", args->designs, "the designs searched: restir (per pixel), particle_restir (per particle texel), voxel_cache (world cells); all by default")
         ->delimiter(',');
-    cmd->add_option("--space", args->space, "quick (34 restir and 8 particle_restir configurations) or full (1080 and 488: hours)");
+    cmd->add_option("--space", args->space, "quick (34 restir, 8 particle_restir and 2 voxel_cache configurations) or full (1080, 488 and 32: hours)");
     cmd->add_option("--reference", args->references,
                     "Reference EXRs of --frame, one per crop in stratum order, row by row (default: rendered once, exact up to 20K "
                     "particles, else split)")
