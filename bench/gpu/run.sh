@@ -283,7 +283,7 @@ step_voxels() {
     one vox_tree -D render.source=tree
     one vox_power_camera -D render.source=power -D voxel.basis=camera
     one vox_uniform_h1 -D render.source=uniform -D voxel.history=1 -D voxel.cells=16
-    grep -E '^(vox_|restir_m32_t_basic_1x_100k|restir_m32_t_pairwise_05x_1m|prt_m8_k16_100k|prt_m8_k4_1m) ' bench/gpu/designs.txt > "$W/voxels.txt"
+    grep -E '^(vox_[a-z0-9_]*|restir_m32_t_basic_1x_100k|restir_m32_t_pairwise_05x_1m|prt_m8_k16_100k|prt_m8_k4_1m) ' bench/gpu/designs.txt > "$W/voxels.txt"
     time_configs voxels "$W/voxels.txt" 5
 }
 
