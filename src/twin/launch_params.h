@@ -90,12 +90,14 @@ struct RestirParams {
 /// voxel_cache (voxel_cache_passes.h) as the CPU's VoxelCache runs it: the
 /// cells read (last frame's in updateVoxelCache, this frame's in
 /// shadeVoxelPixels) and written, double-buffered so that a timed pass
-/// run again computes the same cells.
+/// run again computes the same cells; each cell's rays, traced one a
+/// thread, then summed per cell in order.
 struct VoxelLaunch {
     voxel::VoxelParams params;
     const std::uint8_t* occupied = nullptr;  ///< per cell: a particle reaches it
     const voxel::VoxelCell* read = nullptr;
     voxel::VoxelCell* write = nullptr;
+    voxel::CellRay* rays = nullptr;          ///< cell c's ray r at c x params.rays + r
 };
 
 struct LaunchParams {

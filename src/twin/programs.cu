@@ -213,14 +213,18 @@ __device__ void resampleParticlePixel() {
 
 }  // namespace
 
-/// voxel_cache's updateVoxelCache: voxel_cache_passes.h's body at cell
-/// (y nx + x) of the grid, with OptiX's shadow rays.
+/// voxel_cache's updateVoxelCache, its rays: one thread per ray of each
+/// occupied cell (launch x = cell x * rays + ray, y = cell y + z ny),
+/// voxel_cache_passes.h's traceCellRay with OptiX's shadow rays, written for
+/// the per-cell sum (voxel_kernels.cu).
 extern "C" __global__ void __raygen__updateVoxelCache() {
     const uint3 idx = optixGetLaunchIndex();
-    const std::uint32_t c = idx.y * params.voxel.params.grid.nx + idx.x;
+    const VoxelLaunch& v = params.voxel;
+    const std::uint32_t rays = v.params.rays, c = idx.y * v.params.grid.nx + idx.x / rays, r = idx.x % rays;
+    if (!v.occupied[c]) return;
     LaunchCounters counters;
     VoxelBridge<OptixShadowRays<false>> b(params, OptixShadowRays<false>{&counters}, &counters);
-    voxel::updateVoxelCell(b, c);
+    v.rays[std::size_t(c) * rays + r] = voxel::traceCellRay(b, c, r);
     addCounters(counters);
 }
 

@@ -96,7 +96,7 @@ struct FrameBuffers {
     DeviceBuffer aliasProb, aliasAlias, aliasPmf;  // power: the alias table
     DeviceBuffer treeNodes;                       // tree: the light tree's nodes
     DeviceBuffer Lr_stderr, spp, rejectedSamples;  // uniform / power
-    DeviceBuffer voxelCells[2], voxelOccupied;      // voxel_cache: last frame's cells and this frame's; the reached cells
+    DeviceBuffer voxelCells[2], voxelOccupied, voxelRays;  // voxel_cache: last frame's cells and this frame's; the reached cells; their rays
 };
 
 void copyDevice(DeviceBuffer& to, const DeviceBuffer& from, std::size_t bytes, cudaStream_t stream) {
@@ -492,13 +492,20 @@ void TwinRun::placeVoxels(const Particles& particles) {
         CUDA_CHECK(cudaMemsetAsync(b.as<void>(), 0, cells * sizeof(voxel::VoxelCell), stream_));
     }
     buf_.voxelOccupied.reserve(cells);
+    if (double(cells) * s_.voxel.rays > double(1u << 30))
+        throw InputError(fmt::format("voxel.cells = {} with voxel.rays = {}: {} rays a frame, more than an OptiX launch holds (2^30)",
+                                     s_.voxel.cells, s_.voxel.rays, double(cells) * s_.voxel.rays));
+    buf_.voxelRays.reserve(cells * s_.voxel.rays * sizeof(voxel::CellRay));
     voxelLast_ = 0;
 }
 
 /// voxel_cache's passes (the CPU's VoxelCache::render): updateVoxelCache
-/// (the reached cells marked, then a raygen per cell reading last frame's
-/// cells and writing this frame's) and shadeVoxelPixels (a kernel per
-/// pixel). Run again, they compute the same cells: last frame's stay.
+/// (the reached cells marked; a raygen over their rays, one a thread: a
+/// cell's rays run at once, not one after another, as a thread per cell
+/// would, which a few thousand cells leave latency-bound; then a kernel per
+/// cell summing them, reading last frame's cells and writing this frame's)
+/// and shadeVoxelPixels (a kernel per pixel). Run again, they compute the
+/// same cells: last frame's stay.
 void TwinRun::runVoxelCache(LaunchParams& lp) {
     VoxelLaunch& v = lp.voxel;
     const voxel::VoxelGrid& grid = v.params.grid;
@@ -509,8 +516,11 @@ void TwinRun::runVoxelCache(LaunchParams& lp) {
         v.occupied = buf_.voxelOccupied.as<std::uint8_t>();
         v.read = buf_.voxelCells[voxelLast_].as<voxel::VoxelCell>();
         v.write = next;
+        v.rays = buf_.voxelRays.as<voxel::CellRay>();
         CUDA_CHECK(cudaMemcpyAsync(buf_.params.as<void>(), &lp, sizeof lp, cudaMemcpyHostToDevice, stream_));
-        pipeline_->launch(Raygen::updateVoxelCache, buf_.params.address(), sizeof lp, grid.nx, grid.ny * grid.nz, stream_);
+        pipeline_->launch(Raygen::updateVoxelCache, buf_.params.address(), sizeof lp, grid.nx * v.params.rays, grid.ny * grid.nz,
+                          stream_);
+        sumVoxelRays(lp, stream_);
     }
     {
         GpuScope t(*timer_, Pass::shadeVoxelPixels);

@@ -22,6 +22,10 @@ public:
 
     __device__ const voxel::VoxelParams& params() const { return p_.voxel.params; }
     __device__ bool occupied(std::uint32_t c) const { return p_.voxel.occupied[c] != 0; }
+    /// The ray the launch of traceCellRays traced (updateVoxelCell sums them).
+    __device__ voxel::CellRay cellRay(std::uint32_t c, std::uint32_t r) const {
+        return p_.voxel.rays[std::size_t(c) * p_.voxel.params.rays + r];
+    }
     __device__ voxel::VoxelCell cell(std::uint32_t c) const { return p_.voxel.read[c]; }
     __device__ void writeCell(std::uint32_t c, const voxel::VoxelCell& v) const { p_.voxel.write[c] = v; }
     /// render.source at a cell's point: the light tree without the cosine

@@ -20,6 +20,13 @@ __global__ void markVoxelCellsKernel(const __grid_constant__ LaunchParams p, std
             for (std::uint32_t x = lo[0]; x <= hi[0]; ++x) occupied[g.index(x, y, z)] = 1;
 }
 
+__global__ void sumVoxelRaysKernel(const __grid_constant__ LaunchParams p) {
+    const std::uint32_t c = blockIdx.x * blockDim.x + threadIdx.x;
+    if (c >= p.voxel.params.grid.count()) return;
+    VoxelBridge<> b(p);
+    voxel::updateVoxelCell(b, c);
+}
+
 template <ShadingModel SM>
 __global__ void shadeVoxelPixelsKernel(const __grid_constant__ LaunchParams p) {
     const std::uint32_t x = blockIdx.x * blockDim.x + threadIdx.x, y = blockIdx.y * blockDim.y + threadIdx.y;
@@ -33,6 +40,11 @@ __global__ void shadeVoxelPixelsKernel(const __grid_constant__ LaunchParams p) {
 void markVoxelCells(const LaunchParams& p, std::uint8_t* occupied, std::uint32_t count, cudaStream_t stream) {
     cudaMemsetAsync(occupied, 0, count, stream);
     if (p.particleCount) markVoxelCellsKernel<<<(p.particleCount + 255) / 256, 256, 0, stream>>>(p, occupied);
+}
+
+void sumVoxelRays(const LaunchParams& p, cudaStream_t stream) {
+    const std::uint32_t cells = p.voxel.params.grid.count();
+    sumVoxelRaysKernel<<<(cells + 255) / 256, 256, 0, stream>>>(p);
 }
 
 void shadeVoxelPixels(const LaunchParams& p, cudaStream_t stream) {

@@ -333,6 +333,7 @@ struct VoxelCheckBridge {
     Vec3* Lr;
     ACC_HD const voxel::VoxelParams& params() const { return p; }
     ACC_HD bool occupied(std::uint32_t c) const { return c % 3u != 0u; }
+    ACC_HD voxel::CellRay cellRay(std::uint32_t c, std::uint32_t r) const { return voxel::traceCellRay(*this, c, r); }
     ACC_HD voxel::VoxelCell cell(std::uint32_t c) const {
         voxel::VoxelCell v;
         v.A = Vec3(float(c % 7u), float(c % 5u), float(c % 3u)) * 0.5f;

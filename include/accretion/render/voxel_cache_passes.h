@@ -6,6 +6,8 @@
 //
 //   const VoxelParams& params()             the frame's grid and settings
 //   bool occupied(c)                        some particle's box reaches cell c's stencil
+//   CellRay cellRay(c, r)                   ray r of cell c: traceCellRay's (the CPU calls it; the
+//                                           twin's rays ran in a launch of their own, one a thread)
 //   VoxelCell cell(c)                       the cell as last frame left it
 //   void writeCell(c, cell)
 //   LightSample sampleLight(sp, rng)        a light from render.source at a cell's point: uniform or
@@ -152,10 +154,35 @@ ACC_HD inline void addLight(VoxelCell& c, const Vec3& a, const Vec3& w, const Ve
     if (cosC > 0.0f) c.C += a * cosC;
 }
 
-/// updateVoxelCache at cell c: an empty cell unless occupied; else `rays`
-/// lights from render.source at its centre, a = 4 pi x the isotropic term / (pdf
-/// rays) when seen, this frame's estimate averaged with the cell's last
-/// value over min(frames + 1, history) frames.
+/// What one ray of a cell brings: the amount a (0 when the light was not
+/// seen) and its direction.
+struct CellRay {
+    Vec3 a{0.0f};
+    Vec3 w{0.0f, 0.0f, 1.0f};
+};
+
+/// Ray r of cell c: a light from render.source at the cell's centre, from
+/// the ray's own stream (so that the rays of a cell can run apart), and
+/// a = 4 pi x its isotropic term / (pdf rays) when seen.
+template <class B>
+ACC_HD_BODY CellRay traceCellRay(B& b, std::uint32_t c, std::uint32_t r) {
+    const VoxelParams& p = b.params();
+    const ShadingPoint sp = cellPoint(p.grid.centre(c));
+    PortableRng rng(c, p.frame, RngPass::voxelCache, p.seed, r + 1);
+    const LightSample s = b.sampleLight(sp, rng);
+    CellRay out;
+    if (!(s.pdf > 0.0f)) return out;
+    LightTerm t;
+    if (!b.cellTerm(sp, s.i, t)) return out;
+    if (b.shadows() && !b.visible(sp, s.i, t)) return out;
+    out.a = t.value * (4.0f * kPi / (float(p.rays) * s.pdf));
+    out.w = t.w;
+    return out;
+}
+
+/// updateVoxelCache at cell c: an empty cell unless occupied; else its
+/// `rays` rays (traceCellRay) summed in order, this frame's estimate
+/// averaged with the cell's last value over min(frames + 1, history) frames.
 template <class B>
 ACC_HD_BODY void updateVoxelCell(B& b, std::uint32_t c) {
     const VoxelParams& p = b.params();
@@ -163,19 +190,11 @@ ACC_HD_BODY void updateVoxelCell(B& b, std::uint32_t c) {
         b.writeCell(c, VoxelCell{});
         return;
     }
-    const Vec3 x = p.grid.centre(c);
-    const ShadingPoint sp = cellPoint(x);
-    const Vec3 nc = p.cameraNormal(x);
-    PortableRng rng(c, p.frame, RngPass::voxelCache, p.seed);
+    const Vec3 nc = p.cameraNormal(p.grid.centre(c));
     VoxelCell est;
-    const float perRay = 4.0f * kPi / float(p.rays);
     for (std::uint32_t r = 0; r < p.rays; ++r) {
-        const LightSample s = b.sampleLight(sp, rng);
-        if (!(s.pdf > 0.0f)) continue;
-        LightTerm t;
-        if (!b.cellTerm(sp, s.i, t)) continue;
-        if (b.shadows() && !b.visible(sp, s.i, t)) continue;
-        addLight(est, t.value * (perRay / s.pdf), t.w, nc);
+        const CellRay ray = b.cellRay(c, r);
+        addLight(est, ray.a, ray.w, nc);
     }
     VoxelCell cell = b.cell(c);
     const float n = cell.frames + 1.0f < p.history ? cell.frames + 1.0f : p.history;

@@ -47,6 +47,7 @@ public:
         rec_.read(1);
         return f_.occupied[c] != 0;
     }
+    CellRay cellRay(std::uint32_t c, std::uint32_t r) { return traceCellRay(*this, c, r); }
     VoxelCell cell(std::uint32_t c) {
         rec_.read(sizeof(VoxelCell));
         rec_.gather(1);
