@@ -89,7 +89,10 @@ std::uint32_t historyBefore(const HistoryChoice& history, const Settings& settin
             "command line --history {}: {} needs {} history frames before frame {} ({}), and frames start at 0: measure frame "
             "{} or later (--frame, with a reference of that frame) or give --history {}",
             history.label(), what, h, frame,
-            history.frames ? "as asked" : fmt::format("temporal reuse to its M cap of {:g}, at least 8", settings.restir.m_cap), h,
+            history.frames                               ? std::string("as asked")
+            : estimatorInfo(settings.render.estimator).worldCache ? fmt::format("the cells' running mean to voxel.history = {:g}, at least 8", settings.voxel.history)
+                                                         : fmt::format("temporal reuse to its M cap of {:g}, at least 8", settings.restir.m_cap),
+            h,
             frame));
     return h;
 }
