@@ -255,15 +255,22 @@ step_streams() {
 # layouts are (frame 1 after a history frame, 5 timed runs); and
 # particle_restir's frames on quickstart at 320x180 (frames 0-2) for the
 # per-pixel comparison with the CPU (compare_cpu.sh).
+# Frames 0-2 of quickstart at 320x180 into $W/STEP/images/NAME.{frame}
+# (compare_cpu.sh renders the CPU's beside them):
+#   quickstart_frames STEP ESTIMATOR NAME OVERRIDES...
+quickstart_frames() {
+    local step=$1 estimator=$2 name=$3
+    shift 3
+    mkdir -p "$W/$step/images"
+    $BIN scenes/quickstart.toml -D camera.width=320 -D camera.height=180 -D render.estimator="$estimator" "$@" --frames 0:3 \
+        --repeat 1 -q -o "$W/$step/images/$name.{frame}.exr" || echo "$step: $name failed"
+}
+
 step_designs() {
-    local q=scenes/quickstart.toml small="-D camera.width=320 -D camera.height=180 -D render.estimator=particle_restir"
-    local t="$W/designs/images"
-    mkdir -p "$t"
-    one() { local name=$1; shift; $BIN $q $small --frames 0:3 --repeat 1 -q -o "$t/$name.{frame}.exr" "$@" || echo "designs: $name failed"; }
-    one prt_interp -D restir.bias_correction=pairwise
-    one prt_resample -D restir.bias_correction=pairwise -D restir.pixel_shading=resample
-    one prt_2x2_k2 -D restir.texels=2 -D restir.texel_rays=2
-    one prt_history -D restir.texel_rays=4 -D restir.texel_history=0.5 -D restir.spatial_neighbours=0
+    quickstart_frames designs particle_restir prt_interp -D restir.bias_correction=pairwise
+    quickstart_frames designs particle_restir prt_resample -D restir.bias_correction=pairwise -D restir.pixel_shading=resample
+    quickstart_frames designs particle_restir prt_2x2_k2 -D restir.texels=2 -D restir.texel_rays=2
+    quickstart_frames designs particle_restir prt_history -D restir.texel_rays=4 -D restir.texel_history=0.5 -D restir.spatial_neighbours=0
     time_configs designs bench/gpu/designs.txt 5
     # The flattened cluster from raw buffers (made here: they are not committed).
     python3 scenes/cluster/make_cluster.py 3
@@ -271,20 +278,20 @@ step_designs() {
 }
 
 # seed 004's voxel radiance cache (designs.txt's vox_ lines, 100K and 1M at
-# 1080p), timed as the designs are, beside today's recommendations and
+# 1080p, and designs_cluster.txt's on cluster_150k), timed as the designs are, beside today's recommendations and
 # particle_restir's best timed again in the same run; and its frames on
 # quickstart at 320x180 (frames 0-2) for the per-pixel comparison with the
 # CPU (compare_cpu.sh).
 step_voxels() {
-    local q=scenes/quickstart.toml small="-D camera.width=320 -D camera.height=180 -D render.estimator=voxel_cache"
-    local t="$W/voxels/images"
-    mkdir -p "$t"
-    one() { local name=$1; shift; $BIN $q $small --frames 0:3 --repeat 1 -q -o "$t/$name.{frame}.exr" "$@" || echo "voxels: $name failed"; }
-    one vox_tree -D render.source=tree
-    one vox_power_camera -D render.source=power -D voxel.basis=camera
-    one vox_uniform_h1 -D render.source=uniform -D voxel.history=1 -D voxel.cells=16
+    quickstart_frames voxels voxel_cache vox_tree -D render.source=tree
+    quickstart_frames voxels voxel_cache vox_power_camera -D render.source=power -D voxel.basis=camera
+    quickstart_frames voxels voxel_cache vox_uniform_h1 -D render.source=uniform -D voxel.history=1 -D voxel.cells=16
     grep -E '^(vox_[a-z0-9_]*|restir_m32_t_basic_1x_100k|restir_m32_t_pairwise_05x_1m|prt_m8_k16_100k|prt_m8_k4_1m) ' bench/gpu/designs.txt > "$W/voxels.txt"
     time_configs voxels "$W/voxels.txt" 5
+    # And on the flattened cluster (designs_cluster.txt's vox_ lines).
+    python3 scenes/cluster/make_cluster.py 3
+    grep -E '^vox_[a-z0-9_]* ' bench/gpu/designs_cluster.txt > "$W/voxels_cluster.txt"
+    time_configs voxels/cluster "$W/voxels_cluster.txt" 5 1/1 scenes/cluster_150k.toml
 }
 
 # The configurations on tune's Pareto fronts (bench/gpu/front.txt, written

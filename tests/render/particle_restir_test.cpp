@@ -86,14 +86,11 @@ TEST_CASE("particle_restir: every particle a pixel sees has one slot and its tex
     s.camera.height = 64;
     s.restir.texels = 2;
     s.restir.texel_rays = 3;
-    const Particles particles = ParticleSource(s).frame(0);
-    const Camera camera = Camera::atFrame(s.camera, 0);
-    EmbreeDevice device;
-    ParticleBvh bvh(device, s.geometry);
-    bvh.build(particles, camera);
-    GBuffer gbuffer;
-    traceGBuffer(bvh, particles, camera, s.shading.model, gbuffer);
-    const ParticleTexels t = gatherParticleTexels(gbuffer, particles, bvh, camera, s);
+    const test::TracedFrame f(s);
+    const Particles& particles = f.particles;
+    const ParticleBvh& bvh = f.bvh;
+    const GBuffer& gbuffer = f.gbuffer;
+    const ParticleTexels t = gatherParticleTexels(gbuffer, particles, bvh, f.camera, s);
 
     std::vector<std::uint8_t> seen(particles.size(), 0);
     for (const GBufferTexel& g : gbuffer.texels)

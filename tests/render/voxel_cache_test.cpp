@@ -56,18 +56,13 @@ TEST_CASE("voxel grid: every cell a hit pixel reads is one updateVoxelCache upda
     s.particles.count = 300;
     s.camera.width = 96;
     s.camera.height = 64;
-    const Particles particles = ParticleSource(s).frame(0);
-    const Camera camera = Camera::atFrame(s.camera, 0);
-    EmbreeDevice device;
-    ParticleBvh bvh(device, s.geometry);
-    bvh.build(particles, camera);
-    GBuffer gbuffer;
-    traceGBuffer(bvh, particles, camera, s.shading.model, gbuffer);
+    const test::TracedFrame f(s);
+    const Particles& particles = f.particles;
     for (const std::uint32_t cells : {8u, 32u, 96u}) {
         const voxel::VoxelGrid g = placeVoxelGrid(particles, Vec3(0.0f), cells).inFrame(Vec3(0.0f));
         const std::vector<std::uint8_t> occupied = occupiedCells(g, particles);
         std::size_t hits = 0, used = 0;
-        for (const GBufferTexel& t : gbuffer.texels) {
+        for (const GBufferTexel& t : f.gbuffer.texels) {
             if (!t.hit()) continue;
             ++hits;
             const Vec3 x = particles.position[t.particle] + t.local;

@@ -48,6 +48,12 @@ DiskLights::DiskLights(ShadingModel model, std::uint32_t count)
       particles(ParticleSource(settings).frame(0)),
       tree(particles, settings.shading) {}
 
+TracedFrame::TracedFrame(const Settings& settings)
+    : particles(ParticleSource(settings).frame(0)), camera(Camera::atFrame(settings.camera, 0)), bvh(device, settings.geometry) {
+    bvh.build(particles, camera);
+    traceGBuffer(bvh, particles, camera, settings.shading.model, gbuffer);
+}
+
 FrameImage renderParticles(const Settings& settings, const Particles& particles, std::uint32_t frame) {
     FrameRenderer renderer(settings, ParticleSource::fixed(particles), RenderOptions{true});
     FrameStats stats;

@@ -26,6 +26,16 @@ struct DiskLights {
     LightTree tree;
 };
 
+/// Frame 0 of `settings` traced: its particles, camera, BVH and G-buffer.
+struct TracedFrame {
+    explicit TracedFrame(const Settings& settings);
+    Particles particles;
+    Camera camera;
+    EmbreeDevice device;
+    ParticleBvh bvh;
+    GBuffer gbuffer;
+};
+
 /// Render one frame of a fixed particle set.
 FrameImage renderParticles(const Settings& settings, const Particles& particles, std::uint32_t frame = 0);
 
