@@ -6,21 +6,28 @@
 # SEEDS seeds; each bias run beside the GPU ms the twin measured for the
 # same configuration (bench/gpu/results/designs.csv). The configurations
 # are bench/gpu/designs.txt's lighting (the geometry changes the time, not
-# the image).
-#   bash bench/designs.sh [PARTICLES] [SEEDS] [OUT] [NAME...]   (100000, 8, bench/results/operating_point_<N>; all)
+# the image). PARTICLES "cluster": cluster_150k (raw buffers from
+# scenes/cluster/make_cluster.py, made here when absent) and the
+# configurations of bench/gpu/designs_cluster.txt.
+#   bash bench/designs.sh [PARTICLES|cluster] [SEEDS] [OUT] [NAME...]   (100000, 8, bench/results/operating_point_<N>; all)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 n=${1:-100000} seeds=${2:-8} out=${3:-bench/results/operating_point_$n}
 shift $(($# < 3 ? $# : 3))
 A=${ACCRETION:-build/accretion}
-scene=scenes/disk_100k.toml
+scene=scenes/disk_100k.toml list=bench/gpu/designs.txt suffix=100k
 D=(-D camera.width=1920 -D camera.height=1080 -D particles.count=$n)
+if [ "$n" = 1000000 ]; then suffix=1m; fi
+if [ "$n" = cluster ]; then
+    scene=scenes/cluster_150k.toml list=bench/gpu/designs_cluster.txt suffix=cluster
+    D=(-D camera.width=1920 -D camera.height=1080)
+    [ -f scenes/cluster/frames/c.0020.bin ] || python3 scenes/cluster/make_cluster.py
+fi
 mkdir -p "$out"
 source bench/operating_point_refs.sh
-suffix=$([ "$n" = 1000000 ] && echo 1m || echo 100k)
 : >> "$out/times.txt"
-# designs.txt's lines of this size: name, then the lighting overrides as a bias spec.
-grep -v '^#' bench/gpu/designs.txt | sed 's/ *#.*//' | grep "_$suffix " | while read -r name args; do
+# the list's lines of this size: name, then the lighting overrides as a bias spec.
+grep -v '^#' "$list" | sed 's/ *#.*//' | grep "_$suffix " | while read -r name args; do
     base=${name%_"$suffix"}
     if [ $# -gt 0 ] && [[ " $* " != *" $base "* ]]; then continue; fi
     spec=$(python3 - "$args" <<'PY'
