@@ -85,6 +85,8 @@ voxel::VoxelParams voxelParams(const Settings& s, const VoxelPlacement& placemen
     p.grid = placement.inFrame(origin);
     p.rays = s.voxel.rays;
     p.history = float(s.voxel.history);
+    const double clamp = s.voxel.near_clamp * placement.cellSize;
+    p.nearClamp2 = float(clamp * clamp);
     p.basis = s.voxel.basis;
     p.frame = frame;
     p.seed = seed;

@@ -39,9 +39,11 @@ public:
         }
         return p_.source.sample(rng);
     }
-    __device__ bool cellTerm(const ShadingPoint& sp, std::uint32_t i, LightTerm& t) const {
+    __device__ bool cellTerm(const ShadingPoint& sp, std::uint32_t i, float minDist2, LightTerm& t) const {
         if (counters_) ++counters_->lightTerms;
-        return twin::lightTerm<ShadingModel::isotropic>(p_.lights, sp, i, t);
+        const LightView& L = p_.lights;
+        if (i >= L.count) return false;
+        return evalLight<ShadingModel::isotropic>(sp, L.position[i], L.emission[i], fmaxf(L.dmin2[i], minDist2), t);
     }
     __device__ bool shadows() const { return p_.shadows; }
     __device__ bool visible(const ShadingPoint& sp, std::uint32_t i, const LightTerm& t) const { return visibility_(sp, i, t); }

@@ -348,9 +348,9 @@ struct VoxelCheckBridge {
     ACC_HD LightSample sampleLight(const ShadingPoint&, PortableRng& g) const {
         return {g.uniformInt(in.particles), 1.0f / float(in.particles)};
     }
-    ACC_HD bool cellTerm(const ShadingPoint& sp, std::uint32_t i, LightTerm& t) const {
+    ACC_HD bool cellTerm(const ShadingPoint& sp, std::uint32_t i, float minDist2, LightTerm& t) const {
         if (i >= in.particles) return false;
-        return evalLight<ShadingModel::isotropic>(sp, in.historyPositions[i], in.emission[i], 0.01f, t);
+        return evalLight<ShadingModel::isotropic>(sp, in.historyPositions[i], in.emission[i], minDist2 > 0.01f ? minDist2 : 0.01f, t);
     }
     ACC_HD bool shadows() const { return true; }
     ACC_HD bool visible(const ShadingPoint& sp, std::uint32_t i, const LightTerm&) const { return (bits(sp.x.x) ^ (i * 7u)) % 5u != 0u; }
@@ -577,6 +577,7 @@ int main() {
         v.grid.nx = kVoxelNx, v.grid.ny = kVoxelNy, v.grid.nz = kVoxelNz;
         v.rays = 6;
         v.history = 3.0f;
+        v.nearClamp2 = b == 0 ? 0.0f : 0.36f;  // camera: half a cell
         v.basis = b == 0 ? VoxelBasis::l1 : VoxelBasis::camera;
         v.frame = 4;
         v.seed = 13;

@@ -13,7 +13,8 @@
 //   LightSample sampleLight(sp, rng)        a light from render.source at a cell's point: uniform or
 //                                           power (SourcePmf), or the light tree without the cosine
 //                                           (LightTreeView, isotropic): the same draws on both
-//   bool cellTerm(sp, i, t)                 light i's isotropic term at a cell's point (rho = 1)
+//   bool cellTerm(sp, i, d2, t)             light i's isotropic term at a cell's point (rho = 1), its
+//                                           distance clamped at max(dmin_i^2, d2)
 //   bool shadows()                          shading.visibility
 //   bool visible(sp, i, t)                  a shadow ray (traced and counted by the bridge)
 //   GBufferTexel pixel(px); ShadingPoint shadingPoint(g)
@@ -107,6 +108,7 @@ struct VoxelParams {
     VoxelGrid grid;
     std::uint32_t rays = 8;       ///< voxel.rays
     float history = 16.0f;        ///< voxel.history
+    float nearClamp2 = 0.0f;      ///< (voxel.near_clamp x the cell size)^2: a light nearer a cell's centre counts as that far
     VoxelBasis basis = VoxelBasis::l1;
     std::uint32_t frame = 0;
     std::uint64_t seed = 0;
@@ -173,7 +175,7 @@ ACC_HD_BODY CellRay traceCellRay(B& b, std::uint32_t c, std::uint32_t r) {
     CellRay out;
     if (!(s.pdf > 0.0f)) return out;
     LightTerm t;
-    if (!b.cellTerm(sp, s.i, t)) return out;
+    if (!b.cellTerm(sp, s.i, p.nearClamp2, t)) return out;
     if (b.shadows() && !b.visible(sp, s.i, t)) return out;
     out.a = t.value * (4.0f * kPi / (float(p.rays) * s.pdf));
     out.w = t.w;
@@ -234,7 +236,7 @@ ACC_HD_BODY void shadeVoxelPixel(B& b, std::size_t px) {
         if (cell.frames > 0.0f) {  // the receiver's own light, as the cell saw it unshadowed
             const Vec3 x = grid.centre(c);
             LightTerm t;
-            if (b.cellTerm(cellPoint(x), g.particle, t)) {
+            if (b.cellTerm(cellPoint(x), g.particle, p.nearClamp2, t)) {
                 VoxelCell own;
                 addLight(own, t.value * (4.0f * kPi), t.w, p.cameraNormal(x));
                 addScaled(sum, own, -w);

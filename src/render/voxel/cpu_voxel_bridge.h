@@ -72,9 +72,11 @@ public:
         rec_.read((f_.source.power ? gpu_layout::kAliasEntry : 0u) + gpu_layout::kParticleRecord);
         return f_.source.sample(rng);
     }
-    bool cellTerm(const ShadingPoint& sp, std::uint32_t i, LightTerm& t) {
+    bool cellTerm(const ShadingPoint& sp, std::uint32_t i, float minDist2, LightTerm& t) {
         ++c_.lightTerms;
-        return f_.L.term<ShadingModel::isotropic>(sp, i, t);
+        if (i >= f_.L.count) return false;
+        const PackedLight& l = f_.L.packed[i];
+        return evalLight<ShadingModel::isotropic>(sp, l.position, l.emission, std::max(l.dmin2, minDist2), t);
     }
     bool shadows() const { return f_.shadows; }
     bool visible(const ShadingPoint& sp, std::uint32_t i, const LightTerm& t) {
