@@ -140,6 +140,17 @@ TEST_CASE("voxel_cache: one light's Lr in each basis, in closed form", "[voxel]"
         const auto [Lr, exact] = s.centre();
         for (int c = 0; c < 3; ++c) CHECK(Lr[c] == Approx(exact[c]).epsilon(0.01));
     }
+    SECTION("near_clamp: a light nearer a cell than the clamp counts as at the clamp") {
+        // 2 cells along the longest side, a clamp of 4 cells: every cell's
+        // centre is nearer the light than the clamp, so each holds I / c^2.
+        OneLight s(ShadingModel::isotropic, Vec3(0.0f), I);
+        s.settings.voxel.cells = 2;
+        s.settings.voxel.near_clamp = 4.0;
+        const double c = 4.0 * placeVoxelGrid(s.particles, Vec3(0.0f), 2).cellSize;
+        REQUIRE(c > 5.0 + 2.0);  // beyond the farthest cell centre's distance to the light
+        const auto [Lr, exact] = s.centre();
+        for (int k = 0; k < 3; ++k) CHECK(Lr[k] == Approx(exact[k] * 25.0 / (c * c)).epsilon(1e-4));
+    }
 }
 
 TEST_CASE("voxel_cache: a receiver lit by its own light alone is dark (i != j)", "[voxel]") {
