@@ -247,13 +247,13 @@ std::vector<LightingChoice> lightingChoices(const std::string& space) {
         d.cells = cells, d.cellRays = rays, d.basis = basis;
         return LightingChoice{LightSource::tree, 0, 0, 1, basic, false, 1.0, d};
     };
+    designs.push_back(voxels(32, 8, VoxelBasis::camera));
     designs.push_back(voxels(64, 8, VoxelBasis::camera));
-    designs.push_back(voxels(128, 16, VoxelBasis::camera));
     if (space == "full")
         for (std::uint32_t cells : {32u, 64u, 128u, 256u})
             for (std::uint32_t rays : {4u, 8u, 16u, 32u})
                 for (const VoxelBasis basis : {VoxelBasis::l1, VoxelBasis::camera})
-                    if (!(rays == 8 && cells == 64 && basis == VoxelBasis::camera) && !(rays == 16 && cells == 128 && basis == VoxelBasis::camera))
+                    if (!(rays == 8 && basis == VoxelBasis::camera && (cells == 32 || cells == 64)))
                         designs.push_back(voxels(cells, rays, basis));
     out.insert(out.end(), designs.begin(), designs.end());
     return out;
