@@ -77,10 +77,21 @@ void recordGather(const RestirInputs& in, PassCounters& pc) {
     }
 }
 
-/// particle_restir's reservoir AOVs: each hit pixel's spp and the reservoir
-/// of its particle's first texel.
+/// A frame that is a window of the image (restir.crop_margin): its grid's
+/// texels keyed by their place in the whole grid (ReuseParams::pixelKey),
+/// the window's origin at `scale` x its pixel origin.
+void keyByWholeGrid(restir::FrameContext& f, const Camera& camera, float scale, std::uint32_t wholeWidth) {
+    f.originX = std::uint32_t(camera.pixelX0 * scale);
+    f.originY = std::uint32_t(camera.pixelY0 * scale);
+    f.wholeWidth = wholeWidth;
+}
+
+/// particle_restir's reservoir AOVs: each hit pixel's spp, the reservoir of
+/// its particle's first texel, and the non-finite values rejected at the
+/// pixel and at its particle's texels (those its Lr was made from).
 void writeTexelAovs(const GBuffer& full, const ParticleTexels& texels, const std::vector<StoredReservoir>& a,
-                    const std::vector<std::uint32_t>& pixelRejected, LightingImage& out, ReservoirImage& aov) {
+                    const std::vector<std::uint32_t>& pixelRejected, const std::vector<std::uint32_t>& texelRejected,
+                    LightingImage& out, ReservoirImage& aov) {
     const std::size_t pixels = full.texels.size();
     aov.W.assign(pixels, 0.0f);
     aov.M.assign(pixels, 0.0f);
@@ -91,8 +102,11 @@ void writeTexelAovs(const GBuffer& full, const ParticleTexels& texels, const std
         const GBufferTexel& g = full.texels[px];
         if (!g.hit()) continue;
         out.spp[px] = 1.0f;
-        out.rejected[px] = float(pixelRejected[px]);
-        const StoredReservoir& r = a[std::size_t(texels.slotOf[g.particle]) * texels.perParticle()];
+        const std::size_t first = std::size_t(texels.slotOf[g.particle]) * texels.perParticle();
+        std::uint32_t rejected = pixelRejected[px];
+        for (std::size_t k = 0; k < texels.perParticle(); ++k) rejected += texelRejected[first + k];
+        out.rejected[px] = float(rejected);
+        const StoredReservoir& r = a[first];
         aov.W[px] = r.W;
         aov.M[px] = float(r.M);
         aov.light[px] = r.W > 0.0f ? r.y : kNoLight;
@@ -189,11 +203,8 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
                    lowRejected.data()};
     if (plan.particleTexels) f.texels = &texels;
 
-    if (in.camera.isWindow() && !plan.particleTexels) {  // restir.crop_margin: the frame's window, each texel keyed by its place in the whole grid
-        f.originX = std::uint32_t(in.camera.pixelX0 * f.scale);
-        f.originY = std::uint32_t(in.camera.pixelY0 * f.scale);
-        f.wholeWidth = lg == &full ? in.camera.imageWidth : lightingGridExtent(in.camera.imageWidth, scale);
-    }
+    if (in.camera.isWindow() && !plan.particleTexels)  // restir.crop_margin: the frame's window
+        keyByWholeGrid(f, in.camera, f.scale, lg == &full ? in.camera.imageWidth : lightingGridExtent(in.camera.imageWidth, scale));
     // particle_restir's texels are keyed by particle: their reuse is counted whatever render.crop.
     if (!in.settings.render.crop.empty() && !plan.particleTexels) {  // reuse is counted over render.crop's texels, not the rest rendered for it
         const PixelWindow crop = PixelWindow::of(in.settings);
@@ -225,15 +236,11 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
         std::vector<std::uint32_t> pixelRejected(pixels, 0);
         restir::FrameContext fp{in, pixelRs, codec_, full, L, prev, 1.0f, f.vis, plan.shadowRays, in.counters, pixelRejected.data()};
         fp.texels = &texels;
-        if (in.camera.isWindow()) {
-            fp.originX = std::uint32_t(in.camera.pixelX0);
-            fp.originY = std::uint32_t(in.camera.pixelY0);
-            fp.wholeWidth = in.camera.imageWidth;
-        }
+        if (in.camera.isWindow()) keyByWholeGrid(fp, in.camera, 1.0f, in.camera.imageWidth);
         const LightingCounters c = restir::shadeParticlePixels(fp, a, lowLr, out.Lr);
         counters += c;
         if (c.nonFinite) rejected[Pass::shadeParticlePixels] += c.nonFinite;
-        writeTexelAovs(full, texels, a, pixelRejected, out, aov);
+        writeTexelAovs(full, texels, a, pixelRejected, lowRejected, out, aov);
     } else if (!plan.upsample) {
         out.Lr = lowLr;
     } else {
