@@ -24,7 +24,7 @@ void printEstimators() {
                "|---|---|---|---|---|---|---|---|\n");
     for (const EstimatorInfo& e : kEstimators)
         fmt::print("| `{}` | {} | {} | {} | {} | {} | {} | {} |\n", enumName(e.kind), e.summary,
-                   e.resampling || e.worldCache ? "render.source's" : samplerName(e.sampler), yesNo(e.resampling), yesNo(e.reuse),
+                   e.drawsFromSource() ? "render.source's" : samplerName(e.sampler), yesNo(e.resampling), yesNo(e.reuse),
                    e.unbiased ? std::string_view("yes") : e.unbiasedWhen, yesNo(e.adaptive), yesNo(e.twin));
 }
 

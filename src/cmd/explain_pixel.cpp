@@ -109,7 +109,7 @@ void explainPixel(const Settings& settings, std::uint32_t x, std::uint32_t y, bo
     FrameRenderer renderer(settings, ParticleSource(settings), RenderOptions{quiet});
     const std::uint32_t first = settings.render.frame_start, last = first + settings.render.frames - 1;
     const EstimatorInfo& e = estimatorInfo(settings.render.estimator);
-    const bool restir = e.reuse && !e.worldCache;
+    const bool restir = e.restirPasses();
     PixelTrace trace;
     trace.px = std::size_t(y) * settings.camera.width + x;
     FrameImage img;

@@ -110,7 +110,7 @@ GpuReport makeGpuReport(const FrameCounters& counters, const Settings& settings,
     }
 
     const std::uint64_t pixels = std::uint64_t(settings.camera.width) * settings.camera.height;
-    const bool reuse = estimatorInfo(settings.render.estimator).reuse && !estimatorInfo(settings.render.estimator).worldCache;
+    const bool reuse = estimatorInfo(settings.render.estimator).restirPasses();
     const double s = reuse ? settings.restir.resolution_scale : 1.0;
     const std::uint64_t lightingPixels = static_cast<std::uint64_t>(double(pixels) * s * s + 0.5);
     const bool temporal = reuse && settings.restir.temporal;

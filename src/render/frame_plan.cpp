@@ -26,7 +26,7 @@ PixelWindow restirWindow(const Settings& s) {
 void planRun(const Settings& s, FramePlan& plan) {
     const bool staticCamera = s.camera.path == CameraPath::static_pose ||
                               (s.camera.path == CameraPath::orbit && s.camera.orbit_speed == 0.0);
-    const bool restir = estimatorInfo(s.render.estimator).reuse && !estimatorInfo(s.render.estimator).worldCache;
+    const bool restir = estimatorInfo(s.render.estimator).restirPasses();
     plan.staticGeometry = staticParticles(s.particles) && staticCamera;
     plan.updateInPlace = s.geometry.build == BuildPolicy::refit || s.geometry.build == BuildPolicy::partial;
     plan.alphaFilter = s.geometry.primitive == Primitive::billboard && s.geometry.alpha == AlphaMode::disc;
@@ -50,7 +50,7 @@ void planPasses(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
     if (plan.lighting) plan.sampler = samplerFor(s.render);  // tiles and the ReGIR grid are drawn from the power table
     plan.chooseNearLights = plan.lighting && est.nearField && s.render.near_lights == 0;
     const LightSourceInfo& source = sourceInfo(s.render.source);
-    plan.restir = plan.lighting && est.reuse && !est.worldCache;
+    plan.restir = plan.lighting && est.restirPasses();
     plan.voxelCache = plan.lighting && est.worldCache;
     plan.presampleTiles = plan.restir && source.presampled;
     plan.presampleRegir = plan.restir && source.regirGrid;
@@ -67,7 +67,7 @@ void planPasses(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
 /// The plan as lines, with what each step does or why it is skipped.
 void describe(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
     const EstimatorKind est = s.render.estimator;
-    const bool restir = estimatorInfo(est).reuse && !estimatorInfo(est).worldCache;
+    const bool restir = estimatorInfo(est).restirPasses();
     const bool manyFrames = s.render.frames > 1;
     auto step = [&](Pass pass, std::string why) { plan.steps.push_back({pass, {}, true, std::move(why)}); };
     auto work = [&](std::string name, bool runs, std::string why) {
@@ -188,7 +188,7 @@ bool emissive(const Particles& particles) {
 }
 
 bool needsPreviousBvh(const Settings& s) {
-    return estimatorInfo(s.render.estimator).reuse && !estimatorInfo(s.render.estimator).worldCache && s.restir.temporal &&
+    return estimatorInfo(s.render.estimator).restirPasses() && s.restir.temporal &&
            s.restir.bias_correction == BiasCorrection::basic && s.restir.basic_visibility &&
            (s.restir.visibility_reuse || s.restir.candidate_visibility) &&
            (s.geometry.build == BuildPolicy::rebuild || s.geometry.build == BuildPolicy::fast_trace);

@@ -145,7 +145,7 @@ FrameRenderer::FrameRenderer(std::vector<Settings> lanes, ParticleSource source,
             throw std::invalid_argument("FrameRenderer: gpu.counters counts one view's work; it takes one lane");
         const EstimatorInfo& e = estimatorInfo(lane.settings.render.estimator);
         if (e.worldCache) lane.voxel = std::make_unique<VoxelCache>(lane.settings);
-        else if (e.reuse) lane.restir = std::make_unique<Restir>(lane.settings, lane.plan.keepHistory);
+        else if (e.restirPasses()) lane.restir = std::make_unique<Restir>(lane.settings, lane.plan.keepHistory);
         lanes_.push_back(std::move(lane));
     }
 }

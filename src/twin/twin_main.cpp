@@ -73,7 +73,7 @@ void requireSupported(const Settings& s, bool lighting) {
     // all: the scene's rules refuse them for every command (loadScene).
     const EstimatorKind e = s.render.estimator;
     if (lighting && !estimatorInfo(e).twin) refuse(fmt::format("render.estimator = \"{}\"", enumName(e)));
-    if (lighting && estimatorInfo(e).reuse && !estimatorInfo(e).worldCache) {
+    if (lighting && estimatorInfo(e).restirPasses()) {
         const RestirSettings& r = s.restir;
         if (!sourceInfo(s.render.source).twin) refuse(fmt::format("render.source = \"{}\"", enumName(s.render.source)));
         if (r.layout != ReservoirLayout::full) refuse("restir.layout = \"packed\"");
@@ -487,14 +487,14 @@ void TwinRun::placeVoxels(const Particles& particles) {
     if (voxelPlacement_.holds(particles, origin_)) return;
     voxelPlacement_ = placeVoxelGrid(particles, origin_, s_.voxel.cells);
     const std::size_t cells = voxelPlacement_.cells();
+    if (double(cells) * s_.voxel.rays > double(1u << 30))
+        throw InputError(fmt::format("voxel.cells = {} with voxel.rays = {}: {} rays a frame, more than an OptiX launch holds (2^30)",
+                                     s_.voxel.cells, s_.voxel.rays, double(cells) * s_.voxel.rays));
     for (DeviceBuffer& b : buf_.voxelCells) {
         b.reserve(cells * sizeof(voxel::VoxelCell));
         CUDA_CHECK(cudaMemsetAsync(b.as<void>(), 0, cells * sizeof(voxel::VoxelCell), stream_));
     }
     buf_.voxelOccupied.reserve(cells);
-    if (double(cells) * s_.voxel.rays > double(1u << 30))
-        throw InputError(fmt::format("voxel.cells = {} with voxel.rays = {}: {} rays a frame, more than an OptiX launch holds (2^30)",
-                                     s_.voxel.cells, s_.voxel.rays, double(cells) * s_.voxel.rays));
     buf_.voxelRays.reserve(cells * s_.voxel.rays * sizeof(voxel::CellRay));
     voxelLast_ = 0;
 }

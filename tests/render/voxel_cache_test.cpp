@@ -146,7 +146,10 @@ TEST_CASE("voxel_cache: one light's Lr in each basis, in closed form", "[voxel]"
         OneLight s(ShadingModel::isotropic, Vec3(0.0f), I);
         s.settings.voxel.cells = 2;
         s.settings.voxel.near_clamp = 4.0;
-        const double c = 4.0 * placeVoxelGrid(s.particles, Vec3(0.0f), 2).cellSize;
+        // The particles' reach spans z from -0.75 (j: 1.5 x 0.5) to 4.075 (i:
+        // 4 + 1.5 x 0.05), the longest side; with 5% around it, 2 cells.
+        const double h = 1.1 * (4.075 + 0.75) / 2.0, c = 4.0 * h;
+        REQUIRE(placeVoxelGrid(s.particles, Vec3(0.0f), 2).cellSize == Approx(h).epsilon(1e-7));  // the float radii
         REQUIRE(c > 5.0 + 2.0);  // beyond the farthest cell centre's distance to the light
         const auto [Lr, exact] = s.centre();
         for (int k = 0; k < 3; ++k) CHECK(Lr[k] == Approx(exact[k] * 25.0 / (c * c)).epsilon(1e-4));

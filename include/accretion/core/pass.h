@@ -86,7 +86,7 @@ inline constexpr std::array<PassInfo, kPassCount> kPasses = {{
     {Pass::shadeParticlePixels, "shadeParticlePixels", Pass::estimateLighting, PassGrid::pixels, Pass::shadeParticlePixels, false,
      "the G-buffer and the pixel's particle's texels (their Lr, or their reservoirs and a shadow ray); writes Lr"},
     {Pass::updateVoxelCache, "updateVoxelCache", Pass::estimateLighting, PassGrid::entries, Pass::traceShadowRays, true,
-     "the particles' boxes (which cells are occupied), the power alias table, light records and the BVH; writes the cells"},
+     "the particles' boxes (which cells are occupied), render.source's sampler, light records and the BVH; writes the cells"},
     {Pass::shadeVoxelPixels, "shadeVoxelPixels", Pass::estimateLighting, PassGrid::pixels, Pass::upsampleLighting, false,
      "the G-buffer and the 8 cells around the pixel's point; writes Lr"},
     {Pass::upsampleLighting, "upsampleLighting", Pass::estimateLighting, PassGrid::pixels, Pass::upsampleLighting, false,

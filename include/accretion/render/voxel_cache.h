@@ -43,16 +43,10 @@ public:
     /// Render Lr of one frame (spp = 1, no per-pixel standard error).
     LightingCounters render(const VoxelInputs& in, LightingImage& out, PassTimer& timer);
 
-    const VoxelPlacement& placement() const { return placement_; }
-    /// Times the grid was placed (the first frame and every frame a particle left it).
-    std::uint32_t placements() const { return placements_; }
-    const std::vector<voxel::VoxelCell>& cells() const { return cells_; }
-    std::size_t bytes() const { return cells_.size() * sizeof(voxel::VoxelCell); }
 
 private:
     VoxelSettings vs_;
     VoxelPlacement placement_;
-    std::uint32_t placements_ = 0;
     std::vector<voxel::VoxelCell> cells_;
 };
 

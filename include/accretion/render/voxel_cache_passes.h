@@ -2,7 +2,7 @@
 // The voxel radiance cache of seed 004 (docs/MODEL.md section 4b,
 // docs/designs.md): its cells, its grid and the bodies of its two passes,
 // written once for the CPU (src/render/voxel/) and the GPU twin
-// (src/twin/programs.cu, restir_kernels.cu), over a bridge B:
+// (src/twin/programs.cu, voxel_kernels.cu), over a bridge B:
 //
 //   const VoxelParams& params()             the frame's grid and settings
 //   bool occupied(c)                        some particle's box reaches cell c's stencil

@@ -31,7 +31,7 @@ struct VoxelPlacement {
 
 /// The placement over `particles` (frame coordinates + origin), `cells`
 /// along the longest side. Throws InputError (naming voxel.cells) above
-/// kMaxCells cells.
+/// kMaxVoxelCells cells.
 VoxelPlacement placeVoxelGrid(const Particles& particles, const Vec3& origin, std::uint32_t cells);
 inline constexpr std::uint64_t kMaxVoxelCells = std::uint64_t(1) << 25;  ///< 2 GiB of cells
 

@@ -31,6 +31,11 @@ struct EstimatorInfo {
     std::string_view unbiasedWhen = "with a bias correction";
     /// Lit from a world-space cache (VoxelCache's passes), not restir's reservoirs.
     bool worldCache = false;
+
+    /// Runs restir's passes (Restir): reuse through reservoirs, not a world cache.
+    constexpr bool restirPasses() const { return reuse && !worldCache; }
+    /// Draws its lights from render.source (ris and restir's candidates, the voxel cache's rays).
+    constexpr bool drawsFromSource() const { return resampling || worldCache; }
 };
 
 inline constexpr std::array<EstimatorInfo, 9> kEstimators = {{
@@ -129,7 +134,7 @@ template <class Fn> decltype(auto) withLightSource(LightSource kind, Fn&& fn) {
 /// its render.source's.
 constexpr LightSamplerKind samplerFor(const RenderSettings& render) {
     const EstimatorInfo& e = estimatorInfo(render.estimator);
-    return e.resampling || e.worldCache ? sourceInfo(render.source).sampler : e.sampler;
+    return e.drawsFromSource() ? sourceInfo(render.source).sampler : e.sampler;
 }
 
 /// Whether render.crop traces, lights and holds its window alone (each pixel

@@ -354,7 +354,7 @@ struct VoxelSettings {
     double near_clamp = 0.0;       ///< a light nearer a cell's centre than this many cells counts as that far
     template <class V> void visit(V& v) {
         v.field("cells", cells, "voxel_cache: cells along the longest side of the particles' bounding box (cubic cells)", Range{1, 1024});
-        v.field("rays", rays, "voxel_cache: lights drawn by power per occupied cell and frame, one shadow ray each from the cell's centre", Range{1, 1024});
+        v.field("rays", rays, "voxel_cache: lights drawn from render.source per occupied cell and frame, one shadow ray each from the cell's centre", Range{1, 1024});
         v.field("history", history, "voxel_cache: a cell's value is the mean of its last min(n, history) frames' (a running mean, then exponential with weight 1/history)", Range{1.0, 1e6});
         v.field("near_clamp", near_clamp, "voxel_cache: a light nearer a cell's centre than this many cells counts as that far (its 1/d^2 clamped there, as dmin clamps it), in the cells and in the own light taken out (0: the lights' own dmin only)", Range{0.0, 4.0});
         v.field("basis", basis, "voxel_cache: l1 (the incident light's L1 moments: any normal, the clamped cosine by its L1 convolution) or camera (the cosine lobe toward the camera from the cell's centre: billboards)");

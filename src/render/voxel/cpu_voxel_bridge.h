@@ -3,6 +3,8 @@
 // (accretion/render/voxel_cache_passes.h): the frame's cells, Embree for
 // shadow rays, the thread records of counting mode. Internal to
 // src/render/voxel/.
+#include <algorithm>
+#include <bit>
 #include <cstdint>
 #include <vector>
 
@@ -10,9 +12,6 @@
 #include <tbb/parallel_for.h>
 
 #include "accretion/counters/gpu_layouts.h"
-#include <algorithm>
-#include <bit>
-
 #include "accretion/lighting/light_arrays.h"
 #include "accretion/lighting/light_tree_view.h"
 #include "accretion/lighting/source_pmf.h"
@@ -62,7 +61,7 @@ public:
         if (f_.tree.nodes) {
             const LightSample s = f_.tree.sample(sp, rng);
             if constexpr (Count) {  // a node pair per level, then the light's record
-                const std::uint32_t levels = std::bit_width(std::max(1u, f_.L.count)) ;
+                const std::uint32_t levels = std::bit_width(std::max(1u, f_.L.count));
                 rec_.gather(levels + 1);
                 rec_.read(2 * levels * gpu_layout::kLightTreeNode + gpu_layout::kParticleRecord);
             }

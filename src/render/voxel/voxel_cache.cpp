@@ -22,7 +22,6 @@ LightingCounters VoxelCache::render(const VoxelInputs& in, LightingImage& out, P
     // The grid stays where it was placed while it holds the particles.
     if (!placement_.holds(in.particles, in.origin)) {
         placement_ = placeVoxelGrid(in.particles, in.origin, vs_.cells);
-        ++placements_;
         cells_.assign(placement_.cells(), voxel::VoxelCell{});
     }
     const voxel::VoxelParams params = voxelParams(in.settings, placement_, in.origin, in.camera, in.frame, in.settings.render.seed);
