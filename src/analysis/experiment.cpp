@@ -61,8 +61,13 @@ Settings specSettings(const std::filesystem::path& scene, const std::vector<std:
 
 std::uint32_t steadyStateHistory(const Settings& settings) {
     constexpr std::uint32_t kAtLeast = 8;
-    if (estimatorInfo(settings.render.estimator).worldCache)  // the cells' running mean to its cap
+    const LightingPasses passes = estimatorInfo(settings.render.estimator).passes;
+    if (passes == LightingPasses::voxelCache)  // the cells' running mean to its cap
         return settings.voxel.history > 1.0 ? std::max(kAtLeast, static_cast<std::uint32_t>(std::ceil(settings.voxel.history))) : 0;
+    if (passes == LightingPasses::particleSplit) {  // the texels' exponential average, until the first frame weighs under 1%
+        const double h = settings.particle_split.history;
+        return h > 0.0 ? std::max(kAtLeast, static_cast<std::uint32_t>(std::ceil(std::log(0.01) / std::log(h)))) : 0;
+    }
     if (!estimatorInfo(settings.render.estimator).reuse || !settings.restir.temporal) return 0;
     return std::max(kAtLeast, static_cast<std::uint32_t>(std::ceil(settings.restir.m_cap)));
 }
@@ -90,8 +95,12 @@ std::uint32_t historyBefore(const HistoryChoice& history, const Settings& settin
             "{} or later (--frame, with a reference of that frame) or give --history {}",
             history.label(), what, h, frame,
             history.frames                               ? std::string("as asked")
-            : estimatorInfo(settings.render.estimator).worldCache ? fmt::format("the cells' running mean to voxel.history = {:g}, at least 8", settings.voxel.history)
-                                                         : fmt::format("temporal reuse to its M cap of {:g}, at least 8", settings.restir.m_cap),
+            : estimatorInfo(settings.render.estimator).passes == LightingPasses::voxelCache
+                ? fmt::format("the cells' running mean to voxel.history = {:g}, at least 8", settings.voxel.history)
+            : estimatorInfo(settings.render.estimator).passes == LightingPasses::particleSplit
+                ? fmt::format("the texels' average with particle_split.history = {:g} until the first frame weighs under 1%, at least 8",
+                              settings.particle_split.history)
+                : fmt::format("temporal reuse to its M cap of {:g}, at least 8", settings.restir.m_cap),
             h,
             frame));
     return h;

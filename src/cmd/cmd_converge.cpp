@@ -211,8 +211,11 @@ std::vector<Point> measureLevels(const ConvergeRun& run, const std::vector<Estim
             if (spent > 0.0 && spent + 2.2 * last > run.budget) break;  // the next level would overrun the budget
             EstimatorSpec level = spec;
             const std::string flag = fmt::format("--min-effort/--max-effort (level {})", effort);
-            if (estimatorInfo(spec.kind).worldCache)  // effort: the voxel cache's rays per cell
+            const LightingPasses passes = estimatorInfo(spec.kind).passes;
+            if (passes == LightingPasses::voxelCache)  // effort: the voxel cache's rays per cell
                 level.settings.push_back({"voxel.rays", flag, [effort](Settings& st) { st.voxel.rays = effort; }});
+            else if (passes == LightingPasses::particleSplit)  // effort: particle_split's far draws per texel
+                level.settings.push_back({"particle_split.far", flag, [effort](Settings& st) { st.particle_split.far = effort; }});
             else if (estimatorInfo(spec.kind).reuse)  // effort: restir's candidates (one reservoir a pixel)
                 level.settings.push_back({"render.candidates", flag, [effort](Settings& st) { st.render.candidates = effort; }});
             else

@@ -51,7 +51,8 @@ void planPasses(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
     plan.chooseNearLights = plan.lighting && est.nearField && s.render.near_lights == 0;
     const LightSourceInfo& source = sourceInfo(s.render.source);
     plan.restir = plan.lighting && est.restirPasses();
-    plan.voxelCache = plan.lighting && est.worldCache;
+    plan.voxelCache = plan.lighting && est.passes == LightingPasses::voxelCache;
+    plan.particleSplit = plan.lighting && est.passes == LightingPasses::particleSplit;
     plan.presampleTiles = plan.restir && source.presampled;
     plan.presampleRegir = plan.restir && source.regirGrid;
     plan.temporal = plan.restir && plan.keepHistory && facts.historyAvailable;
@@ -108,7 +109,9 @@ void describe(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
              : fmt::format("one primary ray per pixel of render.crop's {}x{} window", plan.traced.width(), plan.traced.height()));
     step(Pass::estimateLighting,
          dark ? noLight : restir ? "the restir passes below"
-         : estimatorInfo(est).worldCache ? "the voxel cache's passes below" : std::string(enumName(est)));
+         : estimatorInfo(est).passes == LightingPasses::voxelCache    ? "the voxel cache's passes below"
+         : estimatorInfo(est).passes == LightingPasses::particleSplit ? "particle_split's passes below"
+                                                                      : std::string(enumName(est)));
     if (restir) {
         const RestirSettings& r = s.restir;
         step(Pass::presampleLightTiles,
@@ -150,7 +153,19 @@ void describe(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
                      : "resample: the particle's bilinear texels' samples at the pixel's point, its own shadow ray (unbiased)");
         step(Pass::upsampleLighting,
              plan.upsample ? fmt::format("lighting at scale {}", s.restir.resolution_scale) : "full-resolution lighting");
-    } else if (estimatorInfo(est).worldCache) {
+    } else if (estimatorInfo(est).passes == LightingPasses::particleSplit) {
+        const ParticleSplitSettings& ps = s.particle_split;
+        step(Pass::gatherParticleTexels,
+             dark ? noLight : fmt::format("the visible particles in Morton order, {0}x{0} texels each", ps.texels));
+        step(Pass::findNearLights,
+             dark ? noLight : fmt::format("each visible particle's {} nearest lights on the light tree (no rays)", ps.near));
+        step(Pass::shadeSplitTexels,
+             dark ? noLight
+                  : fmt::format("per texel: the near lights summed and {} far draws from the light tree, {}{}", ps.far,
+                                plan.shadowRays ? "a shadow ray each" : "visibility off (V = 1)",
+                                ps.history > 0.0 ? fmt::format(", Lr averaged with last frame's (h = {})", ps.history) : ""));
+        step(Pass::shadeParticlePixels, dark ? noLight : "interpolate: bilinear over the pixel's particle's texels' Lr (biased)");
+    } else if (estimatorInfo(est).passes == LightingPasses::voxelCache) {
         const VoxelSettings& v = s.voxel;
         step(Pass::updateVoxelCache,
              dark ? noLight
@@ -215,11 +230,13 @@ bool FramePlan::runs(Pass pass) const {
     case Pass::generateCandidates: return restir;
     case Pass::temporalResampling: return temporal;
     case Pass::spatialResampling: return spatialIterations > 0;
-    case Pass::gatherParticleTexels: return particleTexels;
+    case Pass::gatherParticleTexels: return particleTexels || particleSplit;
     case Pass::traceShadowRays: return traceShadowRays;
-    case Pass::shadeParticlePixels: return particleTexels;
+    case Pass::shadeParticlePixels: return particleTexels || particleSplit;
     case Pass::updateVoxelCache: return voxelCache;
     case Pass::shadeVoxelPixels: return voxelCache;
+    case Pass::findNearLights: return particleSplit;
+    case Pass::shadeSplitTexels: return particleSplit;
     case Pass::upsampleLighting: return upsample;
     case Pass::composeImage: return true;
     case Pass::writeOutputs: return true;

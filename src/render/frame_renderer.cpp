@@ -139,12 +139,13 @@ FrameRenderer::FrameRenderer(std::vector<Settings> lanes, ParticleSource source,
         if (sharedPart(lanes[k], lanes[0]) != shared)
             throw std::invalid_argument("FrameRenderer: lanes differ in more than render.seed, render.crop and restir.crop_margin");
     for (Settings& s : lanes) {
-        Lane lane{std::move(s), {}, nullptr};
+        Lane lane{std::move(s), {}, nullptr, nullptr, nullptr};
         lane.plan = planFrame(lane.settings, FrameFacts{});
         if (lanes_.size() > 0 && lane.plan.counting)
             throw std::invalid_argument("FrameRenderer: gpu.counters counts one view's work; it takes one lane");
         const EstimatorInfo& e = estimatorInfo(lane.settings.render.estimator);
-        if (e.worldCache) lane.voxel = std::make_unique<VoxelCache>(lane.settings);
+        if (e.passes == LightingPasses::voxelCache) lane.voxel = std::make_unique<VoxelCache>(lane.settings);
+        else if (e.passes == LightingPasses::particleSplit) lane.split = std::make_unique<ParticleSplit>(lane.settings);
         else if (e.restirPasses()) lane.restir = std::make_unique<Restir>(lane.settings, lane.plan.keepHistory);
         lanes_.push_back(std::move(lane));
     }
@@ -229,6 +230,12 @@ void FrameRenderer::lightFrame(Lane& lane, std::uint32_t frame, const Camera& ca
         VoxelInputs in{*bvh_, particles, gbuffer, camera, settings, plan, frame, powerTable, lightTree, origin_,
                        plan.counting ? &img.counters : nullptr};
         stats.lighting = lane.voxel->render(in, img.lighting, stats.timer);
+        return;
+    }
+    if (plan.particleSplit) {
+        ParticleSplitInputs in{*bvh_, particles, gbuffer, camera, settings, plan, frame, *lightTree,
+                               plan.counting ? &img.counters : nullptr};
+        stats.lighting = lane.split->render(in, img.lighting, stats.timer);
         return;
     }
     if (plan.restir) {

@@ -7,16 +7,17 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 
+#include "accretion/counters/gpu_layouts.h"
 #include "accretion/geometry/particle_bvh.h"
 #include "accretion/particles/particles.h"
 
 namespace accretion {
 
 ParticleTexels gatherParticleTexels(const GBuffer& gbuffer, const Particles& particles, const ParticleBvh& bvh,
-                                    const Camera& camera, const Settings& settings) {
+                                    const Camera& camera, ShadingModel model, std::uint32_t side, std::uint32_t layers) {
     ParticleTexels t;
-    t.side = settings.restir.texels;
-    t.layers = settings.restir.texel_rays;
+    t.side = side;
+    t.layers = layers;
     const std::size_t n = particles.size();
 
     // The particles some pixel sees.
@@ -50,7 +51,6 @@ ParticleTexels gatherParticleTexels(const GBuffer& gbuffer, const Particles& par
     t.grid.height = std::uint32_t((count + kTexelRowWidth - 1) / kTexelRowWidth);
     t.grid.window = PixelWindow::whole(t.grid.width, t.grid.height);
     t.grid.texels.assign(std::size_t(t.grid.width) * t.grid.height, GBufferTexel{});
-    const ShadingModel model = settings.shading.model;
     tbb::parallel_for(std::uint32_t(0), t.visible(), [&](std::uint32_t v) {
         const std::uint32_t j = t.particleOf[v];
         const BillboardFrame& f = bvh.frame(j);
@@ -60,6 +60,14 @@ ParticleTexels gatherParticleTexels(const GBuffer& gbuffer, const Particles& par
         }
     });
     return t;
+}
+
+void recordGatherParticleTexels(const GBuffer& gbuffer, const Particles& particles, const ParticleBvh& bvh, PassCounters& pc) {
+    for (std::size_t px = 0; px < gbuffer.texels.size(); ++px) {
+        ThreadCounters& t = pc.threads[px];
+        recordTexel(t, gbuffer.texels[px], particles, bvh, gpu_layout::kGBufferTexel);
+        if (gbuffer.texels[px].hit()) t.bytesWritten += 1;
+    }
 }
 
 }  // namespace accretion

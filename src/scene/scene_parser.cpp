@@ -384,9 +384,11 @@ void validateLightingAndGeometry(const Settings& s, const RuleFailure& fail) {
         fail("render.source", fmt::format("\"{}\" is a restir source: its presampled lights are drawn once per frame, and ris "
                                           "averages many samples of one frame, which would converge to that frame's draw, not "
                                           "to Lr (use uniform, power or tree)", enumName(s.render.source)));
-    if (estimatorInfo(s.render.estimator).worldCache && sourceInfo(s.render.source).presampled)
+    if (estimatorInfo(s.render.estimator).passes == LightingPasses::voxelCache && sourceInfo(s.render.source).presampled)
         fail("render.source", fmt::format("\"{}\" is a restir source (presampled once per frame for its pixels): the voxel cache "
                                           "draws its cells' lights from uniform, power or tree", enumName(s.render.source)));
+    if (s.render.estimator == EstimatorKind::particle_split && s.particle_split.near == 0 && s.particle_split.far == 0)
+        fail("particle_split.far", "particle_split.near and particle_split.far are both 0: no light reaches a texel");
     if (static_cast<std::uint64_t>(s.restir.regir_cells) * s.restir.regir_cells * s.restir.regir_cells * s.restir.regir_lights_per_cell >
         (std::uint64_t(1) << 28))
         fail("restir.regir_lights_per_cell", fmt::format("{}^3 cells x {} lights is more than 2^28 slots", s.restir.regir_cells,

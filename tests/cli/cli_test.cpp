@@ -43,9 +43,10 @@ TEST_CASE("bit-identical EXR for 1 and 2 threads", "[cli][determinism]") {
     const auto dir = accretion::test::scratchDir("threads");
     // restir: three frames of temporal + spatial reuse (pairwise, packed
     // reservoirs, reduced resolution); tree: adaptive sampling.
-    const std::string estimator = GENERATE("exact", "power", "uniform", "ris", "tree", "split", "restir", "particle_restir", "voxel_cache");
+    const std::string estimator = GENERATE("exact", "power", "uniform", "ris", "tree", "split", "restir", "particle_restir", "voxel_cache",
+                                            "particle_split");
     const bool reuse = estimator == std::string("restir") || estimator == std::string("particle_restir") ||
-                       estimator == std::string("voxel_cache");
+                       estimator == std::string("voxel_cache") || estimator == std::string("particle_split");
     std::string extra = " --spp 8";
     if (estimator == std::string("tree")) extra += " --target-stderr 5% -D render.max_samples=64";
     // split: k from the pilot (threads work on one cache each); more lights than the near field holds.
@@ -60,6 +61,10 @@ TEST_CASE("bit-identical EXR for 1 and 2 threads", "[cli][determinism]") {
     // voxel_cache: three frames of the cells' running mean, lights from the tree.
     if (estimator == std::string("voxel_cache"))
         extra = " -D render.frames=3 -D render.source=\"tree\" -D voxel.cells=16 -D particles.gm=40";
+    // particle_split: three frames of 2x2 texels averaged by id, near and far lights.
+    if (estimator == std::string("particle_split"))
+        extra = " -D render.frames=3 -D particle_split.texels=2 -D particle_split.history=0.5 -D particle_split.near=8"
+                " -D particle_split.far=4 -D particles.gm=40";
     const std::string last = reuse ? ".0002.exr" : ".exr";
     const std::string pattern = reuse ? ".{frame}.exr" : ".exr";
     std::string out;

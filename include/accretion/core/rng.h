@@ -19,6 +19,7 @@ enum class RngPass : std::uint32_t {
     tileSelection = 8,     ///< light tiles: the tile of a pixel block
     nearLightPilot = 9,    ///< split: the far samples of the pilot that picks k
     voxelCache = 10,       ///< voxel_cache: a cell's light draws
+    particleSplit = 11,    ///< particle_split: a texel's far draws
 };
 
 /// 64-bit finaliser (SplitMix64), a bijection with good avalanche.

@@ -79,6 +79,9 @@ struct FramePlan {
     bool texelHistory = false;
     /// voxel_cache: updateVoxelCache and shadeVoxelPixels instead of restir's passes.
     bool voxelCache = false;
+    /// particle_split: gatherParticleTexels, findNearLights, shadeSplitTexels
+    /// and shadeParticlePixels instead of restir's passes.
+    bool particleSplit = false;
     std::vector<PlannedStep> steps;
 
     /// Whether a frame with these facts loads (and builds) its particles: the

@@ -16,6 +16,7 @@
 #include "accretion/render/gbuffer.h"
 #include "accretion/render/frame_plan.h"
 #include "accretion/render/pixel_window.h"
+#include "accretion/render/particle_split.h"
 #include "accretion/render/voxel_cache.h"
 #include "accretion/scene/settings.h"
 
@@ -115,6 +116,7 @@ private:
         FramePlan plan;
         std::unique_ptr<Restir> restir;
         std::unique_ptr<VoxelCache> voxel;  ///< voxel_cache: the world's cells, kept from frame to frame
+        std::unique_ptr<ParticleSplit> split;  ///< particle_split: last frame's texels, by particle id
     };
     /// What every lane of a frame shares: the camera, the particles and the light sampler.
     struct FrameGeometry;

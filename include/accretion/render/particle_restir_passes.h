@@ -114,18 +114,7 @@ ACC_HD_BODY void accumulateTexelLr(B& b, std::size_t px) {
 template <class B>
 ACC_HD std::uint32_t pixelTexels(const B& b, const GBufferTexel& g, std::size_t q[kMaxPixelOffers], float w[kMaxPixelOffers]) {
     const ReuseParams& p = b.params();
-    std::uint32_t sub[4];
-    float bw[4];
-    const std::uint32_t k = bilinearTexels(b.pixelUv(g), p.texelSide, sub, bw);
-    const std::size_t base = std::size_t(b.slotOf(g.particle)) * p.texelsPerParticle();
-    const std::uint32_t perLayer = p.texelSide * p.texelSide;
-    std::uint32_t n = 0;
-    for (std::uint32_t layer = 0; layer < p.texelLayers; ++layer)
-        for (std::uint32_t c = 0; c < k; ++c) {
-            q[n] = base + layer * perLayer + sub[c];
-            w[n++] = bw[c] / float(p.texelLayers);
-        }
-    return n;
+    return texelStencil(b.pixelUv(g), p.texelSide, p.texelLayers, std::size_t(b.slotOf(g.particle)) * p.texelsPerParticle(), q, w);
 }
 
 /// shadeParticlePixels' start at pixel px showing g: Lr = 0 written, and

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "accretion/counters/thread_counters.h"
 #include "accretion/render/gbuffer.h"
 #include "accretion/render/particle_texels.h"
 
@@ -22,8 +23,15 @@ struct ParticleTexels {
 };
 
 /// gatherParticleTexels: the particles some pixel of `gbuffer` sees, in
-/// Morton order of their positions over the particles' bounding cube (ties by id), and their texels on the billboards `bvh` holds for the camera.
+/// Morton order of their positions over the particles' bounding cube (ties
+/// by id), and their side x side x layers texels on the billboards `bvh`
+/// holds for the camera (particle_restir's restir.texels and texel_rays,
+/// particle_split's particle_split.texels and one layer).
 ParticleTexels gatherParticleTexels(const GBuffer& gbuffer, const Particles& particles, const ParticleBvh& bvh,
-                                    const Camera& camera, const Settings& settings);
+                                    const Camera& camera, ShadingModel model, std::uint32_t side, std::uint32_t layers);
+
+/// Counting mode: gatherParticleTexels's per-pixel work (the G-buffer
+/// texel read, the particle's visible flag written).
+void recordGatherParticleTexels(const GBuffer& gbuffer, const Particles& particles, const ParticleBvh& bvh, PassCounters& pc);
 
 }  // namespace accretion

@@ -115,4 +115,23 @@ ACC_HD inline std::uint32_t bilinearTexels(Vec2 uv, std::uint32_t side, std::uin
     return 4;
 }
 
+/// The texels a pixel at billboard uv reads, of the particle whose first
+/// texel is `base` (texelsPerParticle = side x side x layers, layer by
+/// layer): the bilinear four (one for side 1) of each layer, weights
+/// summing to 1 over all of them. q and w hold 4 x layers entries. Returns how many.
+ACC_HD inline std::uint32_t texelStencil(Vec2 uv, std::uint32_t side, std::uint32_t layers, std::size_t base, std::size_t* q,
+                                         float* w) {
+    std::uint32_t sub[4];
+    float bw[4];
+    const std::uint32_t k = bilinearTexels(uv, side, sub, bw);
+    const std::uint32_t perLayer = side * side;
+    std::uint32_t n = 0;
+    for (std::uint32_t layer = 0; layer < layers; ++layer)
+        for (std::uint32_t c = 0; c < k; ++c) {
+            q[n] = base + layer * perLayer + sub[c];
+            w[n++] = bw[c] / float(layers);
+        }
+    return n;
+}
+
 }  // namespace accretion

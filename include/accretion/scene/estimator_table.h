@@ -11,6 +11,14 @@ namespace accretion {
 /// The light sampler buildLightSampler builds.
 enum class LightSamplerKind { none, power, tree };
 
+/// The passes that light a frame of an estimator (FramePlan).
+enum class LightingPasses {
+    perPixel,       ///< estimateLighting's per-pixel loop (exact, the samplers, ris, split)
+    restir,         ///< restir's reservoir passes (Restir), on pixels or particle texels
+    voxelCache,     ///< updateVoxelCache and shadeVoxelPixels (VoxelCache)
+    particleSplit,  ///< findNearLights, shadeSplitTexels and shadeParticlePixels (ParticleSplit)
+};
+
 /// What an estimator of Lr is and what it needs: the one place the
 /// settings' checks (scene_parser), the frame plan, the commands (converge,
 /// bias, experiment, render's outputs, the twin) and `accretion estimators`
@@ -21,7 +29,7 @@ struct EstimatorInfo {
     bool sums;                ///< sums every light (exact): no samples, no standard error
     LightSamplerKind sampler; ///< the light sampler it draws from itself (ris and restir: their render.source's)
     bool resampling;          ///< draws render.candidates candidates from render.source, keeps one by RIS
-    bool reuse;               ///< state reused across pixels and frames (restir's reservoirs, the voxel cache): history frames first, one estimate a pixel
+    bool reuse;               ///< state reused across pixels and frames (restir's reservoirs, the voxel cache, particle_split's texel history): history frames first, one estimate a pixel
     bool unbiased;            ///< converges to exact whatever its settings (restir: only with a bias correction)
     bool adaptive;            ///< render.target_stderr stops each pixel at its error
     bool twin;                ///< accretion-optix runs it
@@ -29,16 +37,16 @@ struct EstimatorInfo {
     std::string_view summary;
     /// When it is unbiased, where not always (`accretion estimators`).
     std::string_view unbiasedWhen = "with a bias correction";
-    /// Lit from a world-space cache (VoxelCache's passes), not restir's reservoirs.
-    bool worldCache = false;
+    /// The passes that light its frames.
+    LightingPasses passes = LightingPasses::perPixel;
 
-    /// Runs restir's passes (Restir): reuse through reservoirs, not a world cache.
-    constexpr bool restirPasses() const { return reuse && !worldCache; }
+    /// Runs restir's passes (Restir).
+    constexpr bool restirPasses() const { return passes == LightingPasses::restir; }
     /// Draws its lights from render.source (ris and restir's candidates, the voxel cache's rays).
-    constexpr bool drawsFromSource() const { return resampling || worldCache; }
+    constexpr bool drawsFromSource() const { return resampling || passes == LightingPasses::voxelCache; }
 };
 
-inline constexpr std::array<EstimatorInfo, 9> kEstimators = {{
+inline constexpr std::array<EstimatorInfo, 10> kEstimators = {{
     {EstimatorKind::exact, true, LightSamplerKind::none, false, false, true, false, true, false,
      "every light i != j with its shadow ray: the reference"},
     {EstimatorKind::uniform, false, LightSamplerKind::none, false, false, true, true, true, false,
@@ -48,17 +56,21 @@ inline constexpr std::array<EstimatorInfo, 9> kEstimators = {{
     {EstimatorKind::ris, false, LightSamplerKind::none, true, false, true, true, false, false,
      "S reservoirs of render.candidates candidates from render.source, one shadow ray each"},
     {EstimatorKind::restir, false, LightSamplerKind::none, true, true, false, false, true, false,
-     "ReSTIR DI: RIS candidates, temporal and spatial reuse, one shadow ray"},
+     "ReSTIR DI: RIS candidates, temporal and spatial reuse, one shadow ray", "with a bias correction",
+     LightingPasses::restir},
     {EstimatorKind::tree, false, LightSamplerKind::tree, false, false, true, true, false, false,
      "S lights drawn from the light tree at the receiver, with the standard error"},
     {EstimatorKind::split, false, LightSamplerKind::tree, false, false, true, true, false, true,
      "the nearest lights summed, the far ones drawn from the light tree"},
     {EstimatorKind::particle_restir, false, LightSamplerKind::none, true, true, false, false, true, false,
      "ReSTIR DI on the visible particles' billboard texels (history by particle id, world-space neighbours); pixels interpolate or resample them",
-     "pixel_shading resample, with a bias correction (interpolate: no)"},
+     "pixel_shading resample, with a bias correction (interpolate: no)", LightingPasses::restir},
     {EstimatorKind::voxel_cache, false, LightSamplerKind::none, false, true, false, false, true, false,
      "seed 004's voxel radiance cache: lights from render.source at each occupied cell's centre, one shadow ray each, averaged over frames; pixels read it trilinearly",
-     "never (the light at the cells' centres, in an L1 or cosine basis)", true},
+     "never (the light at the cells' centres, in an L1 or cosine basis)", LightingPasses::voxelCache},
+    {EstimatorKind::particle_split, false, LightSamplerKind::tree, false, true, false, false, true, false,
+     "seed 004's hybrid compute on the visible particles' billboard texels: the nearest lights summed, far ones drawn from the light tree, a shadow ray each; pixels interpolate",
+     "never (the light at the texels, not at the pixel)", LightingPasses::particleSplit},
 }};
 
 constexpr bool estimatorTableMatchesEnum() {

@@ -41,7 +41,7 @@ enum class BuildPolicy { rebuild, refit, fast_trace, partial };
 enum class AccelLayout { clusters, instances, aabbs };
 enum class CpuLayout { fastest, gpu };
 enum class ShadingModel { lambert, sphere, isotropic };
-enum class EstimatorKind { exact, uniform, power, ris, restir, tree, split, particle_restir, voxel_cache };
+enum class EstimatorKind { exact, uniform, power, ris, restir, tree, split, particle_restir, voxel_cache, particle_split };
 enum class PixelShading { interpolate, resample };
 enum class VoxelBasis { l1, camera };
 enum class BiasCorrection { none, basic, pairwise };
@@ -63,7 +63,8 @@ ACC_ENUM_NAMES(BuildPolicy, "rebuild", "refit", "fast_trace", "partial");
 ACC_ENUM_NAMES(AccelLayout, "clusters", "instances", "aabbs");
 ACC_ENUM_NAMES(CpuLayout, "fastest", "gpu");
 ACC_ENUM_NAMES(ShadingModel, "lambert", "sphere", "isotropic");
-ACC_ENUM_NAMES(EstimatorKind, "exact", "uniform", "power", "ris", "restir", "tree", "split", "particle_restir", "voxel_cache");
+ACC_ENUM_NAMES(EstimatorKind, "exact", "uniform", "power", "ris", "restir", "tree", "split", "particle_restir", "voxel_cache",
+               "particle_split");
 ACC_ENUM_NAMES(PixelShading, "interpolate", "resample");
 ACC_ENUM_NAMES(VoxelBasis, "l1", "camera");
 ACC_ENUM_NAMES(BiasCorrection, "none", "basic", "pairwise");
@@ -361,6 +362,23 @@ struct VoxelSettings {
     }
 };
 
+/// [particle_split]: seed 004's hybrid compute (docs/MODEL.md section 4b,
+/// docs/designs.md): each visible particle's billboard texels lit by its
+/// nearest lights summed exactly and far lights drawn from the light tree,
+/// a shadow ray each; the pixels interpolate their particle's texels.
+struct ParticleSplitSettings {
+    std::uint32_t near = 16;       ///< nearest lights per particle, summed exactly
+    std::uint32_t far = 8;         ///< far lights drawn per texel and frame
+    std::uint32_t texels = 1;      ///< texels per billboard side
+    double history = 0.0;          ///< weight of a texel's last Lr in its new one
+    template <class V> void visit(V& v) {
+        v.field("near", near, "particle_split: the lights nearest each visible particle's centre (on the light tree, no rays), summed exactly at each of its texels with a shadow ray each", Range{0, 64});
+        v.field("far", far, "particle_split: lights drawn per texel and frame from the light tree at the texel, the near lights' ball taken out, one shadow ray each", Range{0, 1024});
+        v.field("texels", texels, "particle_split: texels per billboard side (1, 2, 3 or 4); the pixels interpolate them bilinearly", Range{1, 4});
+        v.field("history", history, "particle_split: a texel's Lr is (1 - h) x this frame's + h x its own last frame's, found by particle id (an exponential average: biased where the light changes)", Range{0.0, 0.99});
+    }
+};
+
 /// An SER sort key as the settings hold it: its components, most
 /// significant first ("hit,type" in a scene file).
 struct SerKeySpec {
@@ -425,6 +443,7 @@ struct Settings {
     RenderSettings render;
     RestirSettings restir;
     VoxelSettings voxel;
+    ParticleSplitSettings particle_split;
     GpuSettings gpu;
 
     std::string sceneName = "scene"; ///< stem of the scene file
@@ -438,6 +457,7 @@ struct Settings {
         v.section("render", render);
         v.section("restir", restir);
         v.section("voxel", voxel);
+        v.section("particle_split", particle_split);
         v.section("gpu", gpu);
     }
 };

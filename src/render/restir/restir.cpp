@@ -66,17 +66,6 @@ LightingCounters runPasses(restir::FrameContext& f, std::vector<StoredReservoir>
     return total;
 }
 
-/// Counting mode: gatherParticleTexels's per-pixel work (the G-buffer texel
-/// read, the particle's visible flag written).
-void recordGather(const RestirInputs& in, PassCounters& pc) {
-    const GBuffer& g = in.gbuffer;
-    for (std::size_t px = 0; px < g.texels.size(); ++px) {
-        ThreadCounters& t = pc.threads[px];
-        recordTexel(t, g.texels[px], in.particles, in.bvh, gpu_layout::kGBufferTexel);
-        if (g.texels[px].hit()) t.bytesWritten += 1;
-    }
-}
-
 /// A frame that is a window of the image (restir.crop_margin): its grid's
 /// texels keyed by their place in the whole grid (ReuseParams::pixelKey),
 /// the window's origin at `scale` x its pixel origin.
@@ -184,8 +173,9 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
     ParticleTexels texels;  // particle_restir: the lighting grid is the visible particles' texels
     if (in.plan.particleTexels) {
         auto t = timer.scope(Pass::gatherParticleTexels);
-        texels = gatherParticleTexels(full, in.particles, in.bvh, in.camera, in.settings);
-        if (in.counters) recordGather(in, in.counters->add(Pass::gatherParticleTexels, full.width, full.height));
+        texels = gatherParticleTexels(full, in.particles, in.bvh, in.camera, in.settings.shading.model, rs_.texels, rs_.texel_rays);
+        if (in.counters)
+            recordGatherParticleTexels(full, in.particles, in.bvh, in.counters->add(Pass::gatherParticleTexels, full.width, full.height));
         lg = &texels.grid;
     }
     const std::size_t lpixels = std::size_t(lg->width) * lg->height;

@@ -1,0 +1,268 @@
+#pragma once
+// particle_split: seed 004's hybrid compute (docs/MODEL.md section 4b,
+// docs/designs.md). Particle-to-particle lighting in compute with a spatial
+// acceleration structure, ray tracing for visibility alone, lit per
+// particle, not per pixel: on the texels of the visible particles'
+// billboards (particle_texels.h, particle_restir's grid), each texel
+//
+//   Lr = sum over the near lights N of f I G V          (every one, exactly)
+//      + 1/S sum over S far draws y of f I G V / p(y)   (the light tree, N's
+//                                                        ball taken out)
+//
+// N is the particle's particle_split.near lights nearest to its centre c
+// other than itself, found on the light tree (nearestLights: a pruned
+// search, no rays), shared by its texels. The far draws descend the light
+// tree at the texel's point with FarImportance: a node wholly inside the
+// ball of N (every light below it is nearer c than the farthest of N, so
+// in N) gets no draw; a draw that still lands on a light of N (from a node
+// that straddles the ball) adds nothing. Every far light keeps its tree
+// pdf, so the far sum is unbiased for the lights outside N, and the texel's
+// Lr is unbiased for the light at the texel. With particle_split.history h
+// a texel's Lr is (1 - h) x this frame's + h x its own last frame's (the
+// same texel of the same particle, by id). The pixels interpolate their
+// particle's texels: biased by the light at the texels, not at the pixel.
+//
+// The bodies are the CPU's (src/render/particle_split/) and the twin's
+// (src/twin/), over a bridge B:
+//
+//   const SplitParams& params()
+//   findNearLights:   std::uint32_t particleOfSlot(v); Vec3 particlePosition(j);
+//                     const LightTreeView& tree(); void writeNear(v, light, count, radius2)
+//   shadeSplitTexels: GBufferTexel texel(q); ShadingPoint shadingPoint(g);
+//                     std::uint32_t nearLights(v, light) (returns the count); float nearRadius2(v)
+//                     LightSample sampleFar(sp, rng, importance)  the tree's descent (counted)
+//                     bool term(sp, i, t)     light i's term f I G in the frame's shading model (counted)
+//                     bool shadows(); bool visible(sp, i, t)  a shadow ray (traced, counted)
+//                     void reject(q)          a far draw's non-finite contribution rejected (render.nonfinite)
+//                     bool historyTexelOf(j, sub, q); Vec3 historyLr(q); void writeTexelLr(q, Lr)
+//   shadePixels:      GBufferTexel pixel(px); std::uint32_t slotOf(j); Vec2 pixelUv(g);
+//                     Vec3 texelLr(q); void writePixelLr(px, Lr)
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+
+#include "accretion/core/math.h"
+#include "accretion/core/rng.h"
+#include "accretion/lighting/light_sample.h"
+#include "accretion/lighting/light_tree_view.h"
+#include "accretion/lighting/shading.h"
+#include "accretion/render/gbuffer_texel.h"
+#include "accretion/render/particle_texels.h"
+
+namespace accretion::psplit {
+
+/// The most near lights a particle sums (particle_split.near).
+inline constexpr std::uint32_t kMaxNear = 64;
+inline constexpr std::uint32_t kNoNearLight = 0xffffffffu;
+
+/// What the passes read of the settings and the frame.
+struct SplitParams {
+    std::uint32_t nearCount = 16;   ///< particle_split.near: k
+    std::uint32_t farSamples = 8;   ///< particle_split.far: S
+    std::uint32_t side = 1;         ///< particle_split.texels: texels per billboard side
+    float history = 0.0f;           ///< particle_split.history
+    bool discardNonFinite = false;  ///< render.nonfinite discard: a non-finite far draw is not counted (else it counts as 0)
+    std::uint32_t visible = 0;      ///< the frame's visible particles (slots)
+    std::uint32_t frame = 0;
+    std::uint64_t seed = 0;
+    ACC_HD std::uint32_t texelsPerParticle() const { return side * side; }
+};
+
+/// The frame's parameters from the settings (the CPU's and the twin's).
+inline SplitParams splitParams(const Settings& s, std::uint32_t visible, std::uint32_t frame, std::uint64_t seed) {
+    SplitParams p;
+    p.nearCount = s.particle_split.near;
+    p.farSamples = s.particle_split.far;
+    p.side = s.particle_split.texels;
+    p.history = float(s.particle_split.history);
+    p.discardNonFinite = s.render.nonfinite == NonFinitePolicy::discard;
+    p.visible = visible;
+    p.frame = frame;
+    p.seed = seed;
+    return p;
+}
+
+/// The min(k, kMaxNear) lights nearest to x other than `self` on the light
+/// tree's nodes, nearest first (ties: the smaller index first), with their
+/// squared distances (each leaf's centre to x, as FarImportance measures
+/// them). A depth-first search, the nearer child first, pruned by the k-th
+/// distance so far. Returns how many (fewer where the tree holds fewer).
+ACC_HD inline std::uint32_t nearestLights(const LightTreeView& tree, const Vec3& x, std::uint32_t self, std::uint32_t k,
+                                          std::uint32_t* light, float* d2) {
+    if (k > kMaxNear) k = kMaxNear;
+    if (tree.nodeCount == 0 || k == 0) return 0;
+    // A max-heap of the best so far on (d2, light).
+    std::uint32_t found = 0;
+    const auto worse = [&](std::uint32_t a, std::uint32_t b) {  // entry a is farther than entry b
+        return d2[a] > d2[b] || (d2[a] == d2[b] && light[a] > light[b]);
+    };
+    const auto swapEntries = [&](std::uint32_t a, std::uint32_t b) {
+        const float t = d2[a];
+        d2[a] = d2[b];
+        d2[b] = t;
+        const std::uint32_t u = light[a];
+        light[a] = light[b];
+        light[b] = u;
+    };
+    const auto siftDown = [&](std::uint32_t at, std::uint32_t n) {
+        for (;;) {
+            const std::uint32_t l = 2 * at + 1, r = l + 1;
+            std::uint32_t top = at;
+            if (l < n && worse(l, top)) top = l;
+            if (r < n && worse(r, top)) top = r;
+            if (top == at) return;
+            swapEntries(at, top);
+            at = top;
+        }
+    };
+    const auto sphereBound = [&](const LightTreeNode& n) {
+        const Vec3 delta = n.center - x;
+        const float d = sqrtf(delta.x * delta.x + delta.y * delta.y + delta.z * delta.z) - n.radius;
+        return d > 0.0f ? d * d : 0.0f;
+    };
+    struct Pending {
+        std::uint32_t node;
+        float bound;
+    };
+    Pending stack[2 * 64 + 2];  // the tree is at most 64 deep (LightTree's build)
+    std::uint32_t top = 0;
+    stack[top++] = {0u, sphereBound(tree.nodes[0])};
+    while (top > 0) {
+        const Pending p = stack[--top];
+        if (found == k && !(p.bound <= d2[0])) continue;
+        const LightTreeNode& n = tree.nodes[p.node];
+        if (n.count == 1) {
+            if (n.child == self) continue;
+            const Vec3 delta = n.center - x;
+            const float dd = delta.x * delta.x + delta.y * delta.y + delta.z * delta.z;
+            if (found < k) {  // sift the new entry up
+                std::uint32_t at = found++;
+                d2[at] = dd;
+                light[at] = n.child;
+                while (at > 0 && worse(at, (at - 1) / 2)) {
+                    swapEntries(at, (at - 1) / 2);
+                    at = (at - 1) / 2;
+                }
+            } else if (dd < d2[0] || (dd == d2[0] && n.child < light[0])) {
+                d2[0] = dd;
+                light[0] = n.child;
+                siftDown(0, found);
+            }
+            continue;
+        }
+        const Pending a{n.child, sphereBound(tree.nodes[n.child])}, b{n.child + 1, sphereBound(tree.nodes[n.child + 1])};
+        stack[top++] = a.bound <= b.bound ? b : a;  // pushed far first: the near one is popped first
+        stack[top++] = a.bound <= b.bound ? a : b;
+    }
+    // Nearest first: the heap sorted in place.
+    for (std::uint32_t n = found; n > 1; --n) {
+        swapEntries(0, n - 1);
+        siftDown(0, n - 1);
+    }
+    return found;
+}
+
+/// The ball of the near lights: every light nearer `centre` than
+/// sqrt(radius2) is one of them (nearestLights kept the nearest). `inner2`
+/// is radius2 less a margin for the rounding of the node's bounds.
+ACC_HD inline float innerRadius2(float radius2) { return radius2 * (1.0f - 2e-3f); }
+
+/// The far draws' importance of a node (LightTreeView::sample's
+/// importanceOf): 0 for a node wholly inside the near lights' ball, else
+/// the tree's own descent importance at the receiver.
+struct FarImportance {
+    Vec3 centre{0.0f};
+    float inner2 = 0.0f;
+    ACC_HD bool inside(const LightTreeNode& n) const {
+        const Vec3 d = n.center - centre;
+        const float dd = d.x * d.x + d.y * d.y + d.z * d.z;
+        if (n.count == 1) return dd < inner2;
+        const float reach = sqrtf(dd) + n.radius;
+        return reach * reach < inner2;
+    }
+    ACC_HD float operator()(const LightTreeView& tree, std::uint32_t n, const ShadingPoint& sp) const {
+        return inside(tree.nodes[n]) ? 0.0f : tree.descentImportance(n, tree.nodes[n].power, sp);
+    }
+};
+
+/// Whether light i is one of the `count` near lights.
+ACC_HD inline bool isNear(const std::uint32_t* light, std::uint32_t count, std::uint32_t i) {
+    for (std::uint32_t m = 0; m < count; ++m)
+        if (light[m] == i) return true;
+    return false;
+}
+
+/// findNearLights at slot v: its particle's near lights and their ball.
+template <class B>
+ACC_HD_BODY void findNearLightsOf(B& b, std::uint32_t v) {
+    const SplitParams& p = b.params();
+    const std::uint32_t j = b.particleOfSlot(v);
+    std::uint32_t light[kMaxNear];
+    float d2[kMaxNear];
+    const std::uint32_t n = nearestLights(b.tree(), b.particlePosition(j), j, p.nearCount, light, d2);
+    b.writeNear(v, light, n, n > 0 ? d2[n - 1] : 0.0f);
+}
+
+/// shadeSplitTexels at texel q: its particle's near lights summed with a
+/// shadow ray each, S far draws, and with history the texel's last Lr.
+template <class B>
+ACC_HD_BODY void shadeSplitTexel(B& b, std::size_t q) {
+    const SplitParams& p = b.params();
+    const GBufferTexel g = b.texel(q);
+    if (!g.hit()) {  // the grid's last row's tail
+        b.writeTexelLr(q, Vec3(0.0f));
+        return;
+    }
+    const std::uint32_t per = p.texelsPerParticle();
+    const std::uint32_t slot = std::uint32_t(q / per), sub = std::uint32_t(q % per);
+    const ShadingPoint sp = b.shadingPoint(g);
+    std::uint32_t near[kMaxNear];
+    const std::uint32_t k = b.nearLights(slot, near);
+    Vec3 Lr(0.0f);
+    for (std::uint32_t m = 0; m < k; ++m) {
+        LightTerm t;
+        if (b.term(sp, near[m], t) && (!b.shadows() || b.visible(sp, near[m], t))) Lr += t.value;
+    }
+    if (p.farSamples > 0) {
+        const FarImportance importance{sp.centre, k > 0 ? innerRadius2(b.nearRadius2(slot)) : 0.0f};
+        // The texel's own stream, by particle id: the same draws whatever its slot.
+        PortableRng rng(std::uint64_t(g.particle) * per + sub, p.frame, RngPass::particleSplit, p.seed);
+        Vec3 far(0.0f);
+        std::uint32_t counted = p.farSamples;
+        for (std::uint32_t s = 0; s < p.farSamples; ++s) {
+            const LightSample y = b.sampleFar(sp, rng, importance);
+            if (!(y.pdf > 0.0f) || isNear(near, k, y.i)) continue;
+            LightTerm t;
+            if (!b.term(sp, y.i, t) || (b.shadows() && !b.visible(sp, y.i, t))) continue;
+            const Vec3 c = t.value / y.pdf;
+            if (!isFiniteNumber(c.x + c.y + c.z)) {
+                b.reject(q);
+                if (p.discardNonFinite) --counted;
+                continue;
+            }
+            far += c;
+        }
+        if (counted > 0) Lr += far / float(counted);
+    }
+    std::size_t h = 0;
+    if (p.history > 0.0f && b.historyTexelOf(g.particle, sub, h)) Lr = (1.0f - p.history) * Lr + p.history * b.historyLr(h);
+    b.writeTexelLr(q, Lr);
+}
+
+/// shadeParticlePixels at image pixel px: its particle's texels' Lr,
+/// bilinear at its billboard uv (texelStencil).
+template <class B>
+ACC_HD_BODY void interpolateSplitPixel(B& b, std::size_t px) {
+    const SplitParams& p = b.params();
+    const GBufferTexel g = b.pixel(px);
+    Vec3 Lr(0.0f);
+    if (g.hit()) {
+        std::size_t q[4];
+        float w[4];
+        const std::uint32_t n = texelStencil(b.pixelUv(g), p.side, 1, std::size_t(b.slotOf(g.particle)) * p.texelsPerParticle(), q, w);
+        for (std::uint32_t c = 0; c < n; ++c) Lr += w[c] * b.texelLr(q[c]);
+    }
+    b.writePixelLr(px, Lr);
+}
+
+}  // namespace accretion::psplit

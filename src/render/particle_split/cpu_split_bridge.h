@@ -1,0 +1,210 @@
+#pragma once
+// The CPU's bridge of particle_split's pass bodies
+// (accretion/render/particle_split_passes.h): the frame's texels and near
+// lights, Embree for shadow rays, the thread records of counting mode.
+// Internal to src/render/particle_split/.
+#include <algorithm>
+#include <bit>
+#include <cstdint>
+#include <vector>
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include "accretion/counters/gpu_layouts.h"
+#include "accretion/lighting/light_arrays.h"
+#include "accretion/render/particle_split.h"
+#include "accretion/render/particle_split_passes.h"
+#include "accretion/render/particle_texel_grid.h"
+#include "accretion/render/visibility.h"
+
+namespace accretion::psplit {
+
+/// What the CPU passes read and write.
+struct CpuFrame {
+    const ParticleSplitInputs& in;
+    const SplitParams& params;
+    const LightArrays& L;
+    LightTreeView tree;
+    VisibilityOptions vis;
+    bool shadows = true;                           ///< plan.shadowRays
+    const ParticleTexels& texels;
+    std::vector<std::uint32_t>& near;              ///< slot v's near lights at v x params.nearCount
+    std::vector<std::uint32_t>& nearFound;         ///< how many each slot has
+    std::vector<float>& nearRadius2;               ///< the farthest one's squared distance
+    const std::vector<std::uint32_t>& prevSlotOf;  ///< history: last frame's slots (empty: none)
+    const std::vector<Vec3>& prevTexelLr;
+    std::vector<Vec3>& texelLr;
+    std::vector<std::uint32_t>& texelRejected;     ///< non-finite far draws per texel
+    std::vector<Vec3>& Lr;                         ///< the pixels'
+};
+
+/// One item's bridge (a slot, a texel or a pixel), with its thread record in counting mode.
+template <ShadingModel SM, Primitive P, bool Count>
+class CpuSplitBridge {
+public:
+    CpuSplitBridge(const CpuFrame& f, ThreadCounters* t, LightingCounters& c) : f_(f), rec_(t), c_(c) {}
+
+    const SplitParams& params() const { return f_.params; }
+
+    // findNearLights
+    std::uint32_t particleOfSlot(std::uint32_t v) {
+        rec_.read(4 + gpu_layout::kParticleRecord);
+        return f_.texels.particleOf[v];
+    }
+    Vec3 particlePosition(std::uint32_t j) const { return f_.in.particles.position[j]; }
+    const LightTreeView& tree() {
+        if constexpr (Count) {  // a search visits about a node pair per level per near light's neighbourhood
+            const std::uint32_t levels = std::bit_width(std::max(1u, f_.L.count));
+            rec_.trip(levels + f_.params.nearCount);
+            rec_.gather(2 * (levels + f_.params.nearCount));
+            rec_.read(2 * (levels + f_.params.nearCount) * gpu_layout::kLightTreeNode);
+        }
+        return f_.tree;
+    }
+    void writeNear(std::uint32_t v, const std::uint32_t* light, std::uint32_t count, float radius2) {
+        rec_.write(4 * (count + 2));
+        const std::size_t base = std::size_t(v) * f_.params.nearCount;
+        std::copy(light, light + count, f_.near.begin() + base);
+        std::fill(f_.near.begin() + base + count, f_.near.begin() + base + f_.params.nearCount, kNoNearLight);
+        f_.nearFound[v] = count;
+        f_.nearRadius2[v] = radius2;
+    }
+
+    // shadeSplitTexels
+    GBufferTexel texel(std::size_t q) {
+        const GBufferTexel& g = f_.texels.grid.texels[q];
+        if constexpr (Count) {
+            rec_.read(gpu_layout::kGBufferTexel);
+            if (g.hit()) rec_.shade(true, f_.in.particles.type[g.particle], f_.in.bvh.clusterOf(g.particle));
+        }
+        return g;
+    }
+    ShadingPoint shadingPoint(const GBufferTexel& g) const { return accretion::shadingPoint(g, f_.in.particles); }
+    std::uint32_t nearLights(std::uint32_t v, std::uint32_t* light) {
+        const std::uint32_t n = f_.nearFound[v];
+        rec_.read(4 * (n + 2));
+        std::copy_n(f_.near.begin() + std::size_t(v) * f_.params.nearCount, n, light);
+        return n;
+    }
+    float nearRadius2(std::uint32_t v) const { return f_.nearRadius2[v]; }
+    LightSample sampleFar(const ShadingPoint& sp, PortableRng& rng, const FarImportance& importance) {
+        rec_.trip();
+        if constexpr (Count) {  // a node pair per level
+            const std::uint32_t levels = std::bit_width(std::max(1u, f_.L.count));
+            rec_.gather(levels);
+            rec_.read(2 * levels * gpu_layout::kLightTreeNode);
+        }
+        return f_.tree.sample(sp, rng, importance);
+    }
+    bool term(const ShadingPoint& sp, std::uint32_t i, LightTerm& t) {
+        ++c_.lightTerms;
+        rec_.read(gpu_layout::kParticleRecord);
+        rec_.gather(1);
+        if (i >= f_.L.count) return false;
+        const PackedLight& l = f_.L.packed[i];
+        return evalLight<SM>(sp, l.position, l.emission, l.dmin2, t);
+    }
+    bool shadows() const { return f_.shadows; }
+    bool visible(const ShadingPoint& sp, std::uint32_t i, const LightTerm& t) {
+        RayCounters rc;
+        const bool seen = accretion::visible<P>(f_.in.bvh, f_.vis, sp, i, f_.L.position[i], f_.L.radius[i], t, rec_.rayCounters(rc));
+        if constexpr (Count) rec_.ray(rc);
+        ++c_.shadowRays;
+        c_.shadowOccluded += !seen;
+        return seen;
+    }
+    void reject(std::size_t q) {
+        ++f_.texelRejected[q];
+        ++c_.nonFinite;
+    }
+    bool historyTexelOf(std::uint32_t j, std::uint32_t sub, std::size_t& q) {
+        rec_.read(4);
+        rec_.gather(1);
+        if (j >= f_.prevSlotOf.size() || f_.prevSlotOf[j] == kNoSlot) return false;
+        q = std::size_t(f_.prevSlotOf[j]) * f_.params.texelsPerParticle() + sub;
+        return true;
+    }
+    Vec3 historyLr(std::size_t q) {
+        rec_.read(gpu_layout::kRadiance);
+        return f_.prevTexelLr[q];
+    }
+    void writeTexelLr(std::size_t q, const Vec3& Lr) {
+        rec_.write(gpu_layout::kRadiance);
+        f_.texelLr[q] = Lr;
+    }
+
+    // shadeParticlePixels
+    GBufferTexel pixel(std::size_t px) {
+        const GBufferTexel& g = f_.in.gbuffer.texels[px];
+        if constexpr (Count) {
+            rec_.read(gpu_layout::kGBufferTexel);
+            if (g.hit()) rec_.shade(true, f_.in.particles.type[g.particle], f_.in.bvh.clusterOf(g.particle));
+        }
+        return g;
+    }
+    std::uint32_t slotOf(std::uint32_t j) {
+        rec_.read(4);
+        rec_.gather(1);
+        return f_.texels.slotOf[j];
+    }
+    Vec2 pixelUv(const GBufferTexel& g) const {
+        return billboardUv(g.local, f_.in.particles.radius[g.particle], f_.in.bvh.frame(g.particle));
+    }
+    Vec3 texelLr(std::size_t q) {
+        rec_.read(gpu_layout::kRadiance);
+        return f_.texelLr[q];
+    }
+    void writePixelLr(std::size_t px, const Vec3& Lr) {
+        rec_.write(gpu_layout::kRadiance);
+        f_.Lr[px] = Lr;
+    }
+
+private:
+    const CpuFrame& f_;
+    Recorder<Count> rec_;
+    LightingCounters& c_;
+};
+
+/// Runs body(bridge, item) over items [0, n) on every core, each with its
+/// own bridge (and, counting, the thread record `pc->threads[item]`), for
+/// the frame's shading model, primitive and counting mode; returns the
+/// threads' counters summed.
+template <class Body>
+LightingCounters forEachItem(const CpuFrame& f, std::size_t n, PassCounters* pc, Body&& body) {
+    const auto run = [&]<ShadingModel SM, Primitive P, bool Count>() {
+        tbb::enumerable_thread_specific<LightingCounters> counters;
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 64), [&](const auto& r) {
+            LightingCounters& c = counters.local();
+            for (std::size_t k = r.begin(); k != r.end(); ++k) {
+                CpuSplitBridge<SM, P, Count> b(f, Count ? &pc->threads[k] : nullptr, c);
+                body(b, k);
+            }
+        });
+        LightingCounters total;
+        for (const LightingCounters& c : counters) total += c;
+        return total;
+    };
+    const auto byPrimitive = [&]<ShadingModel SM>() {
+        const bool spheres = f.in.bvh.settings().primitive == Primitive::sphere;
+        if (pc) return spheres ? run.template operator()<SM, Primitive::sphere, true>() : run.template operator()<SM, Primitive::billboard, true>();
+        return spheres ? run.template operator()<SM, Primitive::sphere, false>() : run.template operator()<SM, Primitive::billboard, false>();
+    };
+    switch (f.in.settings.shading.model) {
+    case ShadingModel::lambert: return byPrimitive.template operator()<ShadingModel::lambert>();
+    case ShadingModel::sphere: return byPrimitive.template operator()<ShadingModel::sphere>();
+    case ShadingModel::isotropic: return byPrimitive.template operator()<ShadingModel::isotropic>();
+    }
+    return LightingCounters{};
+}
+
+}  // namespace accretion::psplit
+
+namespace accretion::psplit {
+
+// The passes (one file each).
+LightingCounters findNearLights(const CpuFrame& f);
+LightingCounters shadeSplitTexels(const CpuFrame& f);
+LightingCounters shadeSplitPixels(const CpuFrame& f);
+
+}  // namespace accretion::psplit

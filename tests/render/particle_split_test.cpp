@@ -1,0 +1,249 @@
+// particle_split, seed 004's hybrid compute (docs/MODEL.md section 4b,
+// docs/designs.md): the near search against brute force, a texel lit by
+// every light in closed form, the far draws unbiased against a brute-force
+// sum that shares nothing with the renderer (the near lights' ball taken
+// out of the tree), and the texels' history unbiased with less variance.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <utility>
+#include <vector>
+
+#include "accretion/render/frame_plan.h"
+#include "accretion/render/particle_split_passes.h"
+#include "support/test_scenes.h"
+
+using namespace accretion;
+
+namespace {
+
+/// Lr at particle j's centre from every other particle, by MODEL.md's
+/// formula written out here: isotropic, f = rho / (4 pi), no visibility;
+/// lambert, f = rho / pi with max(0, n . w), n given.
+DVec3 bruteForceLr(const Particles& ps, std::uint32_t j, const Settings& s, const Vec3& n) {
+    const double dmin = s.shading.dmin;
+    DVec3 sum(0.0);
+    for (std::uint32_t i = 0; i < ps.size(); ++i) {
+        if (i == j) continue;
+        const DVec3 d = DVec3(ps.position[i]) - DVec3(ps.position[j]);
+        const double d2 = glm::dot(d, d);
+        double g = 1.0 / std::max(d2, std::max(dmin * dmin, 1e-30));
+        if (s.shading.model == ShadingModel::lambert) g *= std::max(0.0, glm::dot(DVec3(n), d / std::sqrt(d2))) * 4.0;
+        sum += DVec3(ps.emission[i]) * g;
+    }
+    return DVec3(s.shading.albedo) * sum / (4.0 * 3.14159265358979323846);
+}
+
+/// The particle_split settings of these tests: 1x1 texels (the texel is the
+/// particle's centre), visibility off (the brute force has none).
+Settings splitSettings(ShadingModel model, std::uint32_t count, std::uint32_t near, std::uint32_t far) {
+    Settings s = test::smallDiskSettings();
+    s.particles.count = count;
+    s.camera.width = 96;
+    s.camera.height = 64;
+    s.shading.model = model;
+    s.shading.visibility = false;
+    s.render.estimator = EstimatorKind::particle_split;
+    s.particle_split.near = near;
+    s.particle_split.far = far;
+    s.particle_split.texels = 1;
+    return s;
+}
+
+/// Each visible particle's Lr in one frame (its pixels agree for 1x1 texels) and the normal it was shaded with.
+std::map<std::uint32_t, std::pair<DVec3, Vec3>> particleLr(const FrameImage& img) {
+    std::map<std::uint32_t, std::pair<DVec3, Vec3>> out;
+    for (std::size_t px = 0; px < img.particle.size(); ++px)
+        if (img.particle[px] != kNoParticle) out[img.particle[px]] = {DVec3(img.lighting.Lr[px]), img.normal[px]};
+    return out;
+}
+
+}  // namespace
+
+TEST_CASE("particle_split: nearestLights on the light tree is the brute-force k nearest, nearest first", "[particle_split]") {
+    const test::DiskLights d(ShadingModel::lambert, 3000);
+    const LightTreeView view = d.tree.view();
+    for (const std::uint32_t k : {1u, 7u, 16u, 64u}) {
+        for (std::uint32_t j = 0; j < d.particles.size(); j += 37) {
+            std::vector<std::pair<float, std::uint32_t>> all;
+            for (std::uint32_t i = 0; i < d.particles.size(); ++i) {
+                if (i == j) continue;
+                const Vec3 delta = d.particles.position[i] - d.particles.position[j];
+                all.push_back({glm::dot(delta, delta), i});
+            }
+            std::sort(all.begin(), all.end());
+            std::uint32_t light[psplit::kMaxNear];
+            float d2[psplit::kMaxNear];
+            const std::uint32_t n = psplit::nearestLights(view, d.particles.position[j], j, k, light, d2);
+            INFO("k " << k << " particle " << j);
+            REQUIRE(n == k);
+            for (std::uint32_t m = 0; m < n; ++m) {
+                CHECK(light[m] == all[m].second);
+                CHECK(d2[m] == all[m].first);
+            }
+        }
+    }
+    // The tree holds fewer lights than asked: all of them but the receiver.
+    const test::DiskLights few(ShadingModel::lambert, 10);
+    std::uint32_t light[psplit::kMaxNear];
+    float d2[psplit::kMaxNear];
+    REQUIRE(psplit::nearestLights(few.tree.view(), few.particles.position[3], 3, 64, light, d2) == 9);
+    REQUIRE_FALSE(psplit::isNear(light, 9, 3));
+}
+
+TEST_CASE("particle_split: FarImportance never takes out a node that holds a light outside the near lights' ball", "[particle_split]") {
+    const test::DiskLights d(ShadingModel::lambert, 3000);
+    const LightTreeView view = d.tree.view();
+    std::uint32_t insideNodes = 0;
+    for (std::uint32_t j = 0; j < d.particles.size(); j += 101) {
+        std::uint32_t light[psplit::kMaxNear];
+        float d2[psplit::kMaxNear];
+        const std::uint32_t n = psplit::nearestLights(view, d.particles.position[j], j, 32, light, d2);
+        const psplit::FarImportance imp{d.particles.position[j], psplit::innerRadius2(d2[n - 1])};
+        // Every node taken out holds near lights (or the receiver) alone.
+        for (std::uint32_t node = 0; node < view.nodeCount; ++node) {
+            if (!imp.inside(view.nodes[node])) continue;
+            ++insideNodes;
+            std::vector<std::uint32_t> stack{node};
+            while (!stack.empty()) {
+                const LightTreeNode& m = view.nodes[stack.back()];
+                stack.pop_back();
+                if (m.count > 1) {
+                    stack.push_back(m.child);
+                    stack.push_back(m.child + 1);
+                    continue;
+                }
+                INFO("particle " << j << " node " << node << " light " << m.child);
+                REQUIRE((m.child == j || psplit::isNear(light, n, m.child)));
+            }
+        }
+    }
+    REQUIRE(insideNodes > 100);  // the test has power: the ball takes out subtrees
+}
+
+TEST_CASE("particle_split: with every light near, a texel's Lr is the closed-form sum over all of them", "[particle_split]") {
+    for (const ShadingModel model : {ShadingModel::isotropic, ShadingModel::lambert}) {
+        const Settings s = splitSettings(model, 60, 64, 0);  // 59 others: all near, no far draw
+        const Particles ps = ParticleSource(s).frame(0);
+        const auto lit = particleLr(test::renderParticles(s, ps));
+        REQUIRE(lit.size() > 20);
+        for (const auto& [j, v] : lit) {
+            const DVec3 expect = bruteForceLr(ps, j, s, v.second);
+            INFO(enumName(model) << " particle " << j);
+            for (int c = 0; c < 3; ++c) CHECK(v.first[c] == Approx(expect[c]).epsilon(1e-4));
+        }
+    }
+}
+
+TEST_CASE("particle_split: near sum and far draws are unbiased against the brute-force sum (99.99% per particle)", "[particle_split][statistical]") {
+    // 400 lights: a near field of 8 or none, far draws from the tree with the
+    // ball taken out. Over 400 seeds each particle's mean is within 4.5
+    // standard errors (and 1e-5 of float rounding) of its brute-force Lr (a per-particle chance of about
+    // 1e-5 to fail when unbiased), and the frame's total within 4 of its own.
+    for (const auto& [model, near] : {std::pair{ShadingModel::isotropic, 8u}, std::pair{ShadingModel::lambert, 8u},
+                                      std::pair{ShadingModel::lambert, 0u}}) {
+        Settings s = splitSettings(model, 400, near, 2);
+        const Particles ps = ParticleSource(s).frame(0);
+        constexpr int kSeeds = 400;
+        std::map<std::uint32_t, std::pair<DVec3, DVec3>> sums;  // sum, sum of squares (luminance in x)
+        std::map<std::uint32_t, Vec3> normal;
+        for (int k = 0; k < kSeeds; ++k) {
+            s.render.seed = 1000 + k;
+            for (const auto& [j, v] : particleLr(test::renderParticles(s, ps))) {
+                auto& [sum, sq] = sums[j];
+                sum += v.first;
+                sq += v.first * v.first;
+                normal[j] = v.second;
+            }
+        }
+        REQUIRE(sums.size() > 100);
+        double total = 0.0, totalExpect = 0.0, totalVar = 0.0;
+        for (const auto& [j, ss] : sums) {
+            const DVec3 mean = ss.first / double(kSeeds);
+            const DVec3 var = glm::max(DVec3(0.0), ss.second / double(kSeeds) - mean * mean) / double(kSeeds - 1);
+            const DVec3 expect = bruteForceLr(ps, j, s, normal[j]);
+            INFO(enumName(model) << " near " << near << " particle " << j << " mean " << mean.y << " expected " << expect.y
+                                 << " stderr " << std::sqrt(var.y));
+            CHECK(std::abs(mean.y - expect.y) <= 4.5 * std::sqrt(var.y) + 1e-5 * expect.y);
+            total += mean.y;
+            totalExpect += expect.y;
+            totalVar += var.y;
+        }
+        INFO(enumName(model) << " near " << near << ": total " << total << " expected " << totalExpect);
+        CHECK(std::abs(total - totalExpect) <= 4.0 * std::sqrt(totalVar) + 1e-5 * totalExpect);
+    }
+}
+
+TEST_CASE("particle_split: the texels' history stays unbiased in a static scene and divides the variance", "[particle_split][statistical]") {
+    // h = 0.75 over 12 frames: the steady state's variance is (1 - h) / (1 + h)
+    // = 1/7 of one frame's; after 12 frames the first frame weighs 0.75^12 = 3%.
+    Settings s = splitSettings(ShadingModel::lambert, 400, 4, 2);
+    s.particles.gm = 0.0;  // static: the history is the same light
+    const Particles ps = ParticleSource(s).frame(0);
+    constexpr int kSeeds = 40;
+    double varNone = 0.0, varHistory = 0.0, bias = 0.0, biasVar = 0.0;
+    std::map<std::uint32_t, std::pair<double, double>> none, history;
+    for (int k = 0; k < kSeeds; ++k) {
+        Settings a = s, b = s;
+        a.render.seed = b.render.seed = 77 + k;
+        b.particle_split.history = 0.75;
+        b.render.frames = 12;
+        FrameRenderer renderer(b, ParticleSource::fixed(ps), RenderOptions{true});
+        FrameImage last;
+        for (std::uint32_t f = 0; f < 12; ++f) {
+            FrameStats st;
+            last = renderer.render(f, st);
+        }
+        for (const auto& [j, v] : particleLr(test::renderParticles(a, ps))) {
+            none[j].first += v.first.y;
+            none[j].second += v.first.y * v.first.y;
+        }
+        for (const auto& [j, v] : particleLr(last)) {
+            history[j].first += v.first.y;
+            history[j].second += v.first.y * v.first.y;
+        }
+    }
+    REQUIRE(history.size() > 100);
+    for (const auto& [j, h] : history) {
+        const auto& n = none.at(j);
+        const double mh = h.first / kSeeds, mn = n.first / kSeeds;
+        const double vh = std::max(0.0, h.second / kSeeds - mh * mh), vn = std::max(0.0, n.second / kSeeds - mn * mn);
+        varHistory += vh;
+        varNone += vn;
+        bias += mh - mn;
+        biasVar += (vh + vn) / (kSeeds - 1);
+    }
+    INFO("variance with history " << varHistory << " without " << varNone << "; mean difference " << bias << " +- "
+                                  << std::sqrt(biasVar));
+    CHECK(varHistory < 0.3 * varNone);                     // 1/7 expected; 0.3 leaves room for 40 seeds' noise
+    CHECK(std::abs(bias) <= 4.0 * std::sqrt(biasVar));      // the same mean: no bias from the average
+}
+
+TEST_CASE("particle_split: its frame runs its own passes, not restir's", "[particle_split][plan]") {
+    Settings s = splitSettings(ShadingModel::lambert, 400, 8, 4);
+    s.shading.visibility = true;
+    const FramePlan plan = planFrame(s, FrameFacts{});
+    const std::vector<Pass> passes = plan.passes();
+    for (const Pass p : {Pass::buildLightSampler, Pass::gatherParticleTexels, Pass::findNearLights, Pass::shadeSplitTexels,
+                         Pass::shadeParticlePixels})
+        CHECK(std::find(passes.begin(), passes.end(), p) != passes.end());
+    for (const Pass p : {Pass::generateCandidates, Pass::temporalResampling, Pass::spatialResampling, Pass::traceShadowRays,
+                         Pass::updateVoxelCache})
+        CHECK(std::find(passes.begin(), passes.end(), p) == passes.end());
+    REQUIRE(plan.sampler == LightSamplerKind::tree);
+    // Counting mode: each pass's threads recorded, the texels' shadow rays among them.
+    s.gpu.counters = true;
+    const Particles ps = ParticleSource(s).frame(0);
+    const FrameImage img = test::renderParticles(s, ps);
+    std::map<Pass, std::uint64_t> rays;
+    for (const PassCounters& pc : img.counters.passes)
+        for (const ThreadCounters& t : pc.threads) rays[pc.pass] += t.rays;
+    for (const Pass p : {Pass::gatherParticleTexels, Pass::findNearLights, Pass::shadeSplitTexels, Pass::shadeParticlePixels}) {
+        INFO(passName(p));
+        REQUIRE(rays.count(p) == 1);
+    }
+    REQUIRE(rays[Pass::shadeSplitTexels] > 0);
+    REQUIRE(rays[Pass::findNearLights] == 0);  // the near search traces no ray
+}
