@@ -34,7 +34,7 @@ grep -v '^#' "$list" | sed 's/ *#.*//' | grep "_$suffix " | while read -r name a
 import sys
 words = sys.argv[1].split()
 kv = [words[i + 1] for i in range(0, len(words), 2) if words[i] == "-D"]
-lighting = [x for x in kv if x.split("=")[0].split(".")[0] in ("render", "restir", "voxel")]
+lighting = [x for x in kv if x.split("=")[0].split(".")[0] in ("render", "restir", "voxel", "particle_split")]
 est = next((x.split("=")[1] for x in lighting if x.startswith("render.estimator=")), "restir")
 print(":".join([est] + [x for x in lighting if not x.startswith("render.estimator=")]))
 PY

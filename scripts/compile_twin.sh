@@ -64,7 +64,7 @@ cxxflags=(-std=c++20 -O2 -Wall -Wextra -Wno-unused-parameter -Iinclude -Isrc/twi
 
 pids=()
 "$nvcc" "${cuflags[@]}" -optix-ir -c src/twin/programs.cu -o "$out/programs.optixir" & pids+=($!)
-for f in kernels restir_kernels gather_particle_texels voxel_kernels; do
+for f in kernels restir_kernels gather_particle_texels voxel_kernels split_kernels; do
     "$nvcc" "${cuflags[@]}" -c src/twin/$f.cu -o "$out/$f.o" & pids+=($!)
 done
 for f in twin_main optix_pipeline particle_accel; do
@@ -72,7 +72,7 @@ for f in twin_main optix_pipeline particle_accel; do
 done
 for p in "${pids[@]}"; do wait "$p"; done
 cudart=$(find "$cuda" "$(dirname "$cuda_inc")" \( -name 'libcudart.so*' -o -name 'libcudart_static.a' \) 2>/dev/null | head -1)
-"$nvcc" -arch=sm_90 "$out"/{twin_main,optix_pipeline,particle_accel,kernels,restir_kernels,gather_particle_texels,voxel_kernels}.o \
+"$nvcc" -arch=sm_90 "$out"/{twin_main,optix_pipeline,particle_accel,kernels,restir_kernels,gather_particle_texels,voxel_kernels,split_kernels}.o \
     "$build/libaccretion_base.a" -L"$(dirname "$cudart")" -ltomlplusplus -ltbb -lfmt -ldl -lpthread -o "$out/accretion-optix"
 echo "compile_twin: $out/accretion-optix and $out/programs.optixir" >&2
 

@@ -12,6 +12,7 @@
 #include "accretion/render/accumulation.h"
 #include "accretion/geometry/camera.h"
 #include "accretion/render/gbuffer_texel.h"
+#include "accretion/render/particle_split_passes.h"
 #include "accretion/render/restir_passes.h"
 #include "accretion/render/voxel_cache_passes.h"
 #include "accretion/render/shadow_query.h"
@@ -100,6 +101,24 @@ struct VoxelLaunch {
     voxel::CellRay* rays = nullptr;          ///< cell c's ray r at c x params.rays + r
 };
 
+/// particle_split (particle_split_passes.h) as the CPU's ParticleSplit runs
+/// it: the visible particles' texels (gatherParticleTexels' grid), their
+/// near lights, the texels' Lr, and last frame's by particle id.
+struct SplitLaunch {
+    psplit::SplitParams params;
+    const std::uint32_t* particleOf = nullptr;  ///< slot -> particle (the gather's sorted ids)
+    const std::uint32_t* slotOf = nullptr;      ///< particle -> slot (kNoSlot: not visible)
+    const GBufferTexel* texels = nullptr;       ///< the grid, kTexelRowWidth a row
+    std::uint32_t* near = nullptr;              ///< slot v's near lights at v x params.nearCount
+    std::uint32_t* nearFound = nullptr;
+    float* nearRadius2 = nullptr;
+    Vec3* texelLr = nullptr;
+    std::uint32_t* rejected = nullptr;          ///< per texel: non-finite far draws
+    const std::uint32_t* prevSlotOf = nullptr;  ///< particle_split.history: last frame's slots
+    std::uint32_t prevSlotCount = 0;            ///< particles prevSlotOf holds (0: no history)
+    const Vec3* prevTexelLr = nullptr;
+};
+
 struct LaunchParams {
     OptixTraversableHandle tlas = 0;
     Camera camera;                       ///< frame coordinates (origin at the first camera)
@@ -133,6 +152,7 @@ struct LaunchParams {
     SamplingParams sampling;
     RestirParams restir;
     VoxelLaunch voxel;
+    SplitLaunch split;
 
     // Outputs.
     GBufferTexel* gbuffer = nullptr;     ///< width x height

@@ -18,6 +18,7 @@
 #include "accretion/render/shadow_query.h"
 #include "launch_params.h"
 #include "device_bridge.h"
+#include "split_device.h"
 #include "voxel_device.h"
 #include "restir_device.h"
 
@@ -226,6 +227,27 @@ extern "C" __global__ void __raygen__updateVoxelCache() {
     VoxelBridge<OptixShadowRays<false>> b(params, OptixShadowRays<false>{&counters}, &counters);
     v.rays[std::size_t(c) * rays + r] = voxel::traceCellRay(b, c, r);
     addCounters(counters);
+}
+
+/// particle_split's shadeSplitTexels: one thread per texel of the grid
+/// (launch kTexelRowWidth x rows), particle_split_passes.h's body with
+/// OptiX's shadow rays, k near and S far a texel.
+template <ShadingModel SM>
+__device__ void shadeSplitTexel() {
+    const uint3 idx = optixGetLaunchIndex();
+    const std::size_t q = std::size_t(idx.y) * kTexelRowWidth + idx.x;
+    LaunchCounters c;
+    SplitBridge<SM, OptixShadowRays<false>> b(params, OptixShadowRays<false>{&c}, &c);
+    psplit::shadeSplitTexel(b, q);
+    addCounters(c);
+}
+
+extern "C" __global__ void __raygen__shadeSplitTexels() {
+    switch (params.model) {
+    case ShadingModel::lambert: shadeSplitTexel<ShadingModel::lambert>(); break;
+    case ShadingModel::sphere: shadeSplitTexel<ShadingModel::sphere>(); break;
+    case ShadingModel::isotropic: shadeSplitTexel<ShadingModel::isotropic>(); break;
+    }
 }
 
 extern "C" __global__ void __raygen__shadeParticlePixels() {

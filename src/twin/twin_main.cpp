@@ -42,6 +42,7 @@
 #include "particle_accel.h"
 #include "accretion/render/voxel_grid.h"
 #include "restir_kernels.h"
+#include "split_kernels.h"
 #include "voxel_kernels.h"
 
 #ifndef ACCRETION_TWIN_PROGRAMS
@@ -97,6 +98,7 @@ struct FrameBuffers {
     DeviceBuffer treeNodes;                       // tree: the light tree's nodes
     DeviceBuffer Lr_stderr, spp, rejectedSamples;  // uniform / power
     DeviceBuffer voxelCells[2], voxelOccupied, voxelRays;  // voxel_cache: last frame's cells and this frame's; the reached cells; their rays
+    DeviceBuffer splitNear, splitNearFound, splitNearRadius2;  // particle_split: each visible particle's near lights
 };
 
 void copyDevice(DeviceBuffer& to, const DeviceBuffer& from, std::size_t bytes, cudaStream_t stream) {
@@ -122,6 +124,7 @@ public:
         history_ = built_ = false;
         prevCount_ = 0;
         voxelPlacement_ = VoxelPlacement{};
+        splitHistory_ = false;
     }
     /// Render, time and write one frame (a .gpuframe and its stats record).
     void renderFrame(std::uint32_t frame, std::uint64_t seed);
@@ -138,6 +141,9 @@ private:
     StoredReservoir* runRestir(const FramePlan& plan, LaunchParams& lp);
     void placeVoxels(const Particles& particles);
     void runVoxelCache(LaunchParams& lp);
+    std::uint32_t gatherTexels(const LaunchParams& lp, std::uint32_t side, std::uint32_t layers);
+    void runParticleSplit(LaunchParams& lp);
+    void keepSplitHistory(std::size_t n);
     StepTimes runPasses(const FramePlan& plan, LaunchParams& lp, const Clusters& clusters, bool recluster,
                         LaunchCounters& counters, StoredReservoir*& finalReservoirs);
     void keepHistory(const Camera& camera, std::size_t particleCount, const StoredReservoir* finalReservoirs);
@@ -172,6 +178,7 @@ private:
     Vec3 origin_{0.0f};
     VoxelPlacement voxelPlacement_;  ///< voxel_cache: where its grid lies (the CPU's VoxelCache's rule)
     unsigned voxelLast_ = 0;         ///< voxel_cache: buf_.voxelCells[voxelLast_] holds last frame's cells
+    bool splitHistory_ = false;      ///< particle_split: buf_.prevSlotOf and prevTexelLr hold last frame's
     Particles particles_;  ///< this frame's, rebased to origin_
     std::map<std::uint32_t, Particles> loaded_;  ///< --seeds: each frame's particles, loaded once
     nlohmann::json stats_;
@@ -283,7 +290,7 @@ void TwinRun::uploadParticles(const Particles& particles, const Camera& camera) 
     buf_.emission.upload(particles.emission);
     buf_.albedo.upload(particles.albedo);
     buf_.radius.upload(particles.radius);
-    if (runPlan_.particleTexels) morton_ = mortonFrame(particles.position.data(), n);
+    if (runPlan_.particleTexels || runPlan_.particleSplit) morton_ = mortonFrame(particles.position.data(), n);
     buf_.dmin2.upload(dmin2);
     buf_.frames.upload(frames);
 }
@@ -351,6 +358,7 @@ LaunchParams TwinRun::launchParams(const FramePlan& plan, const Camera& camera, 
         sp.rejected = buf_.rejectedSamples.as<std::uint32_t>();
     }
     if (plan.voxelCache) lp.voxel.params = voxelParams(s_, voxelPlacement_, origin_, camera, frame, seed);
+    if (plan.particleSplit) lp.split.params = psplit::splitParams(s_, 0, frame, seed);  // visible: after the gather
     if (plan.restir) {
         RestirParams& rp = lp.restir;
         const RestirSettings& rs = s_.restir;
@@ -377,6 +385,89 @@ LaunchParams TwinRun::launchParams(const FramePlan& plan, const Camera& camera, 
     return lp;
 }
 
+/// gatherParticleTexels (particle_restir and particle_split): the visible
+/// particles in Morton order into buf_.gatherSortedIds and their slots into
+/// buf_.slotOf, their side x side x layers texels into buf_.gridGbuffer,
+/// gridW_ x gridH_ (kTexelRowWidth a row). Returns how many are visible.
+std::uint32_t TwinRun::gatherTexels(const LaunchParams& lp, std::uint32_t side, std::uint32_t layers) {
+    const std::uint32_t n = lp.particleCount;
+    buf_.gatherFlags.reserve(n);
+    for (DeviceBuffer* b : {&buf_.gatherIds, &buf_.gatherSortedIds, &buf_.slotOf}) b->reserve(n * sizeof(std::uint32_t));
+    for (DeviceBuffer* b : {&buf_.gatherKeys, &buf_.gatherSortedKeys}) b->reserve(n * sizeof(std::uint64_t));
+    buf_.gatherCount.reserve(sizeof(std::uint32_t));
+    buf_.gatherTemp.reserve(gatherTempBytes(n));
+    const GatherArrays arrays{buf_.gatherFlags.as<std::uint8_t>(), buf_.gatherIds.as<std::uint32_t>(),
+                              buf_.gatherSortedIds.as<std::uint32_t>(), buf_.gatherCount.as<std::uint32_t>(),
+                              buf_.slotOf.as<std::uint32_t>(), buf_.gatherKeys.as<std::uint64_t>(),
+                              buf_.gatherSortedKeys.as<std::uint64_t>(), buf_.gatherTemp.as<void>(), buf_.gatherTemp.bytes()};
+    const std::uint32_t visible = findVisibleParticles(lp, morton_, arrays, stream_);
+    const std::size_t texels = std::size_t(visible) * side * side * layers;
+    gridW_ = kTexelRowWidth;
+    gridH_ = std::max(1u, std::uint32_t((texels + kTexelRowWidth - 1) / kTexelRowWidth));  // one row of misses when none is seen
+    const std::size_t grid = std::size_t(gridW_) * gridH_;
+    buf_.gridGbuffer.reserve(grid * sizeof(GBufferTexel));
+    writeParticleTexels(lp, arrays.sortedIds, visible, side, layers, grid, buf_.gridGbuffer.as<GBufferTexel>(), stream_);
+    return visible;
+}
+
+/// particle_split's passes (the CPU's ParticleSplit::render):
+/// gatherParticleTexels, findNearLights (a kernel per visible particle),
+/// shadeSplitTexels (a raygen per texel: its near and far shadow rays) and
+/// shadeParticlePixels (a kernel per pixel). Run again, they compute the
+/// same texels: last frame's are read from buf_.prevTexelLr, this frame's
+/// written to buf_.gridLr.
+void TwinRun::runParticleSplit(LaunchParams& lp) {
+    SplitLaunch& sl = lp.split;
+    GpuTimer& timer = *timer_;
+    {
+        GpuScope t(timer, Pass::gatherParticleTexels);
+        sl.params.visible = gatherTexels(lp, s_.particle_split.texels, 1);
+    }
+    const std::size_t grid = std::size_t(gridW_) * gridH_, visible = sl.params.visible;
+    buf_.splitNear.reserve(std::max<std::size_t>(1, visible * sl.params.nearCount) * sizeof(std::uint32_t));
+    buf_.splitNearFound.reserve(std::max<std::size_t>(1, visible) * sizeof(std::uint32_t));
+    buf_.splitNearRadius2.reserve(std::max<std::size_t>(1, visible) * sizeof(float));
+    buf_.gridLr.reserve(grid * sizeof(Vec3));
+    buf_.rejected.reserve(std::max(grid, std::size_t(W_) * H_) * sizeof(std::uint32_t));
+    CUDA_CHECK(cudaMemsetAsync(buf_.rejected.as<void>(), 0, grid * sizeof(std::uint32_t), stream_));
+    sl.particleOf = buf_.gatherSortedIds.as<std::uint32_t>();
+    sl.slotOf = buf_.slotOf.as<std::uint32_t>();
+    sl.texels = buf_.gridGbuffer.as<GBufferTexel>();
+    sl.near = buf_.splitNear.as<std::uint32_t>();
+    sl.nearFound = buf_.splitNearFound.as<std::uint32_t>();
+    sl.nearRadius2 = buf_.splitNearRadius2.as<float>();
+    sl.texelLr = buf_.gridLr.as<Vec3>();
+    sl.rejected = buf_.rejected.as<std::uint32_t>();
+    sl.prevSlotOf = buf_.prevSlotOf.as<std::uint32_t>();
+    sl.prevSlotCount = splitHistory_ && sl.params.history > 0.0f ? prevCount_ : 0;
+    sl.prevTexelLr = buf_.prevTexelLr.as<Vec3>();
+    {
+        GpuScope t(timer, Pass::findNearLights);
+        findNearLights(lp, stream_);
+    }
+    {
+        GpuScope t(timer, Pass::shadeSplitTexels);
+        CUDA_CHECK(cudaMemcpyAsync(buf_.params.as<void>(), &lp, sizeof lp, cudaMemcpyHostToDevice, stream_));
+        pipeline_->launch(Raygen::shadeSplitTexels, buf_.params.address(), sizeof lp, gridW_, gridH_, stream_);
+    }
+    {
+        GpuScope t(timer, Pass::shadeParticlePixels);
+        interpolateSplitPixels(lp, stream_);
+    }
+    CUDA_CHECK(cudaGetLastError());
+}
+
+/// particle_split.history: this frame's slots and texels become the next
+/// frame's history (by particle id).
+void TwinRun::keepSplitHistory(std::size_t n) {
+    if (s_.particle_split.history <= 0.0) return;
+    copyDevice(buf_.prevSlotOf, buf_.slotOf, n * sizeof(std::uint32_t), stream_);
+    copyDevice(buf_.prevTexelLr, buf_.gridLr, std::size_t(gridW_) * gridH_ * sizeof(Vec3), stream_);
+    CUDA_CHECK(cudaStreamSynchronize(stream_));
+    prevCount_ = static_cast<std::uint32_t>(n);
+    splitHistory_ = true;
+}
+
 /// The restir passes of a frame after the G-buffer, as the plan has them
 /// (the CPU's Restir::render): generateCandidates, temporalResampling,
 /// spatialResampling x plan.spatialIterations, traceShadowRays, and with
@@ -387,25 +478,8 @@ StoredReservoir* TwinRun::runRestir(const FramePlan& plan, LaunchParams& lp) {
     GpuTimer& timer = *timer_;
     if (plan.particleTexels) {  // the lighting grid: the visible particles' texels, kTexelRowWidth a row
         GpuScope t(timer, Pass::gatherParticleTexels);
-        const RestirSettings& rs = s_.restir;
-        const std::uint32_t n = lp.particleCount;
-        buf_.gatherFlags.reserve(n);
-        for (DeviceBuffer* b : {&buf_.gatherIds, &buf_.gatherSortedIds, &buf_.slotOf}) b->reserve(n * sizeof(std::uint32_t));
-        for (DeviceBuffer* b : {&buf_.gatherKeys, &buf_.gatherSortedKeys}) b->reserve(n * sizeof(std::uint64_t));
-        buf_.gatherCount.reserve(sizeof(std::uint32_t));
-        buf_.gatherTemp.reserve(gatherTempBytes(n));
-        const GatherArrays arrays{buf_.gatherFlags.as<std::uint8_t>(), buf_.gatherIds.as<std::uint32_t>(),
-                                  buf_.gatherSortedIds.as<std::uint32_t>(), buf_.gatherCount.as<std::uint32_t>(),
-                                  buf_.slotOf.as<std::uint32_t>(), buf_.gatherKeys.as<std::uint64_t>(),
-                                  buf_.gatherSortedKeys.as<std::uint64_t>(), buf_.gatherTemp.as<void>(), buf_.gatherTemp.bytes()};
-        const std::uint32_t visible = findVisibleParticles(lp, morton_, arrays, stream_);
-        const std::size_t texels = std::size_t(visible) * rp.reuse.texelsPerParticle();
-        gridW_ = kTexelRowWidth;
-        gridH_ = std::max(1u, std::uint32_t((texels + kTexelRowWidth - 1) / kTexelRowWidth));  // one row of misses when none is seen
+        const std::uint32_t visible = gatherTexels(lp, s_.restir.texels, s_.restir.texel_rays);
         const std::size_t grid = std::size_t(gridW_) * gridH_;
-        buf_.gridGbuffer.reserve(grid * sizeof(GBufferTexel));
-        writeParticleTexels(lp, arrays.sortedIds, visible, rs.texels, rs.texel_rays, std::size_t(gridW_) * gridH_,
-                            buf_.gridGbuffer.as<GBufferTexel>(), stream_);
         buf_.resA.reserve(grid * sizeof(StoredReservoir));
         buf_.resB.reserve(grid * sizeof(StoredReservoir));
         buf_.gridLr.reserve(grid * sizeof(Vec3));
@@ -561,6 +635,8 @@ StepTimes TwinRun::runPasses(const FramePlan& plan, LaunchParams& lp, const Clus
             finalReservoirs = runRestir(plan, lp);
         } else if (plan.voxelCache) {
             runVoxelCache(lp);
+        } else if (plan.particleSplit) {
+            runParticleSplit(lp);
         } else if (plan.lighting) {
             GpuScope s(*timer_, Pass::estimateLighting);
             pipeline_->launch(sampling_ ? Raygen::sample : Raygen::exact, buf_.params.address(), sizeof lp, W_, H_, stream_);
@@ -664,6 +740,7 @@ void TwinRun::renderFrame(std::uint32_t frame, std::uint64_t seed) {
     const StepTimes ms = runPasses(plan, lp, clusters, recluster, counters, finalReservoirs);
     built_ = true;
     if (plan.voxelCache) voxelLast_ ^= 1u;  // this frame's cells are the next one's last
+    if (plan.particleSplit) keepSplitHistory(n);
     keepHistory(camera, n, finalReservoirs);
 
     std::size_t hits = 0, nonFinite = 0;
