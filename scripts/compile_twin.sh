@@ -79,7 +79,8 @@ echo "compile_twin: $out/accretion-optix and $out/programs.optixir" >&2
 # The shared steps checked where they run: on the GPU against the CPU
 # (tests/twin/shared_core_check.cu). Compiled on every run; run only where
 # there is a GPU (bench/gpu/run.sh shared_core on the lent one).
-"$nvcc" "${cuflags[@]}" tests/twin/shared_core_check.cu src/geometry/camera.cpp -o "$out/shared_core_check"
+"$nvcc" "${cuflags[@]}" tests/twin/shared_core_check.cu "$build/libaccretion_base.a" -L"$(dirname "$cudart")" -ltomlplusplus -ltbb \
+    -lfmt -ldl -lpthread -o "$out/shared_core_check"  # the library: particle_split's step builds a LightTree
 if command -v nvidia-smi >/dev/null 2>&1 && nvidia-smi -L >/dev/null 2>&1; then
     "$out/shared_core_check"
 else

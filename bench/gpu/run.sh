@@ -1,7 +1,7 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine, from the repository root:
 #   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
-#                                      layout_images layouts streams front identity shared_core ab designs voxels
+#                                      layout_images layouts streams front identity shared_core ab designs voxels splits
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -294,6 +294,22 @@ step_voxels() {
     time_configs voxels/cluster "$W/voxels_cluster.txt" 5 1/1 scenes/cluster_150k.toml
 }
 
+# seed 004's hybrid compute, particle_split (designs.txt's ps_ lines, 100K
+# and 1M at 1080p, and designs_cluster.txt's), timed as the designs are,
+# beside today's recommendations and particle_restir's best timed again in
+# the same run; and its frames on quickstart at 320x180 (frames 0-2) for
+# the per-pixel comparison with the CPU (compare_cpu.sh).
+step_splits() {
+    quickstart_frames splits particle_split ps_n8_f4 -D particle_split.near=8 -D particle_split.far=4
+    quickstart_frames splits particle_split ps_2x2_c4_h5 -D particle_split.texels=2 -D particle_split.candidates=4 -D particle_split.history=0.5
+    quickstart_frames splits particle_split ps_n64_f0 -D particle_split.near=64 -D particle_split.far=0
+    grep -E '^(ps_[a-z0-9_]*|restir_m32_t_basic_1x_100k|restir_m32_t_pairwise_05x_1m|prt_m8_k16_100k|prt_m8_k4_1m) ' bench/gpu/designs.txt > "$W/splits.txt"
+    time_configs splits "$W/splits.txt" 5
+    python3 scenes/cluster/make_cluster.py 3
+    grep -E '^(ps_[a-z0-9_]*|restir_m32_t_basic_1x_cluster|prt_m8_k16_cluster) ' bench/gpu/designs_cluster.txt > "$W/splits_cluster.txt"
+    time_configs splits/cluster "$W/splits_cluster.txt" 5 1/1 scenes/cluster_150k.toml
+}
+
 # The configurations on tune's Pareto fronts (bench/gpu/front.txt, written
 # by bench/gpu/front_configs.py), timed as the layouts are.
 step_front() { time_configs front bench/gpu/front.txt 5; }
@@ -415,7 +431,9 @@ PY
 step_shared_core() {
     mkdir -p "$W/shared_core"
     local flags=(-std=c++20 -O3 --expt-relaxed-constexpr -diag-suppress=20012,20011,20014,20044 -arch=sm_90 -Iinclude -I"$S/include")
-    local src=(tests/twin/shared_core_check.cu src/geometry/camera.cpp)
+    # The library (particle_split's step builds a LightTree): the twin's build's (step build first).
+    [ -f build-gpu/libaccretion_base.a ] || { echo "shared_core: run the build step first (build-gpu/libaccretion_base.a)"; return 1; }
+    local src=(tests/twin/shared_core_check.cu build-gpu/libaccretion_base.a -L"$L" -ltomlplusplus -ltbb -lfmt -ldl -lpthread)
     nvcc "${flags[@]}" -fmad=false "${src[@]}" -o "$W/shared_core/check" &&
         nvcc "${flags[@]}" -fmad=true "${src[@]}" -o "$W/shared_core/check_fma" || return 1
     { echo "commit $(cat "$D/commit")"; nvidia-smi --query-gpu=name,driver_version --format=csv,noheader

@@ -139,12 +139,17 @@ TEST_CASE("particle_split: with every light near, a texel's Lr is the closed-for
 
 TEST_CASE("particle_split: near sum and far draws are unbiased against the brute-force sum (99.99% per particle)", "[particle_split][statistical]") {
     // 400 lights: a near field of 8 or none, far draws from the tree with the
-    // ball taken out. Over 400 seeds each particle's mean is within 4.5
+    // ball taken out, each the draw itself or the one RIS keeps among 4. Over 400 seeds each particle's mean is within 4.5
     // standard errors (and 1e-5 of float rounding) of its brute-force Lr (a per-particle chance of about
     // 1e-5 to fail when unbiased), and the frame's total within 4 of its own.
-    for (const auto& [model, near] : {std::pair{ShadingModel::isotropic, 8u}, std::pair{ShadingModel::lambert, 8u},
-                                      std::pair{ShadingModel::lambert, 0u}}) {
+    struct Case {
+        ShadingModel model;
+        std::uint32_t near, candidates;
+    };
+    for (const auto& [model, near, candidates] : {Case{ShadingModel::isotropic, 8, 1}, Case{ShadingModel::lambert, 8, 1},
+                                                  Case{ShadingModel::lambert, 0, 1}, Case{ShadingModel::lambert, 8, 4}}) {
         Settings s = splitSettings(model, 400, near, 2);
+        s.particle_split.candidates = candidates;
         const Particles ps = ParticleSource(s).frame(0);
         constexpr int kSeeds = 400;
         std::map<std::uint32_t, std::pair<DVec3, DVec3>> sums;  // sum, sum of squares (luminance in x)
@@ -164,14 +169,14 @@ TEST_CASE("particle_split: near sum and far draws are unbiased against the brute
             const DVec3 mean = ss.first / double(kSeeds);
             const DVec3 var = glm::max(DVec3(0.0), ss.second / double(kSeeds) - mean * mean) / double(kSeeds - 1);
             const DVec3 expect = bruteForceLr(ps, j, s, normal[j]);
-            INFO(enumName(model) << " near " << near << " particle " << j << " mean " << mean.y << " expected " << expect.y
+            INFO(enumName(model) << " near " << near << " candidates " << candidates << " particle " << j << " mean " << mean.y << " expected " << expect.y
                                  << " stderr " << std::sqrt(var.y));
             CHECK(std::abs(mean.y - expect.y) <= 4.5 * std::sqrt(var.y) + 1e-5 * expect.y);
             total += mean.y;
             totalExpect += expect.y;
             totalVar += var.y;
         }
-        INFO(enumName(model) << " near " << near << ": total " << total << " expected " << totalExpect);
+        INFO(enumName(model) << " near " << near << " candidates " << candidates << ": total " << total << " expected " << totalExpect);
         CHECK(std::abs(total - totalExpect) <= 4.0 * std::sqrt(totalVar) + 1e-5 * totalExpect);
     }
 }

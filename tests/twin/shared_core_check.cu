@@ -25,6 +25,8 @@
 #include "accretion/render/restir_passes.h"
 #include "accretion/render/sample_sums.h"
 #include "accretion/render/restir_steps.h"
+#include "accretion/lighting/light_tree.h"
+#include "accretion/render/particle_split_passes.h"
 #include "accretion/render/voxel_cache_passes.h"
 
 namespace {
@@ -381,6 +383,76 @@ ACC_HD void voxelCase(int k, const PassInputs* variants, const voxel::VoxelParam
     o = Out{{bits(Lr.x), bits(Lr.y), bits(Lr.z), 3u, 0u, 0u, 0u, 0u}};
 }
 
+// ---------------------------------------------------------------- particle_split
+// particle_split_passes.h's bodies over a bridge of plain arrays, on the
+// passes' lights and the light tree built over them (LightTree, host):
+// case k < texels searches light k's 16 nearest; the rest shade each texel
+// of the passes' grid (texel px: particle px, one texel each) with 16 near
+// and no far, 8 near and 4 far draws, and 8 near and 4 far each kept by
+// RIS among 4 with a history (even particles: a fixed last Lr).
+// Visibility is a fixed function of (point, light).
+
+constexpr int kSplitVariants = 3;
+constexpr int kSplitCases = (1 + kSplitVariants) * int(kGridW * kGridH);
+
+struct SplitCheckBridge {
+    const PassInputs& in;
+    LightTreeView view;
+    const psplit::SplitParams& p;
+    Out& o;
+    ACC_HD const psplit::SplitParams& params() const { return p; }
+    ACC_HD std::uint32_t particleOfSlot(std::uint32_t v) const { return v; }
+    ACC_HD Vec3 particlePosition(std::uint32_t j) const { return in.historyPositions[j]; }
+    ACC_HD const LightTreeView& tree() const { return view; }
+    ACC_HD void writeNear(std::uint32_t, const std::uint32_t* light, std::uint32_t count, float radius2) const {
+        std::uint32_t h = 0;
+        for (std::uint32_t m = 0; m < count; ++m) h = h * 0x9e3779b1u + light[m];
+        o = Out{{count, bits(radius2), h, count ? light[0] : 0u, count ? light[count - 1] : 0u, 4u, 0u, 0u}};
+    }
+    ACC_HD GBufferTexel texel(std::size_t q) const { return in.texels[q]; }
+    ACC_HD ShadingPoint shadingPoint(const GBufferTexel& g) const {
+        const Vec3 c = in.historyPositions[g.particle];
+        return {c + g.local, g.normal, g.geomNormal, Vec3(0.7f), g.particle, c, g.local};
+    }
+    ACC_HD std::uint32_t nearLights(std::uint32_t v, std::uint32_t* light) const {
+        float d2[psplit::kMaxNear];
+        return psplit::nearestLights(view, in.historyPositions[v], v, p.nearCount, light, d2);
+    }
+    ACC_HD float nearRadius2(std::uint32_t v) const {
+        std::uint32_t light[psplit::kMaxNear];
+        float d2[psplit::kMaxNear];
+        const std::uint32_t n = psplit::nearestLights(view, in.historyPositions[v], v, p.nearCount, light, d2);
+        return n ? d2[n - 1] : 0.0f;
+    }
+    ACC_HD LightSample sampleFar(const ShadingPoint& sp, PortableRng& rng, const psplit::FarImportance& imp) const {
+        return view.sample(sp, rng, imp);
+    }
+    ACC_HD bool term(const ShadingPoint& sp, std::uint32_t i, LightTerm& t) const {
+        if (i >= in.particles) return false;
+        return evalLight<ShadingModel::lambert>(sp, in.historyPositions[i], in.emission[i], 0.01f, t);
+    }
+    ACC_HD bool shadows() const { return true; }
+    ACC_HD bool visible(const ShadingPoint& sp, std::uint32_t i, const LightTerm&) const { return (bits(sp.x.x) ^ (i * 7u)) % 5u != 0u; }
+    ACC_HD void reject(std::size_t) const {}
+    ACC_HD bool historyTexelOf(std::uint32_t j, std::uint32_t, std::size_t& q) const {
+        q = j;
+        return j % 2u == 0u;
+    }
+    ACC_HD Vec3 historyLr(std::size_t q) const { return Vec3(0.1f * float(q % 7u), 0.2f, 0.05f * float(q % 3u)); }
+    ACC_HD void writeTexelLr(std::size_t, const Vec3& Lr) const { o = Out{{bits(Lr.x), bits(Lr.y), bits(Lr.z), 5u, 0u, 0u, 0u, 0u}}; }
+};
+
+ACC_HD void splitCase(int k, const PassInputs* variants, const LightTreeView* tree, const psplit::SplitParams* params, Out& o) {
+    const PassInputs& in = variants[0];
+    const std::uint32_t texels = kGridW * kGridH;
+    const int variant = k / int(texels);
+    const std::size_t px = std::size_t(k) % texels;
+    o = Out{};
+    SplitCheckBridge b{in, *tree, params[variant], o};
+    if (variant == 0) psplit::findNearLightsOf(b, std::uint32_t(px));
+    else psplit::shadeSplitTexel(b, px);
+}
+
 // ---------------------------------------------------------------- the hosts
 
 struct Inputs {
@@ -390,11 +462,13 @@ struct Inputs {
     float* shades;
     PassInputs* passes;  ///< none, basic, pairwise
     voxel::VoxelParams* voxel;  ///< l1, camera
+    LightTreeView* tree;        ///< the light tree over the passes' lights
+    psplit::SplitParams* split; ///< the near search; the three texel variants
 };
 
-enum class Step { neighbours, reprojections, caps, candidates, combines, shades, passes, loops, voxels };
+enum class Step { neighbours, reprojections, caps, candidates, combines, shades, passes, loops, voxels, splits };
 constexpr Step kSteps[] = {Step::neighbours, Step::reprojections, Step::caps, Step::candidates, Step::combines, Step::shades,
-                           Step::passes, Step::loops, Step::voxels};
+                           Step::passes, Step::loops, Step::voxels, Step::splits};
 
 ACC_HD int caseCount(Step s) {
     switch (s) {
@@ -407,6 +481,7 @@ ACC_HD int caseCount(Step s) {
         case Step::passes: return kPassCases;
         case Step::loops: return kLoopCases;
         case Step::voxels: return kVoxelCases;
+        case Step::splits: return kSplitCases;
     }
     return 0;
 }
@@ -422,6 +497,7 @@ ACC_HD void runCase(Step s, int k, const Inputs& in, Out& o) {
         case Step::passes: passCase(k, in.passes, o); break;
         case Step::loops: loopCase(k, in.passes, o); break;
         case Step::voxels: voxelCase(k, in.passes, in.voxel, o); break;
+        case Step::splits: splitCase(k, in.passes, in.tree, in.split, o); break;
     }
 }
 
@@ -441,6 +517,7 @@ const char* stepName(Step s) {
         case Step::passes: return "the pass bodies (restir_passes.h)";
         case Step::loops: return "exact and uniform loops (light_estimates.h)";
         case Step::voxels: return "the voxel cache's bodies (voxel_cache_passes.h)";
+        case Step::splits: return "particle_split's bodies (particle_split_passes.h)";
     }
     return "?";
 }
@@ -584,9 +661,32 @@ int main() {
         v.camera = gridCam.position;
         v.facesPlane = false;
     }
+    // particle_split: the light tree over the passes' lights (lambert), one
+    // texel a particle; the near search's and the three texel variants' settings.
+    Particles lights;
+    lights.position = centres;
+    lights.emission = emission;
+    lights.radius.assign(texels, 0.05f);
+    ShadingSettings lambert;
+    lambert.dmin = 0.1;
+    const LightTree lightTree(lights, lambert);
+    LightTreeView hostTree = lightTree.view(), deviceTree = hostTree;
+    deviceTree.nodes = toDevice(lightTree.nodes());
+    std::vector<psplit::SplitParams> splits(1 + kSplitVariants);
+    for (std::size_t v = 0; v < splits.size(); ++v) {
+        psplit::SplitParams& s = splits[v];
+        s.nearCount = v <= 1 ? 16 : 8;
+        s.farSamples = v <= 1 ? 0 : 4;
+        s.candidates = v == 3 ? 4 : 1;
+        s.history = v == 3 ? 0.6f : 0.0f;
+        s.visible = texels;
+        s.frame = 3;
+        s.seed = 21;
+    }
     const Inputs host{Camera::lookAt(Vec3(0.0f, 7.0f, 17.0f), Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f), 45.0, 320, 180), points.data(),
-                      offers.data(), shades.data(), hostPasses.data(), voxels.data()};
-    const Inputs device{host.cam, toDevice(points), toDevice(offers), toDevice(shades), toDevice(devicePasses), toDevice(voxels)};
+                      offers.data(), shades.data(), hostPasses.data(), voxels.data(), &hostTree, splits.data()};
+    const Inputs device{host.cam, toDevice(points), toDevice(offers), toDevice(shades), toDevice(devicePasses), toDevice(voxels),
+                        toDevice(std::vector<LightTreeView>{deviceTree}), toDevice(splits)};
 
     std::printf("shared_core_check: %s, CUDA %d.%d; host results from the host compiler, device results from sm_%d%d\n",
                 prop.name, CUDART_VERSION / 1000, (CUDART_VERSION % 1000) / 10, prop.major, prop.minor);

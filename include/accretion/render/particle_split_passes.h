@@ -9,6 +9,9 @@
 //      + 1/S sum over S far draws y of f I G V / p(y)   (the light tree, N's
 //                                                        ball taken out)
 //
+// (with particle_split.candidates C > 1 each far draw is the one kept by
+// RIS among C, p_hat the unshadowed term: f I G V sum(p_hat / p) / (C p_hat))
+//
 // N is the particle's particle_split.near lights nearest to its centre c
 // other than itself, found on the light tree (nearestLights: a pruned
 // search, no rays), shared by its texels. The far draws descend the light
@@ -59,6 +62,7 @@ inline constexpr std::uint32_t kNoNearLight = 0xffffffffu;
 struct SplitParams {
     std::uint32_t nearCount = 16;   ///< particle_split.near: k
     std::uint32_t farSamples = 8;   ///< particle_split.far: S
+    std::uint32_t candidates = 1;   ///< particle_split.candidates: C far draws resampled into each far shadow ray
     std::uint32_t side = 1;         ///< particle_split.texels: texels per billboard side
     float history = 0.0f;           ///< particle_split.history
     bool discardNonFinite = false;  ///< render.nonfinite discard: a non-finite far draw is not counted (else it counts as 0)
@@ -73,6 +77,7 @@ inline SplitParams splitParams(const Settings& s, std::uint32_t visible, std::ui
     SplitParams p;
     p.nearCount = s.particle_split.near;
     p.farSamples = s.particle_split.far;
+    p.candidates = s.particle_split.candidates;
     p.side = s.particle_split.texels;
     p.history = float(s.particle_split.history);
     p.discardNonFinite = s.render.nonfinite == NonFinitePolicy::discard;
@@ -230,11 +235,28 @@ ACC_HD_BODY void shadeSplitTexel(B& b, std::size_t q) {
         Vec3 far(0.0f);
         std::uint32_t counted = p.farSamples;
         for (std::uint32_t s = 0; s < p.farSamples; ++s) {
-            const LightSample y = b.sampleFar(sp, rng, importance);
-            if (!(y.pdf > 0.0f) || isNear(near, k, y.i)) continue;
+            // RIS over C far draws (C = 1: the draw itself): the one kept in
+            // proportion to w = p_hat / pdf, p_hat the unshadowed term's
+            // luminance, then f V sum(w) / (C p_hat).
+            float wSum = 0.0f, pHat = 0.0f;
+            std::uint32_t kept = kNoLightSample;
             LightTerm t;
-            if (!b.term(sp, y.i, t) || (b.shadows() && !b.visible(sp, y.i, t))) continue;
-            const Vec3 c = t.value / y.pdf;
+            for (std::uint32_t c = 0; c < p.candidates; ++c) {
+                const LightSample y = b.sampleFar(sp, rng, importance);
+                if (!(y.pdf > 0.0f) || isNear(near, k, y.i)) continue;
+                LightTerm ty;
+                if (!b.term(sp, y.i, ty)) continue;
+                const float ph = luminance(ty.value), w = ph / y.pdf;
+                if (!(w > 0.0f)) continue;
+                wSum += w;
+                if (c == 0 || rng.uniform() * wSum < w) {
+                    kept = y.i;
+                    pHat = ph;
+                    t = ty;
+                }
+            }
+            if (kept == kNoLightSample || (b.shadows() && !b.visible(sp, kept, t))) continue;
+            const Vec3 c = t.value * (wSum / (float(p.candidates) * pHat));
             if (!isFiniteNumber(c.x + c.y + c.z)) {
                 b.reject(q);
                 if (p.discardNonFinite) --counted;

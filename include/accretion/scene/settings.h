@@ -369,11 +369,13 @@ struct VoxelSettings {
 struct ParticleSplitSettings {
     std::uint32_t near = 16;       ///< nearest lights per particle, summed exactly
     std::uint32_t far = 8;         ///< far lights drawn per texel and frame
+    std::uint32_t candidates = 1;  ///< far draws resampled into each far shadow ray
     std::uint32_t texels = 1;      ///< texels per billboard side
     double history = 0.0;          ///< weight of a texel's last Lr in its new one
     template <class V> void visit(V& v) {
         v.field("near", near, "particle_split: the lights nearest each visible particle's centre (on the light tree, no rays), summed exactly at each of its texels with a shadow ray each", Range{0, 64});
         v.field("far", far, "particle_split: lights drawn per texel and frame from the light tree at the texel, the near lights' ball taken out, one shadow ray each", Range{0, 1024});
+        v.field("candidates", candidates, "particle_split: each far shadow ray's light is the one kept by RIS among this many far draws (the unshadowed term's luminance as target; 1: the draw itself)", Range{1, 256});
         v.field("texels", texels, "particle_split: texels per billboard side (1, 2, 3 or 4); the pixels interpolate them bilinearly", Range{1, 4});
         v.field("history", history, "particle_split: a texel's Lr is (1 - h) x this frame's + h x its own last frame's, found by particle id (an exponential average: biased where the light changes)", Range{0.0, 0.99});
     }
