@@ -229,24 +229,26 @@ extern "C" __global__ void __raygen__updateVoxelCache() {
     addCounters(counters);
 }
 
-/// particle_split's shadeSplitTexels: one thread per texel of the grid
-/// (launch kTexelRowWidth x rows), particle_split_passes.h's body with
-/// OptiX's shadow rays, k near and S far a texel.
+/// particle_split's shadeSplitTexels, its rays: one thread per ray of each
+/// texel (launch x = the ray, y = the texel), particle_split_passes.h's
+/// traceSplitRay with OptiX's shadow rays, written for the per-texel sum
+/// (split_kernels.cu). A thread per texel ran its near and far rays in
+/// turn, latency-bound: 36 ms at 100K for 8 near and 8 far of 8 candidates.
 template <ShadingModel SM>
-__device__ void shadeSplitTexel() {
+__device__ void traceSplitRay() {
     const uint3 idx = optixGetLaunchIndex();
-    const std::size_t q = std::size_t(idx.y) * kTexelRowWidth + idx.x;
     LaunchCounters c;
     SplitBridge<SM, OptixShadowRays<false>> b(params, OptixShadowRays<false>{&c}, &c);
-    psplit::shadeSplitTexel(b, q);
+    const SplitLaunch& s = params.split;
+    s.rays[std::size_t(idx.y) * psplit::raysPerTexel(s.params) + idx.x] = psplit::traceSplitRay(b, idx.y, idx.x);
     addCounters(c);
 }
 
 extern "C" __global__ void __raygen__shadeSplitTexels() {
     switch (params.model) {
-    case ShadingModel::lambert: shadeSplitTexel<ShadingModel::lambert>(); break;
-    case ShadingModel::sphere: shadeSplitTexel<ShadingModel::sphere>(); break;
-    case ShadingModel::isotropic: shadeSplitTexel<ShadingModel::isotropic>(); break;
+    case ShadingModel::lambert: traceSplitRay<ShadingModel::lambert>(); break;
+    case ShadingModel::sphere: traceSplitRay<ShadingModel::sphere>(); break;
+    case ShadingModel::isotropic: traceSplitRay<ShadingModel::isotropic>(); break;
     }
 }
 

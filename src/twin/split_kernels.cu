@@ -14,6 +14,13 @@ __global__ void findNearLightsKernel(const __grid_constant__ LaunchParams p) {
     psplit::findNearLightsOf(b, v);
 }
 
+__global__ void sumSplitTexelsKernel(const __grid_constant__ LaunchParams p, std::size_t texels) {
+    const std::size_t q = std::size_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (q >= texels) return;
+    SplitBridge<ShadingModel::isotropic> b(p);  // no light term: the model does not matter
+    psplit::sumSplitTexel(b, q);
+}
+
 __global__ void interpolateSplitPixelsKernel(const __grid_constant__ LaunchParams p) {
     const std::uint32_t x = blockIdx.x * blockDim.x + threadIdx.x, y = blockIdx.y * blockDim.y + threadIdx.y;
     if (x >= p.camera.width || y >= p.camera.height) return;
@@ -26,6 +33,10 @@ __global__ void interpolateSplitPixelsKernel(const __grid_constant__ LaunchParam
 void findNearLights(const LaunchParams& p, cudaStream_t stream) {
     const std::uint32_t n = p.split.params.visible;
     if (n) findNearLightsKernel<<<(n + 127) / 128, 128, 0, stream>>>(p);
+}
+
+void sumSplitTexels(const LaunchParams& p, std::size_t texels, cudaStream_t stream) {
+    if (texels) sumSplitTexelsKernel<<<unsigned((texels + 127) / 128), 128, 0, stream>>>(p, texels);
 }
 
 void interpolateSplitPixels(const LaunchParams& p, cudaStream_t stream) {

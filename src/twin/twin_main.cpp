@@ -98,7 +98,7 @@ struct FrameBuffers {
     DeviceBuffer treeNodes;                       // tree: the light tree's nodes
     DeviceBuffer Lr_stderr, spp, rejectedSamples;  // uniform / power
     DeviceBuffer voxelCells[2], voxelOccupied, voxelRays;  // voxel_cache: last frame's cells and this frame's; the reached cells; their rays
-    DeviceBuffer splitNear, splitNearFound, splitNearRadius2;  // particle_split: each visible particle's near lights
+    DeviceBuffer splitNear, splitNearFound, splitNearRadius2, splitRays;  // particle_split: each visible particle's near lights; the texels' rays
 };
 
 void copyDevice(DeviceBuffer& to, const DeviceBuffer& from, std::size_t bytes, cudaStream_t stream) {
@@ -412,7 +412,8 @@ std::uint32_t TwinRun::gatherTexels(const LaunchParams& lp, std::uint32_t side, 
 
 /// particle_split's passes (the CPU's ParticleSplit::render):
 /// gatherParticleTexels, findNearLights (a kernel per visible particle),
-/// shadeSplitTexels (a raygen per texel: its near and far shadow rays) and
+/// shadeSplitTexels (a raygen of a thread per ray of each texel, then a
+/// kernel that sums each texel's rays in order) and
 /// shadeParticlePixels (a kernel per pixel). Run again, they compute the
 /// same texels: last frame's are read from buf_.prevTexelLr, this frame's
 /// written to buf_.gridLr.
@@ -427,6 +428,10 @@ void TwinRun::runParticleSplit(LaunchParams& lp) {
     buf_.splitNear.reserve(std::max<std::size_t>(1, visible * sl.params.nearCount) * sizeof(std::uint32_t));
     buf_.splitNearFound.reserve(std::max<std::size_t>(1, visible) * sizeof(std::uint32_t));
     buf_.splitNearRadius2.reserve(std::max<std::size_t>(1, visible) * sizeof(float));
+    const std::uint32_t rays = psplit::raysPerTexel(sl.params);
+    if (double(grid) * rays > double(1u << 30))
+        throw InputError(fmt::format("particle_split: {} texels x {} rays, more than an OptiX launch holds (2^30)", grid, rays));
+    buf_.splitRays.reserve(std::max<std::size_t>(1, grid * rays) * sizeof(psplit::SplitRay));
     buf_.gridLr.reserve(grid * sizeof(Vec3));
     buf_.rejected.reserve(std::max(grid, std::size_t(W_) * H_) * sizeof(std::uint32_t));
     CUDA_CHECK(cudaMemsetAsync(buf_.rejected.as<void>(), 0, grid * sizeof(std::uint32_t), stream_));
@@ -436,6 +441,7 @@ void TwinRun::runParticleSplit(LaunchParams& lp) {
     sl.near = buf_.splitNear.as<std::uint32_t>();
     sl.nearFound = buf_.splitNearFound.as<std::uint32_t>();
     sl.nearRadius2 = buf_.splitNearRadius2.as<float>();
+    sl.rays = buf_.splitRays.as<psplit::SplitRay>();
     sl.texelLr = buf_.gridLr.as<Vec3>();
     sl.rejected = buf_.rejected.as<std::uint32_t>();
     sl.prevSlotOf = buf_.prevSlotOf.as<std::uint32_t>();
@@ -448,7 +454,8 @@ void TwinRun::runParticleSplit(LaunchParams& lp) {
     {
         GpuScope t(timer, Pass::shadeSplitTexels);
         CUDA_CHECK(cudaMemcpyAsync(buf_.params.as<void>(), &lp, sizeof lp, cudaMemcpyHostToDevice, stream_));
-        pipeline_->launch(Raygen::shadeSplitTexels, buf_.params.address(), sizeof lp, gridW_, gridH_, stream_);
+        if (rays > 0) pipeline_->launch(Raygen::shadeSplitTexels, buf_.params.address(), sizeof lp, rays, unsigned(grid), stream_);
+        sumSplitTexels(lp, grid, stream_);
     }
     {
         GpuScope t(timer, Pass::shadeParticlePixels);

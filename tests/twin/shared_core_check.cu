@@ -424,6 +424,7 @@ struct SplitCheckBridge {
         const std::uint32_t n = psplit::nearestLights(view, in.historyPositions[v], v, p.nearCount, light, d2);
         return n ? d2[n - 1] : 0.0f;
     }
+    ACC_HD psplit::SplitRay splitRay(std::size_t q, std::uint32_t r) const { return psplit::traceSplitRay(*this, q, r); }
     ACC_HD LightSample sampleFar(const ShadingPoint& sp, PortableRng& rng, const psplit::FarImportance& imp) const {
         return view.sample(sp, rng, imp);
     }
@@ -450,7 +451,7 @@ ACC_HD void splitCase(int k, const PassInputs* variants, const LightTreeView* tr
     o = Out{};
     SplitCheckBridge b{in, *tree, params[variant], o};
     if (variant == 0) psplit::findNearLightsOf(b, std::uint32_t(px));
-    else psplit::shadeSplitTexel(b, px);
+    else psplit::sumSplitTexel(b, px);
 }
 
 // ---------------------------------------------------------------- the hosts

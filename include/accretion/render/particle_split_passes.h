@@ -32,11 +32,14 @@
 //   findNearLights:   std::uint32_t particleOfSlot(v); Vec3 particlePosition(j);
 //                     const LightTreeView& tree(); void writeNear(v, light, count, radius2)
 //   shadeSplitTexels: GBufferTexel texel(q); ShadingPoint shadingPoint(g);
+//                     SplitRay splitRay(q, r)  texel q's ray r: traceSplitRay's (the CPU
+//                                             calls it; the twin's rays ran in a launch of
+//                                             their own, one a thread)
 //                     std::uint32_t nearLights(v, light) (returns the count); float nearRadius2(v)
 //                     LightSample sampleFar(sp, rng, importance)  the tree's descent (counted)
 //                     bool term(sp, i, t)     light i's term f I G in the frame's shading model (counted)
 //                     bool shadows(); bool visible(sp, i, t)  a shadow ray (traced, counted)
-//                     void reject(q)          a far draw's non-finite contribution rejected (render.nonfinite)
+//                     void reject(q)          a far ray's non-finite value rejected (render.nonfinite)
 //                     bool historyTexelOf(j, sub, q); Vec3 historyLr(q); void writeTexelLr(q, Lr)
 //   shadePixels:      GBufferTexel pixel(px); std::uint32_t slotOf(j); Vec2 pixelUv(g);
 //                     Vec3 texelLr(q); void writePixelLr(px, Lr)
@@ -208,66 +211,91 @@ ACC_HD_BODY void findNearLightsOf(B& b, std::uint32_t v) {
     b.writeNear(v, light, n, n > 0 ? d2[n - 1] : 0.0f);
 }
 
-/// shadeSplitTexels at texel q: its particle's near lights summed with a
-/// shadow ray each, S far draws, and with history the texel's last Lr.
+/// What one ray of a texel brings: near light r's f I G V, or far draw s's
+/// f I G V / p (RIS: f I G V sum(w) / (C p_hat)); `rejected` when that was
+/// not finite (render.nonfinite: the value is 0).
+struct SplitRay {
+    Vec3 value{0.0f};
+    std::uint32_t rejected = 0;
+};
+
+/// The rays of a texel: params.nearCount near slots, then params.farSamples far draws.
+ACC_HD inline std::uint32_t raysPerTexel(const SplitParams& p) { return p.nearCount + p.farSamples; }
+
+/// Ray r of texel q: for r < nearCount its particle's near light r (none
+/// where the particle has fewer), else its far draw r - nearCount, from its
+/// own stream (by particle id and texel, so that a texel's rays can run
+/// apart and its draws do not depend on its slot).
 template <class B>
-ACC_HD_BODY void shadeSplitTexel(B& b, std::size_t q) {
+ACC_HD_BODY SplitRay traceSplitRay(B& b, std::size_t q, std::uint32_t r) {
     const SplitParams& p = b.params();
+    SplitRay out;
     const GBufferTexel g = b.texel(q);
-    if (!g.hit()) {  // the grid's last row's tail
-        b.writeTexelLr(q, Vec3(0.0f));
-        return;
-    }
+    if (!g.hit()) return out;  // the grid's last row's tail
     const std::uint32_t per = p.texelsPerParticle();
     const std::uint32_t slot = std::uint32_t(q / per), sub = std::uint32_t(q % per);
     const ShadingPoint sp = b.shadingPoint(g);
     std::uint32_t near[kMaxNear];
     const std::uint32_t k = b.nearLights(slot, near);
-    Vec3 Lr(0.0f);
-    for (std::uint32_t m = 0; m < k; ++m) {
-        LightTerm t;
-        if (b.term(sp, near[m], t) && (!b.shadows() || b.visible(sp, near[m], t))) Lr += t.value;
+    LightTerm t;
+    if (r < p.nearCount) {
+        if (r < k && b.term(sp, near[r], t) && (!b.shadows() || b.visible(sp, near[r], t))) out.value = t.value;
+        return out;
     }
-    if (p.farSamples > 0) {
-        const FarImportance importance{sp.centre, k > 0 ? innerRadius2(b.nearRadius2(slot)) : 0.0f};
-        // The texel's own stream, by particle id: the same draws whatever its slot.
-        PortableRng rng(std::uint64_t(g.particle) * per + sub, p.frame, RngPass::particleSplit, p.seed);
-        Vec3 far(0.0f);
-        std::uint32_t counted = p.farSamples;
-        for (std::uint32_t s = 0; s < p.farSamples; ++s) {
-            // RIS over C far draws (C = 1: the draw itself): the one kept in
-            // proportion to w = p_hat / pdf, p_hat the unshadowed term's
-            // luminance, then f V sum(w) / (C p_hat).
-            float wSum = 0.0f, pHat = 0.0f;
-            std::uint32_t kept = kNoLightSample;
-            LightTerm t;
-            for (std::uint32_t c = 0; c < p.candidates; ++c) {
-                const LightSample y = b.sampleFar(sp, rng, importance);
-                if (!(y.pdf > 0.0f) || isNear(near, k, y.i)) continue;
-                LightTerm ty;
-                if (!b.term(sp, y.i, ty)) continue;
-                const float ph = luminance(ty.value), w = ph / y.pdf;
-                if (!(w > 0.0f)) continue;
-                wSum += w;
-                if (c == 0 || rng.uniform() * wSum < w) {
-                    kept = y.i;
-                    pHat = ph;
-                    t = ty;
-                }
-            }
-            if (kept == kNoLightSample || (b.shadows() && !b.visible(sp, kept, t))) continue;
-            const Vec3 c = t.value * (wSum / (float(p.candidates) * pHat));
-            if (!isFiniteNumber(c.x + c.y + c.z)) {
-                b.reject(q);
-                if (p.discardNonFinite) --counted;
-                continue;
-            }
-            far += c;
+    const FarImportance importance{sp.centre, k > 0 ? innerRadius2(b.nearRadius2(slot)) : 0.0f};
+    PortableRng rng(std::uint64_t(g.particle) * per + sub, p.frame, RngPass::particleSplit, p.seed, r - p.nearCount + 1);
+    // RIS over C far draws (C = 1: the draw itself): the one kept in
+    // proportion to w = p_hat / pdf, p_hat the unshadowed term's luminance.
+    float wSum = 0.0f, pHat = 0.0f;
+    std::uint32_t kept = kNoLightSample;
+    for (std::uint32_t c = 0; c < p.candidates; ++c) {
+        const LightSample y = b.sampleFar(sp, rng, importance);
+        if (!(y.pdf > 0.0f) || isNear(near, k, y.i)) continue;
+        LightTerm ty;
+        if (!b.term(sp, y.i, ty)) continue;
+        const float ph = luminance(ty.value), w = ph / y.pdf;
+        if (!(w > 0.0f)) continue;
+        wSum += w;
+        if (c == 0 || rng.uniform() * wSum < w) {
+            kept = y.i;
+            pHat = ph;
+            t = ty;
         }
-        if (counted > 0) Lr += far / float(counted);
     }
+    if (kept == kNoLightSample || (b.shadows() && !b.visible(sp, kept, t))) return out;
+    const Vec3 v = t.value * (wSum / (float(p.candidates) * pHat));
+    if (isFiniteNumber(v.x + v.y + v.z)) out.value = v;
+    else out.rejected = 1;
+    return out;
+}
+
+/// shadeSplitTexels at texel q: its rays (b.splitRay: traceSplitRay's)
+/// summed in order, the near ones as they are and the far ones' mean, and
+/// with history the texel's last Lr.
+template <class B>
+ACC_HD_BODY void sumSplitTexel(B& b, std::size_t q) {
+    const SplitParams& p = b.params();
+    const GBufferTexel g = b.texel(q);
+    if (!g.hit()) {
+        b.writeTexelLr(q, Vec3(0.0f));
+        return;
+    }
+    Vec3 Lr(0.0f), far(0.0f);
+    for (std::uint32_t r = 0; r < p.nearCount; ++r) Lr += b.splitRay(q, r).value;
+    std::uint32_t counted = p.farSamples;
+    for (std::uint32_t s = 0; s < p.farSamples; ++s) {
+        const SplitRay ray = b.splitRay(q, p.nearCount + s);
+        if (ray.rejected) {
+            b.reject(q);
+            if (p.discardNonFinite) --counted;
+        }
+        far += ray.value;
+    }
+    if (counted > 0) Lr += far / float(counted);
+    const std::uint32_t per = p.texelsPerParticle();
     std::size_t h = 0;
-    if (p.history > 0.0f && b.historyTexelOf(g.particle, sub, h)) Lr = (1.0f - p.history) * Lr + p.history * b.historyLr(h);
+    if (p.history > 0.0f && b.historyTexelOf(g.particle, std::uint32_t(q % per), h))
+        Lr = (1.0f - p.history) * Lr + p.history * b.historyLr(h);
     b.writeTexelLr(q, Lr);
 }
 

@@ -88,6 +88,7 @@ public:
         return n;
     }
     float nearRadius2(std::uint32_t v) const { return f_.nearRadius2[v]; }
+    SplitRay splitRay(std::size_t q, std::uint32_t r) { return traceSplitRay(*this, q, r); }
     LightSample sampleFar(const ShadingPoint& sp, PortableRng& rng, const FarImportance& importance) {
         rec_.trip();
         if constexpr (Count) {  // a node pair per level

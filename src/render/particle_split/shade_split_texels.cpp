@@ -7,7 +7,7 @@ namespace accretion::psplit {
 LightingCounters shadeSplitTexels(const CpuFrame& f) {
     const GBuffer& grid = f.texels.grid;
     PassCounters* pc = f.in.counters ? &f.in.counters->add(Pass::shadeSplitTexels, grid.width, grid.height) : nullptr;
-    return forEachItem(f, grid.texels.size(), pc, [](auto& b, std::size_t q) { shadeSplitTexel(b, q); });
+    return forEachItem(f, grid.texels.size(), pc, [](auto& b, std::size_t q) { sumSplitTexel(b, q); });
 }
 
 }  // namespace accretion::psplit
