@@ -230,17 +230,19 @@ extern "C" __global__ void __raygen__updateVoxelCache() {
 }
 
 /// particle_split's shadeSplitTexels, its rays: one thread per ray of each
-/// texel (launch x = the ray, y = the texel), particle_split_passes.h's
-/// traceSplitRay with OptiX's shadow rays, written for the per-texel sum
-/// (split_kernels.cu). A thread per texel ran its near and far rays in
-/// turn, latency-bound: 36 ms at 100K for 8 near and 8 far of 8 candidates.
+/// texel (launch x = the texel, y = the ray: a warp traces one kind of ray,
+/// near or far, for 32 texels), particle_split_passes.h's traceSplitRay
+/// with OptiX's shadow rays, written for the per-texel sum
+/// (split_kernels.cu). At 100K, 8 near and 8 far of 8 candidates: 36 ms
+/// with a thread per texel, 9.6 with a thread per ray and a warp's rays
+/// those of two texels (near and far ones mixed).
 template <ShadingModel SM>
 __device__ void traceSplitRay() {
     const uint3 idx = optixGetLaunchIndex();
     LaunchCounters c;
     SplitBridge<SM, OptixShadowRays<false>> b(params, OptixShadowRays<false>{&c}, &c);
     const SplitLaunch& s = params.split;
-    s.rays[std::size_t(idx.y) * psplit::raysPerTexel(s.params) + idx.x] = psplit::traceSplitRay(b, idx.y, idx.x);
+    s.rays[std::size_t(idx.y) * s.texels + idx.x] = psplit::traceSplitRay(b, idx.x, idx.y);
     addCounters(c);
 }
 

@@ -442,6 +442,7 @@ void TwinRun::runParticleSplit(LaunchParams& lp) {
     sl.nearFound = buf_.splitNearFound.as<std::uint32_t>();
     sl.nearRadius2 = buf_.splitNearRadius2.as<float>();
     sl.rays = buf_.splitRays.as<psplit::SplitRay>();
+    sl.texels = grid;
     sl.texelLr = buf_.gridLr.as<Vec3>();
     sl.rejected = buf_.rejected.as<std::uint32_t>();
     sl.prevSlotOf = buf_.prevSlotOf.as<std::uint32_t>();
@@ -454,7 +455,7 @@ void TwinRun::runParticleSplit(LaunchParams& lp) {
     {
         GpuScope t(timer, Pass::shadeSplitTexels);
         CUDA_CHECK(cudaMemcpyAsync(buf_.params.as<void>(), &lp, sizeof lp, cudaMemcpyHostToDevice, stream_));
-        if (rays > 0) pipeline_->launch(Raygen::shadeSplitTexels, buf_.params.address(), sizeof lp, rays, unsigned(grid), stream_);
+        if (rays > 0) pipeline_->launch(Raygen::shadeSplitTexels, buf_.params.address(), sizeof lp, unsigned(grid), rays, stream_);
         sumSplitTexels(lp, grid, stream_);
     }
     {
