@@ -112,8 +112,8 @@ struct SplitLaunch {
     std::uint32_t* near = nullptr;              ///< slot v's near lights at v x params.nearCount
     std::uint32_t* nearFound = nullptr;
     float* nearRadius2 = nullptr;
-    psplit::SplitRay* rays = nullptr;           ///< texel q's ray r at r x texels + q (a warp: one ray of 32 texels)
-    std::size_t texels = 0;                     ///< the grid's texels
+    psplit::SplitRay* rays = nullptr;           ///< texel q's ray r at r x rayStride + q (a warp: one ray of 32 texels)
+    std::size_t rayStride = 0;                  ///< the grid's texels: ray r of every texel at r x rayStride
     Vec3* texelLr = nullptr;
     std::uint32_t* rejected = nullptr;          ///< per texel: non-finite far draws
     const std::uint32_t* prevSlotOf = nullptr;  ///< particle_split.history: last frame's slots

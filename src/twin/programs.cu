@@ -242,7 +242,7 @@ __device__ void traceSplitRay() {
     LaunchCounters c;
     SplitBridge<SM, OptixShadowRays<false>> b(params, OptixShadowRays<false>{&c}, &c);
     const SplitLaunch& s = params.split;
-    s.rays[std::size_t(idx.y) * s.texels + idx.x] = psplit::traceSplitRay(b, idx.x, idx.y);
+    s.rays[std::size_t(idx.y) * s.rayStride + idx.x] = psplit::traceSplitRay(b, idx.x, idx.y);
     addCounters(c);
 }
 

@@ -45,7 +45,7 @@ public:
     __device__ float nearRadius2(std::uint32_t v) const { return s_.nearRadius2[v]; }
     /// The ray the launch of traceSplitRays traced (sumSplitTexel sums them).
     __device__ psplit::SplitRay splitRay(std::size_t q, std::uint32_t r) const {
-        return s_.rays[std::size_t(r) * s_.texels + q];
+        return s_.rays[std::size_t(r) * s_.rayStride + q];
     }
     __device__ LightSample sampleFar(const ShadingPoint& sp, PortableRng& rng, const psplit::FarImportance& importance) const {
         return p_.tree.sample(sp, rng, importance);

@@ -442,7 +442,7 @@ void TwinRun::runParticleSplit(LaunchParams& lp) {
     sl.nearFound = buf_.splitNearFound.as<std::uint32_t>();
     sl.nearRadius2 = buf_.splitNearRadius2.as<float>();
     sl.rays = buf_.splitRays.as<psplit::SplitRay>();
-    sl.texels = grid;
+    sl.rayStride = grid;
     sl.texelLr = buf_.gridLr.as<Vec3>();
     sl.rejected = buf_.rejected.as<std::uint32_t>();
     sl.prevSlotOf = buf_.prevSlotOf.as<std::uint32_t>();
