@@ -64,7 +64,7 @@ struct TuneArgs : SceneArgs {
     std::string cropSize = "160x90";    ///< each crop's size at the scene's resolution
     std::uint32_t cropMargin = 32;      ///< the pixels around a crop restir renders for its reuse
     std::string space = "quick";
-    std::vector<std::string> designs{"restir", "particle_restir", "voxel_cache"};
+    std::vector<std::string> designs{"restir", "particle_restir", "voxel_cache", "particle_split"};
     std::vector<std::string> references;  ///< --reference: one per crop
     std::uint32_t referenceSpp = 1024;
     std::string out, cache;
@@ -123,14 +123,17 @@ std::vector<GeometryChoice> geometryChoices(const Settings& s) {
 
 /// The design a lighting choice runs: restir per pixel, particle_restir
 /// per particle texel (texels per side, reservoirs a texel, how the pixels
-/// read them), or voxel_cache in world cells (cells along the longest side,
-/// rays a cell, its basis).
+/// read them), voxel_cache in world cells (cells along the longest side,
+/// rays a cell, its basis), or particle_split per particle texel (near
+/// lights, far rays, candidates a far ray, the texels' history).
 struct Design {
     EstimatorKind estimator = EstimatorKind::restir;
     std::uint32_t texels = 1, texelRays = 1;
     PixelShading shading = PixelShading::interpolate;
     std::uint32_t cells = 64, cellRays = 8;
     VoxelBasis basis = VoxelBasis::camera;
+    std::uint32_t near = 16, far = 8, farCandidates = 8;
+    double history = 0.75;
 };
 
 /// A lighting choice: its design (restir or particle_restir), candidate
@@ -148,7 +151,11 @@ struct LightingChoice {
 
     bool particles() const { return design.estimator == EstimatorKind::particle_restir; }
     bool voxels() const { return design.estimator == EstimatorKind::voxel_cache; }
+    bool split() const { return design.estimator == EstimatorKind::particle_split; }
     std::string label() const {
+        if (split())
+            return fmt::format("split near={} far={} C={} h={:g} {}x{}", design.near, design.far, design.farCandidates, design.history,
+                               design.texels, design.texels);
         if (voxels())
             return fmt::format("voxels {} cells={} rays={} {}", enumName(source), design.cells, design.cellRays, enumName(design.basis));
         if (particles())
@@ -164,6 +171,10 @@ struct LightingChoice {
             return {"render.estimator=voxel_cache", fmt::format("render.source={}", enumName(source)),
                     fmt::format("voxel.cells={}", design.cells), fmt::format("voxel.rays={}", design.cellRays),
                     fmt::format("voxel.basis={}", enumName(design.basis))};
+        if (split())  // its own settings alone, as the voxel cache's
+            return {"render.estimator=particle_split", fmt::format("particle_split.near={}", design.near),
+                    fmt::format("particle_split.far={}", design.far), fmt::format("particle_split.candidates={}", design.farCandidates),
+                    fmt::format("particle_split.history={:g}", design.history), fmt::format("particle_split.texels={}", design.texels)};
         std::vector<std::string> d = restirDefines();
         if (particles()) {
             d.front() = "render.estimator=particle_restir";
@@ -189,8 +200,8 @@ private:
 };
 
 /// The lighting choices of `space`: quick, 34 restir points around the GPU
-/// team's settings, 8 of particle_restir and 2 of voxel_cache; full, the
-/// whole grids (hours).
+/// team's settings, 8 of particle_restir, 2 of voxel_cache and 2 of
+/// particle_split; full, the whole grids (hours).
 std::vector<LightingChoice> lightingChoices(const std::string& space) {
     struct Axes {
         std::vector<LightSource> sources;
@@ -255,18 +266,35 @@ std::vector<LightingChoice> lightingChoices(const std::string& space) {
                 for (const VoxelBasis basis : {VoxelBasis::l1, VoxelBasis::camera})
                     if (!(rays == 8 && basis == VoxelBasis::camera && (cells == 32 || cells == 64)))
                         designs.push_back(voxels(cells, rays, basis));
+    // particle_split (seed 004's hybrid compute): near lights, far rays each
+    // kept by RIS among tree draws, the texels averaged by id.
+    const auto split = [](std::uint32_t near, std::uint32_t far, std::uint32_t candidates, double history, std::uint32_t texels = 1) {
+        Design d{EstimatorKind::particle_split};
+        d.near = near, d.far = far, d.farCandidates = candidates, d.history = history, d.texels = texels;
+        return LightingChoice{LightSource::tree, 0, 0, 1, basic, false, 1.0, d};
+    };
+    designs.push_back(split(16, 8, 8, 0.75));
+    designs.push_back(split(8, 4, 8, 0.75));
+    if (space == "full")
+        for (std::uint32_t near : {4u, 8u, 16u, 32u})
+            for (std::uint32_t far : {4u, 8u, 16u})
+                for (std::uint32_t c : {1u, 4u, 8u, 16u})
+                    for (const double h : {0.0, 0.5, 0.75})
+                        if (!(c == 8 && h == 0.75 && ((near == 16 && far == 8) || (near == 8 && far == 4))))
+                            designs.push_back(split(near, far, c, h));
     out.insert(out.end(), designs.begin(), designs.end());
     return out;
 }
 
-/// The choices of the designs named by --designs (restir, particle_restir, voxel_cache).
+/// The choices of the designs named by --designs (restir, particle_restir, voxel_cache, particle_split).
 std::vector<LightingChoice> designChoices(const std::vector<LightingChoice>& all, const std::vector<std::string>& designs) {
     std::vector<LightingChoice> out;
     for (const std::string& d : designs) {
         EstimatorKind kind{};
         if (!parseEnum(d, kind) ||
-            (kind != EstimatorKind::restir && kind != EstimatorKind::particle_restir && kind != EstimatorKind::voxel_cache))
-            throw InputError(fmt::format("command line --designs {}: expected restir, particle_restir or voxel_cache", d));
+            (kind != EstimatorKind::restir && kind != EstimatorKind::particle_restir && kind != EstimatorKind::voxel_cache &&
+             kind != EstimatorKind::particle_split))
+            throw InputError(fmt::format("command line --designs {}: expected restir, particle_restir, voxel_cache or particle_split", d));
         if (std::count(designs.begin(), designs.end(), d) > 1)
             throw InputError(fmt::format("command line --designs {}: named twice", d));
         for (const LightingChoice& c : all)
@@ -819,7 +847,7 @@ Table lightingTable(const TuneArgs& a, const TuneResult& r) {
     return lt;
 }
 
-/// Per design (restir, particle_restir, voxel_cache), its point of lowest relMSE under
+/// Per design (restir, particle_restir, voxel_cache, particle_split), its point of lowest relMSE under
 /// the budget (biased points only with --allow-biased).
 std::map<std::string, const ParetoPoint*> bestPerDesign(const TuneArgs& a, const TuneResult& r) {
     std::map<std::string, const ParetoPoint*> best;
@@ -1010,9 +1038,9 @@ void addTuneCommand(CLI::App& app) {
     cmd->add_option("--crop-size", args->cropSize, "Each crop's size in pixels, WIDTHxHEIGHT");
     cmd->add_option("--crop-margin", args->cropMargin, "The pixels around each crop that restir renders for its reuse (restir.crop_margin)")
         ->check(CLI::Range(0u, 16384u));
-    cmd->add_option("--designs", args->designs, "the designs searched: restir (per pixel), particle_restir (per particle texel), voxel_cache (world cells); all by default")
+    cmd->add_option("--designs", args->designs, "the designs searched: restir (per pixel), particle_restir (per particle texel), voxel_cache (world cells), particle_split (per particle texel: near lights and light-tree rays); all by default")
         ->delimiter(',');
-    cmd->add_option("--space", args->space, "quick (34 restir, 8 particle_restir and 2 voxel_cache configurations) or full (1080, 488 and 32: hours)");
+    cmd->add_option("--space", args->space, "quick (34 restir, 8 particle_restir, 2 voxel_cache and 2 particle_split configurations) or full (1080, 488, 32 and 144: hours)");
     cmd->add_option("--reference", args->references,
                     "Reference EXRs of --frame, one per crop in stratum order, row by row (default: rendered once, exact up to 20K "
                     "particles, else split)")

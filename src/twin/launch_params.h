@@ -107,6 +107,7 @@ struct VoxelLaunch {
 struct SplitLaunch {
     psplit::SplitParams params;
     const std::uint32_t* particleOf = nullptr;  ///< slot -> particle (the gather's sorted ids)
+    const std::uint64_t* lightPath = nullptr;   ///< each light's path in the light tree (LightTree::paths)
     const std::uint32_t* slotOf = nullptr;      ///< particle -> slot (kNoSlot: not visible)
     const GBufferTexel* texels = nullptr;       ///< the grid, kTexelRowWidth a row
     std::uint32_t* near = nullptr;              ///< slot v's near lights at v x params.nearCount

@@ -25,6 +25,7 @@ public:
     // findNearLights
     __device__ std::uint32_t particleOfSlot(std::uint32_t v) const { return s_.particleOf[v]; }
     __device__ Vec3 particlePosition(std::uint32_t j) const { return p_.position[j]; }
+    __device__ std::uint64_t lightPath(std::uint32_t j) const { return s_.lightPath[j]; }
     __device__ const LightTreeView& tree() const { return p_.tree; }
     __device__ void writeNear(std::uint32_t v, const std::uint32_t* light, std::uint32_t count, float radius2) const {
         std::uint32_t* out = s_.near + std::size_t(v) * s_.params.nearCount;

@@ -95,7 +95,7 @@ struct FrameBuffers {
     DeviceBuffer prevSlotOf, prevTexelLr;
     DeviceBuffer prevPosition, prevEmission, prevAlbedo, prevDmin2, prevGbuffer, prevReservoirs;
     DeviceBuffer aliasProb, aliasAlias, aliasPmf;  // power: the alias table
-    DeviceBuffer treeNodes;                       // tree: the light tree's nodes
+    DeviceBuffer treeNodes, treePaths;            // tree: the light tree's nodes; particle_split: each light's path
     DeviceBuffer Lr_stderr, spp, rejectedSamples;  // uniform / power
     DeviceBuffer voxelCells[2], voxelOccupied, voxelRays;  // voxel_cache: last frame's cells and this frame's; the reached cells; their rays
     DeviceBuffer splitNear, splitNearFound, splitNearRadius2, splitRays;  // particle_split: each visible particle's near lights; the texels' rays
@@ -342,6 +342,10 @@ LaunchParams TwinRun::launchParams(const FramePlan& plan, const Camera& camera, 
         buf_.treeNodes.upload(tree.nodes());
         lp.tree = tree.view();
         lp.tree.nodes = buf_.treeNodes.as<LightTreeNode>();
+        if (plan.particleSplit) {  // the near search starts below the root, on each light's path
+            buf_.treePaths.upload(tree.paths());
+            lp.split.lightPath = buf_.treePaths.as<std::uint64_t>();
+        }
     }
     lp.source.count = lp.lights.count;
     lp.source.uniformPdf = lp.lights.uniformPdf;

@@ -387,7 +387,7 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
     const nlohmann::json j = nlohmann::json::parse(slurp(dir / "t.json"));
     // Every measured point: the front is exactly the set no other point beats on both axes.
     const nlohmann::json& rows = j.at("lighting");
-    REQUIRE(rows.size() == 44);  // 34 of restir, 8 of particle_restir, 2 of voxel_cache
+    REQUIRE(rows.size() == 46);  // 34 of restir, 8 of particle_restir, 2 of voxel_cache, 2 of particle_split
     for (const auto& p : rows) {
         bool dominated = false;
         for (const auto& q : rows)
@@ -415,11 +415,15 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
     const nlohmann::json& designs = j.at("best_per_design");
     REQUIRE(designs.contains("restir"));
     REQUIRE(designs.contains("particle_restir"));
-    // The voxel cache is biased by design: it has a best only where a point of it was under the budget and no test detected its bias.
-    bool voxelEligible = false;
-    for (const auto& p : rows)
-        voxelEligible |= p["lighting"].get<std::string>().starts_with("voxels") && !p["biased"].get<bool>() && p["gpu_ms"].get<double>() <= 50.0;
-    CHECK(designs.contains("voxel_cache") == voxelEligible);
+    // The voxel cache and particle_split are biased by design: each has a best only where a point of it was under the budget
+    // and no test detected its bias.
+    for (const auto& [design, prefix] : {std::pair{"voxel_cache", "voxels"}, std::pair{"particle_split", "split"}}) {
+        bool eligible = false;
+        for (const auto& p : rows)
+            eligible |= p["lighting"].get<std::string>().starts_with(prefix) && !p["biased"].get<bool>() && p["gpu_ms"].get<double>() <= 50.0;
+        INFO(design);
+        CHECK(designs.contains(design) == eligible);
+    }
     CHECK(designs.at(r["design"].get<std::string>())["lighting"] == r["lighting"]);
     for (const auto& [design, best] : designs.items()) CHECK(best["rel_mse"].get<double>() >= r["rel_mse"].get<double>());
     // Reuse per configuration, at the steady state it was measured at: no
@@ -430,7 +434,7 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
     for (const auto& p : rows) {
         const std::string label = p["lighting"];
         INFO(label);
-        if (label.starts_with("voxels")) {  // the cache reuses cells, not reservoirs: no reuse passes, no offers
+        if (label.starts_with("voxels") || label.starts_with("split")) {  // cells or texels by id, not reservoirs: no reuse passes, no offers
             CHECK_FALSE(j.at("reuse").contains(label));
             CHECK(p["temporal_kept_pct"].is_null());
             continue;
@@ -461,9 +465,9 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
     const nlohmann::json firstTime = j.at("time");
     // Each configuration's bias once: --max-seeds 3 adds none (the escalation is checked below, with --max-seeds 12).
     for (const auto& p : rows) CHECK(p["seeds"] == 3);
-    CHECK(firstTime["error (bias)"]["runs"] == 44);
+    CHECK(firstTime["error (bias)"]["runs"] == 46);
     CHECK(firstTime["error (bias)"]["cached"] == 0);
-    CHECK(firstTime["GPU time (cost)"]["runs"] == 12 + 44);
+    CHECK(firstTime["GPU time (cost)"]["runs"] == 12 + 46);
     CHECK(firstTime["references"]["runs"] == 4);  // one per crop
     // Measured where the engine runs: four crops of the 96x64 frame, one per stratum, at its resolution.
     REQUIRE(j.at("crops").size() == 4);
@@ -490,7 +494,7 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
             ++measurements;
             CHECK_THAT(line, Contains("(cached)"));
         }
-    CHECK(measurements == 4 + 12 + 2 * 44);  // the crops' references, 6 layouts rebuilt and refitted, then cost and bias per lighting option
+    CHECK(measurements == 4 + 12 + 2 * 46);  // the crops' references, 6 layouts rebuilt and refitted, then cost and bias per lighting option
     CHECK(slurp(dir / "t.csv") == first);
     // ... and accounts for the cached measurements with what they cost when run (kept beside them, to the ms).
     const nlohmann::json again = nlohmann::json::parse(slurp(dir / "t.json")).at("time");

@@ -65,6 +65,7 @@ std::map<std::uint32_t, std::pair<DVec3, Vec3>> particleLr(const FrameImage& img
 TEST_CASE("particle_split: nearestLights on the light tree is the brute-force k nearest, nearest first", "[particle_split]") {
     const test::DiskLights d(ShadingModel::lambert, 3000);
     const LightTreeView view = d.tree.view();
+    const std::vector<std::uint64_t> paths = d.tree.paths();
     for (const std::uint32_t k : {1u, 7u, 16u, 64u}) {
         for (std::uint32_t j = 0; j < d.particles.size(); j += 37) {
             std::vector<std::pair<float, std::uint32_t>> all;
@@ -76,12 +77,15 @@ TEST_CASE("particle_split: nearestLights on the light tree is the brute-force k 
             std::sort(all.begin(), all.end());
             std::uint32_t light[psplit::kMaxNear];
             float d2[psplit::kMaxNear];
-            const std::uint32_t n = psplit::nearestLights(view, d.particles.position[j], j, k, light, d2);
             INFO("k " << k << " particle " << j);
-            REQUIRE(n == k);
-            for (std::uint32_t m = 0; m < n; ++m) {
-                CHECK(light[m] == all[m].second);
-                CHECK(d2[m] == all[m].first);
+            // Started below its own path's node, and below the leftmost path's (any start is exact).
+            for (const std::uint64_t path : {paths[j], std::uint64_t(0)}) {
+                const std::uint32_t n = psplit::nearestLights(view, d.particles.position[j], j, path, k, light, d2);
+                REQUIRE(n == k);
+                for (std::uint32_t m = 0; m < n; ++m) {
+                    CHECK(light[m] == all[m].second);
+                    CHECK(d2[m] == all[m].first);
+                }
             }
         }
     }
@@ -89,7 +93,7 @@ TEST_CASE("particle_split: nearestLights on the light tree is the brute-force k 
     const test::DiskLights few(ShadingModel::lambert, 10);
     std::uint32_t light[psplit::kMaxNear];
     float d2[psplit::kMaxNear];
-    REQUIRE(psplit::nearestLights(few.tree.view(), few.particles.position[3], 3, 64, light, d2) == 9);
+    REQUIRE(psplit::nearestLights(few.tree.view(), few.particles.position[3], 3, few.tree.paths()[3], 64, light, d2) == 9);
     REQUIRE_FALSE(psplit::isNear(light, 9, 3));
 }
 
@@ -100,7 +104,7 @@ TEST_CASE("particle_split: FarImportance never takes out a node that holds a lig
     for (std::uint32_t j = 0; j < d.particles.size(); j += 101) {
         std::uint32_t light[psplit::kMaxNear];
         float d2[psplit::kMaxNear];
-        const std::uint32_t n = psplit::nearestLights(view, d.particles.position[j], j, 32, light, d2);
+        const std::uint32_t n = psplit::nearestLights(view, d.particles.position[j], j, d.tree.paths()[j], 32, light, d2);
         const psplit::FarImportance imp{d.particles.position[j], psplit::innerRadius2(d2[n - 1])};
         // Every node taken out holds near lights (or the receiver) alone.
         for (std::uint32_t node = 0; node < view.nodeCount; ++node) {

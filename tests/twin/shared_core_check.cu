@@ -398,11 +398,13 @@ constexpr int kSplitCases = (1 + kSplitVariants) * int(kGridW * kGridH);
 struct SplitCheckBridge {
     const PassInputs& in;
     LightTreeView view;
+    const std::uint64_t* paths;
     const psplit::SplitParams& p;
     Out& o;
     ACC_HD const psplit::SplitParams& params() const { return p; }
     ACC_HD std::uint32_t particleOfSlot(std::uint32_t v) const { return v; }
     ACC_HD Vec3 particlePosition(std::uint32_t j) const { return in.historyPositions[j]; }
+    ACC_HD std::uint64_t lightPath(std::uint32_t j) const { return paths[j]; }
     ACC_HD const LightTreeView& tree() const { return view; }
     ACC_HD void writeNear(std::uint32_t, const std::uint32_t* light, std::uint32_t count, float radius2) const {
         std::uint32_t h = 0;
@@ -416,12 +418,12 @@ struct SplitCheckBridge {
     }
     ACC_HD std::uint32_t nearLights(std::uint32_t v, std::uint32_t* light) const {
         float d2[psplit::kMaxNear];
-        return psplit::nearestLights(view, in.historyPositions[v], v, p.nearCount, light, d2);
+        return psplit::nearestLights(view, in.historyPositions[v], v, paths[v], p.nearCount, light, d2);
     }
     ACC_HD float nearRadius2(std::uint32_t v) const {
         std::uint32_t light[psplit::kMaxNear];
         float d2[psplit::kMaxNear];
-        const std::uint32_t n = psplit::nearestLights(view, in.historyPositions[v], v, p.nearCount, light, d2);
+        const std::uint32_t n = psplit::nearestLights(view, in.historyPositions[v], v, paths[v], p.nearCount, light, d2);
         return n ? d2[n - 1] : 0.0f;
     }
     ACC_HD psplit::SplitRay splitRay(std::size_t q, std::uint32_t r) const { return psplit::traceSplitRay(*this, q, r); }
@@ -443,13 +445,14 @@ struct SplitCheckBridge {
     ACC_HD void writeTexelLr(std::size_t, const Vec3& Lr) const { o = Out{{bits(Lr.x), bits(Lr.y), bits(Lr.z), 5u, 0u, 0u, 0u, 0u}}; }
 };
 
-ACC_HD void splitCase(int k, const PassInputs* variants, const LightTreeView* tree, const psplit::SplitParams* params, Out& o) {
+ACC_HD void splitCase(int k, const PassInputs* variants, const LightTreeView* tree, const std::uint64_t* paths,
+                      const psplit::SplitParams* params, Out& o) {
     const PassInputs& in = variants[0];
     const std::uint32_t texels = kGridW * kGridH;
     const int variant = k / int(texels);
     const std::size_t px = std::size_t(k) % texels;
     o = Out{};
-    SplitCheckBridge b{in, *tree, params[variant], o};
+    SplitCheckBridge b{in, *tree, paths, params[variant], o};
     if (variant == 0) psplit::findNearLightsOf(b, std::uint32_t(px));
     else psplit::sumSplitTexel(b, px);
 }
@@ -464,6 +467,7 @@ struct Inputs {
     PassInputs* passes;  ///< none, basic, pairwise
     voxel::VoxelParams* voxel;  ///< l1, camera
     LightTreeView* tree;        ///< the light tree over the passes' lights
+    std::uint64_t* paths;       ///< its lights' paths
     psplit::SplitParams* split; ///< the near search; the three texel variants
 };
 
@@ -498,7 +502,7 @@ ACC_HD void runCase(Step s, int k, const Inputs& in, Out& o) {
         case Step::passes: passCase(k, in.passes, o); break;
         case Step::loops: loopCase(k, in.passes, o); break;
         case Step::voxels: voxelCase(k, in.passes, in.voxel, o); break;
-        case Step::splits: splitCase(k, in.passes, in.tree, in.split, o); break;
+        case Step::splits: splitCase(k, in.passes, in.tree, in.paths, in.split, o); break;
     }
 }
 
@@ -673,6 +677,7 @@ int main() {
     const LightTree lightTree(lights, lambert);
     LightTreeView hostTree = lightTree.view(), deviceTree = hostTree;
     deviceTree.nodes = toDevice(lightTree.nodes());
+    std::vector<std::uint64_t> paths = lightTree.paths();
     std::vector<psplit::SplitParams> splits(1 + kSplitVariants);
     for (std::size_t v = 0; v < splits.size(); ++v) {
         psplit::SplitParams& s = splits[v];
@@ -685,9 +690,9 @@ int main() {
         s.seed = 21;
     }
     const Inputs host{Camera::lookAt(Vec3(0.0f, 7.0f, 17.0f), Vec3(0.0f), Vec3(0.0f, 1.0f, 0.0f), 45.0, 320, 180), points.data(),
-                      offers.data(), shades.data(), hostPasses.data(), voxels.data(), &hostTree, splits.data()};
+                      offers.data(), shades.data(), hostPasses.data(), voxels.data(), &hostTree, paths.data(), splits.data()};
     const Inputs device{host.cam, toDevice(points), toDevice(offers), toDevice(shades), toDevice(devicePasses), toDevice(voxels),
-                        toDevice(std::vector<LightTreeView>{deviceTree}), toDevice(splits)};
+                        toDevice(std::vector<LightTreeView>{deviceTree}), toDevice(paths), toDevice(splits)};
 
     std::printf("shared_core_check: %s, CUDA %d.%d; host results from the host compiler, device results from sm_%d%d\n",
                 prop.name, CUDART_VERSION / 1000, (CUDART_VERSION % 1000) / 10, prop.major, prop.minor);

@@ -95,6 +95,13 @@ public:
     /// The descent over the node array, as plain data (what the OptiX twin uploads).
     LightTreeView view() const { return {nodes_.data(), static_cast<std::uint32_t>(nodes_.size()), model_}; }
     const std::vector<LightTreeNode>& nodes() const { return nodes_; }
+    /// Each light's path from the root (bit k: went right at depth k), for
+    /// a search that starts below the root (particle_split's nearestLights).
+    std::vector<std::uint64_t> paths() const {
+        std::vector<std::uint64_t> out(trail_.size());
+        for (std::size_t i = 0; i < trail_.size(); ++i) out[i] = trail_[i].bits;
+        return out;
+    }
     std::size_t nodeCount() const { return nodes_.size(); }
     std::uint32_t depth() const { return depth_; }
     std::size_t bytes() const { return nodes_.size() * sizeof(Node) + trail_.size() * sizeof(Trail); }

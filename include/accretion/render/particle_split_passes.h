@@ -29,7 +29,8 @@
 // (src/twin/), over a bridge B:
 //
 //   const SplitParams& params()
-//   findNearLights:   std::uint32_t particleOfSlot(v); Vec3 particlePosition(j);
+//   findNearLights:   std::uint32_t particleOfSlot(v); Vec3 particlePosition(j); std::uint64_t lightPath(j)
+//                     (LightTree::paths);
 //                     const LightTreeView& tree(); void writeNear(v, light, count, radius2)
 //   shadeSplitTexels: GBufferTexel texel(q); ShadingPoint shadingPoint(g);
 //                     SplitRay splitRay(q, r)  texel q's ray r: traceSplitRay's (the CPU
@@ -94,9 +95,13 @@ inline SplitParams splitParams(const Settings& s, std::uint32_t visible, std::ui
 /// tree's nodes, nearest first (ties: the smaller index first), with their
 /// squared distances (each leaf's centre to x, as FarImportance measures
 /// them). A depth-first search, the nearer child first, pruned by the k-th
-/// distance so far. Returns how many (fewer where the tree holds fewer).
-ACC_HD inline std::uint32_t nearestLights(const LightTreeView& tree, const Vec3& x, std::uint32_t self, std::uint32_t k,
-                                          std::uint32_t* light, float* d2) {
+/// distance so far: first below the smallest node on self's path from the
+/// root (`selfPath`, LightTree::paths) that holds more than k lights, whose
+/// lights are its spatial neighbours, so that the search from the root
+/// starts with a tight k-th distance and skips that subtree (x is self's
+/// position). Returns how many (fewer where the tree holds fewer).
+ACC_HD inline std::uint32_t nearestLights(const LightTreeView& tree, const Vec3& x, std::uint32_t self, std::uint64_t selfPath,
+                                          std::uint32_t k, std::uint32_t* light, float* d2) {
     if (k > kMaxNear) k = kMaxNear;
     if (tree.nodeCount == 0 || k == 0) return 0;
     // A max-heap of the best so far on (d2, light).
@@ -134,9 +139,21 @@ ACC_HD inline std::uint32_t nearestLights(const LightTreeView& tree, const Vec3&
     };
     Pending stack[2 * 64 + 2];  // the tree is at most 64 deep (LightTree's build)
     std::uint32_t top = 0;
+    std::uint32_t seed = 0;
+    for (std::uint32_t depth = 0; depth < 64 && tree.nodes[seed].count > 1; ++depth) {
+        const std::uint32_t next = tree.nodes[seed].child + std::uint32_t((selfPath >> depth) & 1u);
+        if (tree.nodes[next].count <= k) break;
+        seed = next;
+    }
     stack[top++] = {0u, sphereBound(tree.nodes[0])};
+    if (seed != 0) stack[top++] = {seed, 0.0f};  // popped first
+    bool seedSearched = false;
     while (top > 0) {
         const Pending p = stack[--top];
+        if (seed != 0 && p.node == seed) {  // the second time, reached from the root: searched already
+            if (seedSearched) continue;
+            seedSearched = true;
+        }
         if (found == k && !(p.bound <= d2[0])) continue;
         const LightTreeNode& n = tree.nodes[p.node];
         if (n.count == 1) {
@@ -207,7 +224,7 @@ ACC_HD_BODY void findNearLightsOf(B& b, std::uint32_t v) {
     const std::uint32_t j = b.particleOfSlot(v);
     std::uint32_t light[kMaxNear];
     float d2[kMaxNear];
-    const std::uint32_t n = nearestLights(b.tree(), b.particlePosition(j), j, p.nearCount, light, d2);
+    const std::uint32_t n = nearestLights(b.tree(), b.particlePosition(j), j, b.lightPath(j), p.nearCount, light, d2);
     b.writeNear(v, light, n, n > 0 ? d2[n - 1] : 0.0f);
 }
 

@@ -26,6 +26,7 @@ struct CpuFrame {
     const SplitParams& params;
     const LightArrays& L;
     LightTreeView tree;
+    const std::vector<std::uint64_t>& paths;       ///< each light's path in the tree (LightTree::paths)
     VisibilityOptions vis;
     bool shadows = true;                           ///< plan.shadowRays
     const ParticleTexels& texels;
@@ -53,6 +54,7 @@ public:
         return f_.texels.particleOf[v];
     }
     Vec3 particlePosition(std::uint32_t j) const { return f_.in.particles.position[j]; }
+    std::uint64_t lightPath(std::uint32_t j) const { return f_.paths[j]; }
     const LightTreeView& tree() {
         if constexpr (Count) {  // a search visits about a node pair per level per near light's neighbourhood
             const std::uint32_t levels = std::bit_width(std::max(1u, f_.L.count));

@@ -33,7 +33,8 @@ LightingCounters ParticleSplit::render(const ParticleSplitInputs& in, LightingIm
     static const std::vector<std::uint32_t> kNoSlots;
     static const std::vector<Vec3> kNoLr;
     const bool history = params.history > 0.0f;
-    const psplit::CpuFrame f{in, params, L, in.lightTree.view(), VisibilityOptions::from(in.settings.render), plan.shadowRays,
+    const std::vector<std::uint64_t> paths = in.lightTree.paths();
+    const psplit::CpuFrame f{in, params, L, in.lightTree.view(), paths, VisibilityOptions::from(in.settings.render), plan.shadowRays,
                              texels, near, nearFound, nearRadius2, history ? prevSlotOf_ : kNoSlots,
                              history ? prevTexelLr_ : kNoLr, texelLr, texelRejected, out.Lr};
     LightingCounters counters;
