@@ -90,17 +90,22 @@ restir_case prt_interp prt_interp -D render.estimator=particle_restir -D restir.
 restir_case prt_resample prt_resample -D render.estimator=particle_restir -D restir.bias_correction=pairwise -D restir.pixel_shading=resample
 restir_case prt_2x2_k2 prt_2x2_k2 -D render.estimator=particle_restir -D restir.texels=2 -D restir.texel_rays=2
 restir_case prt_history prt_history -D render.estimator=particle_restir -D restir.texel_rays=4 -D restir.texel_history=0.5 -D restir.spatial_neighbours=0
-# voxel_cache (run.sh voxels): the cells and the pixels read from them, frames 0-2.
-voxel_case() {
-    local gpu=$1
-    shift
+# voxel_cache (run.sh voxels: the cells and the pixels read from them) and
+# particle_split (run.sh splits: the texels and the pixels), frames 0-2:
+#   design_case ESTIMATOR GPU_STEM OVERRIDES...
+design_case() {
+    local estimator=$1 gpu=$2
+    shift 2
     [ -f "$T/$gpu.0000.exr" ] || return 0
-    cpu "$gpu" 0:3 -D render.estimator=voxel_cache "$@"
-    for f in 0 1 2; do compare "voxel_cache $gpu" $f "$T/$gpu.000$f.exr" "$T/cpu_$gpu.000$f.exr"; done
+    cpu "$gpu" 0:3 -D render.estimator="$estimator" "$@"
+    for f in 0 1 2; do compare "$estimator $gpu" $f "$T/$gpu.000$f.exr" "$T/cpu_$gpu.000$f.exr"; done
 }
-voxel_case vox_tree -D render.source=tree
-voxel_case vox_power_camera -D render.source=power -D voxel.basis=camera
-voxel_case vox_uniform_h1 -D render.source=uniform -D voxel.history=1 -D voxel.cells=16
+design_case voxel_cache vox_tree -D render.source=tree
+design_case voxel_cache vox_power_camera -D render.source=power -D voxel.basis=camera
+design_case voxel_cache vox_uniform_h1 -D render.source=uniform -D voxel.history=1 -D voxel.cells=16
+design_case particle_split ps_n8_f4 -D particle_split.near=8 -D particle_split.far=4
+design_case particle_split ps_2x2_c4_h5 -D particle_split.texels=2 -D particle_split.candidates=4 -D particle_split.history=0.5
+design_case particle_split ps_n64_f0 -D particle_split.near=64 -D particle_split.far=0
 
 # uniform and power (one frame): Lr, its standard error and the samples taken.
 declare -A sampled=(

@@ -577,7 +577,7 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
     CHECK(runCommand(kBin + " tune " + tinyScene() + " --budget-ms 5 --space huge -o " + (dir / "bad").string(), out) == 1);
     CHECK_THAT(out, Contains("--space huge"));
     CHECK(runCommand(kBin + " tune " + tinyScene() + " --budget-ms 5 --designs restir,voxels -o " + (dir / "bad").string(), out) == 1);
-    CHECK_THAT(out, Contains("--designs voxels: expected restir, particle_restir or voxel_cache"));
+    CHECK_THAT(out, Contains("--designs voxels: expected restir, particle_restir, voxel_cache or particle_split"));
     CHECK(runCommand(kBin + " tune " + tinyScene() + " --budget-ms 5 --error-crops 2x2 --crop-size 32x24 --reference " +
                          (dir / "t.csv").string() + " --cache " + (dir / "bad_cache").string() + " -o " + (dir / "bad").string(), out) == 1);
     CHECK_THAT(out, Contains("--reference: 1 given, one per crop of --error-crops 2x2 (4)"));
