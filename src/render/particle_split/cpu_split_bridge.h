@@ -8,15 +8,13 @@
 #include <cstdint>
 #include <vector>
 
-#include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
-
 #include "accretion/counters/gpu_layouts.h"
 #include "accretion/lighting/light_arrays.h"
 #include "accretion/render/particle_split.h"
 #include "accretion/render/particle_split_passes.h"
 #include "accretion/render/particle_texel_grid.h"
 #include "accretion/render/visibility.h"
+#include "../cpu_passes.h"
 
 namespace accretion::psplit {
 
@@ -74,14 +72,7 @@ public:
     }
 
     // shadeSplitTexels
-    GBufferTexel texel(std::size_t q) {
-        const GBufferTexel& g = f_.texels.grid.texels[q];
-        if constexpr (Count) {
-            rec_.read(gpu_layout::kGBufferTexel);
-            if (g.hit()) rec_.shade(true, f_.in.particles.type[g.particle], f_.in.bvh.clusterOf(g.particle));
-        }
-        return g;
-    }
+    GBufferTexel texel(std::size_t q) { return recordedTexel(rec_, f_.texels.grid.texels[q], f_.in.particles, f_.in.bvh); }
     ShadingPoint shadingPoint(const GBufferTexel& g) const { return accretion::shadingPoint(g, f_.in.particles); }
     std::uint32_t nearLights(std::uint32_t v, std::uint32_t* light) {
         const std::uint32_t n = f_.nearFound[v];
@@ -110,10 +101,7 @@ public:
     }
     bool shadows() const { return f_.shadows; }
     bool visible(const ShadingPoint& sp, std::uint32_t i, const LightTerm& t) {
-        RayCounters rc;
-        const bool seen = accretion::visible<P>(f_.in.bvh, f_.vis, sp, i, f_.L.position[i], f_.L.radius[i], t, rec_.rayCounters(rc));
-        if constexpr (Count) rec_.ray(rc);
-        ++c_.shadowRays;
+        const bool seen = countedShadowRay<P>(f_.in.bvh, f_.vis, f_.L, sp, i, t, c_, rec_);
         c_.shadowOccluded += !seen;
         return seen;
     }
@@ -138,14 +126,7 @@ public:
     }
 
     // shadeParticlePixels
-    GBufferTexel pixel(std::size_t px) {
-        const GBufferTexel& g = f_.in.gbuffer.texels[px];
-        if constexpr (Count) {
-            rec_.read(gpu_layout::kGBufferTexel);
-            if (g.hit()) rec_.shade(true, f_.in.particles.type[g.particle], f_.in.bvh.clusterOf(g.particle));
-        }
-        return g;
-    }
+    GBufferTexel pixel(std::size_t px) { return recordedTexel(rec_, f_.in.gbuffer.texels[px], f_.in.particles, f_.in.bvh); }
     std::uint32_t slotOf(std::uint32_t j) {
         rec_.read(4);
         rec_.gather(1);
@@ -175,30 +156,14 @@ private:
 /// threads' counters summed.
 template <class Body>
 LightingCounters forEachItem(const CpuFrame& f, std::size_t n, PassCounters* pc, Body&& body) {
-    const auto run = [&]<ShadingModel SM, Primitive P, bool Count>() {
-        tbb::enumerable_thread_specific<LightingCounters> counters;
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 64), [&](const auto& r) {
-            LightingCounters& c = counters.local();
-            for (std::size_t k = r.begin(); k != r.end(); ++k) {
+    return withShadingModel(f.in.settings.shading.model, [&]<ShadingModel SM>() {
+        return withPrimitiveAndCount(f.in.bvh.settings().primitive, pc != nullptr, [&]<Primitive P, bool Count>() {
+            return forEachItemParallel(n, 64, [&](std::size_t k, LightingCounters& c) {
                 CpuSplitBridge<SM, P, Count> b(f, Count ? &pc->threads[k] : nullptr, c);
                 body(b, k);
-            }
+            });
         });
-        LightingCounters total;
-        for (const LightingCounters& c : counters) total += c;
-        return total;
-    };
-    const auto byPrimitive = [&]<ShadingModel SM>() {
-        const bool spheres = f.in.bvh.settings().primitive == Primitive::sphere;
-        if (pc) return spheres ? run.template operator()<SM, Primitive::sphere, true>() : run.template operator()<SM, Primitive::billboard, true>();
-        return spheres ? run.template operator()<SM, Primitive::sphere, false>() : run.template operator()<SM, Primitive::billboard, false>();
-    };
-    switch (f.in.settings.shading.model) {
-    case ShadingModel::lambert: return byPrimitive.template operator()<ShadingModel::lambert>();
-    case ShadingModel::sphere: return byPrimitive.template operator()<ShadingModel::sphere>();
-    case ShadingModel::isotropic: return byPrimitive.template operator()<ShadingModel::isotropic>();
-    }
-    return LightingCounters{};
+    });
 }
 
 }  // namespace accretion::psplit

@@ -3,22 +3,10 @@
 // offers of a pass, with the CPU's counters and, for basic_visibility, its
 // shadow rays.
 #include "accretion/render/restir_steps.h"
+#include "../cpu_passes.h"
 #include "restir_pass.h"
 
 namespace accretion::restir {
-
-/// One shadow ray of a restir pass on the CPU, toward light i of `lights`
-/// through `bvh`: counted (c.shadowRays) and its traversal recorded.
-template <Primitive P, bool Count>
-bool countedShadowRay(const ParticleBvh& bvh, const VisibilityOptions& vis, const LightArrays& lights, const ShadingPoint& sp,
-                      std::uint32_t i, const LightTerm& t, LightingCounters& c, Recorder<Count>& rec) {
-    ++c.shadowRays;
-    RayCounters rc;
-    const PackedLight& l = lights.packed[i];
-    const bool seen = visible<P>(bvh, vis, sp, i, l.position, l.radius, t, rec.rayCounters(rc));
-    rec.ray(rc);
-    return seen;
-}
 
 /// The offers of a CPU pass as restir_steps.h's Domains: each domain's
 /// p_hat from its own lights, the light terms counted, and basic's support

@@ -8,15 +8,13 @@
 #include <cstdint>
 #include <vector>
 
-#include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
-
 #include "accretion/counters/gpu_layouts.h"
 #include "accretion/lighting/light_arrays.h"
 #include "accretion/lighting/light_tree_view.h"
 #include "accretion/lighting/source_pmf.h"
 #include "accretion/render/visibility.h"
 #include "accretion/render/voxel_cache.h"
+#include "../cpu_passes.h"
 
 namespace accretion::voxel {
 
@@ -79,21 +77,11 @@ public:
     }
     bool shadows() const { return f_.shadows; }
     bool visible(const ShadingPoint& sp, std::uint32_t i, const LightTerm& t) {
-        RayCounters rc;
-        const bool seen = accretion::visible<P>(f_.in.bvh, f_.vis, sp, i, f_.L.position[i], f_.L.radius[i], t, rec_.rayCounters(rc));
-        if constexpr (Count) rec_.ray(rc);
-        ++c_.shadowRays;
+        const bool seen = countedShadowRay<P>(f_.in.bvh, f_.vis, f_.L, sp, i, t, c_, rec_);
         c_.shadowOccluded += !seen;
         return seen;
     }
-    GBufferTexel pixel(std::size_t px) {
-        const GBufferTexel& g = f_.in.gbuffer.texels[px];
-        if constexpr (Count) {
-            rec_.read(gpu_layout::kGBufferTexel);
-            if (g.hit()) rec_.shade(true, f_.in.particles.type[g.particle], f_.in.bvh.clusterOf(g.particle));
-        }
-        return g;
-    }
+    GBufferTexel pixel(std::size_t px) { return recordedTexel(rec_, f_.in.gbuffer.texels[px], f_.in.particles, f_.in.bvh); }
     ShadingPoint shadingPoint(const GBufferTexel& g) const { return accretion::shadingPoint(g, f_.in.particles); }
     void writePixelLr(std::size_t px, const Vec3& Lr) {
         rec_.write(gpu_layout::kRadiance);
@@ -111,26 +99,16 @@ private:
 /// returns the threads' counters summed.
 template <Primitive P, bool Count, class Body>
 LightingCounters forEachItem(const CpuFrame& f, std::size_t n, PassCounters* pc, Body&& body) {
-    tbb::enumerable_thread_specific<LightingCounters> counters;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& r) {
-        LightingCounters& c = counters.local();
-        for (std::size_t k = r.begin(); k != r.end(); ++k) {
-            CpuVoxelBridge<P, Count> b(f, Count ? &pc->threads[k] : nullptr, c);
-            body(b, k);
-        }
+    return forEachItemParallel(n, 256, [&](std::size_t k, LightingCounters& c) {
+        CpuVoxelBridge<P, Count> b(f, Count ? &pc->threads[k] : nullptr, c);
+        body(b, k);
     });
-    LightingCounters total;
-    for (const LightingCounters& c : counters) total += c;
-    return total;
 }
 
 /// fn.template operator()<P, Count>() for the frame's primitive and counting mode.
 template <class Fn>
 LightingCounters dispatchVoxel(const CpuFrame& f, Fn&& fn) {
-    const bool spheres = f.in.bvh.settings().primitive == Primitive::sphere;
-    if (f.in.counters)
-        return spheres ? fn.template operator()<Primitive::sphere, true>() : fn.template operator()<Primitive::billboard, true>();
-    return spheres ? fn.template operator()<Primitive::sphere, false>() : fn.template operator()<Primitive::billboard, false>();
+    return withPrimitiveAndCount(f.in.bvh.settings().primitive, f.in.counters != nullptr, fn);
 }
 
 // The passes (one file each).
