@@ -161,7 +161,8 @@ void describe(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
              dark ? noLight : fmt::format("each visible particle's {} nearest lights on the light tree (no rays)", ps.near));
         step(Pass::shadeSplitTexels,
              dark ? noLight
-                  : fmt::format("per texel: the near lights summed and {} far draws from the light tree, {}{}", ps.far,
+                  : fmt::format("per texel: the near lights summed and {} far rays, each {} from the light tree, {}{}", ps.far,
+                                ps.candidates > 1 ? fmt::format("kept by RIS among {} draws", ps.candidates) : std::string("one draw"),
                                 plan.shadowRays ? "a shadow ray each" : "visibility off (V = 1)",
                                 ps.history > 0.0 ? fmt::format(", Lr averaged with last frame's (h = {})", ps.history) : ""));
         step(Pass::shadeParticlePixels, dark ? noLight : "interpolate: bilinear over the pixel's particle's texels' Lr (biased)");
