@@ -43,6 +43,12 @@ nlohmann::json reportHoldout(const std::vector<CostRow>& rows, double fraction, 
             if (k < x.passes.size()) line += fmt::format("  {:>14.1f}% {:>14.1f}%", 100 * x.passes[k].median, 100 * x.passes[k].worst);
         fmt::print("{}\n", line);
     }
+    // A configuration's frame, and its spatial reuse run 2 or more times: each summed over its passes or runs.
+    for (const auto& [name, of] : {std::pair{"frames", &Holdout::frames}, std::pair{"spatial, 2+ runs", &Holdout::iteratedSpatial}}) {
+        std::string line = fmt::format("{:<22} {:>5}", name, (h[0].*of).rows);
+        for (const Holdout& x : h) line += fmt::format("  {:>14.1f}% {:>14.1f}%", 100 * (x.*of).median, 100 * (x.*of).worst);
+        fmt::print("{}\n", line);
+    }
     nlohmann::json j = {{"fraction", fraction}, {"split_seed", seed}};
     for (std::size_t i = 0; i < h.size(); ++i) j[costModelFormName(forms[i])] = h[i].toJson();
     return j;

@@ -549,6 +549,11 @@ Holdout holdout(const std::vector<CostRow>& rows, CostModelForm form, double fra
     using Errors = std::vector<std::pair<double, std::string>>;  // relative error, configuration
     std::map<Pass, Errors> byPass;
     Errors all;
+    struct Sum {
+        double predicted = 0.0, measured = 0.0;
+        std::uint32_t runs = 0;
+    };
+    std::map<std::string, Sum> frame, spatial;  // by configuration
     for (const CostRow& r : priced) {
         if (!in(h.predicted, r.config) || !(r.measuredMs > 0.0)) continue;
         const double predicted = c.predictMs(r.pass.pass, r.features);
@@ -557,6 +562,12 @@ Holdout holdout(const std::vector<CostRow>& rows, CostModelForm form, double fra
         const double e = std::abs(predicted - r.measuredMs) / r.measuredMs;
         byPass[r.pass.pass].push_back({e, r.config});
         all.push_back({e, r.config});
+        for (Sum* s : {&frame[r.config], r.pass.pass == Pass::spatialResampling ? &spatial[r.config] : nullptr})
+            if (s) {
+                s->predicted += predicted;
+                s->measured += r.measuredMs;
+                ++s->runs;
+            }
     }
     auto summary = [](std::optional<Pass> pass, const Errors& es) {
         HoldoutError he{pass, es.size(), 0.0, 0.0, ""};
@@ -573,6 +584,12 @@ Holdout holdout(const std::vector<CostRow>& rows, CostModelForm form, double fra
     };
     for (const auto& [pass, es] : byPass) h.passes.push_back(summary(pass, es));
     if (!all.empty()) h.passes.push_back(summary(std::nullopt, all));
+    Errors frames, iterated;
+    for (const auto& [config, s] : frame) frames.push_back({std::abs(s.predicted - s.measured) / s.measured, config});
+    for (const auto& [config, s] : spatial)
+        if (s.runs >= 2) iterated.push_back({std::abs(s.predicted - s.measured) / s.measured, config});
+    h.frames = summary(std::nullopt, frames);
+    h.iteratedSpatial = summary(Pass::spatialResampling, iterated);
     return h;
 }
 
@@ -585,8 +602,12 @@ nlohmann::json Holdout::toJson() const {
     for (std::size_t i = 0; i < rows.size(); ++i)
         rs.push_back({{"config", rows[i].config}, {"pass", rows[i].pass.label()}, {"measured_ms", rows[i].measuredMs},
                       {"predicted_ms", predictedMs[i]}});
-    return {{"form", costModelFormName(form)}, {"fitted", fitted}, {"predicted", predicted},
-            {"passes", p}, {"rows", rs}};
+    const auto summary = [](const HoldoutError& e) {
+        return nlohmann::json{{"configurations", e.rows}, {"median_relative_error", e.median}, {"worst_relative_error", e.worst},
+                              {"worst_config", e.worstConfig}};
+    };
+    return {{"form", costModelFormName(form)}, {"fitted", fitted}, {"predicted", predicted}, {"passes", p},
+            {"frames", summary(frames)}, {"iterated_spatial", summary(iteratedSpatial)}, {"rows", rs}};
 }
 
 nlohmann::json Calibration::toJson() const {

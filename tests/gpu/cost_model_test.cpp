@@ -7,6 +7,7 @@
 #include <fstream>
 #include <random>
 
+#include "accretion/core/median.h"
 #include "accretion/gpu/cost_model.h"
 
 using namespace accretion;
@@ -134,8 +135,47 @@ TEST_CASE("the per-pass form predicts held-out configurations its form made exac
         INFO(e.label());
         CHECK(e.worst < 1e-6);
     }
+    CHECK(perPass.frames.rows == 10);
+    CHECK(perPass.frames.worst < 1e-6);
     const Holdout shared = holdout(rows, CostModelForm::shared, 0.5, 1);
     CHECK(shared.passes.back().worst > 0.3);
+    // Its frames: each predicted configuration's passes summed, the error of the sums (not of the passes).
+    std::map<std::string, std::pair<double, double>> sums;  // predicted, measured
+    for (std::size_t i = 0; i < shared.rows.size(); ++i) {
+        sums[shared.rows[i].config].first += shared.predictedMs[i];
+        sums[shared.rows[i].config].second += shared.rows[i].measuredMs;
+    }
+    REQUIRE(sums.size() == 10);
+    std::vector<double> frameErrors;
+    for (const auto& [config, s] : sums) frameErrors.push_back(std::abs(s.first - s.second) / s.second);
+    CHECK(shared.frames.rows == 10);
+    CHECK(shared.frames.worst == Approx(*std::max_element(frameErrors.begin(), frameErrors.end())));
+    CHECK(shared.frames.median == Approx(median(frameErrors)));
+    CHECK(shared.iteratedSpatial.rows == 0);  // no spatial pass here
+    // Spatial reuse run twice in half the configurations: its runs summed per configuration.
+    std::vector<CostRow> spatialRows = rows;
+    for (int c = 0; c < 20; ++c)
+        for (std::uint32_t run = 1; run <= (c % 2 ? 2u : 1u); ++run) {
+            CostRow r{"c" + std::to_string(c), {Pass::spatialResampling, run}, {}, 0.0};
+            r.features[CostFeature::threads] = 1e5 * (1.0 + c);
+            r.features[CostFeature::dispatches] = 1.0;
+            r.measuredMs = 0.5 + 0.01 * c + 0.2 * run;
+            spatialRows.push_back(r);
+        }
+    const Holdout spatial = holdout(spatialRows, CostModelForm::per_pass, 0.5, 1);
+    std::map<std::string, std::pair<double, double>> runs;  // predicted, measured of the configurations run twice
+    std::size_t twice = 0;
+    for (const std::string& config : spatial.predicted) twice += std::stoi(config.substr(1)) % 2;
+    for (std::size_t i = 0; i < spatial.rows.size(); ++i)
+        if (spatial.rows[i].pass.pass == Pass::spatialResampling && std::stoi(spatial.rows[i].config.substr(1)) % 2) {
+            runs[spatial.rows[i].config].first += spatial.predictedMs[i];
+            runs[spatial.rows[i].config].second += spatial.rows[i].measuredMs;
+        }
+    REQUIRE(twice > 0);
+    CHECK(spatial.iteratedSpatial.rows == twice);
+    double worst = 0.0;
+    for (const auto& [config, r] : runs) worst = std::max(worst, std::abs(r.first - r.second) / r.second);
+    CHECK(spatial.iteratedSpatial.worst == Approx(worst));
     // The split is the seed's: the same seed, the same halves; another, others.
     CHECK(holdout(rows, CostModelForm::per_pass, 0.5, 1).fitted == perPass.fitted);
     CHECK(holdout(rows, CostModelForm::per_pass, 0.5, 2).fitted != perPass.fitted);

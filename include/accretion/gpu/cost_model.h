@@ -265,7 +265,10 @@ Calibration calibrate(const std::vector<CostRow>& rows, CostModelForm form = Cos
 
 /// The fit judged on configurations it has not seen: the configurations
 /// split at random (a seeded Fisher-Yates), `fraction` of them fitted, the
-/// rest predicted; per pass the median and worst relative error.
+/// rest predicted; per pass the median and worst relative error, and per
+/// predicted configuration its frame (the sum of its timed passes) and its
+/// spatial reuse run more than once (the sum of its spatialResampling runs,
+/// for configurations with a second run).
 struct HoldoutError {
     std::optional<Pass> pass;  ///< nullopt: all passes
     std::string label() const { return pass ? std::string(passName(*pass)) : std::string("all passes"); }
@@ -277,6 +280,8 @@ struct Holdout {
     CostModelForm form;
     std::vector<std::string> fitted, predicted;  ///< configurations
     std::vector<HoldoutError> passes;           ///< and last, "all passes"
+    HoldoutError frames;                        ///< the predicted configurations' frames
+    HoldoutError iteratedSpatial;               ///< their spatialResampling runs summed, where there are 2 or more
     std::vector<CostRow> rows;                  ///< the predicted rows (measuredMs) ...
     std::vector<double> predictedMs;            ///< ... and their predictions
     nlohmann::json toJson() const;
