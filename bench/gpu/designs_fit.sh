@@ -4,7 +4,8 @@
 # cost CSVs of the 100K and cluster_150k configurations, results/designs.csv's
 # H100 rows),
 # fitted per pass on half the configurations and predicting the other half
-# (`calibrate --holdout 0.5`, split seeds 1-3); each run's report in OUT.
+# (`calibrate --holdout 0.5`, split seeds 1-12: the one configuration with 2
+# spatial iterations is held out in some of them); each run's report in OUT.
 #   bash bench/gpu/designs_fit.sh COST_DIR [OUT]   (OUT: bench/gpu/results/designs_fit)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -20,7 +21,7 @@ for r in csv.DictReader(open("bench/gpu/results/designs.csv")):
     if "H100" in r["gpu"] and r["pass"] != "frame" and r["config"].endswith(("_100k", "_cluster")):
         print(",".join((r["config"], r["pass"], r["ms"])))'
 } > "$T/timings.csv"
-for seed in 1 2 3; do
+for seed in $(seq 1 12); do
     "$A" calibrate bench/gpu/results/sweep_counters.csv "$costs"/cost_*_100k.csv "$costs"/cost_*_cluster.csv "$T/timings.csv" --form per_pass --holdout 0.5 \
         --split-seed $seed -o "$T/c$seed.json" | sed -n '/^held out/,$p' | grep -v '^coefficients:' > "$out/holdout_seed$seed.txt"
 done

@@ -322,6 +322,21 @@ void joinTimings(const std::string& path, std::vector<CostRow>& rows) {
             throw InputError(fmt::format("{}:{}: a second timing for config '{}' pass '{}'", path, lineNo, key.first, r["pass"]));
         ms[key] = parseNumber(r["ms"], fmt::format("{}:{}: ms", path, lineNo));
     }
+    // A pass timed once for all its runs: its runs' counters summed into the first run's row.
+    std::map<std::pair<std::string, Pass>, std::vector<CostRow*>> runsOf;
+    for (CostRow& row : rows) runsOf[{row.config, row.pass.pass}].push_back(&row);
+    for (auto& [key, runs] : runsOf) {
+        if (runs.size() < 2) continue;
+        const auto timed = [&](const CostRow* r) { return ms.count({key.first, r->pass}) > 0; };
+        CostRow* first = *std::min_element(runs.begin(), runs.end(), [](const CostRow* a, const CostRow* b) { return a->pass.run < b->pass.run; });
+        if (!timed(first) || std::any_of(runs.begin(), runs.end(), [&](const CostRow* r) { return r != first && timed(r); })) continue;
+        for (const CostRow* r : runs) {
+            if (r == first) continue;
+            for (std::size_t k = 0; k < first->features.size(); ++k) first->features[k] += r->features[k];
+            first->workingSetBytes = std::max(first->workingSetBytes, r->workingSetBytes);
+            first->runs += r->runs;
+        }
+    }
     std::vector<CostRow> joined;
     for (CostRow& row : rows) {
         auto it = ms.find({row.config, row.pass});
@@ -566,7 +581,7 @@ Holdout holdout(const std::vector<CostRow>& rows, CostModelForm form, double fra
             if (s) {
                 s->predicted += predicted;
                 s->measured += r.measuredMs;
-                ++s->runs;
+                s->runs += r.runs;
             }
     }
     auto summary = [](std::optional<Pass> pass, const Errors& es) {

@@ -9,6 +9,7 @@
 
 #include "accretion/core/median.h"
 #include "accretion/gpu/cost_model.h"
+#include "support/test_scenes.h"
 
 using namespace accretion;
 
@@ -363,4 +364,45 @@ TEST_CASE("cost prices with the committed calibration, the uncalibrated guess on
     const CostCoefficients guess = CostCoefficients::forSetting("uncalibrated");
     REQUIRE_FALSE(guess.calibrated);
     REQUIRE_THAT(guess.source, Catch::Matchers::Contains("uncalibrated"));
+}
+
+TEST_CASE("a pass timed once for all its runs joins its runs' counters summed; timed run by run, each its own", "[gpu][cost]") {
+    const auto dir = accretion::test::scratchDir("cost_join_runs");
+    const auto counters = [] {
+        std::vector<CostRow> rows;
+        for (std::uint32_t run : {1u, 2u}) {
+            CostRow r{"a", {Pass::spatialResampling, run}, {}, 0.0};
+            r.features[CostFeature::threads] = 100.0 * run;
+            r.features[CostFeature::dispatches] = 1.0;
+            r.workingSetBytes = 1000.0 * run;
+            rows.push_back(r);
+        }
+        CostRow t{"a", {Pass::traceShadowRays}, {}, 0.0};
+        t.features[CostFeature::rays] = 50.0;
+        rows.push_back(t);
+        return rows;
+    };
+    const auto write = [&](const std::string& name, const std::string& text) {
+        std::ofstream(dir / name) << text;
+        return (dir / name).string();
+    };
+    // As the twin times it: the spatial iterations' loop under the pass's name alone.
+    std::vector<CostRow> total = counters();
+    joinTimings(write("total.csv", "config,pass,ms\na,spatialResampling,3.0\na,traceShadowRays,1.0\n"), total);
+    REQUIRE(total.size() == 2);
+    const CostRow& s = total[0].pass.pass == Pass::spatialResampling ? total[0] : total[1];
+    CHECK(s.runs == 2);
+    CHECK(s.features[CostFeature::threads] == 300.0);
+    CHECK(s.features[CostFeature::dispatches] == 2.0);
+    CHECK(s.workingSetBytes == 2000.0);
+    CHECK(s.measuredMs == 3.0);
+    // Timed run by run: each run joins its own timing, nothing summed.
+    std::vector<CostRow> perRun = counters();
+    joinTimings(write("runs.csv", "config,pass,ms\na,spatialResampling,1.0\na,spatialResampling[2],2.0\na,traceShadowRays,1.0\n"),
+                perRun);
+    REQUIRE(perRun.size() == 3);
+    for (const CostRow& r : perRun) {
+        CHECK(r.runs == 1);
+        if (r.pass.pass == Pass::spatialResampling) CHECK(r.measuredMs == double(r.pass.run));
+    }
 }

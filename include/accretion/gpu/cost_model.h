@@ -239,6 +239,9 @@ struct CostRow {
     double measuredMs = 0.0;
     double workingSetBytes = 0.0;  ///< PassReport::workingSetBytes (cold_work is recomputed from it for a cache)
     std::string origin;            ///< "FILE:LINE" of the counter row (readCounterCsv)
+    /// The runs of the pass its counters hold: more than one where one
+    /// timing named the pass for all its runs (joinTimings summed them).
+    std::uint32_t runs = 1;
 };
 
 /// counters.csv as `accretion cost` writes it (config,pass,<features...>,
@@ -249,7 +252,12 @@ std::vector<CostRow> readCounterCsv(const std::string& path);
 /// timings.csv: config,pass,ms (one row per pass per configuration, as
 /// exported from Nsight); joined to the counters on (config, pass). Two
 /// counter rows of one (config, pass), from one file or two, are refused:
-/// a timing must name the one row it times.
+/// a timing must name the one row it times. A pass that ran several times
+/// in the frame (spatialResampling[2] ...) timed once under its name alone,
+/// as the twin times the loop of spatial iterations, times all its runs:
+/// their counters are summed into one row (features added, the largest
+/// working set) that the timing joins. Where a later run is timed on its
+/// own, each run joins its own timing.
 void joinTimings(const std::string& path, std::vector<CostRow>& rows);
 
 struct Calibration {
