@@ -366,7 +366,7 @@ TEST_CASE("cost prices with the committed calibration, the uncalibrated guess on
     REQUIRE_THAT(guess.source, Catch::Matchers::Contains("uncalibrated"));
 }
 
-TEST_CASE("a pass timed once for all its runs joins its runs' counters summed; timed run by run, each its own", "[gpu][cost]") {
+TEST_CASE("a pass timed once for all its runs joins its runs' counters summed, and timed run by run each its own", "[gpu][cost]") {
     const auto dir = accretion::test::scratchDir("cost_join_runs");
     const auto counters = [] {
         std::vector<CostRow> rows;
