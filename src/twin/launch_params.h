@@ -110,7 +110,7 @@ struct SplitLaunch {
     const std::uint64_t* lightPath = nullptr;   ///< each light's path in the light tree (LightTree::paths)
     const std::uint32_t* slotOf = nullptr;      ///< particle -> slot (kNoSlot: not visible)
     const GBufferTexel* texels = nullptr;       ///< the grid, kTexelRowWidth a row
-    std::uint32_t* near = nullptr;              ///< slot v's near lights at v x params.nearCount
+    std::uint32_t* near = nullptr;              ///< slot v's near lights at v x params.nearCount (kNoNearLight past its count)
     std::uint32_t* nearFound = nullptr;
     float* nearRadius2 = nullptr;
     psplit::SplitRay* rays = nullptr;           ///< texel q's ray r at r x rayStride + q (a warp: one ray of 32 texels)

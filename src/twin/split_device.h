@@ -37,6 +37,9 @@ public:
     // shadeSplitTexels
     __device__ GBufferTexel texel(std::size_t q) const { return s_.texels[q]; }
     __device__ ShadingPoint shadingPoint(const GBufferTexel& g) const { return shadingPointOf(g, p_.lights); }
+    __device__ std::uint32_t nearLight(std::uint32_t v, std::uint32_t m) const {
+        return s_.near[std::size_t(v) * s_.params.nearCount + m];
+    }
     __device__ std::uint32_t nearLights(std::uint32_t v, std::uint32_t* light) const {
         const std::uint32_t n = s_.nearFound[v];
         const std::uint32_t* in = s_.near + std::size_t(v) * s_.params.nearCount;

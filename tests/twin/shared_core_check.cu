@@ -420,6 +420,10 @@ struct SplitCheckBridge {
         float d2[psplit::kMaxNear];
         return psplit::nearestLights(view, in.historyPositions[v], v, paths[v], p.nearCount, light, d2);
     }
+    ACC_HD std::uint32_t nearLight(std::uint32_t v, std::uint32_t m) const {
+        std::uint32_t light[psplit::kMaxNear];
+        return m < nearLights(v, light) ? light[m] : psplit::kNoNearLight;
+    }
     ACC_HD float nearRadius2(std::uint32_t v) const {
         std::uint32_t light[psplit::kMaxNear];
         float d2[psplit::kMaxNear];

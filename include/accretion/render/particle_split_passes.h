@@ -36,7 +36,8 @@
 //                     SplitRay splitRay(q, r)  texel q's ray r: traceSplitRay's (the CPU
 //                                             calls it; the twin's rays ran in a launch of
 //                                             their own, one a thread)
-//                     std::uint32_t nearLights(v, light) (returns the count); float nearRadius2(v)
+//                     std::uint32_t nearLight(v, m)   slot v's near light m (kNoNearLight past its count)
+//                     std::uint32_t nearLights(v, light) (all of them; returns the count); float nearRadius2(v)
 //                     LightSample sampleFar(sp, rng, importance)  the tree's descent (counted)
 //                     bool term(sp, i, t)     light i's term f I G in the frame's shading model (counted)
 //                     bool shadows(); bool visible(sp, i, t)  a shadow ray (traced, counted)
@@ -252,13 +253,14 @@ ACC_HD_BODY SplitRay traceSplitRay(B& b, std::size_t q, std::uint32_t r) {
     const std::uint32_t per = p.texelsPerParticle();
     const std::uint32_t slot = std::uint32_t(q / per), sub = std::uint32_t(q % per);
     const ShadingPoint sp = b.shadingPoint(g);
-    std::uint32_t near[kMaxNear];
-    const std::uint32_t k = b.nearLights(slot, near);
     LightTerm t;
-    if (r < p.nearCount) {
-        if (r < k && b.term(sp, near[r], t) && (!b.shadows() || b.visible(sp, near[r], t))) out.value = t.value;
+    if (r < p.nearCount) {  // a near ray reads its own light alone
+        const std::uint32_t i = b.nearLight(slot, r);
+        if (i != kNoNearLight && b.term(sp, i, t) && (!b.shadows() || b.visible(sp, i, t))) out.value = t.value;
         return out;
     }
+    std::uint32_t near[kMaxNear];  // a far ray reads them all: its draws must miss them
+    const std::uint32_t k = b.nearLights(slot, near);
     const FarImportance importance{sp.centre, k > 0 ? innerRadius2(b.nearRadius2(slot)) : 0.0f};
     PortableRng rng(std::uint64_t(g.particle) * per + sub, p.frame, RngPass::particleSplit, p.seed, r - p.nearCount + 1);
     // RIS over C far draws (C = 1: the draw itself): the one kept in

@@ -28,7 +28,7 @@ struct CpuFrame {
     VisibilityOptions vis;
     bool shadows = true;                           ///< plan.shadowRays
     const ParticleTexels& texels;
-    std::vector<std::uint32_t>& near;              ///< slot v's near lights at v x params.nearCount
+    std::vector<std::uint32_t>& near;              ///< slot v's near lights at v x params.nearCount (kNoNearLight past its count)
     std::vector<std::uint32_t>& nearFound;         ///< how many each slot has
     std::vector<float>& nearRadius2;               ///< the farthest one's squared distance
     const std::vector<std::uint32_t>& prevSlotOf;  ///< history: last frame's slots (empty: none)
@@ -74,6 +74,10 @@ public:
     // shadeSplitTexels
     GBufferTexel texel(std::size_t q) { return recordedTexel(rec_, f_.texels.grid.texels[q], f_.in.particles, f_.in.bvh); }
     ShadingPoint shadingPoint(const GBufferTexel& g) const { return accretion::shadingPoint(g, f_.in.particles); }
+    std::uint32_t nearLight(std::uint32_t v, std::uint32_t m) {
+        rec_.read(4);
+        return f_.near[std::size_t(v) * f_.params.nearCount + m];
+    }
     std::uint32_t nearLights(std::uint32_t v, std::uint32_t* light) {
         const std::uint32_t n = f_.nearFound[v];
         rec_.read(4 * (n + 2));

@@ -30,13 +30,10 @@ LightingCounters ParticleSplit::render(const ParticleSplitInputs& in, LightingIm
     std::vector<float> nearRadius2(texels.visible());
     std::vector<Vec3> texelLr(texels.grid.texels.size());
     std::vector<std::uint32_t> texelRejected(texels.grid.texels.size(), 0);
-    static const std::vector<std::uint32_t> kNoSlots;
-    static const std::vector<Vec3> kNoLr;
-    const bool history = params.history > 0.0f;
     const std::vector<std::uint64_t> paths = in.lightTree.paths();
+    // Last frame's texels: kept only with a history, so empty without one.
     const psplit::CpuFrame f{in, params, L, in.lightTree.view(), paths, VisibilityOptions::from(in.settings.render), plan.shadowRays,
-                             texels, near, nearFound, nearRadius2, history ? prevSlotOf_ : kNoSlots,
-                             history ? prevTexelLr_ : kNoLr, texelLr, texelRejected, out.Lr};
+                             texels, near, nearFound, nearRadius2, prevSlotOf_, prevTexelLr_, texelLr, texelRejected, out.Lr};
     LightingCounters counters;
     {
         auto t = timer.scope(Pass::findNearLights);
@@ -61,7 +58,7 @@ LightingCounters ParticleSplit::render(const ParticleSplitInputs& in, LightingIm
         for (std::uint32_t k = 0; k < per; ++k) rejected += texelRejected[first + k];
         out.rejected[px] = float(rejected);
     }
-    if (history) {
+    if (params.history > 0.0f) {
         prevSlotOf_ = std::move(texels.slotOf);
         prevTexelLr_ = std::move(texelLr);
     }
