@@ -1,7 +1,7 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine, from the repository root:
 #   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
-#                                      layout_images layouts streams front identity shared_core ab designs voxels splits
+#                                      layout_images layouts streams front identity shared_core ab designs voxels splits iterations
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -308,6 +308,19 @@ step_splits() {
     python3 scenes/cluster/make_cluster.py 3
     grep -E '^(ps_[a-z0-9_]*|restir_m32_t_basic_1x_cluster|prt_m8_k16_cluster) ' bench/gpu/designs_cluster.txt > "$W/splits_cluster.txt"
     time_configs splits/cluster "$W/splits_cluster.txt" 5 1/1 scenes/cluster_150k.toml
+}
+
+# The spatial pass run once and twice, each iteration timed apart
+# ("spatialResampling[2]"): designs.txt's and designs_cluster.txt's restir
+# lines of 5 and 10 neighbours and particle_restir's world neighbours, for
+# the cost model's held-out check of the iterated pass (designs_fit.sh).
+step_iterations() {
+    local pick='^(restir_m8_nb[0-9]+(x2)?_[a-z]+_[0-9x]+|prt_m8_k4_world5(x2)?)_'
+    grep -E "${pick}100k " bench/gpu/designs.txt > "$W/iterations.txt"
+    time_configs iterations "$W/iterations.txt" 5
+    python3 scenes/cluster/make_cluster.py 3
+    grep -E "${pick}cluster " bench/gpu/designs_cluster.txt > "$W/iterations_cluster.txt"
+    time_configs iterations/cluster "$W/iterations_cluster.txt" 5 1/1 scenes/cluster_150k.toml
 }
 
 # The configurations on tune's Pareto fronts (bench/gpu/front.txt, written

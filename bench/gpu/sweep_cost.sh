@@ -21,8 +21,10 @@ cat "${LISTS[@]}" | grep -v '^#' | while read -r name args; do
         --cluster-sizes "" --omm-levels "" --ser-keys hit --config "$name" -q -o "$OUT/$name.cost.json" > /dev/null < /dev/null
     echo "cost: $name" >&2
 done
-# The twin times a pass's runs together (spatialResampling over its
-# iterations): the counters of spatialResampling[2]... are added to spatialResampling's.
+# The sweep's timings (results/sweep_timings.csv) are of a twin that timed a
+# pass's runs together (spatialResampling over its iterations; the twin now
+# times each run apart, as "spatialResampling[2]"): the counters of
+# spatialResampling[2]... are added to spatialResampling's to join them.
 python3 - "$OUT" <<'PY'
 import csv, glob, os, re, sys
 out = sys.argv[1]

@@ -22,10 +22,12 @@ public:
     GpuTimer(const GpuTimer&) = delete;
     GpuTimer& operator=(const GpuTimer&) = delete;
 
-    /// Opens `step` of `pass` (the pass itself when step is empty).
-    void begin(Pass pass, std::string_view step = {}) {
-        const std::string name(step.empty() ? passName(pass) : step);
-        passOf_.emplace(name, pass);
+    /// Opens `step` of run `run` of `pass` (the run itself, labelled as
+    /// PassRun labels it, when step is empty: "spatialResampling[2]").
+    void begin(Pass pass, std::string_view step = {}, std::uint32_t run = 1) {
+        const PassRun id{pass, run};
+        const std::string name = step.empty() ? id.label() : std::string(step);
+        passOf_.emplace(name, id);
         cudaEvent_t a, b;
         CUDA_CHECK(cudaEventCreate(&a));
         CUDA_CHECK(cudaEventCreate(&b));
@@ -37,8 +39,8 @@ public:
         done_.push_back(open_.back());
         open_.pop_back();
     }
-    /// The pass a step belongs to (a step this timer has opened).
-    Pass passOf(const std::string& step) const { return passOf_.at(step); }
+    /// The run of a pass a step belongs to (a step this timer has opened).
+    PassRun passOf(const std::string& step) const { return passOf_.at(step); }
     /// Milliseconds per step (summed over its spans); synchronises the stream.
     std::vector<std::pair<std::string, double>> read() {
         CUDA_CHECK(cudaStreamSynchronize(stream_));
@@ -68,13 +70,13 @@ private:
     }
     cudaStream_t stream_;
     std::vector<Span> open_, done_;
-    std::map<std::string, Pass> passOf_;
+    std::map<std::string, PassRun> passOf_;
 };
 
-/// begin .. end of a pass, or of a step of one, for a scope.
+/// begin .. end of a pass, or of a step of one, or of its run `run`, for a scope.
 class GpuScope {
 public:
-    GpuScope(GpuTimer& t, Pass pass, std::string_view step = {}) : t_(t) { t_.begin(pass, step); }
+    GpuScope(GpuTimer& t, Pass pass, std::string_view step = {}, std::uint32_t run = 1) : t_(t) { t_.begin(pass, step, run); }
     ~GpuScope() { t_.end(); }
     GpuScope(const GpuScope&) = delete;
     GpuScope& operator=(const GpuScope&) = delete;

@@ -528,15 +528,13 @@ StoredReservoir* TwinRun::runRestir(const FramePlan& plan, LaunchParams& lp) {
         std::swap(a, b);
     }
     const std::uint32_t iterations = plan.spatialIterations;
-    if (iterations > 0) {
-        GpuScope t(timer, Pass::spatialResampling);
-        for (std::uint32_t it = 0; it < iterations; ++it) {
-            rp.in = a;
-            rp.out = b;
-            if (plan.particleTexels) spatialResamplingWorld(lp, it, stream_);
-            else spatialResampling(lp, it, stream_);
-            std::swap(a, b);
-        }
+    for (std::uint32_t it = 0; it < iterations; ++it) {  // each iteration timed apart, as the CPU counts it
+        GpuScope t(timer, Pass::spatialResampling, {}, it + 1);
+        rp.in = a;
+        rp.out = b;
+        if (plan.particleTexels) spatialResamplingWorld(lp, it, stream_);
+        else spatialResampling(lp, it, stream_);
+        std::swap(a, b);
     }
     if (plan.traceShadowRays) {
         GpuScope t(timer, Pass::traceShadowRays);
@@ -758,10 +756,10 @@ void TwinRun::renderFrame(std::uint32_t frame, std::uint64_t seed) {
     std::size_t hits = 0, nonFinite = 0;
     GpuFrame out = composeFrame(plan, particles, frame, pose, hits, nonFinite);
     nlohmann::json timing;
-    std::map<std::string, double> calibrated;  // by the pass names of `accretion cost`
+    std::map<std::string, double> calibrated;  // by the pass runs of `accretion cost` ("spatialResampling[2]")
     for (const auto& [step, v] : ms) {
         timing[step] = {{"median_ms", median(v)}, {"ms", v}};
-        calibrated[std::string(passName(timer_->passOf(step)))] += median(v);
+        calibrated[timer_->passOf(step).label()] += median(v);
     }
     timingsCsv_ = "config,pass,ms\n";  // the last frame's
     if (!a_.config.empty())

@@ -256,4 +256,18 @@ TEST_CASE("particle_split: its frame runs its own passes, not restir's", "[parti
     }
     REQUIRE(rays[Pass::shadeSplitTexels] > 0);
     REQUIRE(rays[Pass::findNearLights] == 0);  // the near search traces no ray
+    // shadeSplitTexels is counted as the twin runs it: a thread per ray of
+    // each texel (x the texel, y the ray), each tracing at most its one
+    // shadow ray, and the per-texel sum's dispatch.
+    const auto texels = std::find_if(img.counters.passes.begin(), img.counters.passes.end(),
+                                     [](const PassCounters& pc) { return pc.pass == Pass::shadeSplitTexels; });
+    REQUIRE(texels->height == s.particle_split.near + s.particle_split.far);
+    CHECK(texels->dispatches == 2);
+    std::uint64_t tracing = 0, most = 0;
+    for (const ThreadCounters& t : texels->threads) {
+        tracing += t.rays > 0;
+        most = std::max<std::uint64_t>(most, t.rays);
+    }
+    CHECK(most == 1);
+    CHECK(tracing == rays[Pass::shadeSplitTexels]);
 }

@@ -177,3 +177,30 @@ TEST_CASE("voxel_cache: a receiver lit by its own light alone is dark (i != j)",
     }
     REQUIRE(hits > 100);
 }
+
+TEST_CASE("voxel_cache: updateVoxelCache is counted as the twin runs it, a thread per ray of each cell", "[voxel][counters]") {
+    // The twin marks the occupied cells, traces a thread per ray of each
+    // (launch x = cell x * rays + ray, y = the cell's row) and sums each
+    // cell's rays in a kernel: three dispatches, each ray thread at most one
+    // shadow ray, record c * rays + r for ray r of cell c.
+    OneLight s(ShadingModel::lambert, Vec3(0.0f), Vec3(3.0f, 2.0f, 1.0f));
+    s.settings.shading.visibility = true;
+    s.settings.gpu.counters = true;
+    const FrameImage img = test::renderParticles(s.settings, s.particles);
+    const auto pc = std::find_if(img.counters.passes.begin(), img.counters.passes.end(),
+                                 [](const PassCounters& p) { return p.pass == Pass::updateVoxelCache; });
+    REQUIRE(pc != img.counters.passes.end());
+    const voxel::VoxelGrid g = placeVoxelGrid(s.particles, Vec3(0.0f), s.settings.voxel.cells).inFrame(Vec3(0.0f));
+    CHECK(pc->width == g.nx * s.settings.voxel.rays);
+    CHECK(pc->height == g.ny * g.nz);
+    CHECK(pc->dispatches == 3);
+    std::uint64_t traced = 0, tracing = 0, most = 0;
+    for (const ThreadCounters& t : pc->threads) {
+        traced += t.rays;
+        tracing += t.rays > 0;
+        most = std::max<std::uint64_t>(most, t.rays);
+    }
+    REQUIRE(traced > 0);
+    CHECK(most == 1);
+    CHECK(tracing == traced);
+}

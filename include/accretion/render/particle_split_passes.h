@@ -253,7 +253,7 @@ ACC_HD_BODY SplitRay traceSplitRay(B& b, std::size_t q, std::uint32_t r) {
     const std::uint32_t per = p.texelsPerParticle();
     const std::uint32_t slot = std::uint32_t(q / per), sub = std::uint32_t(q % per);
     const ShadingPoint sp = b.shadingPoint(g);
-    LightTerm t;
+    LightTerm t{};
     if (r < p.nearCount) {  // a near ray reads its own light alone
         const std::uint32_t i = b.nearLight(slot, r);
         if (i != kNoNearLight && b.term(sp, i, t) && (!b.shadows() || b.visible(sp, i, t))) out.value = t.value;

@@ -42,7 +42,10 @@ struct CpuFrame {
 template <ShadingModel SM, Primitive P, bool Count>
 class CpuSplitBridge {
 public:
-    CpuSplitBridge(const CpuFrame& f, ThreadCounters* t, LightingCounters& c) : f_(f), rec_(t), c_(c) {}
+    /// `pc`: the pass's counters in counting mode (shadeSplitTexels' ray
+    /// threads are its records past the texels'), else nullptr.
+    CpuSplitBridge(const CpuFrame& f, ThreadCounters* t, LightingCounters& c, PassCounters* pc = nullptr)
+        : f_(f), rec_(t), c_(c), pc_(pc) {}
 
     const SplitParams& params() const { return f_.params; }
 
@@ -85,7 +88,20 @@ public:
         return n;
     }
     float nearRadius2(std::uint32_t v) const { return f_.nearRadius2[v]; }
-    SplitRay splitRay(std::size_t q, std::uint32_t r) { return traceSplitRay(*this, q, r); }
+    /// Counting, ray r of texel q is the twin's thread (q, r) of its ray
+    /// launch (x the texel, y the ray), which writes the ray for the sum; the
+    /// sum (a kernel per texel) is thread (q, 0)'s record too, as its
+    /// dispatch is the pass's second.
+    SplitRay splitRay(std::size_t q, std::uint32_t r) {
+        if constexpr (Count) {
+            CpuSplitBridge ray(f_, &pc_->threads[std::size_t(r) * f_.texels.grid.texels.size() + q], c_, pc_);
+            const SplitRay out = traceSplitRay(ray, q, r);
+            ray.rec_.write(sizeof(SplitRay));
+            rec_.read(sizeof(SplitRay));
+            return out;
+        }
+        return traceSplitRay(*this, q, r);
+    }
     LightSample sampleFar(const ShadingPoint& sp, PortableRng& rng, const FarImportance& importance) {
         rec_.trip();
         if constexpr (Count) {  // a node pair per level
@@ -152,6 +168,7 @@ private:
     const CpuFrame& f_;
     Recorder<Count> rec_;
     LightingCounters& c_;
+    PassCounters* pc_;
 };
 
 /// Runs body(bridge, item) over items [0, n) on every core, each with its
@@ -163,7 +180,7 @@ LightingCounters forEachItem(const CpuFrame& f, std::size_t n, PassCounters* pc,
     return withShadingModel(f.in.settings.shading.model, [&]<ShadingModel SM>() {
         return withPrimitiveAndCount(f.in.bvh.settings().primitive, pc != nullptr, [&]<Primitive P, bool Count>() {
             return forEachItemParallel(n, 64, [&](std::size_t k, LightingCounters& c) {
-                CpuSplitBridge<SM, P, Count> b(f, Count ? &pc->threads[k] : nullptr, c);
+                CpuSplitBridge<SM, P, Count> b(f, Count ? &pc->threads[k] : nullptr, c, pc);
                 body(b, k);
             });
         });

@@ -37,14 +37,30 @@ struct CpuFrame {
 template <Primitive P, bool Count>
 class CpuVoxelBridge {
 public:
-    CpuVoxelBridge(const CpuFrame& f, ThreadCounters* t, LightingCounters& c) : f_(f), rec_(t), c_(c) {}
+    /// `pc`: the pass's counters in counting mode (updateVoxelCache's ray
+    /// threads are among its records), else nullptr.
+    CpuVoxelBridge(const CpuFrame& f, ThreadCounters* t, LightingCounters& c, PassCounters* pc = nullptr)
+        : f_(f), rec_(t), c_(c), pc_(pc) {}
 
     const VoxelParams& params() const { return f_.params; }
     bool occupied(std::uint32_t c) {
         rec_.read(1);
         return f_.occupied[c] != 0;
     }
-    CellRay cellRay(std::uint32_t c, std::uint32_t r) { return traceCellRay(*this, c, r); }
+    /// Counting, ray r of cell c is the twin's thread of its ray launch
+    /// (x = cell x * rays + r, y = the cell's row: record c * rays + r), which
+    /// writes the ray for the sum; the sum (a kernel per cell) is the record
+    /// of the cell's ray 0 too.
+    CellRay cellRay(std::uint32_t c, std::uint32_t r) {
+        if constexpr (Count) {
+            CpuVoxelBridge ray(f_, &pc_->threads[std::size_t(c) * f_.params.rays + r], c_, pc_);
+            const CellRay out = traceCellRay(ray, c, r);
+            ray.rec_.write(sizeof(CellRay));
+            rec_.read(sizeof(CellRay));
+            return out;
+        }
+        return traceCellRay(*this, c, r);
+    }
     VoxelCell cell(std::uint32_t c) {
         rec_.read(sizeof(VoxelCell));
         rec_.gather(1);
@@ -92,15 +108,17 @@ private:
     const CpuFrame& f_;
     Recorder<Count> rec_;
     LightingCounters& c_;
+    PassCounters* pc_;
 };
 
 /// Runs body(bridge, item) over items [0, n) on every core, each with its
-/// own bridge (and, counting, the thread record `pc->threads[item]`);
+/// own bridge (and, counting, the thread record `pc->threads[item x
+/// threadsPerItem]`);
 /// returns the threads' counters summed.
 template <Primitive P, bool Count, class Body>
-LightingCounters forEachItem(const CpuFrame& f, std::size_t n, PassCounters* pc, Body&& body) {
+LightingCounters forEachItem(const CpuFrame& f, std::size_t n, PassCounters* pc, Body&& body, std::size_t threadsPerItem = 1) {
     return forEachItemParallel(n, 256, [&](std::size_t k, LightingCounters& c) {
-        CpuVoxelBridge<P, Count> b(f, Count ? &pc->threads[k] : nullptr, c);
+        CpuVoxelBridge<P, Count> b(f, Count ? &pc->threads[k * threadsPerItem] : nullptr, c, pc);
         body(b, k);
     });
 }
