@@ -4,8 +4,12 @@
 # cost CSVs of the 100K and cluster_150k configurations, results/designs.csv's
 # H100 rows),
 # fitted per pass on half the configurations and predicting the other half
-# (`calibrate --holdout 0.5`, split seeds 1-12: the one configuration with 2
-# spatial iterations is held out in some of them); each run's report in OUT.
+# (`calibrate --holdout 0.5`, split seeds 1-12); each run's report in OUT,
+# summary.txt per configuration (designs_holdout.py: its frame and its
+# iterated spatial reuse in every split that held it out), and
+# coefficients_h100.json, the fit of them all. The sweep's timings are
+# SWEEP_TIMINGS (results/sweep_timings_d37668c.csv: the twin at d37668c149,
+# whose spatial pass costs 0.69x of results/sweep_timings.csv's).
 #   bash bench/gpu/designs_fit.sh COST_DIR [OUT]   (OUT: bench/gpu/results/designs_fit)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -14,7 +18,7 @@ A=${ACCRETION:-build/accretion}
 mkdir -p "$out"
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
-{ cat bench/gpu/results/sweep_timings.csv
+{ cat "${SWEEP_TIMINGS:-bench/gpu/results/sweep_timings_d37668c.csv}"
   python3 -c '
 import csv
 for r in csv.DictReader(open("bench/gpu/results/designs.csv")):
@@ -25,4 +29,8 @@ for seed in $(seq 1 12); do
     "$A" calibrate bench/gpu/results/sweep_counters.csv "$costs"/cost_*_100k.csv "$costs"/cost_*_cluster.csv "$T/timings.csv" --form per_pass --holdout 0.5 \
         --split-seed $seed -o "$T/c$seed.json" | sed -n '/^held out/,$p' | grep -v '^coefficients:' > "$out/holdout_seed$seed.txt"
 done
-cat "$out"/holdout_seed*.txt
+python3 bench/gpu/designs_holdout.py "$T"/c*.json > "$out/summary.txt"
+# The fit of every configuration (no hold-out): coefficients calibrate writes, for `-D gpu.coefficients=`.
+"$A" calibrate bench/gpu/results/sweep_counters.csv "$costs"/cost_*_100k.csv "$costs"/cost_*_cluster.csv "$T/timings.csv" --form per_pass \
+    -o "$out/coefficients_h100.json" > /dev/null
+cat "$out"/holdout_seed*.txt "$out/summary.txt"
