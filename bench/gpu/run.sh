@@ -310,13 +310,14 @@ step_splits() {
     time_configs splits/cluster "$W/splits_cluster.txt" 5 1/1 scenes/cluster_150k.toml
 }
 
-# The spatial pass run once and twice, each iteration timed apart
-# ("spatialResampling[2]"): designs.txt's and designs_cluster.txt's restir
-# lines of 5 and 10 neighbours and particle_restir's world neighbours, for
-# the cost model's held-out check of the iterated pass (designs_fit.sh).
+# The spatial passes run once and twice, each iteration timed apart
+# ("spatialResampling[2]", "resampleWorldNeighbours[2]"): designs.txt's and
+# designs_cluster.txt's restir lines of 5 and 10 neighbours and
+# particle_restir's world neighbours (at 1M too), for the cost model's
+# held-out check of the iterated passes (designs_fit.sh).
 step_iterations() {
     local pick='^(restir_m8_nb[0-9]+(x2)?_[a-z]+_[0-9x]+|prt_m8_k4_world5(x2)?)_'
-    grep -E "${pick}100k " bench/gpu/designs.txt > "$W/iterations.txt"
+    grep -E "${pick}(100k|1m) " bench/gpu/designs.txt > "$W/iterations.txt"
     time_configs iterations "$W/iterations.txt" 5
     python3 scenes/cluster/make_cluster.py 3
     grep -E "${pick}cluster " bench/gpu/designs_cluster.txt > "$W/iterations_cluster.txt"

@@ -26,6 +26,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <tuple>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -836,7 +837,9 @@ Table lightingTable(const TuneArgs& a, const TuneResult& r) {
     for (const ParetoPoint& p : r.points) {
         const std::string bias = p.error.label();
         const double temporalKept = p.error.kept("temporalResampling").first;
-        const auto [spatialKept, spatialOther] = p.error.kept("spatialResampling");
+        // Spatial reuse: restir's screen disc, or particle_restir's world neighbours.
+        auto [spatialKept, spatialOther] = p.error.kept("spatialResampling");
+        if (std::isnan(spatialKept)) std::tie(spatialKept, spatialOther) = p.error.kept("resampleWorldNeighbours");
         lt.add({p.lighting.label(), p.ms, p.error.relMse, p.error.t, p.error.energyLossPct, p.error.detectablePct,
                 std::uint64_t(p.error.seeds), temporalKept, spatialKept, spatialOther, p.error.visibilitySharePct,
                 100.0 - p.error.visibilitySharePct,

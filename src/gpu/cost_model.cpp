@@ -539,6 +539,12 @@ Calibration calibrate(const std::vector<CostRow>& rows, CostModelForm form) {
     return c;
 }
 
+namespace {
+/// The spatial reuse passes (restir's screen disc, particle_restir's world
+/// neighbours): the iterated ones of the held-out check.
+bool isSpatialReuse(Pass p) { return p == Pass::spatialResampling || p == Pass::resampleWorldNeighbours; }
+}  // namespace
+
 Holdout holdout(const std::vector<CostRow>& rows, CostModelForm form, double fraction, std::uint64_t seed) {
     std::vector<std::string> configs;
     for (const CostRow& r : rows)
@@ -577,7 +583,7 @@ Holdout holdout(const std::vector<CostRow>& rows, CostModelForm form, double fra
         const double e = std::abs(predicted - r.measuredMs) / r.measuredMs;
         byPass[r.pass.pass].push_back({e, r.config});
         all.push_back({e, r.config});
-        for (Sum* s : {&frame[r.config], r.pass.pass == Pass::spatialResampling ? &spatial[r.config] : nullptr})
+        for (Sum* s : {&frame[r.config], isSpatialReuse(r.pass.pass) ? &spatial[r.config] : nullptr})
             if (s) {
                 s->predicted += predicted;
                 s->measured += r.measuredMs;

@@ -132,12 +132,16 @@ void describe(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
              plan.temporal ? (particles ? "the same texel of the same particle (by id)" : "reprojection through particle motion")
              : dark ? noLight : !s.restir.temporal ? "temporal off: no history buffers or motion"
              : !manyFrames ? "one frame: no history buffers or motion" : "first frame: no history yet");
-        step(Pass::spatialResampling,
-             plan.spatialIterations ? fmt::format("{} neighbours x {}{}", s.restir.spatial_neighbours, s.restir.spatial_iterations,
-                                                  particles ? fmt::format(" among the {} visible particles either side in world (Morton) order",
-                                                                          r.world_neighbours)
-                                                            : "")
-                                    : (dark ? noLight : "no neighbours"));
+        const std::string neighbours =
+            plan.spatialIterations ? fmt::format("{} neighbours x {}", s.restir.spatial_neighbours, s.restir.spatial_iterations)
+                                   : (dark ? noLight : "no neighbours");
+        if (particles)
+            step(Pass::resampleWorldNeighbours,
+                 plan.spatialIterations
+                     ? fmt::format("{} among the {} visible particles either side in world (Morton) order", neighbours, r.world_neighbours)
+                     : neighbours);
+        else
+            step(Pass::spatialResampling, neighbours);
         step(Pass::traceShadowRays,
              dark ? noLight
              : !plan.traceShadowRays ? "pixel_shading resample: each pixel traces its own (shadeParticlePixels), the texels none"
@@ -230,7 +234,8 @@ bool FramePlan::runs(Pass pass) const {
     case Pass::presampleRegirGrid: return presampleRegir;
     case Pass::generateCandidates: return restir;
     case Pass::temporalResampling: return temporal;
-    case Pass::spatialResampling: return spatialIterations > 0;
+    case Pass::spatialResampling: return spatialIterations > 0 && !particleTexels;
+    case Pass::resampleWorldNeighbours: return spatialIterations > 0 && particleTexels;
     case Pass::gatherParticleTexels: return particleTexels || particleSplit;
     case Pass::traceShadowRays: return traceShadowRays;
     case Pass::shadeParticlePixels: return particleTexels || particleSplit;

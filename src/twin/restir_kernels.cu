@@ -131,7 +131,7 @@ void temporalResamplingById(const LaunchParams& p, cudaStream_t stream) {
     byModel(p.model, [&]<ShadingModel SM>() { temporalByIdKernel<SM><<<blocks(p), kGroup, 0, stream>>>(p); });
 }
 
-void spatialResamplingWorld(const LaunchParams& p, std::uint32_t iteration, cudaStream_t stream) {
+void resampleWorldNeighbours(const LaunchParams& p, std::uint32_t iteration, cudaStream_t stream) {
     byModel(p.model, [&]<ShadingModel SM>() { spatialWorldKernel<SM><<<blocks(p), kGroup, 0, stream>>>(p, iteration); });
 }
 

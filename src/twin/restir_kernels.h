@@ -17,7 +17,7 @@ void spatialResampling(const LaunchParams& p, std::uint32_t iteration, cudaStrea
 /// and shadeParticlePixels' interpolate over the image (resample is the
 /// raygen shadeParticlePixels: it traces).
 void temporalResamplingById(const LaunchParams& p, cudaStream_t stream);
-void spatialResamplingWorld(const LaunchParams& p, std::uint32_t iteration, cudaStream_t stream);
+void resampleWorldNeighbours(const LaunchParams& p, std::uint32_t iteration, cudaStream_t stream);
 void accumulateTexelLr(const LaunchParams& p, cudaStream_t stream);
 void interpolatePixels(const LaunchParams& p, cudaStream_t stream);
 /// restir.resolution_scale < 1: the lighting grid's G-buffer from the image's

@@ -529,10 +529,10 @@ StoredReservoir* TwinRun::runRestir(const FramePlan& plan, LaunchParams& lp) {
     }
     const std::uint32_t iterations = plan.spatialIterations;
     for (std::uint32_t it = 0; it < iterations; ++it) {  // each iteration timed apart, as the CPU counts it
-        GpuScope t(timer, Pass::spatialResampling, {}, it + 1);
+        GpuScope t(timer, plan.particleTexels ? Pass::resampleWorldNeighbours : Pass::spatialResampling, {}, it + 1);
         rp.in = a;
         rp.out = b;
-        if (plan.particleTexels) spatialResamplingWorld(lp, it, stream_);
+        if (plan.particleTexels) resampleWorldNeighbours(lp, it, stream_);
         else spatialResampling(lp, it, stream_);
         std::swap(a, b);
     }

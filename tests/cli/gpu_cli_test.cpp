@@ -446,9 +446,14 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
         if (label.find("nb=0x") != std::string::npos) {
             CHECK(p["spatial_kept_pct"].is_null());
             CHECK_FALSE(reuse.contains("spatialResampling"));
+            CHECK_FALSE(reuse.contains("resampleWorldNeighbours"));
         } else {
             const double spatial = p["spatial_kept_pct"].get<double>();
             CHECK((spatial >= 0.0 && spatial <= 100.0));
+            // particle_restir's world neighbours are a pass of their own, restir's screen disc another.
+            const bool particles = label.rfind("particles", 0) == 0;
+            CHECK(reuse.contains(particles ? "resampleWorldNeighbours" : "spatialResampling"));
+            CHECK_FALSE(reuse.contains(particles ? "spatialResampling" : "resampleWorldNeighbours"));
         }
     }
     for (const auto& p : rows)

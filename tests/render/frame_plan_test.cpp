@@ -175,6 +175,15 @@ TEST_CASE("the plan is the frame: every frame's timed passes are exactly the pla
         {"restir half scale", [](Settings& s) { s.render.estimator = EstimatorKind::restir; s.restir.resolution_scale = 0.5; }},
         {"restir visibility off", [](Settings& s) { s.render.estimator = EstimatorKind::restir; s.shading.visibility = false; }},
         {"restir static", [](Settings& s) { s.render.estimator = EstimatorKind::restir; s.particles.gm = 0.0; }},
+        {"particle_restir, world neighbours x 2",
+         [](Settings& s) {
+             s.render.estimator = EstimatorKind::particle_restir;
+             s.render.source = LightSource::tree;
+             s.restir.spatial_neighbours = 3;
+             s.restir.spatial_iterations = 2;
+         }},
+        {"voxel_cache", [](Settings& s) { s.render.estimator = EstimatorKind::voxel_cache; s.render.source = LightSource::tree; }},
+        {"particle_split", [](Settings& s) { s.render.estimator = EstimatorKind::particle_split; }},
     };
     for (const Variant& v : variants) {
         Settings s = small();
@@ -192,6 +201,17 @@ TEST_CASE("the plan is the frame: every frame's timed passes are exactly the pla
             CHECK(timed == planned);
         }
     }
+    // particle_restir's spatial reuse is its world-neighbour pass, restir's the screen disc: never both.
+    Settings w = small();
+    w.render.estimator = EstimatorKind::particle_restir;
+    w.restir.spatial_neighbours = 3;
+    const FramePlan particles = planFrame(w, FrameFacts{false, true, true});
+    CHECK(particles.runs(Pass::resampleWorldNeighbours));
+    CHECK_FALSE(particles.runs(Pass::spatialResampling));
+    w.render.estimator = EstimatorKind::restir;
+    const FramePlan pixels = planFrame(w, FrameFacts{false, true, true});
+    CHECK(pixels.runs(Pass::spatialResampling));
+    CHECK_FALSE(pixels.runs(Pass::resampleWorldNeighbours));
     // And the plan says what it skips: frame 0 of restir has no history yet, frame 1 does.
     Settings s = small();
     s.render.estimator = EstimatorKind::restir;

@@ -289,7 +289,7 @@ struct Holdout {
     std::vector<std::string> fitted, predicted;  ///< configurations
     std::vector<HoldoutError> passes;           ///< and last, "all passes"
     HoldoutError frames;                        ///< the predicted configurations' frames
-    HoldoutError iteratedSpatial;               ///< their spatialResampling runs summed, where there are 2 or more
+    HoldoutError iteratedSpatial;               ///< their spatial reuse runs (spatialResampling or resampleWorldNeighbours) summed, where there are 2 or more
     std::vector<CostRow> rows;                  ///< the predicted rows (measuredMs) ...
     std::vector<double> predictedMs;            ///< ... and their predictions
     nlohmann::json toJson() const;

@@ -16,10 +16,10 @@ LightingCounters temporalResamplingById(const FrameContext& f, const std::vector
 }
 
 /// Spatial reuse among the texels of the world neighbours (Morton order).
-LightingCounters spatialResamplingWorld(const FrameContext& f, std::uint32_t iteration, const std::vector<StoredReservoir>& cur,
+LightingCounters resampleWorldNeighbours(const FrameContext& f, std::uint32_t iteration, const std::vector<StoredReservoir>& cur,
                                         std::vector<StoredReservoir>& out) {
     return dispatchKernel(f, [&]<ShadingModel SM, Primitive P, bool Count>() {
-        return forEachTexel<SM, P, Count>(f, Pass::spatialResampling, CpuBuffers{&cur, &out},
+        return forEachTexel<SM, P, Count>(f, Pass::resampleWorldNeighbours, CpuBuffers{&cur, &out},
                                           [&](auto& b, std::size_t px, std::uint32_t, std::uint32_t) {
                                               spatialWorldTexel(b, px, iteration);
                                           });

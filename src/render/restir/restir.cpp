@@ -50,12 +50,13 @@ LightingCounters runPasses(restir::FrameContext& f, std::vector<StoredReservoir>
         std::swap(a, b);
         snapshot({Pass::temporalResampling}, a);
     }
-    if (plan.spatialIterations > 0) {
-        auto t = timer.scope(Pass::spatialResampling);
+    if (plan.spatialIterations > 0) {  // particle_restir's neighbours in world order, restir's in a screen disc
+        const Pass spatial = particles ? Pass::resampleWorldNeighbours : Pass::spatialResampling;
+        auto t = timer.scope(spatial);
         for (std::uint32_t it = 0; it < plan.spatialIterations; ++it) {
-            add(Pass::spatialResampling, particles ? restir::spatialResamplingWorld(f, it, a, b) : restir::spatialResampling(f, it, a, b));
+            add(spatial, particles ? restir::resampleWorldNeighbours(f, it, a, b) : restir::spatialResampling(f, it, a, b));
             std::swap(a, b);
-            snapshot({Pass::spatialResampling, it + 1}, a);
+            snapshot({spatial, it + 1}, a);
         }
     }
     if (plan.traceShadowRays) {

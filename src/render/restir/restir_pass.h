@@ -169,7 +169,7 @@ LightingCounters traceShadowRays(const FrameContext& f, std::vector<StoredReserv
 // from the texels (f.lg the image's G-buffer, f.texels the texels).
 LightingCounters temporalResamplingById(const FrameContext& f, const std::vector<StoredReservoir>& cur,
                                         std::vector<StoredReservoir>& out);
-LightingCounters spatialResamplingWorld(const FrameContext& f, std::uint32_t iteration, const std::vector<StoredReservoir>& cur,
+LightingCounters resampleWorldNeighbours(const FrameContext& f, std::uint32_t iteration, const std::vector<StoredReservoir>& cur,
                                         std::vector<StoredReservoir>& out);
 /// restir.texel_history: each texel's Lr averaged with its own last frame's (in place).
 LightingCounters accumulateTexelLr(const FrameContext& f, std::vector<Vec3>& texelLr);
