@@ -1,7 +1,7 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine, from the repository root:
 #   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
-#                                      layout_images layouts streams front identity shared_core ab designs voxels splits iterations
+#                                      layout_images layouts streams front identity shared_core ab designs voxels splits iterations split_anatomy
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -323,6 +323,11 @@ step_iterations() {
     grep -E "${pick}cluster " bench/gpu/designs_cluster.txt > "$W/iterations_cluster.txt"
     time_configs iterations/cluster "$W/iterations_cluster.txt" 5 1/1 scenes/cluster_150k.toml
 }
+
+# particle_split's shadeSplitTexels taken apart (bench/gpu/split_anatomy.txt):
+# the near lights' count against the far rays' cost, with and without RIS
+# and shadow rays.
+step_split_anatomy() { time_configs split_anatomy bench/gpu/split_anatomy.txt 5; }
 
 # The configurations on tune's Pareto fronts (bench/gpu/front.txt, written
 # by bench/gpu/front_configs.py), timed as the layouts are.
