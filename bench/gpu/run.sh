@@ -1,7 +1,7 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine, from the repository root:
 #   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
-#                                      layout_images layouts streams front identity shared_core ab designs voxels splits iterations split_anatomy
+#                                      layout_images layouts streams front identity shared_core ab designs voxels splits iterations split_anatomy split_ncu
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -328,6 +328,24 @@ step_iterations() {
 # the near lights' count against the far rays' cost, with and without RIS
 # and shadow rays.
 step_split_anatomy() { time_configs split_anatomy bench/gpu/split_anatomy.txt 5; }
+
+# Nsight Compute of particle_split's ray launch (shadeSplitTexels) at 8 and
+# 16 near lights (far 4 of 8; split_anatomy.txt's sa_n8_f4_c8 and
+# sa_n16_f4_c8): time, instructions, SIMT efficiency, local and device
+# memory traffic of each OptiX launch of frame 1.
+step_split_ncu() {
+    local t="$W/split_ncu" m=gpu__time_duration.sum,smsp__inst_executed.sum,smsp__thread_inst_executed_per_inst_executed.ratio
+    m=$m,l1tex__t_bytes_pipe_lsu_mem_local_op_ld.sum,l1tex__t_bytes_pipe_lsu_mem_local_op_st.sum,dram__bytes_read.sum,lts__t_bytes.sum
+    mkdir -p "$t"
+    for n in sa_n8_f4_c8 sa_n16_f4_c8; do
+        # shellcheck disable=SC2046  # the overrides are words
+        timeout 240 ncu --metrics "$m" --kernel-name regex:optixLaunch --log-file "$t/$n.log" -o "$t/$n" \
+            $BIN scenes/disk_100k.toml $(grep "^$n " bench/gpu/split_anatomy.txt | sed 's/ *#.*//' | cut -d' ' -f2-) \
+            --frames 0:2 --repeat 1 -q -o "$t/$n.{frame}.exr" > "$t/$n.run.log" 2>&1
+        ncu --import "$t/$n.ncu-rep" --csv --page raw --metrics "$m" > "$t/$n.csv" 2>&1
+        rm -f "$t"/*.gpuframe "$t"/*.exr "$t/$n.ncu-rep"
+    done
+}
 
 # The configurations on tune's Pareto fronts (bench/gpu/front.txt, written
 # by bench/gpu/front_configs.py), timed as the layouts are.
