@@ -23,28 +23,8 @@ cat "${LISTS[@]}" | grep -v '^#' | while read -r name args; do
 done
 # The sweep's timings (results/sweep_timings.csv) are of a twin that timed a
 # pass's runs together (spatialResampling over its iterations; the twin now
-# times each run apart, as "spatialResampling[2]"): the counters of
-# spatialResampling[2]... are added to spatialResampling's to join them.
-python3 - "$OUT" <<'PY'
-import csv, glob, os, re, sys
-out = sys.argv[1]
-rows, header = {}, None
-for f in sorted(glob.glob(os.path.join(out, "*.cost.csv"))):
-    with open(f) as fh:
-        r = csv.reader(fh)
-        header = next(r)
-        for row in r:
-            key = (row[0], re.sub(r"\[\d+\]$", "", row[1]))
-            vals = [float(x) for x in row[2:]]
-            if key in rows:  # counters add up; a working set is the same data read again
-                rows[key] = [max(a, b) if h == "working_set_bytes" else a + b
-                             for h, a, b in zip(header[2:], rows[key], vals)]
-            else:
-                rows[key] = vals
-with open(os.path.join(out, "counters.csv"), "w", newline="") as fh:
-    w = csv.writer(fh)
-    w.writerow(header)
-    for (config, p), vals in rows.items():
-        w.writerow([config, p] + [f"{v:.10g}" for v in vals])
-PY
+# times each run apart, as "spatialResampling[2]", and sum_runs.py sums
+# those timings likewise): the counters of spatialResampling[2]... are added
+# to spatialResampling's to join them.
+python3 bench/gpu/sum_runs.py "$OUT"/*.cost.csv > "$OUT/counters.csv"
 echo "$OUT/counters.csv"

@@ -275,8 +275,8 @@ Calibration calibrate(const std::vector<CostRow>& rows, CostModelForm form = Cos
 /// split at random (a seeded Fisher-Yates), `fraction` of them fitted, the
 /// rest predicted; per pass the median and worst relative error, and per
 /// predicted configuration its frame (the sum of its timed passes) and its
-/// spatial reuse run more than once (the sum of its spatialResampling runs,
-/// for configurations with a second run).
+/// spatial reuse run more than once (the sum of its spatialResampling or
+/// resampleWorldNeighbours runs, for configurations with a second run).
 struct HoldoutError {
     std::optional<Pass> pass;  ///< nullopt: all passes
     std::string label() const { return pass ? std::string(passName(*pass)) : std::string("all passes"); }
