@@ -60,7 +60,7 @@ std::string difference(const std::map<std::string, std::string>& before, const s
 
 }  // namespace
 
-TEST_CASE("the bad-input corpus: exact errors, exit 1, nothing written, inputs untouched", "[cli][bad_input]") {
+TEST_CASE("the bad-input corpus: exact errors, exit 1, nothing written, inputs untouched", "[cli][bad_input][long]") {
     const fs::path corpus = fs::path(ACCRETION_SOURCE_DIR) / "tests" / "bad_input";
     const std::string bin = ACCRETION_BINARY;
     // The cases run in a copy (links kept as links): a defect that writes over

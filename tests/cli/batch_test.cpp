@@ -118,7 +118,7 @@ TEST_CASE("batch: a bad jobs file is refused with its line, nothing run", "[cli]
 }
 
 TEST_CASE("batch: the example interrupted in its first job resumes to success, --output-dir overrides the file",
-          "[cli][batch][resume]") {
+          "[cli][batch][resume][long]") {
     const fs::path dir = accretion::test::scratchDir("batch_example_resume");
     const std::string jobs = std::string(ACCRETION_SOURCE_DIR) + "/scenes/batch/example_jobs.toml";
     const std::string cmd = kBin + " batch " + jobs + " --quiet --output-dir " + (dir / "out").string();

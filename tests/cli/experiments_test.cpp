@@ -94,7 +94,7 @@ TEST_CASE("converge: error falls with effort, CSV and plot written", "[cli][expe
     CHECK(std::filesystem::exists(dir / "c.png"));
 }
 
-TEST_CASE("bias: 1/M restir is flagged, uniform Monte Carlo is not", "[cli][experiments][statistical]") {
+TEST_CASE("bias: 1/M restir is flagged, uniform Monte Carlo is not", "[cli][experiments][statistical][long]") {
     const auto dir = accretion::test::scratchDir("bias");
     std::string out;
     // restir measured at steady state (the default history: ceil(m_cap) = 20 frames before the measured one).

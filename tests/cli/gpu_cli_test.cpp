@@ -16,6 +16,7 @@
 #include "accretion/analysis/student_t.h"
 #include "accretion/gpu/cost_model.h"
 #include "support/cli.h"
+#include "support/statistics.h"
 
 using namespace accretion;
 using namespace accretion::test;
@@ -374,12 +375,22 @@ TEST_CASE("cost counts the rays that found nothing, and a traced pass's working 
 }
 
 TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbiased one under the budget, cached",
-          "[cli][gpu][tune]") {
+          "[cli][gpu][tune][long]") {
     const auto dir = accretion::test::scratchDir("tune");
     // An M cap of 8: the steady state's history is 8 frames (the least it
     // may be), so each bias run renders 9 frames, not 21 (minutes under ASan).
-    const std::string base = kBin + " tune " + tinyScene() + " -D restir.m_cap=8 --error-crops 2x2 --crop-size 32x24 --crop-margin 8 --seeds 3 --cache " +
-                             (dir / "cache").string() + " -o " + (dir / "t").string() + " --budget-ms 50";
+    // Under the sanitizers (a seed divisor) the same configurations on a
+    // frame half as wide and high, measured on one crop instead of four:
+    // every path of tune runs, on a sixteenth of the pixels (the whole run
+    // took 174 s of CI under ASan).
+    const bool whole = fullStatisticalPower();
+    const std::uint32_t width = whole ? 96 : 48, height = whole ? 64 : 32, cropW = width / 3, cropH = height * 3 / 8, strata = whole ? 2 : 1;
+    const std::size_t crops = strata * strata;
+    const std::string frame = whole ? std::string() : " -D camera.width=48 -D camera.height=32";
+    const std::string base = kBin + " tune " + tinyScene() + frame + " -D restir.m_cap=8 --error-crops " + std::to_string(strata) + "x" +
+                             std::to_string(strata) + " --crop-size " + std::to_string(cropW) + "x" + std::to_string(cropH) + " --crop-margin " +
+                             std::to_string(cropH / 3) + " --seeds 3 --cache " + (dir / "cache").string() + " -o " + (dir / "t").string() +
+                             " --budget-ms 50";
     const std::string cmd = base + " --max-seeds 3";
     std::string out;
     REQUIRE(runCommand(cmd, out) == 0);
@@ -473,18 +484,18 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
     CHECK(firstTime["error (bias)"]["runs"] == 46);
     CHECK(firstTime["error (bias)"]["cached"] == 0);
     CHECK(firstTime["GPU time (cost)"]["runs"] == 12 + 46);
-    CHECK(firstTime["references"]["runs"] == 4);  // one per crop
-    // Measured where the engine runs: four crops of the 96x64 frame, one per stratum, at its resolution.
-    REQUIRE(j.at("crops").size() == 4);
-    for (std::size_t k = 0; k < 4; ++k) {
+    CHECK(firstTime["references"]["runs"] == crops);  // one per crop
+    // Measured where the engine runs: crops of the frame, one per stratum, at its resolution.
+    REQUIRE(j.at("crops").size() == crops);
+    for (std::size_t k = 0; k < crops; ++k) {
         const auto& c = j["crops"][k];
-        const std::uint32_t x0 = c[0], x1 = c[1], y0 = c[2], y1 = c[3];
-        CHECK(x1 - x0 == 32);
-        CHECK(y1 - y0 == 24);
-        CHECK(x0 >= 48 * (k % 2));
-        CHECK(x1 <= 48 * (k % 2 + 1));
-        CHECK(y0 >= 32 * (k / 2));
-        CHECK(y1 <= 32 * (k / 2 + 1));
+        const std::uint32_t x0 = c[0], x1 = c[1], y0 = c[2], y1 = c[3], col = k % strata, row = k / strata;
+        CHECK(x1 - x0 == cropW);
+        CHECK(y1 - y0 == cropH);
+        CHECK(x0 >= width / strata * col);
+        CHECK(x1 <= width / strata * (col + 1));
+        CHECK(y0 >= height / strata * row);
+        CHECK(y1 <= height / strata * (row + 1));
     }
     // A second run reads every measurement back and gives the same table.
     const std::string first = slurp(dir / "t.csv");
@@ -499,7 +510,7 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
             ++measurements;
             CHECK_THAT(line, Contains("(cached)"));
         }
-    CHECK(measurements == 4 + 12 + 2 * 46);  // the crops' references, 6 layouts rebuilt and refitted, then cost and bias per lighting option
+    CHECK(measurements == crops + 12 + 2 * 46);  // the crops' references, 6 layouts rebuilt and refitted, then cost and bias per lighting option
     CHECK(slurp(dir / "t.csv") == first);
     // ... and accounts for the cached measurements with what they cost when run (kept beside them, to the ms).
     const nlohmann::json again = nlohmann::json::parse(slurp(dir / "t.json")).at("time");
@@ -562,7 +573,7 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
     // bias runs here cost CI a minute under ASan).
     REQUIRE(runCommand(cmd + " --anatomy --designs particle_restir -q", out) == 0);
     const nlohmann::json an = nlohmann::json::parse(slurp(dir / "t.json"));
-    CHECK(an["unshadowed_references"].size() == 4);
+    CHECK(an["unshadowed_references"].size() == crops);
     CHECK(an.at("lighting").size() == 8);
     CHECK_FALSE(an.at("best_per_design").contains("restir"));
     std::vector<double> shares;

@@ -105,8 +105,10 @@ std::vector<std::string> brokenFiles(const fs::path& dir, std::size_t& checked) 
                 std::vector<unsigned char> px(in ? in->spec().image_bytes() : 0);
                 if (!in || !in->read_image(0, 0, 0, in->spec().nchannels, OIIO::TypeDesc::UINT8, px.data()))
                     throw std::runtime_error("unreadable PNG");
-            } else if (ext == ".json") (void)nlohmann::json::parse(accretion::test::readFile(p));
-            else if (ext == ".checkpoint" || ext == ".acc") accretion::readAccumulationFile(p);
+            } else if (ext == ".json") {
+                const nlohmann::json parsed = nlohmann::json::parse(accretion::test::readFile(p));  // throws if broken
+                (void)parsed;
+            } else if (ext == ".checkpoint" || ext == ".acc") accretion::readAccumulationFile(p);
             else if (ext == ".toml") {
                 if (accretion::test::readFile(p).find("[render]") == std::string::npos) throw std::runtime_error("truncated");
             } else if (ext == ".lock") {
@@ -124,7 +126,7 @@ std::vector<std::string> brokenFiles(const fs::path& dir, std::size_t& checked) 
 
 }  // namespace
 
-TEST_CASE("SIGTERM writes a checkpoint and --resume gives the uninterrupted image bit for bit", "[cli][resume]") {
+TEST_CASE("SIGTERM writes a checkpoint and --resume gives the uninterrupted image bit for bit", "[cli][resume][long]") {
     // Sweeps go band by band (every chunk of 8 rows at once): the checkpoint
     // stops part-way down the frame; split's near field is found again on resume.
     const std::string estimator = GENERATE("uniform", "split");
@@ -238,7 +240,7 @@ bool awaitMoment(Process& p, const fs::path& dir, KillMoment moment, int n) {
 }
 
 TEST_CASE("kill -9 mid-write and after each write never leaves a broken file, and resuming still gives the same image",
-          "[cli][resume][fault]") {
+          "[cli][resume][fault][long]") {
     const fs::path ref = accretion::test::scratchDir("kill_reference");
     const fs::path dir = accretion::test::scratchDir("kill_trials");
     std::string out;

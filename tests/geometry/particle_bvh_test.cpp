@@ -75,7 +75,7 @@ std::uint32_t overlappedBoxes(const Particles& p, const ParticleBvh& bvh, const 
 
 }  // namespace
 
-TEST_CASE("Embree hits match brute force for every geometry and build policy", "[geometry][bvh]") {
+TEST_CASE("Embree hits match brute force for every geometry and build policy", "[geometry][bvh][long]") {
     GeometrySettings g;
     g.primitive = GENERATE(Primitive::billboard, Primitive::sphere);
     g.alpha = g.primitive == Primitive::sphere ? AlphaMode::opaque : GENERATE(AlphaMode::opaque, AlphaMode::disc);

@@ -71,7 +71,7 @@ EstimatorAgreement compare(const FrameImage& mc, const Reference& ref, float sca
 
 }  // namespace
 
-TEST_CASE("uniform, power, tree, split and ris (every source) agree with the oracle and exact, and a 3% bias is caught", "[estimators][statistical]") {
+TEST_CASE("uniform, power, tree, split and ris (every source) agree with the oracle and exact, and a 3% bias is caught", "[estimators][statistical][long]") {
     struct Config {
         const char* name;
         Primitive primitive;

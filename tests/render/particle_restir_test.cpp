@@ -124,7 +124,7 @@ TEST_CASE("particle_restir: every particle a pixel sees has one slot and its tex
     }
 }
 
-TEST_CASE("particle_restir resampled at the pixels agrees with the oracle", "[particle_restir][statistical]") {
+TEST_CASE("particle_restir resampled at the pixels agrees with the oracle", "[particle_restir][statistical][long]") {
     // pixel_shading resample: each pixel resamples its particle's texels at
     // its own point with basic weights and traces its own shadow ray; the
     // texels' chains (temporal by id, 3 world neighbours) are unbiased with
@@ -149,7 +149,7 @@ TEST_CASE("particle_restir resampled at the pixels agrees with the oracle", "[pa
     s.restir.spatial_neighbours = 3;
     s.restir.world_neighbours = 4;
     const std::uint32_t frames = 4, seeds = test::statisticalSeeds(biased ? 50 : 200);
-    const double oracle = test::oracleImageSum(s, frames - 1);
+    static const double oracle = test::oracleImageSum(s, frames - 1);  // the same scene for the three corrections
     const auto [mean, stderr] = test::seedImageSums(s, EstimatorKind::particle_restir, frames, seeds, 2000);
     const double z = (mean - oracle) / stderr;
     INFO("oracle " << oracle << ", particle_restir " << mean << " +- " << stderr << ", z " << z);
