@@ -1,7 +1,7 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine, from the repository root:
 #   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
-#                                      layout_images layouts streams front identity shared_core ab designs voxels splits iterations split_anatomy split_ncu
+#                                      layout_images layouts streams front identity shared_core ab designs voxels splits iterations split_anatomy split_ncu split_stalls
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -343,6 +343,27 @@ step_split_ncu() {
             $BIN scenes/disk_100k.toml $(grep "^$n " bench/gpu/split_anatomy.txt | sed 's/ *#.*//' | cut -d' ' -f2-) \
             --frames 0:2 --repeat 1 -q -o "$t/$n.{frame}.exr" > "$t/$n.run.log" 2>&1
         ncu --import "$t/$n.ncu-rep" --csv --page raw --metrics "$m" > "$t/$n.csv" 2>&1
+        rm -f "$t"/*.gpuframe "$t"/*.exr "$t/$n.ncu-rep"
+    done
+}
+
+# Why particle_split's ray launch costs more at 8 near lights than at 16
+# (split_ncu: fewer instructions in more time): Nsight Compute's warp-state
+# (stall reasons), scheduler, occupancy, memory and instruction sections of
+# frame 1's shadeSplitTexels launch (the 4th optixLaunch of frames 0-1), at
+# 8 and 16 near lights with and without shadow rays.
+step_split_stalls() {
+    local t="$W/split_stalls" s
+    mkdir -p "$t"
+    s="--section SpeedOfLight --section LaunchStats --section Occupancy --section WarpStateStats --section SchedulerStats"
+    s="$s --section MemoryWorkloadAnalysis --section InstructionStats --section ComputeWorkloadAnalysis --section SourceCounters"
+    for n in sa_n8_f4_c8 sa_n16_f4_c8 sa_n8_f4_c8_novis sa_n16_f4_c8_novis; do
+        # shellcheck disable=SC2046,SC2086  # the overrides and sections are words
+        timeout 240 ncu $s --kernel-name regex:optixLaunch --launch-skip 3 --launch-count 1 --log-file "$t/$n.log" -o "$t/$n" \
+            $BIN scenes/disk_100k.toml $(grep "^$n " bench/gpu/split_anatomy.txt | sed 's/ *#.*//' | cut -d' ' -f2-) \
+            --frames 0:2 --repeat 1 -q -o "$t/$n.{frame}.exr" > "$t/$n.run.log" 2>&1
+        ncu --import "$t/$n.ncu-rep" --csv --page details > "$t/$n.details.csv" 2>&1
+        ncu --import "$t/$n.ncu-rep" --csv --page raw > "$t/$n.raw.csv" 2>&1
         rm -f "$t"/*.gpuframe "$t"/*.exr "$t/$n.ncu-rep"
     done
 }
