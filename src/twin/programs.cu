@@ -238,11 +238,14 @@ extern "C" __global__ void __raygen__updateVoxelCache() {
 /// those of two texels (near and far ones mixed).
 template <ShadingModel SM>
 __device__ void traceSplitRay() {
-    const uint3 idx = optixGetLaunchIndex();
+    const uint3 idx = optixGetLaunchIndex(), dim = optixGetLaunchDimensions();
     LaunchCounters c;
     SplitBridge<SM, OptixShadowRays<false>> b(params, OptixShadowRays<false>{&c}, &c);
     const SplitLaunch& s = params.split;
-    s.rays[std::size_t(idx.y) * s.rayStride + idx.x] = psplit::traceSplitRay(b, idx.x, idx.y);
+    // Ray r of texel q at L = r x rayStride + q, launched as rows (x = q,
+    // y = r) or as one row (x = L): twin --split-launch.
+    const std::size_t L = std::size_t(idx.y) * dim.x + idx.x;
+    s.rays[L] = psplit::traceSplitRay(b, L % s.rayStride, std::uint32_t(L / s.rayStride));
     addCounters(c);
 }
 

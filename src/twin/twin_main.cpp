@@ -57,6 +57,7 @@ struct Args {
     std::vector<std::string> defines;
     std::string frames, output, timings, config, programs = ACCRETION_TWIN_PROGRAMS;
     std::string shadowRays = "trace";
+    std::string splitLaunch = "rows";  ///< shadeSplitTexels' launch: rows (x the texel, y the ray) or linear (one row, ray-major)
     unsigned repeat = 5, buildStreams = 1, buildThreads = 1, seeds = 1;
     bool perBlas = false, compact = false, quiet = false, validation = false, skipLighting = false, lrOnly = false;
 };
@@ -201,6 +202,8 @@ TwinRun::TwinRun(const Args& a, const Settings& settings)
     if (a.shadowRays == "traverse" || a.shadowRays == "reorder") shade_ = Raygen::shadeTraverse;
     else if (a.shadowRays != "trace")
         throw InputError(fmt::format("command line --shadow-rays {}: expected trace, traverse or reorder", a.shadowRays));
+    if (a.splitLaunch != "rows" && a.splitLaunch != "linear")
+        throw InputError(fmt::format("command line --split-launch {}: expected rows or linear", a.splitLaunch));
     cudaDeviceProp prop{};
     CUDA_CHECK(cudaGetDeviceProperties(&prop, 0));
     device_ = prop.name;
@@ -459,7 +462,13 @@ void TwinRun::runParticleSplit(LaunchParams& lp) {
     {
         GpuScope t(timer, Pass::shadeSplitTexels);
         CUDA_CHECK(cudaMemcpyAsync(buf_.params.as<void>(), &lp, sizeof lp, cudaMemcpyHostToDevice, stream_));
-        if (rays > 0) pipeline_->launch(Raygen::shadeSplitTexels, buf_.params.address(), sizeof lp, unsigned(grid), rays, stream_);
+        // The same threads either way (thread L traces ray L / grid of texel
+        // L % grid); OptiX maps a 2D launch's indices to warps and blocks
+        // its own way, a 1D launch in order.
+        if (rays > 0 && a_.splitLaunch == "linear")
+            pipeline_->launch(Raygen::shadeSplitTexels, buf_.params.address(), sizeof lp, unsigned(grid * rays), 1, stream_);
+        else if (rays > 0)
+            pipeline_->launch(Raygen::shadeSplitTexels, buf_.params.address(), sizeof lp, unsigned(grid), rays, stream_);
         sumSplitTexels(lp, grid, stream_);
     }
     {
@@ -842,6 +851,9 @@ int main(int argc, char** argv) {
     app.add_option("--shadow-rays", a.shadowRays,
                    "restir's traceShadowRays: trace (optixTrace, pipeline), traverse (optixTraverse + hit object, "
                    "inline-like) or reorder (traverse after optixReorder by the SER key: gpu.ser_hint_bits of the light's BLAS)");
+    app.add_option("--split-launch", a.splitLaunch,
+                   "particle_split's ray launch (shadeSplitTexels): rows (a 2D launch, x the texel, y the ray) or linear "
+                   "(one row of rays x texels, ray-major)");
     app.add_option("--build-streams", a.buildStreams, "CUDA streams the BLAS builds are spread over (round robin)")
         ->check(CLI::Range(1, 64));
     app.add_option("--build-threads", a.buildThreads,
