@@ -1,7 +1,7 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine, from the repository root:
 #   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
-#                                      layout_images layouts streams front identity shared_core ab designs voxels splits iterations split_anatomy split_ncu split_stalls split_launch
+#                                      layout_images layouts streams front identity shared_core ab designs voxels splits iterations split_anatomy split_ncu split_stalls ray_launch
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -368,20 +368,22 @@ step_split_stalls() {
     done
 }
 
-# particle_split's ray launch as rows (OptiX's 2D launch: x the texel, y
-# the ray) against one row (twin --split-launch linear): split_anatomy's
-# configurations timed both ways, and at 8 and 16 near lights the warps'
-# barrier and memory stalls, occupancy and time of frame 1's launch.
-step_split_launch() {
-    local t="$W/split_launch" list="$W/split_launch.txt" n m
+# The launches of a thread per ray (particle_split's shadeSplitTexels,
+# voxel_cache's updateVoxelCache) as rows (OptiX's 2D launch) against one
+# row (twin --ray-launch): split_anatomy's configurations and designs.txt's
+# 100K voxel ones timed both ways; at 8 and 16 near lights the warps'
+# barrier and memory stalls, occupancy and time of frame 1's split launch;
+# the frames of both, byte for byte.
+step_ray_launch() {
+    local t="$W/ray_launch" list="$W/ray_launch.txt" n m f
     mkdir -p "$t"
-    { grep '^sa_' bench/gpu/split_anatomy.txt | sed 's/ *#.*//'
-      grep '^sa_' bench/gpu/split_anatomy.txt | sed 's/ *#.*//' | awk '{n = $1; $1 = ""; print n "_linear" $0 " --split-launch linear"}'; } > "$list"
-    time_configs split_launch "$list" 5
+    { grep '^sa_' bench/gpu/split_anatomy.txt; grep -E '^vox_[a-z0-9_]*_100k ' bench/gpu/designs.txt; } | sed 's/ *#.*//' |
+        awk '{n = $1; $1 = ""; print n "_rows" $0 " --ray-launch rows"; print n "_linear" $0 " --ray-launch linear"}' > "$list"
+    time_configs ray_launch "$list" 5
     m=gpu__time_duration.sum,smsp__inst_executed.sum,sm__warps_active.avg.pct_of_peak_sustained_active
     m=$m,smsp__average_warps_issue_stalled_barrier_per_issue_active.ratio,smsp__average_warps_issue_stalled_long_scoreboard_per_issue_active.ratio
     m=$m,smsp__average_warps_issue_stalled_wait_per_issue_active.ratio,smsp__thread_inst_executed_per_inst_executed.ratio
-    for n in sa_n8_f4_c8 sa_n16_f4_c8 sa_n8_f4_c8_linear sa_n16_f4_c8_linear; do
+    for n in sa_n8_f4_c8_rows sa_n16_f4_c8_rows sa_n8_f4_c8_linear sa_n16_f4_c8_linear; do
         # shellcheck disable=SC2046  # the overrides are words
         timeout 240 ncu --metrics "$m" --kernel-name regex:optixLaunch --launch-skip 3 --launch-count 1 --log-file "$t/$n.ncu.log" \
             -o "$t/$n" $BIN scenes/disk_100k.toml $(grep "^$n " "$list" | cut -d' ' -f2-) \
@@ -390,13 +392,15 @@ step_split_launch() {
         rm -f "$t"/*.gpuframe "$t"/*.exr "$t/$n.ncu-rep"
     done
     # The same frames both ways, byte for byte (frame 1: with history).
-    for n in sa_n8_f4_c8 sa_n8_f4_c8_linear; do
-        # shellcheck disable=SC2046  # the overrides are words
-        $BIN scenes/disk_100k.toml $(grep "^$n " "$list" | cut -d' ' -f2-) --frames 0:2 --repeat 1 -q -o "$t/same_$n.{frame}.exr"
-    done
-    for f in 0000 0001; do
-        python3 bench/gpu/gpuframe_equal.py "$t/same_sa_n8_f4_c8.$f.gpuframe" "$t/same_sa_n8_f4_c8_linear.$f.gpuframe" &&
-            echo "frame $f: the same with rows and linear" || echo "frame $f: DIFFERS"
+    for n in sa_n8_f4_c8 vox_c64_r8_100k; do
+        for v in rows linear; do
+            # shellcheck disable=SC2046  # the overrides are words
+            $BIN scenes/disk_100k.toml $(grep "^${n}_$v " "$list" | cut -d' ' -f2-) --frames 0:2 --repeat 1 -q -o "$t/same_${n}_$v.{frame}.exr"
+        done
+        for f in 0000 0001; do
+            python3 bench/gpu/gpuframe_equal.py "$t/same_${n}_rows.$f.gpuframe" "$t/same_${n}_linear.$f.gpuframe" &&
+                echo "$n frame $f: the same with rows and linear" || echo "$n frame $f: DIFFERS"
+        done
     done | tee "$t/same.txt"
     rm -f "$t"/*.gpuframe
 }

@@ -214,14 +214,21 @@ __device__ void resampleParticlePixel() {
 
 }  // namespace
 
+/// The thread of a launch of a thread per ray (twin --ray-launch: one row
+/// or rows): idx.y x width + idx.x.
+static __forceinline__ __device__ std::size_t rayThread() {
+    const uint3 idx = optixGetLaunchIndex(), dim = optixGetLaunchDimensions();
+    return std::size_t(idx.y) * dim.x + idx.x;
+}
+
 /// voxel_cache's updateVoxelCache, its rays: one thread per ray of each
-/// occupied cell (launch x = cell x * rays + ray, y = cell y + z ny),
+/// occupied cell (thread c x rays + r: a cell's rays side by side),
 /// voxel_cache_passes.h's traceCellRay with OptiX's shadow rays, written for
 /// the per-cell sum (voxel_kernels.cu).
 extern "C" __global__ void __raygen__updateVoxelCache() {
-    const uint3 idx = optixGetLaunchIndex();
     const VoxelLaunch& v = params.voxel;
-    const std::uint32_t rays = v.params.rays, c = idx.y * v.params.grid.nx + idx.x / rays, r = idx.x % rays;
+    const std::size_t L = rayThread();
+    const std::uint32_t rays = v.params.rays, c = std::uint32_t(L / rays), r = std::uint32_t(L % rays);
     if (!v.occupied[c]) return;
     LaunchCounters counters;
     VoxelBridge<OptixShadowRays<false>> b(params, OptixShadowRays<false>{&counters}, &counters);
@@ -230,21 +237,18 @@ extern "C" __global__ void __raygen__updateVoxelCache() {
 }
 
 /// particle_split's shadeSplitTexels, its rays: one thread per ray of each
-/// texel (launch x = the texel, y = the ray: a warp traces one kind of ray,
-/// near or far, for 32 texels), particle_split_passes.h's traceSplitRay
+/// texel (thread r x texels + q: a warp traces one kind of ray, near or
+/// far, for 32 texels), particle_split_passes.h's traceSplitRay
 /// with OptiX's shadow rays, written for the per-texel sum
 /// (split_kernels.cu). At 100K, 8 near and 8 far of 8 candidates: 36 ms
 /// with a thread per texel, 9.6 with a thread per ray and a warp's rays
 /// those of two texels (near and far ones mixed).
 template <ShadingModel SM>
 __device__ void traceSplitRay() {
-    const uint3 idx = optixGetLaunchIndex(), dim = optixGetLaunchDimensions();
     LaunchCounters c;
     SplitBridge<SM, OptixShadowRays<false>> b(params, OptixShadowRays<false>{&c}, &c);
     const SplitLaunch& s = params.split;
-    // Ray r of texel q at L = r x rayStride + q, launched as rows (x = q,
-    // y = r) or as one row (x = L): twin --split-launch.
-    const std::size_t L = std::size_t(idx.y) * dim.x + idx.x;
+    const std::size_t L = rayThread();
     s.rays[L] = psplit::traceSplitRay(b, L % s.rayStride, std::uint32_t(L / s.rayStride));
     addCounters(c);
 }

@@ -57,7 +57,7 @@ struct Args {
     std::vector<std::string> defines;
     std::string frames, output, timings, config, programs = ACCRETION_TWIN_PROGRAMS;
     std::string shadowRays = "trace";
-    std::string splitLaunch = "rows";  ///< shadeSplitTexels' launch: rows (x the texel, y the ray) or linear (one row, ray-major)
+    std::string rayLaunch = "linear";  ///< the per-ray launches' shape: linear (one row, L = item x rays + ray) or rows (2D)
     unsigned repeat = 5, buildStreams = 1, buildThreads = 1, seeds = 1;
     bool perBlas = false, compact = false, quiet = false, validation = false, skipLighting = false, lrOnly = false;
 };
@@ -142,6 +142,7 @@ private:
     StoredReservoir* runRestir(const FramePlan& plan, LaunchParams& lp);
     void placeVoxels(const Particles& particles);
     void runVoxelCache(LaunchParams& lp);
+    void launchRays(Raygen r, std::size_t threads, unsigned rowWidth);
     std::uint32_t gatherTexels(const LaunchParams& lp, std::uint32_t side, std::uint32_t layers);
     void runParticleSplit(LaunchParams& lp);
     void keepSplitHistory(std::size_t n);
@@ -202,8 +203,8 @@ TwinRun::TwinRun(const Args& a, const Settings& settings)
     if (a.shadowRays == "traverse" || a.shadowRays == "reorder") shade_ = Raygen::shadeTraverse;
     else if (a.shadowRays != "trace")
         throw InputError(fmt::format("command line --shadow-rays {}: expected trace, traverse or reorder", a.shadowRays));
-    if (a.splitLaunch != "rows" && a.splitLaunch != "linear")
-        throw InputError(fmt::format("command line --split-launch {}: expected rows or linear", a.splitLaunch));
+    if (a.rayLaunch != "rows" && a.rayLaunch != "linear")
+        throw InputError(fmt::format("command line --ray-launch {}: expected linear or rows", a.rayLaunch));
     cudaDeviceProp prop{};
     CUDA_CHECK(cudaGetDeviceProperties(&prop, 0));
     device_ = prop.name;
@@ -417,6 +418,14 @@ std::uint32_t TwinRun::gatherTexels(const LaunchParams& lp, std::uint32_t side, 
     return visible;
 }
 
+/// A launch of a thread per ray of each item, `threads` of them: thread L
+/// = idx.y x width + idx.x in one row (--ray-launch linear) or in rows of
+/// `rowWidth` (rows: a 2D launch).
+void TwinRun::launchRays(Raygen r, std::size_t threads, unsigned rowWidth) {
+    if (a_.rayLaunch == "linear") pipeline_->launch(r, buf_.params.address(), sizeof(LaunchParams), unsigned(threads), 1, stream_);
+    else pipeline_->launch(r, buf_.params.address(), sizeof(LaunchParams), rowWidth, unsigned(threads / rowWidth), stream_);
+}
+
 /// particle_split's passes (the CPU's ParticleSplit::render):
 /// gatherParticleTexels, findNearLights (a kernel per visible particle),
 /// shadeSplitTexels (a raygen of a thread per ray of each texel, then a
@@ -462,13 +471,11 @@ void TwinRun::runParticleSplit(LaunchParams& lp) {
     {
         GpuScope t(timer, Pass::shadeSplitTexels);
         CUDA_CHECK(cudaMemcpyAsync(buf_.params.as<void>(), &lp, sizeof lp, cudaMemcpyHostToDevice, stream_));
-        // The same threads either way (thread L traces ray L / grid of texel
-        // L % grid); OptiX maps a 2D launch's indices to warps and blocks
-        // its own way, a 1D launch in order.
-        if (rays > 0 && a_.splitLaunch == "linear")
-            pipeline_->launch(Raygen::shadeSplitTexels, buf_.params.address(), sizeof lp, unsigned(grid * rays), 1, stream_);
-        else if (rays > 0)
-            pipeline_->launch(Raygen::shadeSplitTexels, buf_.params.address(), sizeof lp, unsigned(grid), rays, stream_);
+        // Thread L traces ray L / grid of texel L % grid, launched in one
+        // row or as rows of texels (--ray-launch): OptiX maps a 2D launch
+        // onto warps and blocks its own way, and on the H100 (no RT cores)
+        // the rows' warps stalled at barriers, 1.5-2.6x slower (run.sh ray_launch).
+        if (rays > 0) launchRays(Raygen::shadeSplitTexels, grid * rays, unsigned(grid));
         sumSplitTexels(lp, grid, stream_);
     }
     {
@@ -611,8 +618,7 @@ void TwinRun::runVoxelCache(LaunchParams& lp) {
         v.write = next;
         v.rays = buf_.voxelRays.as<voxel::CellRay>();
         CUDA_CHECK(cudaMemcpyAsync(buf_.params.as<void>(), &lp, sizeof lp, cudaMemcpyHostToDevice, stream_));
-        pipeline_->launch(Raygen::updateVoxelCache, buf_.params.address(), sizeof lp, grid.nx * v.params.rays, grid.ny * grid.nz,
-                          stream_);
+        launchRays(Raygen::updateVoxelCache, std::size_t(grid.count()) * v.params.rays, grid.nx * v.params.rays);
         sumVoxelRays(lp, stream_);
     }
     {
@@ -851,9 +857,9 @@ int main(int argc, char** argv) {
     app.add_option("--shadow-rays", a.shadowRays,
                    "restir's traceShadowRays: trace (optixTrace, pipeline), traverse (optixTraverse + hit object, "
                    "inline-like) or reorder (traverse after optixReorder by the SER key: gpu.ser_hint_bits of the light's BLAS)");
-    app.add_option("--split-launch", a.splitLaunch,
-                   "particle_split's ray launch (shadeSplitTexels): rows (a 2D launch, x the texel, y the ray) or linear "
-                   "(one row of rays x texels, ray-major)");
+    app.add_option("--ray-launch", a.rayLaunch,
+                   "The launches of a thread per ray of each item (updateVoxelCache's cells, shadeSplitTexels' texels): linear "
+                   "(one row) or rows (a 2D launch, as OptiX tiles it)");
     app.add_option("--build-streams", a.buildStreams, "CUDA streams the BLAS builds are spread over (round robin)")
         ->check(CLI::Range(1, 64));
     app.add_option("--build-threads", a.buildThreads,
