@@ -1,7 +1,7 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine, from the repository root:
 #   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
-#                                      layout_images layouts streams front identity shared_core ab designs voxels splits iterations split_anatomy split_ncu split_stalls ray_launch
+#                                      layout_images layouts streams front identity shared_core ab designs voxels splits iterations split_anatomy split_ncu split_stalls ray_launch split_order
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -401,6 +401,29 @@ step_ray_launch() {
             python3 bench/gpu/gpuframe_equal.py "$t/same_${n}_rows.$f.gpuframe" "$t/same_${n}_linear.$f.gpuframe" &&
                 echo "$n frame $f: the same with rows and linear" || echo "$n frame $f: DIFFERS"
         done
+    done | tee "$t/same.txt"
+    rm -f "$t"/*.gpuframe
+}
+
+# particle_split's ray threads in three orders (twin --ray-launch): rows
+# (OptiX's 2D launch), linear (a ray of every texel, then the next) and
+# texels (the near rays texel by texel, then the far ones): designs.txt's
+# 100K particle_split configurations; the frames of texels and linear
+# compared byte for byte.
+step_split_order() {
+    local t="$W/split_order" list="$W/split_order.txt" n v f
+    mkdir -p "$t"
+    grep -E '^ps_[a-z0-9_]*_100k ' bench/gpu/designs.txt | sed 's/ *#.*//' |
+        awk '{n = $1; $1 = ""; for (v = 1; v <= 3; ++v) { o = v == 1 ? "rows" : v == 2 ? "linear" : "texels"; print n "_" o $0 " --ray-launch " o } }' > "$list"
+    time_configs split_order "$list" 5
+    n=ps_n16_f8_c8_h75_100k
+    for v in linear texels; do
+        # shellcheck disable=SC2046  # the overrides are words
+        $BIN scenes/disk_100k.toml $(grep "^${n}_$v " "$list" | cut -d' ' -f2-) --frames 0:2 --repeat 1 -q -o "$t/same_$v.{frame}.exr"
+    done
+    for f in 0000 0001; do
+        python3 bench/gpu/gpuframe_equal.py "$t/same_linear.$f.gpuframe" "$t/same_texels.$f.gpuframe" &&
+            echo "$n frame $f: the same with linear and texels" || echo "$n frame $f: DIFFERS"
     done | tee "$t/same.txt"
     rm -f "$t"/*.gpuframe
 }

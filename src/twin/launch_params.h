@@ -115,6 +115,7 @@ struct SplitLaunch {
     float* nearRadius2 = nullptr;
     psplit::SplitRay* rays = nullptr;           ///< texel q's ray r at r x rayStride + q (a warp: one ray of 32 texels)
     std::size_t rayStride = 0;                  ///< the grid's texels: ray r of every texel at r x rayStride
+    bool texelMajor = false;                    ///< threads texel by texel within each kind of ray (twin --ray-launch texels)
     Vec3* texelLr = nullptr;
     std::uint32_t* rejected = nullptr;          ///< per texel: non-finite far draws
     const std::uint32_t* prevSlotOf = nullptr;  ///< particle_split.history: last frame's slots

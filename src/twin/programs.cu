@@ -249,7 +249,15 @@ __device__ void traceSplitRay() {
     SplitBridge<SM, OptixShadowRays<false>> b(params, OptixShadowRays<false>{&c}, &c);
     const SplitLaunch& s = params.split;
     const std::size_t L = rayThread();
-    s.rays[L] = psplit::traceSplitRay(b, L % s.rayStride, std::uint32_t(L / s.rayStride));
+    std::size_t q = L % s.rayStride;
+    std::uint32_t r = std::uint32_t(L / s.rayStride);
+    if (s.texelMajor) {  // the near rays texel by texel, then the far ones: a warp's rays share a few texels
+        const psplit::SplitParams& p = s.params;
+        const std::size_t nearThreads = s.rayStride * p.nearCount;
+        if (L < nearThreads) q = L / p.nearCount, r = std::uint32_t(L % p.nearCount);
+        else q = (L - nearThreads) / p.farSamples, r = p.nearCount + std::uint32_t((L - nearThreads) % p.farSamples);
+    }
+    s.rays[std::size_t(r) * s.rayStride + q] = psplit::traceSplitRay(b, q, r);
     addCounters(c);
 }
 

@@ -203,8 +203,8 @@ TwinRun::TwinRun(const Args& a, const Settings& settings)
     if (a.shadowRays == "traverse" || a.shadowRays == "reorder") shade_ = Raygen::shadeTraverse;
     else if (a.shadowRays != "trace")
         throw InputError(fmt::format("command line --shadow-rays {}: expected trace, traverse or reorder", a.shadowRays));
-    if (a.rayLaunch != "rows" && a.rayLaunch != "linear")
-        throw InputError(fmt::format("command line --ray-launch {}: expected linear or rows", a.rayLaunch));
+    if (a.rayLaunch != "rows" && a.rayLaunch != "linear" && a.rayLaunch != "texels")
+        throw InputError(fmt::format("command line --ray-launch {}: expected linear, texels or rows", a.rayLaunch));
     cudaDeviceProp prop{};
     CUDA_CHECK(cudaGetDeviceProperties(&prop, 0));
     device_ = prop.name;
@@ -422,7 +422,7 @@ std::uint32_t TwinRun::gatherTexels(const LaunchParams& lp, std::uint32_t side, 
 /// = idx.y x width + idx.x in one row (--ray-launch linear) or in rows of
 /// `rowWidth` (rows: a 2D launch).
 void TwinRun::launchRays(Raygen r, std::size_t threads, unsigned rowWidth) {
-    if (a_.rayLaunch == "linear") pipeline_->launch(r, buf_.params.address(), sizeof(LaunchParams), unsigned(threads), 1, stream_);
+    if (a_.rayLaunch != "rows") pipeline_->launch(r, buf_.params.address(), sizeof(LaunchParams), unsigned(threads), 1, stream_);
     else pipeline_->launch(r, buf_.params.address(), sizeof(LaunchParams), rowWidth, unsigned(threads / rowWidth), stream_);
 }
 
@@ -459,6 +459,7 @@ void TwinRun::runParticleSplit(LaunchParams& lp) {
     sl.nearRadius2 = buf_.splitNearRadius2.as<float>();
     sl.rays = buf_.splitRays.as<psplit::SplitRay>();
     sl.rayStride = grid;
+    sl.texelMajor = a_.rayLaunch == "texels";
     sl.texelLr = buf_.gridLr.as<Vec3>();
     sl.rejected = buf_.rejected.as<std::uint32_t>();
     sl.prevSlotOf = buf_.prevSlotOf.as<std::uint32_t>();
@@ -859,7 +860,8 @@ int main(int argc, char** argv) {
                    "inline-like) or reorder (traverse after optixReorder by the SER key: gpu.ser_hint_bits of the light's BLAS)");
     app.add_option("--ray-launch", a.rayLaunch,
                    "The launches of a thread per ray of each item (updateVoxelCache's cells, shadeSplitTexels' texels): linear "
-                   "(one row) or rows (a 2D launch, as OptiX tiles it)");
+                   "(one row: a cell's rays side by side, a split ray of every texel), texels (shadeSplitTexels' near and then far "
+                   "rays texel by texel) or rows (a 2D launch, as OptiX tiles it)");
     app.add_option("--build-streams", a.buildStreams, "CUDA streams the BLAS builds are spread over (round robin)")
         ->check(CLI::Range(1, 64));
     app.add_option("--build-threads", a.buildThreads,
