@@ -237,8 +237,8 @@ extern "C" __global__ void __raygen__updateVoxelCache() {
 }
 
 /// particle_split's shadeSplitTexels, its rays: one thread per ray of each
-/// texel (thread r x texels + q: a warp traces one kind of ray, near or
-/// far, for 32 texels), particle_split_passes.h's traceSplitRay
+/// texel (by default particle_split_passes.h's splitRayThread order: a warp
+/// traces one kind of ray, near or far, of a few texels), its traceSplitRay
 /// with OptiX's shadow rays, written for the per-texel sum
 /// (split_kernels.cu). At 100K, 8 near and 8 far of 8 candidates: 36 ms
 /// with a thread per texel, 9.6 with a thread per ray and a warp's rays
@@ -251,11 +251,10 @@ __device__ void traceSplitRay() {
     const std::size_t L = rayThread();
     std::size_t q = L % s.rayStride;
     std::uint32_t r = std::uint32_t(L / s.rayStride);
-    if (s.texelMajor) {  // the near rays texel by texel, then the far ones: a warp's rays share a few texels
-        const psplit::SplitParams& p = s.params;
-        const std::size_t nearThreads = s.rayStride * p.nearCount;
-        if (L < nearThreads) q = L / p.nearCount, r = std::uint32_t(L % p.nearCount);
-        else q = (L - nearThreads) / p.farSamples, r = p.nearCount + std::uint32_t((L - nearThreads) % p.farSamples);
+    if (s.texelMajor) {  // twin --ray-launch texels (the default, as the CPU counts it)
+        const psplit::SplitRayOfThread t = psplit::splitRayOfThread(s.params, s.rayStride, L);
+        q = t.texel;
+        r = t.ray;
     }
     s.rays[std::size_t(r) * s.rayStride + q] = psplit::traceSplitRay(b, q, r);
     addCounters(c);

@@ -57,7 +57,7 @@ struct Args {
     std::vector<std::string> defines;
     std::string frames, output, timings, config, programs = ACCRETION_TWIN_PROGRAMS;
     std::string shadowRays = "trace";
-    std::string rayLaunch = "linear";  ///< the per-ray launches' shape: linear (one row, L = item x rays + ray) or rows (2D)
+    std::string rayLaunch = "texels";  ///< the per-ray launches' threads: texels, linear or rows (--ray-launch)
     unsigned repeat = 5, buildStreams = 1, buildThreads = 1, seeds = 1;
     bool perBlas = false, compact = false, quiet = false, validation = false, skipLighting = false, lrOnly = false;
 };
@@ -859,9 +859,10 @@ int main(int argc, char** argv) {
                    "restir's traceShadowRays: trace (optixTrace, pipeline), traverse (optixTraverse + hit object, "
                    "inline-like) or reorder (traverse after optixReorder by the SER key: gpu.ser_hint_bits of the light's BLAS)");
     app.add_option("--ray-launch", a.rayLaunch,
-                   "The launches of a thread per ray of each item (updateVoxelCache's cells, shadeSplitTexels' texels): linear "
-                   "(one row: a cell's rays side by side, a split ray of every texel), texels (shadeSplitTexels' near and then far "
-                   "rays texel by texel) or rows (a 2D launch, as OptiX tiles it)");
+                   "The launches of a thread per ray of each item (updateVoxelCache's cells, shadeSplitTexels' texels), in one "
+                   "row: texels (a cell's rays side by side; a texel's near rays, then its far ones: the CPU's counting order), "
+                   "linear (the same cells; a split ray of every texel, then the next); or rows (a 2D launch of the linear order, "
+                   "as OptiX tiles it)");
     app.add_option("--build-streams", a.buildStreams, "CUDA streams the BLAS builds are spread over (round robin)")
         ->check(CLI::Range(1, 64));
     app.add_option("--build-threads", a.buildThreads,

@@ -258,8 +258,8 @@ TEST_CASE("particle_split: its frame runs its own passes, not restir's", "[parti
     REQUIRE(rays[Pass::shadeSplitTexels] > 0);
     REQUIRE(rays[Pass::findNearLights] == 0);  // the near search traces no ray
     // shadeSplitTexels is counted as the twin runs it: a thread per ray of
-    // each texel (x the texel, y the ray), each tracing at most its one
-    // shadow ray, and the per-texel sum's dispatch.
+    // each texel (the near rays texel by texel, then the far ones), each
+    // tracing at most its one shadow ray, and the per-texel sum's dispatch.
     const auto texels = std::find_if(img.counters.passes.begin(), img.counters.passes.end(),
                                      [](const PassCounters& pc) { return pc.pass == Pass::shadeSplitTexels; });
     REQUIRE(texels->height == s.particle_split.near + s.particle_split.far);
@@ -271,10 +271,38 @@ TEST_CASE("particle_split: its frame runs its own passes, not restir's", "[parti
     REQUIRE(!visible.empty());
     CHECK(texels->width == (visible.size() + kTexelRowWidth - 1) / kTexelRowWidth * kTexelRowWidth);
     std::uint64_t most = 0, pastTexels = 0;
+    const std::size_t nearThreads = std::size_t(texels->width) * s.particle_split.near;
     for (std::size_t k = 0; k < texels->threads.size(); ++k) {
         most = std::max<std::uint64_t>(most, texels->threads[k].rays);
-        if (k % texels->width >= visible.size()) pastTexels += texels->threads[k].rays;  // the last row's tail: no texel
+        const std::size_t texel = k < nearThreads ? k / s.particle_split.near : (k - nearThreads) / s.particle_split.far;
+        if (texel >= visible.size()) pastTexels += texels->threads[k].rays;  // the last row's tail: no texel
     }
     CHECK(most == 1);
     CHECK(pastTexels == 0);
+}
+
+TEST_CASE("particle_split: the ray threads' order visits every ray of every texel once, near before far, and inverts", "[particle_split]") {
+    // shadeSplitTexels' threads (the twin's launch, the CPU's counting
+    // records): a bijection of (texel, ray) onto [0, texels x rays), every
+    // near ray before every far one, a texel's rays of one kind side by side.
+    for (const auto [near, far] : {std::pair{8u, 4u}, std::pair{16u, 8u}, std::pair{1u, 0u}, std::pair{0u, 3u}, std::pair{32u, 16u}}) {
+        psplit::SplitParams p;
+        p.nearCount = near;
+        p.farSamples = far;
+        const std::size_t texels = 24, rays = near + far;
+        INFO("near " << near << ", far " << far);
+        std::vector<int> seen(texels * rays, 0);
+        for (std::size_t q = 0; q < texels; ++q)
+            for (std::uint32_t r = 0; r < rays; ++r) {
+                const std::size_t L = psplit::splitRayThread(p, texels, q, r);
+                REQUIRE(L < seen.size());
+                ++seen[L];
+                CHECK((L < texels * near) == (r < near));
+                if (r > 0 && (r < near) == (r - 1 < near)) CHECK(L == psplit::splitRayThread(p, texels, q, r - 1) + 1);
+                const psplit::SplitRayOfThread back = psplit::splitRayOfThread(p, texels, L);
+                CHECK(back.texel == q);
+                CHECK(back.ray == r);
+            }
+        CHECK(std::count(seen.begin(), seen.end(), 1) == std::ptrdiff_t(seen.size()));
+    }
 }

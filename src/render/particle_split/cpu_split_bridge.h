@@ -88,13 +88,12 @@ public:
         return n;
     }
     float nearRadius2(std::uint32_t v) const { return f_.nearRadius2[v]; }
-    /// Counting, ray r of texel q is the twin's thread (q, r) of its ray
-    /// launch (x the texel, y the ray), which writes the ray for the sum; the
-    /// sum (a kernel per texel) is thread (q, 0)'s record too, as its
-    /// dispatch is the pass's second.
+    /// Counting, ray r of texel q is the twin's thread splitRayThread(q, r)
+    /// of its ray launch, which writes the ray for the sum; the sum (a
+    /// kernel per texel) is record q's too, as its dispatch is the pass's second.
     SplitRay splitRay(std::size_t q, std::uint32_t r) {
         if constexpr (Count) {
-            CpuSplitBridge ray(f_, &pc_->threads[std::size_t(r) * f_.texels.grid.texels.size() + q], c_, pc_);
+            CpuSplitBridge ray(f_, &pc_->threads[splitRayThread(f_.params, f_.texels.grid.texels.size(), q, r)], c_, pc_);
             const SplitRay out = traceSplitRay(ray, q, r);
             ray.rec_.write(sizeof(SplitRay));
             rec_.read(sizeof(SplitRay));
