@@ -411,7 +411,7 @@ step_ray_launch() {
 # 100K particle_split configurations; the frames of texels and linear
 # compared byte for byte.
 step_split_order() {
-    # (texels, the default since 5d1e0c4: particle_split_passes.h's splitRayThread)
+    # texels is the default (particle_split_passes.h: splitRayThread).
     local t="$W/split_order" list="$W/split_order.txt" n v f
     mkdir -p "$t"
     grep -E '^ps_[a-z0-9_]*_100k ' bench/gpu/designs.txt | sed 's/ *#.*//' |
