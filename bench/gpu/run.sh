@@ -368,6 +368,23 @@ step_split_stalls() {
     done
 }
 
+# Whether variants A and B of configuration N of LIST (its lines "N_A ..."
+# and "N_B ...") render frames 0 and 1 of disk_100k the same, byte for byte
+# (frame 1: with history); a line a frame.
+#   same_frames FOLDER LIST N A B
+same_frames() {
+    local t=$1 list=$2 n=$3 a=$4 b=$5 v f
+    for v in "$a" "$b"; do
+        # shellcheck disable=SC2046  # the overrides are words
+        $BIN scenes/disk_100k.toml $(grep "^${n}_$v " "$list" | cut -d' ' -f2-) --frames 0:2 --repeat 1 -q -o "$t/same_${n}_$v.{frame}.exr"
+    done
+    for f in 0000 0001; do
+        python3 bench/gpu/gpuframe_equal.py "$t/same_${n}_$a.$f.gpuframe" "$t/same_${n}_$b.$f.gpuframe" &&
+            echo "$n frame $f: the same with $a and $b" || echo "$n frame $f: DIFFERS"
+    done
+    rm -f "$t"/same_*.gpuframe
+}
+
 # The launches of a thread per ray (particle_split's shadeSplitTexels,
 # voxel_cache's updateVoxelCache) as rows (OptiX's 2D launch) against one
 # row (twin --ray-launch): split_anatomy's configurations and designs.txt's
@@ -375,7 +392,7 @@ step_split_stalls() {
 # barrier and memory stalls, occupancy and time of frame 1's split launch;
 # the frames of both, byte for byte.
 step_ray_launch() {
-    local t="$W/ray_launch" list="$W/ray_launch.txt" n m f
+    local t="$W/ray_launch" list="$W/ray_launch.txt" n m
     mkdir -p "$t"
     { grep '^sa_' bench/gpu/split_anatomy.txt; grep -E '^vox_[a-z0-9_]*_100k ' bench/gpu/designs.txt; } | sed 's/ *#.*//' |
         awk '{n = $1; $1 = ""; print n "_rows" $0 " --ray-launch rows"; print n "_linear" $0 " --ray-launch linear"}' > "$list"
@@ -391,18 +408,7 @@ step_ray_launch() {
         ncu --import "$t/$n.ncu-rep" --csv --page raw --metrics "$m" > "$t/$n.ncu.csv" 2>&1
         rm -f "$t"/*.gpuframe "$t"/*.exr "$t/$n.ncu-rep"
     done
-    # The same frames both ways, byte for byte (frame 1: with history).
-    for n in sa_n8_f4_c8 vox_c64_r8_100k; do
-        for v in rows linear; do
-            # shellcheck disable=SC2046  # the overrides are words
-            $BIN scenes/disk_100k.toml $(grep "^${n}_$v " "$list" | cut -d' ' -f2-) --frames 0:2 --repeat 1 -q -o "$t/same_${n}_$v.{frame}.exr"
-        done
-        for f in 0000 0001; do
-            python3 bench/gpu/gpuframe_equal.py "$t/same_${n}_rows.$f.gpuframe" "$t/same_${n}_linear.$f.gpuframe" &&
-                echo "$n frame $f: the same with rows and linear" || echo "$n frame $f: DIFFERS"
-        done
-    done | tee "$t/same.txt"
-    rm -f "$t"/*.gpuframe
+    { same_frames "$t" "$list" sa_n8_f4_c8 rows linear; same_frames "$t" "$list" vox_c64_r8_100k rows linear; } | tee "$t/same.txt"
 }
 
 # particle_split's ray threads in three orders (twin --ray-launch): rows
@@ -412,21 +418,12 @@ step_ray_launch() {
 # compared byte for byte.
 step_split_order() {
     # texels is the default (particle_split_passes.h: splitRayThread).
-    local t="$W/split_order" list="$W/split_order.txt" n v f
+    local t="$W/split_order" list="$W/split_order.txt"
     mkdir -p "$t"
     grep -E '^ps_[a-z0-9_]*_100k ' bench/gpu/designs.txt | sed 's/ *#.*//' |
         awk '{n = $1; $1 = ""; for (v = 1; v <= 3; ++v) { o = v == 1 ? "rows" : v == 2 ? "linear" : "texels"; print n "_" o $0 " --ray-launch " o } }' > "$list"
     time_configs split_order "$list" 5
-    n=ps_n16_f8_c8_h75_100k
-    for v in linear texels; do
-        # shellcheck disable=SC2046  # the overrides are words
-        $BIN scenes/disk_100k.toml $(grep "^${n}_$v " "$list" | cut -d' ' -f2-) --frames 0:2 --repeat 1 -q -o "$t/same_$v.{frame}.exr"
-    done
-    for f in 0000 0001; do
-        python3 bench/gpu/gpuframe_equal.py "$t/same_linear.$f.gpuframe" "$t/same_texels.$f.gpuframe" &&
-            echo "$n frame $f: the same with linear and texels" || echo "$n frame $f: DIFFERS"
-    done | tee "$t/same.txt"
-    rm -f "$t"/*.gpuframe
+    same_frames "$t" "$list" ps_n16_f8_c8_h75_100k linear texels | tee "$t/same.txt"
 }
 
 # The configurations on tune's Pareto fronts (bench/gpu/front.txt, written
