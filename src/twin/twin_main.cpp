@@ -52,12 +52,20 @@
 namespace accretion::twin {
 namespace {
 
+/// twin --ray-launch: the threads of a launch of a thread per ray of each
+/// item (updateVoxelCache's cells, shadeSplitTexels' texels).
+enum class RayLaunch {
+    texels,  ///< one row: a cell's rays side by side; a texel's near rays, then its far ones (splitRayThread)
+    linear,  ///< one row: the same cells; a split ray of every texel, then the next
+    rows     ///< the linear order as a 2D launch, which OptiX tiles onto warps and blocks
+};
+
 struct Args {
     std::string scene;
     std::vector<std::string> defines;
     std::string frames, output, timings, config, programs = ACCRETION_TWIN_PROGRAMS;
     std::string shadowRays = "trace";
-    std::string rayLaunch = "texels";  ///< the per-ray launches' threads: texels, linear or rows (--ray-launch)
+    RayLaunch rayLaunch = RayLaunch::texels;
     unsigned repeat = 5, buildStreams = 1, buildThreads = 1, seeds = 1;
     bool perBlas = false, compact = false, quiet = false, validation = false, skipLighting = false, lrOnly = false;
 };
@@ -203,8 +211,6 @@ TwinRun::TwinRun(const Args& a, const Settings& settings)
     if (a.shadowRays == "traverse" || a.shadowRays == "reorder") shade_ = Raygen::shadeTraverse;
     else if (a.shadowRays != "trace")
         throw InputError(fmt::format("command line --shadow-rays {}: expected trace, traverse or reorder", a.shadowRays));
-    if (a.rayLaunch != "rows" && a.rayLaunch != "linear" && a.rayLaunch != "texels")
-        throw InputError(fmt::format("command line --ray-launch {}: expected linear, texels or rows", a.rayLaunch));
     cudaDeviceProp prop{};
     CUDA_CHECK(cudaGetDeviceProperties(&prop, 0));
     device_ = prop.name;
@@ -422,7 +428,7 @@ std::uint32_t TwinRun::gatherTexels(const LaunchParams& lp, std::uint32_t side, 
 /// = idx.y x width + idx.x in one row (--ray-launch linear) or in rows of
 /// `rowWidth` (rows: a 2D launch).
 void TwinRun::launchRays(Raygen r, std::size_t threads, unsigned rowWidth) {
-    if (a_.rayLaunch != "rows") pipeline_->launch(r, buf_.params.address(), sizeof(LaunchParams), unsigned(threads), 1, stream_);
+    if (a_.rayLaunch != RayLaunch::rows) pipeline_->launch(r, buf_.params.address(), sizeof(LaunchParams), unsigned(threads), 1, stream_);
     else pipeline_->launch(r, buf_.params.address(), sizeof(LaunchParams), rowWidth, unsigned(threads / rowWidth), stream_);
 }
 
@@ -459,7 +465,7 @@ void TwinRun::runParticleSplit(LaunchParams& lp) {
     sl.nearRadius2 = buf_.splitNearRadius2.as<float>();
     sl.rays = buf_.splitRays.as<psplit::SplitRay>();
     sl.rayStride = grid;
-    sl.texelMajor = a_.rayLaunch == "texels";
+    sl.texelMajor = a_.rayLaunch == RayLaunch::texels;
     sl.texelLr = buf_.gridLr.as<Vec3>();
     sl.rejected = buf_.rejected.as<std::uint32_t>();
     sl.prevSlotOf = buf_.prevSlotOf.as<std::uint32_t>();
@@ -858,11 +864,17 @@ int main(int argc, char** argv) {
     app.add_option("--shadow-rays", a.shadowRays,
                    "restir's traceShadowRays: trace (optixTrace, pipeline), traverse (optixTraverse + hit object, "
                    "inline-like) or reorder (traverse after optixReorder by the SER key: gpu.ser_hint_bits of the light's BLAS)");
-    app.add_option("--ray-launch", a.rayLaunch,
-                   "The launches of a thread per ray of each item (updateVoxelCache's cells, shadeSplitTexels' texels), in one "
-                   "row: texels (a cell's rays side by side; a texel's near rays, then its far ones: the CPU's counting order), "
-                   "linear (the same cells; a split ray of every texel, then the next); or rows (a 2D launch of the linear order, "
-                   "as OptiX tiles it)");
+    app.add_option_function<std::string>(
+           "--ray-launch",
+           [&a](const std::string& v) {
+               using accretion::twin::RayLaunch;
+               a.rayLaunch = v == "linear" ? RayLaunch::linear : v == "rows" ? RayLaunch::rows : RayLaunch::texels;
+           },
+           "The launches of a thread per ray of each item (updateVoxelCache's cells, shadeSplitTexels' texels), in one "
+           "row: texels (a cell's rays side by side; a texel's near rays, then its far ones: the CPU's counting order; the "
+           "default), linear (the same cells; a split ray of every texel, then the next); or rows (a 2D launch of the "
+           "linear order, as OptiX tiles it)")
+        ->check(CLI::IsMember({"texels", "linear", "rows"}));
     app.add_option("--build-streams", a.buildStreams, "CUDA streams the BLAS builds are spread over (round robin)")
         ->check(CLI::Range(1, 64));
     app.add_option("--build-threads", a.buildThreads,
