@@ -113,7 +113,7 @@ struct SplitLaunch {
     std::uint32_t* near = nullptr;              ///< slot v's near lights at v x params.nearCount (kNoNearLight past its count)
     std::uint32_t* nearFound = nullptr;
     float* nearRadius2 = nullptr;
-    psplit::SplitRay* rays = nullptr;           ///< texel q's ray r at r x rayStride + q (a warp: one ray of 32 texels)
+    psplit::SplitRay* rays = nullptr;           ///< texel q's ray r at r x rayStride + q (whichever thread traced it)
     std::size_t rayStride = 0;                  ///< the grid's texels: ray r of every texel at r x rayStride
     bool texelMajor = false;                    ///< threads texel by texel within each kind of ray (twin --ray-launch texels)
     Vec3* texelLr = nullptr;

@@ -425,8 +425,8 @@ std::uint32_t TwinRun::gatherTexels(const LaunchParams& lp, std::uint32_t side, 
 }
 
 /// A launch of a thread per ray of each item, `threads` of them: thread L
-/// = idx.y x width + idx.x in one row (--ray-launch linear) or in rows of
-/// `rowWidth` (rows: a 2D launch).
+/// = idx.y x width + idx.x in one row (--ray-launch texels or linear) or in
+/// rows of `rowWidth` (rows: a 2D launch).
 void TwinRun::launchRays(Raygen r, std::size_t threads, unsigned rowWidth) {
     if (a_.rayLaunch != RayLaunch::rows) pipeline_->launch(r, buf_.params.address(), sizeof(LaunchParams), unsigned(threads), 1, stream_);
     else pipeline_->launch(r, buf_.params.address(), sizeof(LaunchParams), rowWidth, unsigned(threads / rowWidth), stream_);
@@ -478,10 +478,11 @@ void TwinRun::runParticleSplit(LaunchParams& lp) {
     {
         GpuScope t(timer, Pass::shadeSplitTexels);
         CUDA_CHECK(cudaMemcpyAsync(buf_.params.as<void>(), &lp, sizeof lp, cudaMemcpyHostToDevice, stream_));
-        // Thread L traces ray L / grid of texel L % grid, launched in one
-        // row or as rows of texels (--ray-launch): OptiX maps a 2D launch
-        // onto warps and blocks its own way, and on the H100 (no RT cores)
-        // the rows' warps stalled at barriers, 1.5-2.6x slower (run.sh ray_launch).
+        // Thread L traces splitRayOfThread(L) (--ray-launch texels, the
+        // default: the CPU's counting order), or ray L / grid of texel L %
+        // grid (linear, rows). OptiX maps a 2D launch (rows) onto warps and
+        // blocks its own way: on the H100 (no RT cores) its warps stalled at
+        // barriers, up to 2.7x slower (run.sh ray_launch, split_order).
         if (rays > 0) launchRays(Raygen::shadeSplitTexels, grid * rays, unsigned(grid));
         sumSplitTexels(lp, grid, stream_);
     }

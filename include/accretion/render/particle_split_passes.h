@@ -243,9 +243,9 @@ ACC_HD inline std::uint32_t raysPerTexel(const SplitParams& p) { return p.nearCo
 /// shadeSplitTexels' thread of ray r of texel q, of `texels`: the near rays
 /// texel by texel (q x nearCount + r), then the far draws texel by texel.
 /// A warp traces one kind of ray for a few texels, which share their
-/// shading point, near lights and tree descents: on the H100 (no RT cores)
-/// the rays of a ray of 32 texels a warp took 4-19% longer, and OptiX's 2D
-/// launch of texels by rays up to 2.7x longer (bench/gpu run.sh split_order).
+/// shading point, near lights and tree descents. On the H100 (no RT cores)
+/// warps of one ray of 32 texels took 4-19% longer, and OptiX's 2D launch
+/// of texels by rays up to 2.7x longer (bench/gpu run.sh split_order).
 ACC_HD inline std::size_t splitRayThread(const SplitParams& p, std::size_t texels, std::size_t q, std::uint32_t r) {
     return r < p.nearCount ? q * p.nearCount + r : texels * p.nearCount + q * p.farSamples + (r - p.nearCount);
 }
