@@ -1,7 +1,7 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine, from the repository root:
 #   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
-#                                      layout_images layouts streams front identity shared_core ab designs voxels splits iterations split_anatomy split_ncu split_stalls ray_launch split_order prt_launch
+#                                      layout_images layouts streams front identity shared_core ab designs voxels splits iterations split_anatomy split_ncu split_stalls ray_launch split_order
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -424,19 +424,6 @@ step_split_order() {
         awk '{n = $1; $1 = ""; for (v = 1; v <= 3; ++v) { o = v == 1 ? "rows" : v == 2 ? "linear" : "texels"; print n "_" o $0 " --ray-launch " o } }' > "$list"
     time_configs split_order "$list" 5
     same_frames "$t" "$list" ps_n16_f8_c8_h75_100k linear texels | tee "$t/same.txt"
-}
-
-# particle_restir's texel shadow rays (traceShadowRays over the texel
-# grid, kTexelRowWidth a row) as OptiX's 2D launch (--ray-launch rows)
-# against one row (the default): designs.txt's 100K particle_restir
-# configurations, and one's frames compared byte for byte.
-step_prt_launch() {
-    local t="$W/prt_launch" list="$W/prt_launch.txt"
-    mkdir -p "$t"
-    grep -E '^prt_[a-z0-9_]*_100k ' bench/gpu/designs.txt | sed 's/ *#.*//' |
-        awk '{n = $1; $1 = ""; print n "_rows" $0 " --ray-launch rows"; print n "_texels" $0 " --ray-launch texels"}' > "$list"
-    time_configs prt_launch "$list" 5
-    same_frames "$t" "$list" prt_m8_k16_100k rows texels | tee "$t/same.txt"
 }
 
 # The configurations on tune's Pareto fronts (bench/gpu/front.txt, written

@@ -565,11 +565,7 @@ StoredReservoir* TwinRun::runRestir(const FramePlan& plan, LaunchParams& lp) {
         rp.in = nullptr;
         rp.out = a;
         CUDA_CHECK(cudaMemcpyAsync(buf_.params.as<void>(), &lp, sizeof lp, cudaMemcpyHostToDevice, stream_));
-        // particle_restir's texels (a shadow ray each, kTexelRowWidth a
-        // row) are per-ray work too: in one row unless --ray-launch rows.
-        // restir's pixels keep OptiX's 2D tiles (neighbours share a particle).
-        if (plan.particleTexels) launchRays(shade_, std::size_t(rp.reuse.width) * rp.reuse.height, rp.reuse.width);
-        else pipeline_->launch(shade_, buf_.params.address(), sizeof lp, rp.reuse.width, rp.reuse.height, stream_);
+        pipeline_->launch(shade_, buf_.params.address(), sizeof lp, rp.reuse.width, rp.reuse.height, stream_);
         if (plan.texelHistory) accumulateTexelLr(lp, stream_);
     }
     if (plan.particleTexels) {  // the pixels from their particles' texels
