@@ -474,9 +474,10 @@ struct ErrorRow {
     BiasVerdict verdict = BiasVerdict::unknown;
     nlohmann::json reuse;  ///< bias's reuse of the measured frames, per pass (stats.json's counts.reuse)
     /// The share of `pass`'s offers kept, and of those on another particle (NaN where it did not run).
-    std::pair<double, double> kept(const char* pass) const {
-        if (!reuse.is_object() || !reuse.contains(pass)) return {std::nan(""), std::nan("")};
-        const nlohmann::json& r = reuse.at(pass);
+    std::pair<double, double> kept(Pass pass) const {
+        const std::string key(passName(pass));  // bias writes each pass's counts under its name
+        if (!reuse.is_object() || !reuse.contains(key)) return {std::nan(""), std::nan("")};
+        const nlohmann::json& r = reuse.at(key);
         const double offered = r.at("offered").get<double>(), accepted = r.at("accepted").get<double>();
         const double other = r.at("outcomes").at("other_particle").get<double>();
         return {offered > 0.0 ? 100.0 * accepted / offered : std::nan(""), accepted > 0.0 ? 100.0 * other / accepted : std::nan("")};
@@ -836,10 +837,10 @@ Table lightingTable(const TuneArgs& a, const TuneResult& r) {
               {"", "", 0, "{}", "{}", true, "  "}});
     for (const ParetoPoint& p : r.points) {
         const std::string bias = p.error.label();
-        const double temporalKept = p.error.kept("temporalResampling").first;
+        const double temporalKept = p.error.kept(Pass::temporalResampling).first;
         // Spatial reuse: restir's screen disc, or particle_restir's world neighbours.
-        auto [spatialKept, spatialOther] = p.error.kept("spatialResampling");
-        if (std::isnan(spatialKept)) std::tie(spatialKept, spatialOther) = p.error.kept("resampleWorldNeighbours");
+        auto [spatialKept, spatialOther] = p.error.kept(Pass::spatialResampling);
+        if (std::isnan(spatialKept)) std::tie(spatialKept, spatialOther) = p.error.kept(Pass::resampleWorldNeighbours);
         lt.add({p.lighting.label(), p.ms, p.error.relMse, p.error.t, p.error.energyLossPct, p.error.detectablePct,
                 std::uint64_t(p.error.seeds), temporalKept, spatialKept, spatialOther, p.error.visibilitySharePct,
                 100.0 - p.error.visibilitySharePct,

@@ -43,7 +43,7 @@ template <ShadingModel SM, Primitive P, bool Count>
 class CpuSplitBridge {
 public:
     /// `pc`: the pass's counters in counting mode (shadeSplitTexels' ray
-    /// threads are its records r x texels + q), else nullptr.
+    /// threads are its records splitRayThread(q, r)), else nullptr.
     CpuSplitBridge(const CpuFrame& f, ThreadCounters* t, LightingCounters& c, PassCounters* pc = nullptr)
         : f_(f), rec_(t), c_(c), pc_(pc) {}
 
