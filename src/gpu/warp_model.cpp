@@ -8,7 +8,14 @@
 
 namespace accretion {
 
-std::vector<std::uint32_t> dispatchOrder(std::uint32_t width, std::uint32_t height, const WarpLayout& layout) {
+std::vector<std::uint32_t> dispatchOrder(std::uint32_t width, std::uint32_t height, const WarpLayout& layout,
+                                         PassLaunch launch) {
+    if (launch == PassLaunch::row) {
+        const std::size_t threads = std::size_t(width) * height;
+        std::vector<std::uint32_t> order((threads + layout.warpSize - 1) / layout.warpSize * layout.warpSize, kIdleLane);
+        for (std::size_t t = 0; t < threads; ++t) order[t] = std::uint32_t(t);
+        return order;
+    }
     const std::uint32_t gw = layout.groupWidth, gh = layout.groupHeight, ws = layout.warpSize;
     const std::uint32_t groupThreads = gw * gh;
     const std::uint32_t padded = (groupThreads + ws - 1) / ws * ws;
@@ -127,7 +134,7 @@ SerReport serReport(const PassCounters& pass, const WarpLayout& layout, const Se
         hits[i] = t.hit;
         active += t.active;
     }
-    const std::vector<std::uint32_t> before = dispatchOrder(pass.width, pass.height, layout);
+    const std::vector<std::uint32_t> before = dispatchOrder(pass.width, pass.height, layout, passInfo(pass.pass).launch);
     const std::vector<std::uint32_t> after = serReorder(before, sortKey, window, layout.warpSize);
     SerReport r;
     r.key = key.label();

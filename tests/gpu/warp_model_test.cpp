@@ -2,6 +2,7 @@
 // are worked out by hand in each case.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <numeric>
 
 #include "accretion/gpu/warp_model.h"
@@ -20,7 +21,7 @@ PassCounters rowPass(std::uint32_t rows) {
 }  // namespace
 
 TEST_CASE("dispatch order: 8x8 groups, two warps per group, idle lanes at the edges", "[gpu][warp]") {
-    const auto order = dispatchOrder(10, 9, WarpLayout{});
+    const auto order = dispatchOrder(10, 9, WarpLayout{}, PassLaunch::tiles);
     // 2 x 2 groups of 64 threads.
     REQUIRE(order.size() == 4u * 64u);
     // First warp = rows 0-3 of the first group: pixel (3, 2) is lane 2*8 + 3.
@@ -36,7 +37,7 @@ TEST_CASE("dispatch order: 8x8 groups, two warps per group, idle lanes at the ed
 TEST_CASE("SIMT efficiency: one key is 100%, alternating two keys 50%, SER sorts back to 100%", "[gpu][warp]") {
     const WarpLayout layout{32, 1, 32};
     PassCounters p = rowPass(8);
-    const auto order = dispatchOrder(32, 8, layout);
+    const auto order = dispatchOrder(32, 8, layout, PassLaunch::tiles);
     std::vector<std::uint64_t> key(p.threads.size(), 0);
     std::vector<std::uint32_t> work(p.threads.size(), 1);
 
@@ -67,7 +68,7 @@ TEST_CASE("SIMT efficiency: one key is 100%, alternating two keys 50%, SER sorts
 TEST_CASE("SIMT efficiency of a loop runs as long as the longest lane", "[gpu][warp]") {
     const WarpLayout layout{32, 1, 32};
     PassCounters p = rowPass(1);
-    const auto order = dispatchOrder(32, 1, layout);
+    const auto order = dispatchOrder(32, 1, layout, PassLaunch::tiles);
     std::vector<std::uint64_t> key(32, 0);
     std::vector<std::uint32_t> trips(32, 1);
     trips[5] = 8;  // 31 lanes x 1 + 8 = 39 units over 8 steps
@@ -105,4 +106,36 @@ TEST_CASE("SER report on a pass: keys from hit and type, gain net of the reorder
     // A reorder cost of 1 lane-step per thread adds 256 / 32 = 8 warp steps.
     CHECK(serReport(p, WarpLayout{32, 1, 32}, key, 256, 1.0).predictedSpeedup == Approx(56.0 / 40.0));
     CHECK_THROWS_WITH(SerKey::parse("hit,colour", 0, "scene.toml:3"), Catch::Contains("unknown SER key component 'colour'"));
+}
+
+TEST_CASE("dispatch order of a one-row launch: record order, a warp of 32 consecutive threads", "[gpu][warp]") {
+    const auto order = dispatchOrder(20, 2, WarpLayout{}, PassLaunch::row);
+    REQUIRE(order.size() == 64u);  // 40 threads, the second warp padded
+    for (std::uint32_t i = 0; i < 40; ++i) CHECK(order[i] == i);
+    CHECK(std::all_of(order.begin() + 40, order.end(), [](std::uint32_t t) { return t == kIdleLane; }));
+}
+
+TEST_CASE("SER report cuts a pass into warps as it is launched: one row for shadeSplitTexels, 8x8 tiles for shadow rays",
+          "[gpu][warp]") {
+    // 64 texels x 2 rays, records in launch order; runs of 32 records loop 1 and 8 trips by turns.
+    auto build = [](Pass pass) {
+        PassCounters p(pass, 64, 2);
+        for (std::size_t i = 0; i < p.threads.size(); ++i) {
+            p.threads[i].active = 1;
+            p.threads[i].trips = (i / 32) % 2 ? 8 : 1;
+        }
+        return p;
+    };
+    const SerKey key = SerKey::parse("hit", 0, "test");
+    // One row: 4 warps, each of one run: 1 + 8 + 1 + 8 steps for 64 x 1 + 64 x 8 lane trips, 100%.
+    const SerReport row = serReport(build(Pass::shadeSplitTexels), WarpLayout{}, key, 2048, 0.0);
+    CHECK(row.loopBefore.warps == 4);
+    CHECK(row.loopBefore.steps == 18);
+    CHECK(row.loopBefore.efficiency == 1.0);
+    // 8x8 tiles of a 64 x 2 grid: 8 groups of 16 live lanes (rows 0 and 1 of 8 columns), one warp each;
+    // groups 0-3 loop once, 4-7 eight times: 36 steps for 576 lane trips, 50%.
+    const SerReport tiles = serReport(build(Pass::traceShadowRays), WarpLayout{}, key, 2048, 0.0);
+    CHECK(tiles.loopBefore.warps == 8);
+    CHECK(tiles.loopBefore.steps == 36);
+    CHECK(tiles.loopBefore.efficiency == 0.5);
 }

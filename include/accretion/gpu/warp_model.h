@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "accretion/core/pass.h"
 #include "accretion/counters/thread_counters.h"
 #include "accretion/scene/settings.h"
 
@@ -12,18 +13,21 @@ namespace accretion {
 
 inline constexpr std::uint32_t kIdleLane = std::numeric_limits<std::uint32_t>::max();
 
-/// Thread groups of a 2D dispatch and the warps cut from them (docs/MODEL.md section 6).
+/// Thread groups of a 2D dispatch and the warps cut from them (docs/MODEL.md
+/// section 6); a one-row launch uses only warpSize.
 struct WarpLayout {
     std::uint32_t groupWidth = 8;
     std::uint32_t groupHeight = 8;
     std::uint32_t warpSize = 32;
 };
 
-/// The lanes of a width x height dispatch in hardware order: groups in
-/// row-major order, the threads of a group row-major, each group padded to
-/// whole warps; a warp is `warpSize` consecutive entries. Threads outside
-/// the grid (partial groups at the edges) are kIdleLane.
-std::vector<std::uint32_t> dispatchOrder(std::uint32_t width, std::uint32_t height, const WarpLayout& layout);
+/// The lanes of a width x height dispatch in hardware order; a warp is
+/// `warpSize` consecutive entries. tiles: groups in row-major order, the
+/// threads of a group row-major, each group padded to whole warps, threads
+/// outside the grid (partial groups at the edges) kIdleLane. row: the
+/// threads in record order (y x width + x), the last warp padded.
+std::vector<std::uint32_t> dispatchOrder(std::uint32_t width, std::uint32_t height, const WarpLayout& layout,
+                                         PassLaunch launch);
 
 /// SIMT statistics of one region over a lane order.
 struct SimtStats {
@@ -84,7 +88,8 @@ struct SerReport {
 };
 
 /// The SIMT statistics of a pass's threads (branch region on the branch key,
-/// loop region on trips) before and after SER with `key` in windows of `window`.
+/// loop region on trips), cut into warps as the pass is launched
+/// (passInfo(pass).launch), before and after SER with `key` in windows of `window`.
 SerReport serReport(const PassCounters& pass, const WarpLayout& layout, const SerKey& key, std::uint32_t window,
                     double reorderCost);
 
