@@ -329,22 +329,37 @@ step_iterations() {
 # and shadow rays.
 step_split_anatomy() { time_configs split_anatomy bench/gpu/split_anatomy.txt 5; }
 
+# Nsight Compute of configuration N of LIST (its line "N overrides...") on
+# disk_100k, frames 0-1, its OptiX launches only: `ncu ARGS` (and --metrics
+# M where M is not empty) logged to FOLDER/STEM.log, the run's output to
+# STEM.run.log; then each of PAGES (raw, details) imported as CSV, with
+# --metrics M: STEM.csv where PAGES is one page, else STEM.PAGE.csv. The
+# report and the frames are removed.
+#   ncu_config FOLDER STEM LIST N "ARGS" M "PAGES"
+ncu_config() {
+    local t=$1 stem=$2 list=$3 n=$4 args=$5 m=$6 pages=$7 p csv sel=()
+    [ -z "$m" ] || sel=(--metrics "$m")
+    # shellcheck disable=SC2046,SC2086  # the ncu arguments and the overrides are words
+    timeout 240 ncu $args "${sel[@]}" --kernel-name regex:optixLaunch --log-file "$t/$stem.log" -o "$t/$stem" \
+        $BIN scenes/disk_100k.toml $(grep "^$n " "$list" | sed 's/ *#.*//' | cut -d' ' -f2-) \
+        --frames 0:2 --repeat 1 -q -o "$t/$stem.{frame}.exr" > "$t/$stem.run.log" 2>&1
+    for p in $pages; do
+        csv="$t/$stem.$p.csv"
+        [ "$p" != "$pages" ] || csv="$t/$stem.csv"
+        ncu --import "$t/$stem.ncu-rep" --csv --page "$p" "${sel[@]}" > "$csv" 2>&1
+    done
+    rm -f "$t"/*.gpuframe "$t"/*.exr "$t/$stem.ncu-rep"
+}
+
 # Nsight Compute of particle_split's ray launch (shadeSplitTexels) at 8 and
 # 16 near lights (far 4 of 8; split_anatomy.txt's sa_n8_f4_c8 and
 # sa_n16_f4_c8): time, instructions, SIMT efficiency, local and device
 # memory traffic of each OptiX launch of frame 1.
 step_split_ncu() {
-    local t="$W/split_ncu" m=gpu__time_duration.sum,smsp__inst_executed.sum,smsp__thread_inst_executed_per_inst_executed.ratio
+    local t="$W/split_ncu" m=gpu__time_duration.sum,smsp__inst_executed.sum,smsp__thread_inst_executed_per_inst_executed.ratio n
     m=$m,l1tex__t_bytes_pipe_lsu_mem_local_op_ld.sum,l1tex__t_bytes_pipe_lsu_mem_local_op_st.sum,dram__bytes_read.sum,lts__t_bytes.sum
     mkdir -p "$t"
-    for n in sa_n8_f4_c8 sa_n16_f4_c8; do
-        # shellcheck disable=SC2046  # the overrides are words
-        timeout 240 ncu --metrics "$m" --kernel-name regex:optixLaunch --log-file "$t/$n.log" -o "$t/$n" \
-            $BIN scenes/disk_100k.toml $(grep "^$n " bench/gpu/split_anatomy.txt | sed 's/ *#.*//' | cut -d' ' -f2-) \
-            --frames 0:2 --repeat 1 -q -o "$t/$n.{frame}.exr" > "$t/$n.run.log" 2>&1
-        ncu --import "$t/$n.ncu-rep" --csv --page raw --metrics "$m" > "$t/$n.csv" 2>&1
-        rm -f "$t"/*.gpuframe "$t"/*.exr "$t/$n.ncu-rep"
-    done
+    for n in sa_n8_f4_c8 sa_n16_f4_c8; do ncu_config "$t" "$n" bench/gpu/split_anatomy.txt "$n" "" "$m" raw; done
 }
 
 # Why particle_split's ray launch costs more at 8 near lights than at 16
@@ -353,18 +368,12 @@ step_split_ncu() {
 # frame 1's shadeSplitTexels launch (the 4th optixLaunch of frames 0-1), at
 # 8 and 16 near lights with and without shadow rays.
 step_split_stalls() {
-    local t="$W/split_stalls" s
+    local t="$W/split_stalls" s n
     mkdir -p "$t"
     s="--section SpeedOfLight --section LaunchStats --section Occupancy --section WarpStateStats --section SchedulerStats"
     s="$s --section MemoryWorkloadAnalysis --section InstructionStats --section ComputeWorkloadAnalysis --section SourceCounters"
     for n in sa_n8_f4_c8 sa_n16_f4_c8 sa_n8_f4_c8_novis sa_n16_f4_c8_novis; do
-        # shellcheck disable=SC2046,SC2086  # the overrides and sections are words
-        timeout 240 ncu $s --kernel-name regex:optixLaunch --launch-skip 3 --launch-count 1 --log-file "$t/$n.log" -o "$t/$n" \
-            $BIN scenes/disk_100k.toml $(grep "^$n " bench/gpu/split_anatomy.txt | sed 's/ *#.*//' | cut -d' ' -f2-) \
-            --frames 0:2 --repeat 1 -q -o "$t/$n.{frame}.exr" > "$t/$n.run.log" 2>&1
-        ncu --import "$t/$n.ncu-rep" --csv --page details > "$t/$n.details.csv" 2>&1
-        ncu --import "$t/$n.ncu-rep" --csv --page raw > "$t/$n.raw.csv" 2>&1
-        rm -f "$t"/*.gpuframe "$t"/*.exr "$t/$n.ncu-rep"
+        ncu_config "$t" "$n" bench/gpu/split_anatomy.txt "$n" "$s --launch-skip 3 --launch-count 1" "" "details raw"
     done
 }
 
@@ -401,12 +410,7 @@ step_ray_launch() {
     m=$m,smsp__average_warps_issue_stalled_barrier_per_issue_active.ratio,smsp__average_warps_issue_stalled_long_scoreboard_per_issue_active.ratio
     m=$m,smsp__average_warps_issue_stalled_wait_per_issue_active.ratio,smsp__thread_inst_executed_per_inst_executed.ratio
     for n in sa_n8_f4_c8_rows sa_n16_f4_c8_rows sa_n8_f4_c8_linear sa_n16_f4_c8_linear; do
-        # shellcheck disable=SC2046  # the overrides are words
-        timeout 240 ncu --metrics "$m" --kernel-name regex:optixLaunch --launch-skip 3 --launch-count 1 --log-file "$t/$n.ncu.log" \
-            -o "$t/$n" $BIN scenes/disk_100k.toml $(grep "^$n " "$list" | cut -d' ' -f2-) \
-            --frames 0:2 --repeat 1 -q -o "$t/$n.{frame}.exr" > "$t/$n.ncu.run.log" 2>&1
-        ncu --import "$t/$n.ncu-rep" --csv --page raw --metrics "$m" > "$t/$n.ncu.csv" 2>&1
-        rm -f "$t"/*.gpuframe "$t"/*.exr "$t/$n.ncu-rep"
+        ncu_config "$t" "$n.ncu" "$list" "$n" "--launch-skip 3 --launch-count 1" "$m" raw
     done
     { same_frames "$t" "$list" sa_n8_f4_c8 rows linear; same_frames "$t" "$list" vox_c64_r8_100k rows linear; } | tee "$t/same.txt"
 }
