@@ -60,11 +60,29 @@ enum class RayLaunch {
     rows     ///< the linear order as a 2D launch, which OptiX tiles onto warps and blocks
 };
 
+/// twin --shadow-rays: how restir's traceShadowRays traces.
+enum class ShadowRays {
+    trace,     ///< optixTrace (the pipeline)
+    traverse,  ///< optixTraverse and a hit object (inline-like)
+    reorder    ///< optixTraverse after optixReorder by the SER key
+};
+
+/// The options' names, the only place a name meets its value (CLI11 maps them; the outputs write them).
+const std::map<std::string, RayLaunch> kRayLaunchNames{{"texels", RayLaunch::texels}, {"linear", RayLaunch::linear}, {"rows", RayLaunch::rows}};
+const std::map<std::string, ShadowRays> kShadowRayNames{
+    {"trace", ShadowRays::trace}, {"traverse", ShadowRays::traverse}, {"reorder", ShadowRays::reorder}};
+template <class E>
+std::string nameOf(const std::map<std::string, E>& names, E value) {
+    for (const auto& [name, v] : names)
+        if (v == value) return name;
+    return "?";
+}
+
 struct Args {
     std::string scene;
     std::vector<std::string> defines;
     std::string frames, output, timings, config, programs = ACCRETION_TWIN_PROGRAMS;
-    std::string shadowRays = "trace";
+    ShadowRays shadowRays = ShadowRays::trace;
     RayLaunch rayLaunch = RayLaunch::texels;
     unsigned repeat = 5, buildStreams = 1, buildThreads = 1, seeds = 1;
     bool perBlas = false, compact = false, quiet = false, validation = false, skipLighting = false, lrOnly = false;
@@ -208,9 +226,7 @@ TwinRun::TwinRun(const Args& a, const Settings& settings)
                 !estimatorInfo(settings.render.estimator).reuse),
       lightingPlan_(planLighting(settings.render, H_)),
       omm_(settings.geometry.alpha == AlphaMode::disc && settings.gpu.omm != OmmMode::off) {
-    if (a.shadowRays == "traverse" || a.shadowRays == "reorder") shade_ = Raygen::shadeTraverse;
-    else if (a.shadowRays != "trace")
-        throw InputError(fmt::format("command line --shadow-rays {}: expected trace, traverse or reorder", a.shadowRays));
+    if (a.shadowRays != ShadowRays::trace) shade_ = Raygen::shadeTraverse;
     cudaDeviceProp prop{};
     CUDA_CHECK(cudaGetDeviceProperties(&prop, 0));
     device_ = prop.name;
@@ -383,7 +399,7 @@ LaunchParams TwinRun::launchParams(const FramePlan& plan, const Camera& camera, 
         rp.bias = rs.bias_correction;
         rp.visibilityReuse = rs.visibility_reuse;
         rp.discardNonFinite = s_.render.nonfinite == NonFinitePolicy::discard;
-        rp.reorder = a_.shadowRays == "reorder";
+        rp.reorder = a_.shadowRays == ShadowRays::reorder;
         rp.serHintBits = s_.gpu.ser_hint_bits;
         rp.rejected = buf_.rejected.as<std::uint32_t>();
         rp.particleCluster = buf_.particleCluster.as<std::uint32_t>();
@@ -790,7 +806,8 @@ void TwinRun::renderFrame(std::uint32_t frame, std::uint64_t seed) {
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     out.metadata = frameMetadata(s_, settingsToml_, frame, seed, "", wall);
     out.metadata.insert({{"lighting", a_.skipLighting ? "skipped" : std::string(enumName(s_.render.estimator))},
-                         {"shadow_rays", a_.shadowRays}, {"renderer", "accretion-optix"}, {"device", device_},
+                         {"shadow_rays", nameOf(kShadowRayNames, a_.shadowRays)}, {"ray_launch", nameOf(kRayLaunchNames, a_.rayLaunch)},
+                         {"renderer", "accretion-optix"}, {"device", device_},
                          {"tonemap", std::string(enumName(s_.render.tonemap))}});
     std::filesystem::path file = expandPattern(s_.render.output, s_.sceneName, frame);
     file = file.parent_path() /
@@ -864,18 +881,14 @@ int main(int argc, char** argv) {
     app.add_option("--programs", a.programs, "The OptiX-IR of programs.cu");
     app.add_option("--shadow-rays", a.shadowRays,
                    "restir's traceShadowRays: trace (optixTrace, pipeline), traverse (optixTraverse + hit object, "
-                   "inline-like) or reorder (traverse after optixReorder by the SER key: gpu.ser_hint_bits of the light's BLAS)");
-    app.add_option_function<std::string>(
-           "--ray-launch",
-           [&a](const std::string& v) {
-               using accretion::twin::RayLaunch;
-               a.rayLaunch = v == "linear" ? RayLaunch::linear : v == "rows" ? RayLaunch::rows : RayLaunch::texels;
-           },
+                   "inline-like) or reorder (traverse after optixReorder by the SER key: gpu.ser_hint_bits of the light's BLAS)")
+        ->transform(CLI::CheckedTransformer(accretion::twin::kShadowRayNames));
+    app.add_option("--ray-launch", a.rayLaunch,
            "The launches of a thread per ray of each item (updateVoxelCache's cells, shadeSplitTexels' texels), in one "
            "row: texels (a cell's rays side by side; a texel's near rays, then its far ones: the CPU's counting order; the "
            "default), linear (the same cells; a split ray of every texel, then the next); or rows (a 2D launch of the "
            "linear order, as OptiX tiles it)")
-        ->check(CLI::IsMember({"texels", "linear", "rows"}));
+        ->transform(CLI::CheckedTransformer(accretion::twin::kRayLaunchNames));
     app.add_option("--build-streams", a.buildStreams, "CUDA streams the BLAS builds are spread over (round robin)")
         ->check(CLI::Range(1, 64));
     app.add_option("--build-threads", a.buildThreads,
