@@ -99,6 +99,44 @@ TEST_CASE("particle_split: nearestLights on the light tree is the brute-force k 
     REQUIRE_FALSE(psplit::isNear(light, 9, 3));
 }
 
+TEST_CASE("particle_split: the near search's visitor sees each node it reads: all 2L - 1 when nothing can be pruned", "[particle_split]") {
+    // k above the other lights' count: the k-th distance never prunes, so
+    // the search reads every node of the tree once (L leaves, L - 1 inner
+    // nodes), its own leaf too.
+    const test::DiskLights few(ShadingModel::lambert, 10);
+    std::uint32_t light[psplit::kMaxNear];
+    float d2[psplit::kMaxNear];
+    std::uint32_t leaves = 0, inner = 0;
+    const auto count = [&](bool leaf) { ++(leaf ? leaves : inner); };
+    REQUIRE(psplit::nearestLights(few.tree.view(), few.particles.position[3], 3, few.tree.paths()[3], 64, light, d2, count) == 9);
+    CHECK(leaves == 10);
+    CHECK(inner == 9);
+    // 3000 lights, k = 16: pruned, yet every near light was a leaf it read.
+    const test::DiskLights d(ShadingModel::lambert, 3000);
+    for (std::uint32_t j = 0; j < d.particles.size(); j += 301) {
+        leaves = inner = 0;
+        REQUIRE(psplit::nearestLights(d.tree.view(), d.particles.position[j], j, d.tree.paths()[j], 16, light, d2, count) == 16);
+        CHECK(leaves >= 16);
+        CHECK(leaves + inner < 2 * 3000 - 1);
+    }
+}
+
+TEST_CASE("particle_split: findNearLights is counted as its search ran: a trip a node read", "[particle_split][gpu]") {
+    // 40 particles and 64 near lights: each visible particle's search reads
+    // all 2 x 40 - 1 nodes of the frame's light tree.
+    Settings s = splitSettings(ShadingModel::lambert, 40, 64, 1);
+    s.gpu.counters = true;
+    const Particles ps = ParticleSource(s).frame(0);
+    const FrameImage img = test::renderParticles(s, ps);
+    const auto near = std::find_if(img.counters.passes.begin(), img.counters.passes.end(),
+                                   [](const PassCounters& pc) { return pc.pass == Pass::findNearLights; });
+    REQUIRE(near != img.counters.passes.end());
+    std::set<std::uint32_t> visible(img.particle.begin(), img.particle.end());
+    visible.erase(kNoParticle);
+    REQUIRE(near->threads.size() == visible.size());
+    for (const ThreadCounters& t : near->threads) CHECK(t.trips == 2 * 40 - 1);
+}
+
 TEST_CASE("particle_split: FarImportance never takes out a node that holds a light outside the near lights' ball", "[particle_split]") {
     const test::DiskLights d(ShadingModel::lambert, 3000);
     const LightTreeView view = d.tree.view();

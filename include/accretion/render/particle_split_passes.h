@@ -92,6 +92,12 @@ inline SplitParams splitParams(const Settings& s, std::uint32_t visible, std::ui
     return p;
 }
 
+/// nearestLights' visitor by default: nothing (the passes' bodies; the CPU's
+/// counting runs the search again with one that records each node read).
+struct NoSearchVisit {
+    ACC_HD void operator()(bool /*leaf*/) const {}
+};
+
 /// The min(k, kMaxNear) lights nearest to x other than `self` on the light
 /// tree's nodes, nearest first (ties: the smaller index first), with their
 /// squared distances (each leaf's centre to x, as FarImportance measures
@@ -101,8 +107,11 @@ inline SplitParams splitParams(const Settings& s, std::uint32_t visible, std::ui
 /// lights are its spatial neighbours, so that the search from the root
 /// starts with a tight k-th distance and skips that subtree (x is self's
 /// position). Returns how many (fewer where the tree holds fewer).
+/// visit(leaf) is called on each node the search reads (a leaf, or an
+/// inner node and then its two children's bounds), not on the pruned ones.
+template <class Visit = NoSearchVisit>
 ACC_HD inline std::uint32_t nearestLights(const LightTreeView& tree, const Vec3& x, std::uint32_t self, std::uint64_t selfPath,
-                                          std::uint32_t k, std::uint32_t* light, float* d2) {
+                                          std::uint32_t k, std::uint32_t* light, float* d2, Visit visit = {}) {
     if (k > kMaxNear) k = kMaxNear;
     if (tree.nodeCount == 0 || k == 0) return 0;
     // A max-heap of the best so far on (d2, light).
@@ -157,6 +166,7 @@ ACC_HD inline std::uint32_t nearestLights(const LightTreeView& tree, const Vec3&
         }
         if (found == k && !(p.bound <= d2[0])) continue;
         const LightTreeNode& n = tree.nodes[p.node];
+        visit(n.count == 1);
         if (n.count == 1) {
             if (n.child == self) continue;
             const Vec3 delta = n.center - x;

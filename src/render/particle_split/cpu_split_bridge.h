@@ -56,16 +56,9 @@ public:
     }
     Vec3 particlePosition(std::uint32_t j) const { return f_.in.particles.position[j]; }
     std::uint64_t lightPath(std::uint32_t j) const { return f_.paths[j]; }
-    const LightTreeView& tree() {
-        if constexpr (Count) {  // a search visits about a node pair per level per near light's neighbourhood
-            const std::uint32_t levels = std::bit_width(std::max(1u, f_.L.count));
-            rec_.trip(levels + f_.params.nearCount);
-            rec_.gather(2 * (levels + f_.params.nearCount));
-            rec_.read(2 * (levels + f_.params.nearCount) * gpu_layout::kLightTreeNode);
-        }
-        return f_.tree;
-    }
+    const LightTreeView& tree() const { return f_.tree; }
     void writeNear(std::uint32_t v, const std::uint32_t* light, std::uint32_t count, float radius2) {
+        if constexpr (Count) countNearSearch(v);
         rec_.write(4 * (count + 2));
         const std::size_t base = std::size_t(v) * f_.params.nearCount;
         std::copy(light, light + count, f_.near.begin() + base);
@@ -164,6 +157,21 @@ public:
     }
 
 private:
+    /// Counting, slot v's near search as it ran: the same search again,
+    /// each node it reads a trip (a loop iteration, lanes diverging on
+    /// their search's length), a dependent read of the node and, for an
+    /// inner node, of its two children's bounds.
+    void countNearSearch(std::uint32_t v) {
+        const std::uint32_t j = f_.texels.particleOf[v];
+        std::uint32_t light[kMaxNear];
+        float d2[kMaxNear];
+        nearestLights(f_.tree, particlePosition(j), j, lightPath(j), f_.params.nearCount, light, d2, [this](bool leaf) {
+            rec_.trip();
+            rec_.gather(leaf ? 1 : 2);
+            rec_.read((leaf ? 1 : 3) * gpu_layout::kLightTreeNode);
+        });
+    }
+
     const CpuFrame& f_;
     Recorder<Count> rec_;
     LightingCounters& c_;
