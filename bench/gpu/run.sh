@@ -453,7 +453,8 @@ step_ncu() {
 
 # A change that must not move a GPU frame: the twin of the source tree in
 # .twin-deps/old (staged by `bash bench/gpu/stage_deps.sh SDK OLD_COMMIT`)
-# built beside this one, both run on every restir option the twin has, and
+# built beside this one, both run on every restir option the twin has and
+# on particle_split, particle_restir and the voxel cache, and
 # each pair of .gpuframe files compared plane by plane, byte for byte
 # (bench/gpu/gpuframe_equal.py: the metadata records the run and differs).
 step_identity() {
@@ -492,6 +493,11 @@ step_identity() {
 -D render.estimator="power" -D render.samples=8 -D geometry.alpha="disc"
 -D render.estimator="uniform" -D render.samples=4 -D render.target_stderr=0.05 -D render.max_samples=16
 -D particles.gm=0 -D camera.path="static"
+-D render.estimator="particle_split" -D particle_split.near=8 -D particle_split.far=4 -D particle_split.candidates=8 -D particle_split.history=0.75
+-D render.estimator="particle_split" -D particle_split.near=16 -D particle_split.far=8 -D particle_split.candidates=8 -D particle_split.texels=2
+-D render.estimator="particle_restir" -D render.source="tree" -D restir.texel_rays=4 -D restir.spatial_neighbours=5 -D restir.bias_correction="pairwise"
+-D render.estimator="particle_restir" -D render.source="tree" -D restir.texel_rays=4 -D restir.spatial_neighbours=0 -D restir.pixel_shading="resample"
+-D render.estimator="voxel_cache" -D render.source="tree" -D voxel.cells=32 -D voxel.rays=8 -D voxel.basis="camera"
 CONFIGS
     rm -f "$t"/*.gpuframe
     return $differ
