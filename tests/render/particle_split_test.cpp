@@ -106,15 +106,23 @@ TEST_CASE("particle_split: the near search's visitor sees each node it reads: al
     const test::DiskLights few(ShadingModel::lambert, 10);
     std::uint32_t light[psplit::kMaxNear];
     float d2[psplit::kMaxNear];
-    std::uint32_t leaves = 0, inner = 0;
-    const auto count = [&](bool leaf) { ++(leaf ? leaves : inner); };
+    std::uint32_t leaves = 0, inner = 0, sifts = 0;
+    const auto count = [&](psplit::SearchStep step) {
+        ++(step == psplit::SearchStep::leaf ? leaves : step == psplit::SearchStep::inner ? inner : sifts);
+    };
     REQUIRE(psplit::nearestLights(few.tree.view(), few.particles.position[3], 3, few.tree.paths()[3], 64, light, d2, count) == 9);
     CHECK(leaves == 10);
     CHECK(inner == 9);
+    CHECK(sifts > 0);
+    // One near light: a heap of one entry never swaps.
+    leaves = inner = sifts = 0;
+    REQUIRE(psplit::nearestLights(few.tree.view(), few.particles.position[3], 3, few.tree.paths()[3], 1, light, d2, count) == 1);
+    CHECK(sifts == 0);
+    CHECK(leaves >= 1);
     // 3000 lights, k = 16: pruned, yet every near light was a leaf it read.
     const test::DiskLights d(ShadingModel::lambert, 3000);
     for (std::uint32_t j = 0; j < d.particles.size(); j += 301) {
-        leaves = inner = 0;
+        leaves = inner = sifts = 0;
         REQUIRE(psplit::nearestLights(d.tree.view(), d.particles.position[j], j, d.tree.paths()[j], 16, light, d2, count) == 16);
         CHECK(leaves >= 16);
         CHECK(leaves + inner < 2 * 3000 - 1);
@@ -123,7 +131,9 @@ TEST_CASE("particle_split: the near search's visitor sees each node it reads: al
 
 TEST_CASE("particle_split: findNearLights is counted as its search ran: a trip a node read", "[particle_split][gpu]") {
     // 40 particles and 64 near lights: each visible particle's search reads
-    // all 2 x 40 - 1 nodes of the frame's light tree.
+    // all 2 x 40 - 1 nodes of the frame's light tree (a trip each), plus a
+    // trip per swap of its heap, which the same search over the same
+    // particles' tree reports to a visitor of the test's.
     Settings s = splitSettings(ShadingModel::lambert, 40, 64, 1);
     s.gpu.counters = true;
     const Particles ps = ParticleSource(s).frame(0);
@@ -134,7 +144,22 @@ TEST_CASE("particle_split: findNearLights is counted as its search ran: a trip a
     std::set<std::uint32_t> visible(img.particle.begin(), img.particle.end());
     visible.erase(kNoParticle);
     REQUIRE(near->threads.size() == visible.size());
-    for (const ThreadCounters& t : near->threads) CHECK(t.trips == 2 * 40 - 1);
+    const test::DiskLights same(ShadingModel::lambert, 40);
+    REQUIRE(same.particles.position == ps.position);
+    const std::vector<std::uint64_t> paths = same.tree.paths();
+    std::vector<std::uint32_t> expected, counted;
+    for (const std::uint32_t j : visible) {
+        std::uint32_t light[psplit::kMaxNear], reads = 0, sifts = 0;
+        float d2[psplit::kMaxNear];
+        psplit::nearestLights(same.tree.view(), ps.position[j], j, paths[j], 64, light, d2,
+                              [&](psplit::SearchStep step) { ++(step == psplit::SearchStep::sift ? sifts : reads); });
+        REQUIRE(reads == 2 * 40 - 1);
+        expected.push_back(reads + sifts);
+    }
+    for (const ThreadCounters& t : near->threads) counted.push_back(t.trips);
+    std::sort(expected.begin(), expected.end());
+    std::sort(counted.begin(), counted.end());
+    CHECK(counted == expected);
 }
 
 TEST_CASE("particle_split: FarImportance never takes out a node that holds a light outside the near lights' ball", "[particle_split]") {

@@ -92,10 +92,15 @@ inline SplitParams splitParams(const Settings& s, std::uint32_t visible, std::ui
     return p;
 }
 
+/// A step of nearestLights' search, as its visitor sees it: an inner node
+/// read (and its two children's bounds), a leaf read, or one swap of the
+/// heap of the k best (sifting an entry up or down, or sorting it at the end).
+enum class SearchStep : std::uint8_t { inner, leaf, sift };
+
 /// nearestLights' visitor by default: nothing (the passes' bodies; the CPU's
-/// counting runs the search again with one that records each node read).
+/// counting runs the search again with one that records each step).
 struct NoSearchVisit {
-    ACC_HD void operator()(bool /*leaf*/) const {}
+    ACC_HD void operator()(SearchStep) const {}
 };
 
 /// The min(k, kMaxNear) lights nearest to x other than `self` on the light
@@ -107,8 +112,8 @@ struct NoSearchVisit {
 /// lights are its spatial neighbours, so that the search from the root
 /// starts with a tight k-th distance and skips that subtree (x is self's
 /// position). Returns how many (fewer where the tree holds fewer).
-/// visit(leaf) is called on each node the search reads (a leaf, or an
-/// inner node and then its two children's bounds), not on the pruned ones.
+/// visit(step) is called on each node the search reads (not on the pruned
+/// ones) and on each swap of its heap.
 template <class Visit = NoSearchVisit>
 ACC_HD inline std::uint32_t nearestLights(const LightTreeView& tree, const Vec3& x, std::uint32_t self, std::uint64_t selfPath,
                                           std::uint32_t k, std::uint32_t* light, float* d2, Visit visit = {}) {
@@ -120,6 +125,7 @@ ACC_HD inline std::uint32_t nearestLights(const LightTreeView& tree, const Vec3&
         return d2[a] > d2[b] || (d2[a] == d2[b] && light[a] > light[b]);
     };
     const auto swapEntries = [&](std::uint32_t a, std::uint32_t b) {
+        visit(SearchStep::sift);
         const float t = d2[a];
         d2[a] = d2[b];
         d2[b] = t;
@@ -166,7 +172,7 @@ ACC_HD inline std::uint32_t nearestLights(const LightTreeView& tree, const Vec3&
         }
         if (found == k && !(p.bound <= d2[0])) continue;
         const LightTreeNode& n = tree.nodes[p.node];
-        visit(n.count == 1);
+        visit(n.count == 1 ? SearchStep::leaf : SearchStep::inner);
         if (n.count == 1) {
             if (n.child == self) continue;
             const Vec3 delta = n.center - x;

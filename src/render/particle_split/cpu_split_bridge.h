@@ -158,15 +158,18 @@ public:
 
 private:
     /// Counting, slot v's near search as it ran: the same search again,
-    /// each node it reads a trip (a loop iteration, lanes diverging on
-    /// their search's length), a dependent read of the node and, for an
-    /// inner node, of its two children's bounds.
+    /// each step a trip (a loop iteration, lanes diverging on their
+    /// search's length); a node read is a dependent read of the node and,
+    /// for an inner node, of its two children's bounds; a swap of the heap
+    /// of the k best is in the thread's own (local) memory.
     void countNearSearch(std::uint32_t v) {
         const std::uint32_t j = f_.texels.particleOf[v];
         std::uint32_t light[kMaxNear];
         float d2[kMaxNear];
-        nearestLights(f_.tree, particlePosition(j), j, lightPath(j), f_.params.nearCount, light, d2, [this](bool leaf) {
+        nearestLights(f_.tree, particlePosition(j), j, lightPath(j), f_.params.nearCount, light, d2, [this](SearchStep step) {
             rec_.trip();
+            if (step == SearchStep::sift) return;
+            const bool leaf = step == SearchStep::leaf;
             rec_.gather(leaf ? 1 : 2);
             rec_.read((leaf ? 1 : 3) * gpu_layout::kLightTreeNode);
         });
