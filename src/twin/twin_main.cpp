@@ -50,7 +50,6 @@
 #endif
 
 namespace accretion::twin {
-namespace {
 
 /// twin --ray-launch: the threads of a launch of a thread per ray of each
 /// item (updateVoxelCache's cells, shadeSplitTexels' texels).
@@ -67,15 +66,22 @@ enum class ShadowRays {
     reorder    ///< optixTraverse after optixReorder by the SER key
 };
 
-/// The options' names, the only place a name meets its value (CLI11 maps them; the outputs write them).
-const std::map<std::string, RayLaunch> kRayLaunchNames{{"texels", RayLaunch::texels}, {"linear", RayLaunch::linear}, {"rows", RayLaunch::rows}};
-const std::map<std::string, ShadowRays> kShadowRayNames{
-    {"trace", ShadowRays::trace}, {"traverse", ShadowRays::traverse}, {"reorder", ShadowRays::reorder}};
+}  // namespace accretion::twin
+
+namespace accretion {
+ACC_ENUM_NAMES(twin::RayLaunch, "texels", "linear", "rows");
+ACC_ENUM_NAMES(twin::ShadowRays, "trace", "traverse", "reorder");
+}  // namespace accretion
+
+namespace accretion::twin {
+namespace {
+
+/// An option naming a value of E (its names: ACC_ENUM_NAMES), refused unless it is one, read by parseEnum.
 template <class E>
-std::string nameOf(const std::map<std::string, E>& names, E value) {
-    for (const auto& [name, v] : names)
-        if (v == value) return name;
-    return "?";
+CLI::Option* addEnumOption(CLI::App& app, const std::string& name, E& out, const std::string& doc) {
+    const auto& names = EnumNames<E>::names;
+    return app.add_option_function<std::string>(name, [&out](const std::string& v) { parseEnum(v, out); }, doc)
+        ->check(CLI::IsMember(std::vector<std::string>(names.begin(), names.end())));
 }
 
 struct Args {
@@ -806,7 +812,7 @@ void TwinRun::renderFrame(std::uint32_t frame, std::uint64_t seed) {
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     out.metadata = frameMetadata(s_, settingsToml_, frame, seed, "", wall);
     out.metadata.insert({{"lighting", a_.skipLighting ? "skipped" : std::string(enumName(s_.render.estimator))},
-                         {"shadow_rays", nameOf(kShadowRayNames, a_.shadowRays)}, {"ray_launch", nameOf(kRayLaunchNames, a_.rayLaunch)},
+                         {"shadow_rays", std::string(enumName(a_.shadowRays))}, {"ray_launch", std::string(enumName(a_.rayLaunch))},
                          {"renderer", "accretion-optix"}, {"device", device_},
                          {"tonemap", std::string(enumName(s_.render.tonemap))}});
     std::filesystem::path file = expandPattern(s_.render.output, s_.sceneName, frame);
@@ -879,16 +885,14 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(1, 100000));
     app.add_option("--config", a.config, "Configuration name of the timings rows");
     app.add_option("--programs", a.programs, "The OptiX-IR of programs.cu");
-    app.add_option("--shadow-rays", a.shadowRays,
+    accretion::twin::addEnumOption(app, "--shadow-rays", a.shadowRays,
                    "restir's traceShadowRays: trace (optixTrace, pipeline), traverse (optixTraverse + hit object, "
-                   "inline-like) or reorder (traverse after optixReorder by the SER key: gpu.ser_hint_bits of the light's BLAS)")
-        ->transform(CLI::CheckedTransformer(accretion::twin::kShadowRayNames));
-    app.add_option("--ray-launch", a.rayLaunch,
+                   "inline-like) or reorder (traverse after optixReorder by the SER key: gpu.ser_hint_bits of the light's BLAS)");
+    accretion::twin::addEnumOption(app, "--ray-launch", a.rayLaunch,
            "The launches of a thread per ray of each item (updateVoxelCache's cells, shadeSplitTexels' texels), in one "
            "row: texels (a cell's rays side by side; a texel's near rays, then its far ones: the CPU's counting order; the "
            "default), linear (the same cells; a split ray of every texel, then the next); or rows (a 2D launch of the "
-           "linear order, as OptiX tiles it)")
-        ->transform(CLI::CheckedTransformer(accretion::twin::kRayLaunchNames));
+           "linear order, as OptiX tiles it)");
     app.add_option("--build-streams", a.buildStreams, "CUDA streams the BLAS builds are spread over (round robin)")
         ->check(CLI::Range(1, 64));
     app.add_option("--build-threads", a.buildThreads,

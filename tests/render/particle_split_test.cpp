@@ -129,7 +129,7 @@ TEST_CASE("particle_split: the near search's visitor sees each node it reads: al
     }
 }
 
-TEST_CASE("particle_split: findNearLights is counted as its search ran: a trip a node read", "[particle_split][gpu]") {
+TEST_CASE("particle_split: findNearLights is counted as its search ran: a trip a node read and a heap swap", "[particle_split][gpu]") {
     // 40 particles and 64 near lights: each visible particle's search reads
     // all 2 x 40 - 1 nodes of the frame's light tree (a trip each), plus a
     // trip per swap of its heap, which the same search over the same
