@@ -59,7 +59,8 @@ void planPasses(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
     plan.spatialIterations = plan.restir && s.restir.spatial_neighbours > 0 ? s.restir.spatial_iterations : 0;
     plan.upsample = plan.restir && float(s.restir.resolution_scale) < 1.0f;
     plan.particleTexels = plan.restir && s.render.estimator == EstimatorKind::particle_restir;
-    plan.traceShadowRays = plan.restir && (!plan.particleTexels || s.restir.pixel_shading == PixelShading::interpolate ||
+    plan.resamplePixels = plan.particleTexels && s.restir.pixel_shading == PixelShading::resample;
+    plan.traceShadowRays = plan.restir && (!plan.particleTexels || !plan.resamplePixels ||
                                            (s.restir.visibility_reuse && plan.shadowRays));
     plan.texelHistory = plan.particleTexels && plan.temporal && s.restir.pixel_shading == PixelShading::interpolate &&
                         s.restir.texel_history > 0.0;
@@ -144,17 +145,16 @@ void describe(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
             step(Pass::spatialResampling, neighbours);
         step(Pass::traceShadowRays,
              dark ? noLight
-             : !plan.traceShadowRays ? "pixel_shading resample: each pixel traces its own (shadeParticlePixels), the texels none"
+             : !plan.traceShadowRays ? "pixel_shading resample: each pixel traces its own (resampleParticlePixels), the texels none"
              : plan.shadowRays ? (particles ? fmt::format("one shadow ray per particle texel and reservoir{}",
                                                           plan.texelHistory ? fmt::format(", Lr averaged with last frame's (h = {})", r.texel_history) : "")
                                             : "one shadow ray per pixel")
                                : "visibility off: the kept sample shaded with V = 1, no shadow rays");
-        if (particles)
-            step(Pass::shadeParticlePixels,
-                 dark ? noLight
-                 : r.pixel_shading == PixelShading::interpolate
-                     ? "interpolate: bilinear over the pixel's particle's texels' Lr (biased)"
-                     : "resample: the particle's bilinear texels' samples at the pixel's point, its own shadow ray (unbiased)");
+        if (particles && !plan.resamplePixels)
+            step(Pass::shadeParticlePixels, dark ? noLight : "interpolate: bilinear over the pixel's particle's texels' Lr (biased)");
+        else if (particles)
+            step(Pass::resampleParticlePixels,
+                 dark ? noLight : "resample: the particle's bilinear texels' samples at the pixel's point, its own shadow ray (unbiased)");
         step(Pass::upsampleLighting,
              plan.upsample ? fmt::format("lighting at scale {}", s.restir.resolution_scale) : "full-resolution lighting");
     } else if (estimatorInfo(est).passes == LightingPasses::particleSplit) {
@@ -238,7 +238,8 @@ bool FramePlan::runs(Pass pass) const {
     case Pass::resampleWorldNeighbours: return spatialIterations > 0 && particleTexels;
     case Pass::gatherParticleTexels: return particleTexels || particleSplit;
     case Pass::traceShadowRays: return traceShadowRays;
-    case Pass::shadeParticlePixels: return particleTexels || particleSplit;
+    case Pass::shadeParticlePixels: return (particleTexels && !resamplePixels) || particleSplit;
+    case Pass::resampleParticlePixels: return resamplePixels;
     case Pass::updateVoxelCache: return voxelCache;
     case Pass::shadeVoxelPixels: return voxelCache;
     case Pass::findNearLights: return particleSplit;

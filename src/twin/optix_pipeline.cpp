@@ -84,7 +84,7 @@ void TwinPipeline::createProgramGroups(AccelLayout layout, bool spheres) {
         return g;
     };
     const char* raygenNames[] = {"__raygen__gbuffer", "__raygen__exact", "__raygen__sample", "__raygen__shade",
-                                 "__raygen__shadeTraverse", "__raygen__shadeParticlePixels", "__raygen__updateVoxelCache",
+                                 "__raygen__shadeTraverse", "__raygen__resampleParticlePixels", "__raygen__updateVoxelCache",
                                  "__raygen__shadeSplitTexels"};
     static_assert(std::size(raygenNames) == std::size_t(Raygen::count), "a name for every raygen");
     for (int r = 0; r < int(Raygen::count); ++r) {

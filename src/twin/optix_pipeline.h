@@ -17,7 +17,7 @@ namespace accretion::twin {
 /// traceShadowRays with optixTrace (pipeline); shadeTraverse: the same with
 /// optixTraverse and a hit object (the inline-like path), optionally after
 /// optixReorder (SER).
-enum class Raygen { gbuffer, exact, sample, shade, shadeTraverse, shadeParticlePixels, updateVoxelCache, shadeSplitTexels, count };
+enum class Raygen { gbuffer, exact, sample, shade, shadeTraverse, resampleParticlePixels, updateVoxelCache, shadeSplitTexels, count };
 
 class TwinPipeline {
 public:

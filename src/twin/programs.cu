@@ -200,7 +200,7 @@ __device__ void shade() {
     }
 }
 
-/// particle_restir's shadeParticlePixels, resample: the pixel resamples its
+/// particle_restir's resampleParticlePixels (restir.pixel_shading resample): the pixel resamples its
 /// particle's texels (restir.in) at its own point and traces its own shadow ray.
 template <ShadingModel SM>
 __device__ void resampleParticlePixel() {
@@ -268,7 +268,7 @@ extern "C" __global__ void __raygen__shadeSplitTexels() {
     }
 }
 
-extern "C" __global__ void __raygen__shadeParticlePixels() {
+extern "C" __global__ void __raygen__resampleParticlePixels() {
     switch (params.model) {
     case ShadingModel::lambert: resampleParticlePixel<ShadingModel::lambert>(); break;
     case ShadingModel::sphere: resampleParticlePixel<ShadingModel::sphere>(); break;

@@ -66,7 +66,7 @@ __global__ void accumulateTexelLrKernel(const __grid_constant__ LaunchParams p) 
     onTexel<SM>(p, [&](auto& b, std::size_t px, std::uint32_t, std::uint32_t) { restir::accumulateTexelLr(b, px); });
 }
 
-/// shadeParticlePixels, interpolate: one thread per image pixel.
+/// shadeParticlePixels (restir.pixel_shading interpolate): one thread per image pixel.
 template <ShadingModel SM>
 __global__ void interpolatePixelsKernel(const __grid_constant__ LaunchParams p) {
     const std::uint32_t x = blockIdx.x * blockDim.x + threadIdx.x, y = blockIdx.y * blockDim.y + threadIdx.y;

@@ -14,8 +14,8 @@ void temporalResampling(const LaunchParams& p, cudaStream_t stream);
 void spatialResampling(const LaunchParams& p, std::uint32_t iteration, cudaStream_t stream);
 /// particle_restir on the texels (p.restir's grid): temporal reuse by id,
 /// spatial reuse among world neighbours, restir.texel_history's average;
-/// and shadeParticlePixels' interpolate over the image (resample is the
-/// raygen shadeParticlePixels: it traces).
+/// and shadeParticlePixels' interpolation over the image (resample is the
+/// raygen resampleParticlePixels: it traces).
 void temporalResamplingById(const LaunchParams& p, cudaStream_t stream);
 void resampleWorldNeighbours(const LaunchParams& p, std::uint32_t iteration, cudaStream_t stream);
 void accumulateTexelLr(const LaunchParams& p, cudaStream_t stream);

@@ -591,15 +591,15 @@ StoredReservoir* TwinRun::runRestir(const FramePlan& plan, LaunchParams& lp) {
         if (plan.texelHistory) accumulateTexelLr(lp, stream_);
     }
     if (plan.particleTexels) {  // the pixels from their particles' texels
-        GpuScope t(timer, Pass::shadeParticlePixels);
+        GpuScope t(timer, plan.resamplePixels ? Pass::resampleParticlePixels : Pass::shadeParticlePixels);
         rp.in = a;
-        if (s_.restir.pixel_shading == PixelShading::interpolate) {
+        if (!plan.resamplePixels) {
             interpolatePixels(lp, stream_);
         } else {
             const BiasCorrection chain = rp.bias;  // no canonical sample at the pixel: basic for pairwise (the CPU's rule)
             if (rp.bias == BiasCorrection::pairwise) rp.bias = BiasCorrection::basic;
             CUDA_CHECK(cudaMemcpyAsync(buf_.params.as<void>(), &lp, sizeof lp, cudaMemcpyHostToDevice, stream_));
-            pipeline_->launch(Raygen::shadeParticlePixels, buf_.params.address(), sizeof lp, W_, H_, stream_);
+            pipeline_->launch(Raygen::resampleParticlePixels, buf_.params.address(), sizeof lp, W_, H_, stream_);
             rp.bias = chain;
         }
     }

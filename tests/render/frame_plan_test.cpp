@@ -2,6 +2,7 @@
 // skipped work really is not done (no shadow rays, no any-hit calls, one BVH
 // build for a static scene, no history for one frame, no lighting for albedo 0).
 #include <algorithm>
+#include <map>
 
 #include <catch2/catch.hpp>
 
@@ -182,6 +183,11 @@ TEST_CASE("the plan is the frame: every frame's timed passes are exactly the pla
              s.restir.spatial_neighbours = 3;
              s.restir.spatial_iterations = 2;
          }},
+        {"particle_restir, pixels resampled",
+         [](Settings& s) {
+             s.render.estimator = EstimatorKind::particle_restir;
+             s.restir.pixel_shading = PixelShading::resample;
+         }},
         {"voxel_cache", [](Settings& s) { s.render.estimator = EstimatorKind::voxel_cache; s.render.source = LightSource::tree; }},
         {"particle_split", [](Settings& s) { s.render.estimator = EstimatorKind::particle_split; }},
     };
@@ -212,6 +218,30 @@ TEST_CASE("the plan is the frame: every frame's timed passes are exactly the pla
     const FramePlan pixels = planFrame(w, FrameFacts{false, true, true});
     CHECK(pixels.runs(Pass::spatialResampling));
     CHECK_FALSE(pixels.runs(Pass::resampleWorldNeighbours));
+    // particle_restir's pixels interpolate (shadeParticlePixels, after the
+    // texels' shadow rays) or resample and trace (resampleParticlePixels, the
+    // texels tracing none): one pass or the other, and the rays where they are traced.
+    for (const PixelShading shading : {PixelShading::interpolate, PixelShading::resample}) {
+        Settings p = small();
+        p.render.estimator = EstimatorKind::particle_restir;
+        p.restir.pixel_shading = shading;
+        p.gpu.counters = true;
+        const bool resample = shading == PixelShading::resample;
+        INFO(enumName(shading));
+        FrameRenderer r(p, ParticleSource(p), RenderOptions{true});
+        FrameStats fs;
+        const FrameImage img = r.render(0, fs);
+        CHECK(r.plan().runs(Pass::resampleParticlePixels) == resample);
+        CHECK(r.plan().runs(Pass::shadeParticlePixels) == !resample);
+        CHECK(r.plan().runs(Pass::traceShadowRays) == !resample);
+        std::map<Pass, std::uint64_t> rays;
+        for (const PassCounters& c : img.counters.passes)
+            for (const ThreadCounters& t : c.threads) rays[c.pass] += t.rays;
+        CHECK(rays.contains(Pass::resampleParticlePixels) == resample);
+        CHECK(rays.contains(Pass::shadeParticlePixels) == !resample);
+        CHECK(rays[resample ? Pass::resampleParticlePixels : Pass::traceShadowRays] > 0);
+        CHECK(rays[Pass::shadeParticlePixels] == 0);
+    }
     // And the plan says what it skips: frame 0 of restir has no history yet, frame 1 does.
     Settings s = small();
     s.render.estimator = EstimatorKind::restir;

@@ -68,9 +68,13 @@ struct FramePlan {
     bool temporal = false;        ///< temporalResampling
     std::uint32_t spatialIterations = 0;  ///< spatialResampling runs
     bool upsample = false;        ///< upsampleLighting (restir at reduced resolution)
-    /// particle_restir: gatherParticleTexels and shadeParticlePixels around
-    /// the reservoir passes, which run on the texels.
+    /// particle_restir: gatherParticleTexels and shadeParticlePixels (or
+    /// resampleParticlePixels) around the reservoir passes, which run on the texels.
     bool particleTexels = false;
+    /// particle_restir with restir.pixel_shading resample: resampleParticlePixels
+    /// (the pixel resamples its particle's texels' samples and traces its own
+    /// shadow ray) instead of shadeParticlePixels' interpolation.
+    bool resamplePixels = false;
     /// traceShadowRays runs: restir's pixels, particle_restir's texels when
     /// the pixels interpolate their Lr (or visibility reuse needs their V).
     bool traceShadowRays = false;

@@ -117,7 +117,7 @@ ACC_HD std::uint32_t pixelTexels(const B& b, const GBufferTexel& g, std::size_t 
     return texelStencil(b.pixelUv(g), p.texelSide, p.texelLayers, std::size_t(b.slotOf(g.particle)) * p.texelsPerParticle(), q, w);
 }
 
-/// shadeParticlePixels' start at pixel px showing g: Lr = 0 written, and
+/// shadeParticlePixels' and resampleParticlePixels' start at pixel px showing g: Lr = 0 written, and
 /// for a hit the texels it reads (pixelTexels); returns how many (0 on a miss).
 template <class B, class Rec>
 ACC_HD_BODY std::uint32_t beginPixel(B& b, std::size_t px, const GBufferTexel& g, Rec& rec, std::size_t q[kMaxPixelOffers],
@@ -127,7 +127,7 @@ ACC_HD_BODY std::uint32_t beginPixel(B& b, std::size_t px, const GBufferTexel& g
     return g.hit() ? pixelTexels(b, g, q, w) : 0u;
 }
 
-/// shadeParticlePixels, interpolate: the pixel's Lr is its particle's
+/// shadeParticlePixels (restir.pixel_shading interpolate): the pixel's Lr is its particle's
 /// texels' Lr, bilinear at its uv and averaged over the layers (biased: the
 /// light at the texels, not at the pixel's point).
 template <class B>
@@ -145,7 +145,7 @@ ACC_HD_BODY void interpolatePixel(B& b, std::size_t px) {
     b.writePixelLr(px, Lr);
 }
 
-/// shadeParticlePixels, resample: the pixel resamples the samples of its
+/// resampleParticlePixels (restir.pixel_shading resample): the pixel resamples the samples of its
 /// particle's texels (those interpolate would read) at its own point, each
 /// weighed p_hat_pixel(y) W M, normalised by the M of the texels whose own
 /// target could produce the kept sample (basic), and traces its own shadow

@@ -34,16 +34,18 @@ LightingCounters accumulateTexelLr(const FrameContext& f, std::vector<Vec3>& tex
     });
 }
 
-/// The pixels from their particles' texels (restir.pixel_shading).
-LightingCounters shadeParticlePixels(const FrameContext& f, const std::vector<StoredReservoir>& texelReservoirs,
-                                     const std::vector<Vec3>& texelLr, std::vector<Vec3>& Lr) {
-    const bool resample = f.rs.pixel_shading == PixelShading::resample;
+LightingCounters shadeParticlePixels(const FrameContext& f, const std::vector<Vec3>& texelLr, std::vector<Vec3>& Lr) {
     return dispatchKernel(f, [&]<ShadingModel SM, Primitive P, bool Count>() {
-        return forEachTexel<SM, P, Count>(f, Pass::shadeParticlePixels, CpuBuffers{&texelReservoirs, nullptr, &Lr, &texelLr},
-                                          [&](auto& b, std::size_t px, std::uint32_t, std::uint32_t) {
-                                              if (resample) resamplePixel(b, px);
-                                              else interpolatePixel(b, px);
-                                          });
+        return forEachTexel<SM, P, Count>(f, Pass::shadeParticlePixels, CpuBuffers{nullptr, nullptr, &Lr, &texelLr},
+                                          [&](auto& b, std::size_t px, std::uint32_t, std::uint32_t) { interpolatePixel(b, px); });
+    });
+}
+
+LightingCounters resampleParticlePixels(const FrameContext& f, const std::vector<StoredReservoir>& texelReservoirs,
+                                        std::vector<Vec3>& Lr) {
+    return dispatchKernel(f, [&]<ShadingModel SM, Primitive P, bool Count>() {
+        return forEachTexel<SM, P, Count>(f, Pass::resampleParticlePixels, CpuBuffers{&texelReservoirs, nullptr, &Lr, nullptr},
+                                          [&](auto& b, std::size_t px, std::uint32_t, std::uint32_t) { resamplePixel(b, px); });
     });
 }
 

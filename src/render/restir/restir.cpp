@@ -221,16 +221,17 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
     LightingCounters counters = runPasses(f, a, b, lowLr, timer, rejected, reuse, traced);
 
     if (plan.particleTexels) {  // the pixels from their particles' texels, each as restir keys a pixel
-        auto t = timer.scope(Pass::shadeParticlePixels);
+        const Pass pass = plan.resamplePixels ? Pass::resampleParticlePixels : Pass::shadeParticlePixels;
+        auto t = timer.scope(pass);
         RestirSettings pixelRs = rs_;  // no canonical sample at the pixel: pairwise MIS has nothing to weigh against
         if (pixelRs.bias_correction == BiasCorrection::pairwise) pixelRs.bias_correction = BiasCorrection::basic;
         std::vector<std::uint32_t> pixelRejected(pixels, 0);
         restir::FrameContext fp{in, pixelRs, codec_, full, L, prev, 1.0f, f.vis, plan.shadowRays, in.counters, pixelRejected.data()};
         fp.texels = &texels;
         if (in.camera.isWindow()) keyByWholeGrid(fp, in.camera, 1.0f, in.camera.imageWidth);
-        const LightingCounters c = restir::shadeParticlePixels(fp, a, lowLr, out.Lr);
+        const LightingCounters c = plan.resamplePixels ? restir::resampleParticlePixels(fp, a, out.Lr) : restir::shadeParticlePixels(fp, lowLr, out.Lr);
         counters += c;
-        if (c.nonFinite) rejected[Pass::shadeParticlePixels] += c.nonFinite;
+        if (c.nonFinite) rejected[pass] += c.nonFinite;
         writeTexelAovs(full, texels, a, pixelRejected, lowRejected, out, aov);
     } else if (!plan.upsample) {
         out.Lr = lowLr;

@@ -103,7 +103,7 @@ struct FrameContext {
     const LightTiles* tiles = nullptr;  ///< render.source tiles or regir: this frame's presampled tiles
     const RegirGrid* regir = nullptr;   ///< render.source regir: this frame's grid
     /// particle_restir: this frame's particle texels (lg is their grid, or
-    /// the image's G-buffer in shadeParticlePixels).
+    /// the image's G-buffer in shadeParticlePixels and resampleParticlePixels).
     const ParticleTexels* texels = nullptr;
 
     /// Count a non-finite value at px; true if the policy discards the reservoir.
@@ -173,8 +173,12 @@ LightingCounters resampleWorldNeighbours(const FrameContext& f, std::uint32_t it
                                         std::vector<StoredReservoir>& out);
 /// restir.texel_history: each texel's Lr averaged with its own last frame's (in place).
 LightingCounters accumulateTexelLr(const FrameContext& f, std::vector<Vec3>& texelLr);
-LightingCounters shadeParticlePixels(const FrameContext& f, const std::vector<StoredReservoir>& texelReservoirs,
-                                     const std::vector<Vec3>& texelLr, std::vector<Vec3>& Lr);
+/// restir.pixel_shading interpolate: each pixel its particle's texels' Lr, bilinear.
+LightingCounters shadeParticlePixels(const FrameContext& f, const std::vector<Vec3>& texelLr, std::vector<Vec3>& Lr);
+/// restir.pixel_shading resample: each pixel resamples its particle's texels'
+/// samples at its own point and traces its own shadow ray.
+LightingCounters resampleParticlePixels(const FrameContext& f, const std::vector<StoredReservoir>& texelReservoirs,
+                                        std::vector<Vec3>& Lr);
 void upsampleLighting(const GBuffer& full, const GBuffer& lg, const Particles& particles, const std::vector<Vec3>& lowLr,
                       float scale, const RestirSettings& rs, std::vector<Vec3>& Lr);
 /// Counting mode: upsampleLighting's per-pixel work.
