@@ -1,7 +1,7 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine, from the repository root:
 #   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
-#                                      layout_images layouts streams front identity shared_core ab designs voxels splits iterations split_anatomy split_ncu split_stalls ray_launch split_order
+#                                      layout_images layouts streams front identity shared_core ab designs resample voxels splits iterations split_anatomy split_ncu split_stalls ray_launch split_order
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -275,6 +275,18 @@ step_designs() {
     # The flattened cluster from raw buffers (made here: they are not committed).
     python3 scenes/cluster/make_cluster.py 3
     time_configs designs/cluster bench/gpu/designs_cluster.txt 5 1/1 scenes/cluster_150k.toml
+}
+
+# particle_restir's resample variant, resampleParticlePixels since aaf54f8
+# (it had been timed as shadeParticlePixels): designs.txt's and
+# designs_cluster.txt's prt_*_resample lines timed again, beside the
+# interpolating prt_m8_k4 at 100K and on the cluster timed in the same run.
+step_resample() {
+    grep -E '^prt_[a-z0-9_]*resample_(100k|1m) |^prt_m8_k4_100k ' bench/gpu/designs.txt > "$W/resample.txt"
+    time_configs resample "$W/resample.txt" 5
+    python3 scenes/cluster/make_cluster.py 3
+    grep -E '^prt_m8_k4(_resample)?_cluster ' bench/gpu/designs_cluster.txt > "$W/resample_cluster.txt"
+    time_configs resample/cluster "$W/resample_cluster.txt" 5 1/1 scenes/cluster_150k.toml
 }
 
 # seed 004's voxel radiance cache (designs.txt's vox_ lines, 100K and 1M at
