@@ -19,11 +19,7 @@ mkdir -p "$out"
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 { cat "${SWEEP_TIMINGS:-bench/gpu/results/sweep_timings_d37668c.csv}"
-  python3 -c '
-import csv
-for r in csv.DictReader(open("bench/gpu/results/designs.csv")):
-    if "H100" in r["gpu"] and r["pass"] != "frame" and r["config"].endswith(("_100k", "_cluster")):
-        print(",".join((r["config"], r["pass"], r["ms"])))'
+  python3 bench/gpu/designs_timings.py '_(100k|cluster)$'
 } > "$T/timings.csv"
 for seed in $(seq 1 12); do
     "$A" calibrate bench/gpu/results/sweep_counters.csv "$costs"/cost_*_100k.csv "$costs"/cost_*_cluster.csv "$T/timings.csv" --form per_pass --holdout 0.5 \

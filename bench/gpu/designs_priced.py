@@ -10,11 +10,11 @@ import json
 import pathlib
 import sys
 
+sys.path.insert(0, str(pathlib.Path(__file__).parent))
+import designs_timings  # noqa: E402
+
 folder = pathlib.Path(sys.argv[1])
-measured = {}
-for r in csv.DictReader(open("bench/gpu/results/designs.csv")):
-    if "H100" in r["gpu"]:
-        measured.setdefault(r["config"], {})[r["pass"]] = float(r["ms"])
+measured = designs_timings.h100_timings()
 out = csv.writer(sys.stdout, lineterminator="\n")
 out.writerow(["config", "pass", "predicted_ms", "measured_ms", "relative_error"])
 for f in sorted(folder.glob("cost_*.json")):
