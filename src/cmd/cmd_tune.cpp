@@ -289,6 +289,19 @@ std::vector<LightingChoice> lightingChoices(const std::string& space) {
     return out;
 }
 
+/// "34 restir, 8 particle_restir, ...": the configurations of `space` per
+/// design, counted from lightingChoices (--space's help).
+std::string spaceSizes(const std::string& space) {
+    const EstimatorKind kinds[] = {EstimatorKind::restir, EstimatorKind::particle_restir, EstimatorKind::voxel_cache,
+                                   EstimatorKind::particle_split};
+    std::vector<std::string> parts;
+    const std::vector<LightingChoice> all = lightingChoices(space);
+    for (const EstimatorKind k : kinds)
+        parts.push_back(fmt::format("{} {}", std::count_if(all.begin(), all.end(), [&](const LightingChoice& c) { return c.design.estimator == k; }),
+                                    enumName(k)));
+    return fmt::format("{}, {}, {} and {}", parts[0], parts[1], parts[2], parts[3]);
+}
+
 /// The choices of the designs named by --designs (restir, particle_restir, voxel_cache, particle_split).
 std::vector<LightingChoice> designChoices(const std::vector<LightingChoice>& all, const std::vector<std::string>& designs) {
     std::vector<LightingChoice> out;
@@ -1046,7 +1059,8 @@ void addTuneCommand(CLI::App& app) {
         ->check(CLI::Range(0u, 16384u));
     cmd->add_option("--designs", args->designs, "the designs searched: restir (per pixel), particle_restir (per particle texel), voxel_cache (world cells), particle_split (per particle texel: near lights and light-tree rays); all by default")
         ->delimiter(',');
-    cmd->add_option("--space", args->space, "quick (34 restir, 8 particle_restir, 2 voxel_cache and 2 particle_split configurations) or full (1080, 488, 32 and 144: hours)");
+    cmd->add_option("--space", args->space,
+                    fmt::format("quick ({} configurations) or full ({}: hours)", spaceSizes("quick"), spaceSizes("full")));
     cmd->add_option("--reference", args->references,
                     "Reference EXRs of --frame, one per crop in stratum order, row by row (default: rendered once, exact up to 20K "
                     "particles, else split)")
