@@ -10,23 +10,28 @@
 # coefficients_h100.json, the fit of them all. The sweep's timings are
 # SWEEP_TIMINGS (results/sweep_timings_d37668c.csv: the twin at d37668c149,
 # whose spatial pass costs 0.69x of results/sweep_timings.csv's).
+# SIZES: the designs' sizes fitted ("100k cluster" by default; "100k cluster
+# 1m" adds the 1M configurations, results/designs_fit_all: a fit of 100K and
+# the cluster alone extrapolates badly to 1M, docs/designs.md).
 #   bash bench/gpu/designs_fit.sh COST_DIR [OUT]   (OUT: bench/gpu/results/designs_fit)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 costs=$1 out=${2:-bench/gpu/results/designs_fit}
 A=${ACCRETION:-build/accretion}
+read -ra sizes <<< "${SIZES:-100k cluster}"
 mkdir -p "$out"
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 { cat "${SWEEP_TIMINGS:-bench/gpu/results/sweep_timings_d37668c.csv}"
-  python3 bench/gpu/designs_timings.py '_(100k|cluster)$'
+  python3 bench/gpu/designs_timings.py "_($(IFS='|'; echo "${sizes[*]}"))\$"
 } > "$T/timings.csv"
+counters=(bench/gpu/results/sweep_counters.csv)
+for s in "${sizes[@]}"; do counters+=("$costs"/cost_*_"$s".csv); done
 for seed in $(seq 1 12); do
-    "$A" calibrate bench/gpu/results/sweep_counters.csv "$costs"/cost_*_100k.csv "$costs"/cost_*_cluster.csv "$T/timings.csv" --form per_pass --holdout 0.5 \
+    "$A" calibrate "${counters[@]}" "$T/timings.csv" --form per_pass --holdout 0.5 \
         --split-seed $seed -o "$T/c$seed.json" | sed -n '/^held out/,$p' | grep -v '^coefficients:' > "$out/holdout_seed$seed.txt"
 done
 python3 bench/gpu/designs_holdout.py "$T"/c*.json > "$out/summary.txt"
 # The fit of every configuration (no hold-out): coefficients calibrate writes, for `-D gpu.coefficients=`.
-"$A" calibrate bench/gpu/results/sweep_counters.csv "$costs"/cost_*_100k.csv "$costs"/cost_*_cluster.csv "$T/timings.csv" --form per_pass \
-    -o "$out/coefficients_h100.json" > /dev/null
+"$A" calibrate "${counters[@]}" "$T/timings.csv" --form per_pass -o "$out/coefficients_h100.json" > /dev/null
 cat "$out"/holdout_seed*.txt "$out/summary.txt"
