@@ -2,11 +2,11 @@
 # The whole test suite, as CI runs it (the README's second command, after
 # scripts/setup.sh), stage by stage:
 #   1. the Release build of everything, and its Catch2 tests (ctest);
-#   2. the one-node Slurm cluster's job-array and requeue test
-#      (scripts/slurm/cluster_test.sh) and, beside it, the OptiX twin's
-#      compile without a GPU (scripts/compile_twin.sh): the first mostly
-#      waits on daemons and sleeps, the second on nvcc, so they share the
-#      two cores;
+#   2. the OptiX twin's compile without a GPU (scripts/compile_twin.sh),
+#      and the one-node Slurm cluster's job-array and requeue test
+#      (scripts/slurm/cluster_test.sh), which starts beside stage 1's ctest:
+#      it mostly waits on daemons and sleeps (30 s of CPU in 45), which
+#      alone left a core idle for most of its stage;
 #   3. the suite again under AddressSanitizer and UBSan (scripts/sanitize.sh);
 #   4. libFuzzer on every input reader (scripts/fuzz.sh, SECONDS per target).
 # Each stage's wall time goes to stderr; the first failure stops the run.
@@ -23,24 +23,27 @@ stage() {
     echo "test.sh: $name: $((SECONDS - t0)) s" >&2
 }
 
-# The Slurm test's output is held back and printed after the twin's, whole.
-cluster_and_twin() {
-    local log
-    log=$(mktemp)
-    bash scripts/slurm/cluster_test.sh >"$log" 2>&1 &
-    local pid=$! twin=0
+# The Slurm test runs in the background from the Release build's ctest on
+# (it needs the build's binary); its output is held back and printed, whole,
+# after the twin's compile.
+slurm_log=$(mktemp)
+slurm_pid=
+trap 'rm -f "$slurm_log"; [ -z "$slurm_pid" ] || kill "$slurm_pid" 2>/dev/null || true' EXIT
+twin_and_cluster() {
+    local twin=0 cluster=0
     bash scripts/compile_twin.sh || twin=$?
-    local cluster=0
-    wait "$pid" || cluster=$?
-    cat "$log"
-    rm -f "$log"
+    wait "$slurm_pid" || cluster=$?
+    slurm_pid=
+    cat "$slurm_log"
     ((cluster == 0)) || { echo "test.sh: the Slurm test failed (exit $cluster)" >&2; return 1; }
     ((twin == 0)) || { echo "test.sh: the twin's compile failed (exit $twin)" >&2; return 1; }
 }
 
 stage "Release build" bash -c 'cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null && cmake --build build'
-stage "ctest" ctest --test-dir build --output-on-failure -j2
-stage "Slurm test and twin compile" cluster_and_twin
+bash scripts/slurm/cluster_test.sh >"$slurm_log" 2>&1 &
+slurm_pid=$!
+stage "ctest (the Slurm test beside it)" ctest --test-dir build --output-on-failure -j2
+stage "twin compile, and the Slurm test's end" twin_and_cluster
 stage "sanitizers" bash scripts/sanitize.sh
 stage "fuzzing" bash scripts/fuzz.sh "$fuzz_seconds"
 echo "test.sh: all stages passed in $((SECONDS - start)) s" >&2
