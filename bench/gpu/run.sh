@@ -1,7 +1,7 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine, from the repository root:
 #   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
-#                                      layout_images layouts streams front identity shared_core ab designs resample voxels splits iterations split_anatomy split_ncu split_stalls ray_launch split_order
+#                                      layout_images layouts streams front identity shared_core ab designs resample near_ncu voxels splits iterations split_anatomy split_ncu split_stalls ray_launch split_order
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -349,10 +349,10 @@ step_split_anatomy() { time_configs split_anatomy bench/gpu/split_anatomy.txt 5;
 # report and the frames are removed.
 #   ncu_config FOLDER STEM LIST N "ARGS" M "PAGES"
 ncu_config() {
-    local t=$1 stem=$2 list=$3 n=$4 args=$5 m=$6 pages=$7 p csv sel=()
+    local t=$1 stem=$2 list=$3 n=$4 args=$5 m=$6 pages=$7 kernel=${8:-optixLaunch} p csv sel=()
     [ -z "$m" ] || sel=(--metrics "$m")
     # shellcheck disable=SC2046,SC2086  # the ncu arguments and the overrides are words
-    timeout 240 ncu $args "${sel[@]}" --kernel-name regex:optixLaunch --log-file "$t/$stem.log" -o "$t/$stem" \
+    timeout 240 ncu $args "${sel[@]}" --kernel-name regex:"$kernel" --log-file "$t/$stem.log" -o "$t/$stem" \
         $BIN scenes/disk_100k.toml $(grep "^$n " "$list" | sed 's/ *#.*//' | cut -d' ' -f2-) \
         --frames 0:2 --repeat 1 -q -o "$t/$stem.{frame}.exr" > "$t/$stem.run.log" 2>&1
     for p in $pages; do
@@ -367,6 +367,16 @@ ncu_config() {
 # 16 near lights (far 4 of 8; split_anatomy.txt's sa_n8_f4_c8 and
 # sa_n16_f4_c8): time, instructions, SIMT efficiency, local and device
 # memory traffic of each OptiX launch of frame 1.
+# The near search's memory at 100K and 1M (designs.txt's ps_n8_f4_c8_h75_*):
+# findNearLightsKernel's time, its L1 and L2 hit rates and the bytes it
+# reads from DRAM, under Nsight Compute; whether 1M's 32 MB of light
+# records still fit the GPU's L2 (docs/designs.md, tune at 1M).
+step_near_ncu() {
+    local t="$W/near_ncu" m=gpu__time_duration.sum,lts__t_sector_hit_rate.pct,l1tex__t_sector_hit_rate.pct,dram__bytes_read.sum,lts__t_bytes.sum n
+    mkdir -p "$t"
+    for n in ps_n8_f4_c8_h75_100k ps_n8_f4_c8_h75_1m; do ncu_config "$t" "$n" bench/gpu/designs.txt "$n" "" "$m" raw findNearLightsKernel; done
+}
+
 step_split_ncu() {
     local t="$W/split_ncu" m=gpu__time_duration.sum,smsp__inst_executed.sum,smsp__thread_inst_executed_per_inst_executed.ratio n
     m=$m,l1tex__t_bytes_pipe_lsu_mem_local_op_ld.sum,l1tex__t_bytes_pipe_lsu_mem_local_op_st.sum,dram__bytes_read.sum,lts__t_bytes.sum
