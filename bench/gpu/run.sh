@@ -1,7 +1,7 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine, from the repository root:
 #   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
-#                                      layout_images layouts streams front identity shared_core ab designs resample near_ncu voxels splits iterations split_anatomy split_ncu split_stalls ray_launch split_order
+#                                      layout_images layouts streams front identity shared_core ab designs resample near_ncu voxel_ncu voxels splits iterations split_anatomy split_ncu split_stalls ray_launch split_order
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -375,6 +375,17 @@ step_near_ncu() {
     local t="$W/near_ncu" m=gpu__time_duration.sum,lts__t_sector_hit_rate.pct,l1tex__t_sector_hit_rate.pct,dram__bytes_read.sum,lts__t_bytes.sum n
     mkdir -p "$t"
     for n in ps_n8_f4_c8_h75_100k ps_n8_f4_c8_h75_1m; do ncu_config "$t" "$n" bench/gpu/designs.txt "$n" "" "$m" raw findNearLightsKernel; done
+}
+
+# updateVoxelCache's three kernels at 100K and 1M (designs.txt's
+# vox_c32_r8_*): the cells marked (a thread per particle), the cells' rays
+# (an OptiX launch) and their sums, each kernel's time under Nsight Compute.
+step_voxel_ncu() {
+    local t="$W/voxel_ncu" n
+    mkdir -p "$t"
+    for n in vox_c32_r8_100k vox_c32_r8_1m; do
+        ncu_config "$t" "$n" bench/gpu/designs.txt "$n" "" gpu__time_duration.sum raw 'markVoxelCells|sumVoxelRays|optixLaunch'
+    done
 }
 
 step_split_ncu() {
