@@ -150,7 +150,8 @@ void describe(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
                                                           plan.texelHistory ? fmt::format(", Lr averaged with last frame's (h = {})", r.texel_history) : "")
                                             : "one shadow ray per pixel")
                                : "visibility off: the kept sample shaded with V = 1, no shadow rays");
-        if (particles && !plan.resamplePixels)
+        // By the setting, not plan.resamplePixels: a dark frame lists the pass it skips.
+        if (particles && r.pixel_shading == PixelShading::interpolate)
             step(Pass::shadeParticlePixels, dark ? noLight : "interpolate: bilinear over the pixel's particle's texels' Lr (biased)");
         else if (particles)
             step(Pass::resampleParticlePixels,
