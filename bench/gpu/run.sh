@@ -342,12 +342,13 @@ step_iterations() {
 step_split_anatomy() { time_configs split_anatomy bench/gpu/split_anatomy.txt 5; }
 
 # Nsight Compute of configuration N of LIST (its line "N overrides...") on
-# disk_100k, frames 0-1, its OptiX launches only: `ncu ARGS` (and --metrics
+# disk_100k, frames 0-1, its OptiX launches only (or the kernels KERNEL, a
+# regex, matches): `ncu ARGS` (and --metrics
 # M where M is not empty) logged to FOLDER/STEM.log, the run's output to
 # STEM.run.log; then each of PAGES (raw, details) imported as CSV, with
 # --metrics M: STEM.csv where PAGES is one page, else STEM.PAGE.csv. The
 # report and the frames are removed.
-#   ncu_config FOLDER STEM LIST N "ARGS" M "PAGES"
+#   ncu_config FOLDER STEM LIST N "ARGS" M "PAGES" [KERNEL]
 ncu_config() {
     local t=$1 stem=$2 list=$3 n=$4 args=$5 m=$6 pages=$7 kernel=${8:-optixLaunch} p csv sel=()
     [ -z "$m" ] || sel=(--metrics "$m")
@@ -363,10 +364,6 @@ ncu_config() {
     rm -f "$t"/*.gpuframe "$t"/*.exr "$t/$stem.ncu-rep"
 }
 
-# Nsight Compute of particle_split's ray launch (shadeSplitTexels) at 8 and
-# 16 near lights (far 4 of 8; split_anatomy.txt's sa_n8_f4_c8 and
-# sa_n16_f4_c8): time, instructions, SIMT efficiency, local and device
-# memory traffic of each OptiX launch of frame 1.
 # The near search's memory at 100K and 1M (designs.txt's ps_n8_f4_c8_h75_*):
 # findNearLightsKernel's time, its L1 and L2 hit rates and the bytes it
 # reads from DRAM, under Nsight Compute; whether 1M's 32 MB of light
@@ -388,6 +385,10 @@ step_voxel_ncu() {
     done
 }
 
+# Nsight Compute of particle_split's ray launch (shadeSplitTexels) at 8 and
+# 16 near lights (far 4 of 8; split_anatomy.txt's sa_n8_f4_c8 and
+# sa_n16_f4_c8): time, instructions, SIMT efficiency, local and device
+# memory traffic of each OptiX launch of frame 1.
 step_split_ncu() {
     local t="$W/split_ncu" m=gpu__time_duration.sum,smsp__inst_executed.sum,smsp__thread_inst_executed_per_inst_executed.ratio n
     m=$m,l1tex__t_bytes_pipe_lsu_mem_local_op_ld.sum,l1tex__t_bytes_pipe_lsu_mem_local_op_st.sum,dram__bytes_read.sum,lts__t_bytes.sum
