@@ -62,12 +62,18 @@ ParticleTexels gatherParticleTexels(const GBuffer& gbuffer, const Particles& par
     return t;
 }
 
-void recordGatherParticleTexels(const GBuffer& gbuffer, const Particles& particles, const ParticleBvh& bvh, PassCounters& pc) {
+std::uint64_t gatherItemThreads(std::size_t particles, const ParticleTexels& texels) {
+    return 3 * std::uint64_t(particles) + (2 + kSortDigitPasses) * std::uint64_t(texels.visible()) + texels.grid.texels.size();
+}
+
+void recordGatherParticleTexels(const GBuffer& gbuffer, const Particles& particles, const ParticleBvh& bvh, const ParticleTexels& texels,
+                                PassCounters& pc) {
     for (std::size_t px = 0; px < gbuffer.texels.size(); ++px) {
         ThreadCounters& t = pc.threads[px];
         recordTexel(t, gbuffer.texels[px], particles, bvh, gpu_layout::kGBufferTexel);
         if (gbuffer.texels[px].hit()) t.bytesWritten += 1;
     }
+    pc.itemThreads = gatherItemThreads(particles.size(), texels);
 }
 
 }  // namespace accretion

@@ -6,6 +6,8 @@
 
 #include <cmath>
 
+#include "accretion/gpu/cost_model.h"
+#include "accretion/gpu/gpu_report.h"
 #include "accretion/render/voxel_grid.h"
 #include "support/test_scenes.h"
 
@@ -206,4 +208,11 @@ TEST_CASE("voxel_cache: updateVoxelCache is counted as the twin runs it, a threa
     REQUIRE(traced > 0);
     CHECK(most == 1);
     CHECK(unoccupied == 0);
+    // The marking kernel, a thread per particle, is the record's item
+    // threads, and the cost model's item_threads feature of the pass.
+    CHECK(pc->itemThreads == s.particles.size());
+    const GpuReport report = makeGpuReport(img.counters, s.settings, 0);
+    for (const PassReport& p : report.passes)
+        CHECK(costFeatures(p, kDefaultCacheBytes)[CostFeature::item_threads] ==
+              (p.pass.pass == Pass::updateVoxelCache ? double(s.particles.size()) : 0.0));
 }

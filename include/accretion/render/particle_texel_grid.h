@@ -30,8 +30,19 @@ struct ParticleTexels {
 ParticleTexels gatherParticleTexels(const GBuffer& gbuffer, const Particles& particles, const ParticleBvh& bvh,
                                     const Camera& camera, ShadingModel model, std::uint32_t side, std::uint32_t layers);
 
+/// The threads of gatherParticleTexels' kernels beside its grid of pixels
+/// (PassCounters::itemThreads), as the twin launches them: a thread per
+/// particle to list the ids and one to select the visible ones (plus the
+/// slots' reset, a store per particle); per visible particle its Morton key,
+/// its slot, and kSortDigitPasses passes of the radix sort over its key
+/// (8-bit digits of a 63-bit key); a thread per texel of the grid written.
+inline constexpr std::uint64_t kSortDigitPasses = 8;
+std::uint64_t gatherItemThreads(std::size_t particles, const ParticleTexels& texels);
+
 /// Counting mode: gatherParticleTexels's per-pixel work (the G-buffer
-/// texel read, the particle's visible flag written).
-void recordGatherParticleTexels(const GBuffer& gbuffer, const Particles& particles, const ParticleBvh& bvh, PassCounters& pc);
+/// texel read, the particle's visible flag written) and its other kernels'
+/// threads (gatherItemThreads).
+void recordGatherParticleTexels(const GBuffer& gbuffer, const Particles& particles, const ParticleBvh& bvh, const ParticleTexels& texels,
+                                PassCounters& pc);
 
 }  // namespace accretion

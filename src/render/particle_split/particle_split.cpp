@@ -21,7 +21,7 @@ LightingCounters ParticleSplit::render(const ParticleSplitInputs& in, LightingIm
         auto t = timer.scope(Pass::gatherParticleTexels);
         texels = gatherParticleTexels(in.gbuffer, in.particles, in.bvh, in.camera, in.settings.shading.model, ps_.texels, 1);
         if (in.counters)
-            recordGatherParticleTexels(in.gbuffer, in.particles, in.bvh,
+            recordGatherParticleTexels(in.gbuffer, in.particles, in.bvh, texels,
                                        in.counters->add(Pass::gatherParticleTexels, in.gbuffer.width, in.gbuffer.height));
     }
     const psplit::SplitParams params = psplit::splitParams(in.settings, texels.visible(), in.frame, in.settings.render.seed);

@@ -176,7 +176,7 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
         auto t = timer.scope(Pass::gatherParticleTexels);
         texels = gatherParticleTexels(full, in.particles, in.bvh, in.camera, in.settings.shading.model, rs_.texels, rs_.texel_rays);
         if (in.counters)
-            recordGatherParticleTexels(full, in.particles, in.bvh, in.counters->add(Pass::gatherParticleTexels, full.width, full.height));
+            recordGatherParticleTexels(full, in.particles, in.bvh, texels, in.counters->add(Pass::gatherParticleTexels, full.width, full.height));
         lg = &texels.grid;
     }
     const std::size_t lpixels = std::size_t(lg->width) * lg->height;
