@@ -1,7 +1,7 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine, from the repository root:
 #   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
-#                                      layout_images layouts streams front identity shared_core ab designs resample near_ncu voxel_ncu voxels splits iterations split_anatomy split_ncu split_stalls ray_launch split_order
+#                                      layout_images layouts streams front identity shared_core ab designs resample near_ncu voxel_ncu gather_ncu voxels splits iterations split_anatomy split_ncu split_stalls ray_launch split_order
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -382,6 +382,20 @@ step_voxel_ncu() {
     mkdir -p "$t"
     for n in vox_c32_r8_100k vox_c32_r8_1m; do
         ncu_config "$t" "$n" bench/gpu/designs.txt "$n" "" gpu__time_duration.sum raw 'markVoxelCells|sumVoxelRays|optixLaunch'
+    done
+}
+
+# gatherParticleTexels' kernels at 100K and 1M (designs.txt's
+# prt_m8_k4_*): the visible flags (a thread per pixel), the ids, CUB's
+# select and radix sort, the Morton keys, the slots and the texels, each
+# kernel's time and launch size under Nsight Compute: what the pass's
+# item_threads count (docs/cost-model.md).
+step_gather_ncu() {
+    local t="$W/gather_ncu" n
+    mkdir -p "$t"
+    for n in prt_m8_k4_100k prt_m8_k4_1m; do
+        ncu_config "$t" "$n" bench/gpu/designs.txt "$n" "" gpu__time_duration.sum,launch__grid_size,launch__block_size raw \
+            'markVisible|iotaKernel|mortonKeys|writeSlots|writeTexels|Select|Radix|Onesweep|Scan'
     done
 }
 
