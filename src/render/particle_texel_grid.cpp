@@ -63,7 +63,7 @@ ParticleTexels gatherParticleTexels(const GBuffer& gbuffer, const Particles& par
 }
 
 std::uint64_t gatherItemThreads(std::size_t particles, const ParticleTexels& texels) {
-    return 3 * std::uint64_t(particles) + (2 + kSortDigitPasses) * std::uint64_t(texels.visible()) + texels.grid.texels.size();
+    return 2 * std::uint64_t(particles) + (3 + kSortDigitPasses) * std::uint64_t(texels.visible()) + texels.grid.texels.size();
 }
 
 void recordGatherParticleTexels(const GBuffer& gbuffer, const Particles& particles, const ParticleBvh& bvh, const ParticleTexels& texels,
@@ -74,6 +74,7 @@ void recordGatherParticleTexels(const GBuffer& gbuffer, const Particles& particl
         if (gbuffer.texels[px].hit()) t.bytesWritten += 1;
     }
     pc.itemThreads = gatherItemThreads(particles.size(), texels);
+    pc.dispatches = kGatherDispatches;
 }
 
 }  // namespace accretion

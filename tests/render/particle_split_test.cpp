@@ -343,14 +343,16 @@ TEST_CASE("particle_split: its frame runs its own passes, not restir's", "[parti
     CHECK(most == 1);
     CHECK(pastTexels == 0);
     // gatherParticleTexels' kernels beside its pixels, from the image's own
-    // visible set: 3 per particle (ids, select, slots' reset), 10 per visible
-    // particle (key, slot, 8 digit passes of the sort), 1 per texel of the
-    // grid (kTexelRowWidth a row, one texel a particle here).
+    // visible set: 2 per particle (ids, select), 11 per visible particle
+    // (key, slot, the sort's histogram and 8 digit passes), 1 per texel of
+    // the grid (kTexelRowWidth a row, one texel a particle here), in 18
+    // dispatches (2 memsets, 16 kernels).
     const auto gather = std::find_if(img.counters.passes.begin(), img.counters.passes.end(),
                                      [](const PassCounters& pc) { return pc.pass == Pass::gatherParticleTexels; });
     REQUIRE(gather != img.counters.passes.end());
     const std::uint64_t gridTexels = (visible.size() + kTexelRowWidth - 1) / kTexelRowWidth * kTexelRowWidth;
-    CHECK(gather->itemThreads == 3 * ps.size() + 10 * visible.size() + gridTexels);
+    CHECK(gather->itemThreads == 2 * ps.size() + 11 * visible.size() + gridTexels);
+    CHECK(gather->dispatches == 18);
     for (const PassCounters& pc : img.counters.passes)
         if (pc.pass != Pass::gatherParticleTexels) CHECK(pc.itemThreads == 0);
 }

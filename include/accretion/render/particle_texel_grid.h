@@ -31,12 +31,18 @@ ParticleTexels gatherParticleTexels(const GBuffer& gbuffer, const Particles& par
                                     const Camera& camera, ShadingModel model, std::uint32_t side, std::uint32_t layers);
 
 /// The threads of gatherParticleTexels' kernels beside its grid of pixels
-/// (PassCounters::itemThreads), as the twin launches them: a thread per
-/// particle to list the ids and one to select the visible ones (plus the
-/// slots' reset, a store per particle); per visible particle its Morton key,
-/// its slot, and kSortDigitPasses passes of the radix sort over its key
-/// (8-bit digits of a 63-bit key); a thread per texel of the grid written.
+/// (PassCounters::itemThreads), as the twin launches them, an item a thread
+/// (CUB's select and sort: the items each of their kernels passes over): a
+/// thread per particle to list the ids and one to select the visible ones;
+/// per visible particle its Morton key, the sort's histogram and its
+/// kSortDigitPasses passes (8-bit digits of a 63-bit key), and its slot; a
+/// thread per texel of the grid written. Its dispatches: two memsets, the
+/// visible flags, the ids, the select, the keys, the sort's histogram, scan
+/// and digit passes, the slots and the texels (kGatherDispatches). On the
+/// H200 (no RT cores; bench/gpu/run.sh gather_ncu) the digit passes take
+/// 13 us each whatever the keys, the texels 0.08 ns each, the rest less.
 inline constexpr std::uint64_t kSortDigitPasses = 8;
+inline constexpr std::uint64_t kGatherDispatches = 10 + kSortDigitPasses;
 std::uint64_t gatherItemThreads(std::size_t particles, const ParticleTexels& texels);
 
 /// Counting mode: gatherParticleTexels's per-pixel work (the G-buffer
