@@ -389,7 +389,7 @@ step_voxel_ncu() {
 # prt_m8_k4_*): the visible flags (a thread per pixel), the ids, CUB's
 # select and radix sort, the Morton keys, the slots and the texels, each
 # kernel's time and launch size under Nsight Compute: what the pass's
-# item_threads count (docs/cost-model.md).
+# item_steps count (docs/cost-model.md).
 step_gather_ncu() {
     local t="$W/gather_ncu" n
     mkdir -p "$t"

@@ -54,7 +54,7 @@ PassReport summarise(const PassCounters& pc, const GpuSettings& gpu, const SerKe
     p.dispatches = pc.dispatches;
     p.build = pc.build;
     p.footprintBytes = double(pc.footprintBytes);
-    p.itemThreads = pc.itemThreads;
+    p.itemSteps = pc.itemSteps;
     for (const ThreadCounters& t : pc.threads) {
         p.threads += t.active;
         p.hitThreads += t.hit;
@@ -157,7 +157,7 @@ nlohmann::json toJson(const PassReport& p) {
                         {"warp_gathers", p.ser.gathersBefore.steps},
                         {"hit_warps", p.ser.hitsBefore.warps},
                         {"footprint_bytes", p.footprintBytes},
-                        {"item_threads", p.itemThreads},
+                        {"item_steps", p.itemSteps},
                         {"tlas_levels", p.tlasLevels},
                         {"working_set_bytes", p.workingSetBytes},
                         {"max_trips", p.maxTrips},

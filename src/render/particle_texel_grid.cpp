@@ -62,7 +62,7 @@ ParticleTexels gatherParticleTexels(const GBuffer& gbuffer, const Particles& par
     return t;
 }
 
-std::uint64_t gatherItemThreads(std::size_t particles, const ParticleTexels& texels) {
+std::uint64_t gatherItemSteps(std::size_t particles, const ParticleTexels& texels) {
     return 2 * std::uint64_t(particles) + (3 + kSortDigitPasses) * std::uint64_t(texels.visible()) + texels.grid.texels.size();
 }
 
@@ -73,7 +73,7 @@ void recordGatherParticleTexels(const GBuffer& gbuffer, const Particles& particl
         recordTexel(t, gbuffer.texels[px], particles, bvh, gpu_layout::kGBufferTexel);
         if (gbuffer.texels[px].hit()) t.bytesWritten += 1;
     }
-    pc.itemThreads = gatherItemThreads(particles.size(), texels);
+    pc.itemSteps = gatherItemSteps(particles.size(), texels);
     pc.dispatches = kGatherDispatches;
 }
 

@@ -3,9 +3,12 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <functional>
 
 #include <fmt/format.h>
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include "accretion/core/error.h"
 
@@ -77,6 +80,20 @@ std::vector<std::uint8_t> occupiedCells(const voxel::VoxelGrid& grid, const Part
         }
     });
     return occupied;
+}
+
+std::uint64_t reachedCellStores(const voxel::VoxelGrid& grid, const Particles& particles) {
+    return tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, particles.size(), 4096), std::uint64_t(0),
+        [&](const auto& r, std::uint64_t n) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                std::uint32_t lo[3], hi[3];
+                grid.reach(particles.position[i], voxel::particleReach(particles.radius[i]), lo, hi);
+                n += std::uint64_t(hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1);
+            }
+            return n;
+        },
+        std::plus<>());
 }
 
 voxel::VoxelParams voxelParams(const Settings& s, const VoxelPlacement& placement, const Vec3& origin, const Camera& camera,

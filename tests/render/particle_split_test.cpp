@@ -351,10 +351,10 @@ TEST_CASE("particle_split: its frame runs its own passes, not restir's", "[parti
                                      [](const PassCounters& pc) { return pc.pass == Pass::gatherParticleTexels; });
     REQUIRE(gather != img.counters.passes.end());
     const std::uint64_t gridTexels = (visible.size() + kTexelRowWidth - 1) / kTexelRowWidth * kTexelRowWidth;
-    CHECK(gather->itemThreads == 2 * ps.size() + 11 * visible.size() + gridTexels);
+    CHECK(gather->itemSteps == 2 * ps.size() + 11 * visible.size() + gridTexels);
     CHECK(gather->dispatches == 18);
     for (const PassCounters& pc : img.counters.passes)
-        if (pc.pass != Pass::gatherParticleTexels) CHECK(pc.itemThreads == 0);
+        if (pc.pass != Pass::gatherParticleTexels) CHECK(pc.itemSteps == 0);
 }
 
 TEST_CASE("particle_split: the ray threads' order visits every ray of every texel once, near before far, and inverts", "[particle_split]") {

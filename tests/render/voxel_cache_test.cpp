@@ -4,6 +4,7 @@
 // own error in closed form), the receiver's own light taken out.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 #include "accretion/gpu/cost_model.h"
@@ -208,11 +209,28 @@ TEST_CASE("voxel_cache: updateVoxelCache is counted as the twin runs it, a threa
     REQUIRE(traced > 0);
     CHECK(most == 1);
     CHECK(unoccupied == 0);
-    // The marking kernel, a thread per particle, is the record's item
-    // threads, and the cost model's item_threads feature of the pass.
-    CHECK(pc->itemThreads == s.particles.size());
+    // The marking kernel, a thread per particle storing every cell of its
+    // reach (1.5 r around its centre, widened to the trilinear stencils of
+    // its ends, clamped into the grid), is the record's item steps, and
+    // the cost model's item_steps feature of the pass: counted here in
+    // doubles, per axis.
+    std::uint64_t stores = 0;
+    for (std::size_t i = 0; i < s.particles.size(); ++i) {
+        std::uint64_t cells = 1;
+        const std::int64_t n[3] = {g.nx, g.ny, g.nz};
+        for (int k = 0; k < 3; ++k) {
+            const double reach = 1.5 * double(s.particles.radius[i]), p = double(s.particles.position[i][k]);
+            const auto cell = [&](double v) { return std::int64_t(std::floor((v - double(g.lower[k])) / double(g.cellSize) - 0.5)); };
+            const std::int64_t lo = std::clamp<std::int64_t>(cell(p - reach), 0, n[k] - 1);
+            const std::int64_t hi = std::clamp<std::int64_t>(cell(p + reach) + 1, 0, n[k] - 1);
+            cells *= std::uint64_t(hi - lo + 1);
+        }
+        stores += cells;
+    }
+    REQUIRE(stores >= s.particles.size());
+    CHECK(pc->itemSteps == stores);
     const GpuReport report = makeGpuReport(img.counters, s.settings, 0);
     for (const PassReport& p : report.passes)
-        CHECK(costFeatures(p, kDefaultCacheBytes)[CostFeature::item_threads] ==
-              (p.pass.pass == Pass::updateVoxelCache ? double(s.particles.size()) : 0.0));
+        CHECK(costFeatures(p, kDefaultCacheBytes)[CostFeature::item_steps] ==
+              (p.pass.pass == Pass::updateVoxelCache ? double(stores) : 0.0));
 }

@@ -143,13 +143,14 @@ struct PassCounters {
     /// a texel at half resolution, fewer at 0.75): its traffic from memory,
     /// where the per-thread bytes count what the threads ask of the caches.
     std::uint64_t footprintBytes = 0;
-    /// Threads of the pass's kernels over other items than its grid, summed
-    /// over those kernels: a thread per particle (updateVoxelCache's marking
-    /// of the reached cells; gatherParticleTexels' select over every
-    /// particle), per visible particle or per texel (the gather's keys, sort
-    /// and texels). Their time grows with the particles where the grid's
+    /// Steps of the pass's kernels over other items than its grid, summed
+    /// over those kernels: a step per item of a kernel that does one thing
+    /// an item (gatherParticleTexels' select over every particle, its keys,
+    /// sort and texels), and per loop trip of one that loops
+    /// (updateVoxelCache's marking: a thread per particle, a store per cell
+    /// of its reach). Their time grows with the particles where the grid's
     /// does not.
-    std::uint64_t itemThreads = 0;
+    std::uint64_t itemSteps = 0;
 
     PassCounters() = default;
     PassCounters(Pass p, std::uint32_t w, std::uint32_t h) : pass(p), width(w), height(h), threads(std::size_t(w) * h) {}

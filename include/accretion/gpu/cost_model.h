@@ -61,9 +61,9 @@ enum class CostFeature : std::uint8_t {
     refit_launches, cold_work, accel_elements, accel_elements_1k, accel_elements_32k, build_primitives, build_primitives_1k,
     build_primitives_32k, custom_builds, intersections, tlas_levels, misses, segment_boxes, gathers, sphere_refits,
     warp_segment_boxes, dispatch_path, whole_segment_boxes, warp_gathers, hit_warps, footprint_bytes, tlas_instances_32k,
-    item_threads,
+    item_steps,
 };
-inline constexpr std::size_t kCostFeatureCount = std::size_t(CostFeature::item_threads) + 1;
+inline constexpr std::size_t kCostFeatureCount = std::size_t(CostFeature::item_steps) + 1;
 
 /// One row of the cost model's feature table: everything about a feature
 /// that the model, the counter CSVs, the coefficient files and calibrate read.
@@ -131,7 +131,7 @@ inline constexpr std::array<CostFeatureInfo, kCostFeatureCount> kCostFeatureTabl
     {CostFeature::footprint_bytes, "footprint_bytes", false, false, false, [](detail::P p, double) { return p.footprintBytes; }},
     {CostFeature::tlas_instances_32k, "tlas_instances_32k", false, true, false,
      [](detail::P p, double) { return double(p.build.tlasInstancesMid); }},
-    {CostFeature::item_threads, "item_threads", false, false, false, [](detail::P p, double) { return double(p.itemThreads); }},
+    {CostFeature::item_steps, "item_steps", false, false, false, [](detail::P p, double) { return double(p.itemSteps); }},
 }};
 
 namespace detail {

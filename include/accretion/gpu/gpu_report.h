@@ -35,8 +35,8 @@ struct PassReport {
     /// Distinct bytes of the grids the pass reads at other threads' texels
     /// (PassCounters::footprintBytes).
     double footprintBytes = 0.0;
-    /// Threads of its kernels over other items than its grid (PassCounters::itemThreads).
-    std::uint64_t itemThreads = 0;
+    /// Steps of its kernels over other items than its grid (PassCounters::itemSteps).
+    std::uint64_t itemSteps = 0;
     std::uint32_t maxTrips = 0;
     SerReport ser;
     std::string rayModel;  ///< "inline", "pipeline", or "-" (no rays)

@@ -30,8 +30,8 @@ struct ParticleTexels {
 ParticleTexels gatherParticleTexels(const GBuffer& gbuffer, const Particles& particles, const ParticleBvh& bvh,
                                     const Camera& camera, ShadingModel model, std::uint32_t side, std::uint32_t layers);
 
-/// The threads of gatherParticleTexels' kernels beside its grid of pixels
-/// (PassCounters::itemThreads), as the twin launches them, an item a thread
+/// The steps of gatherParticleTexels' kernels beside its grid of pixels
+/// (PassCounters::itemSteps), as the twin launches them, an item a step
 /// (CUB's select and sort: the items each of their kernels passes over): a
 /// thread per particle to list the ids and one to select the visible ones;
 /// per visible particle its Morton key, the sort's histogram and its
@@ -43,11 +43,11 @@ ParticleTexels gatherParticleTexels(const GBuffer& gbuffer, const Particles& par
 /// 13 us each whatever the keys, the texels 0.08 ns each, the rest less.
 inline constexpr std::uint64_t kSortDigitPasses = 8;
 inline constexpr std::uint64_t kGatherDispatches = 10 + kSortDigitPasses;
-std::uint64_t gatherItemThreads(std::size_t particles, const ParticleTexels& texels);
+std::uint64_t gatherItemSteps(std::size_t particles, const ParticleTexels& texels);
 
 /// Counting mode: gatherParticleTexels's per-pixel work (the G-buffer
 /// texel read, the particle's visible flag written) and its other kernels'
-/// threads (gatherItemThreads).
+/// steps (gatherItemSteps).
 void recordGatherParticleTexels(const GBuffer& gbuffer, const Particles& particles, const ParticleBvh& bvh, const ParticleTexels& texels,
                                 PassCounters& pc);
 

@@ -38,6 +38,9 @@ inline constexpr std::uint64_t kMaxVoxelCells = std::uint64_t(1) << 25;  ///< 2 
 /// The cells some particle's reach covers: those updateVoxelCache updates
 /// (1) and empties (0). The same for every view: the cache is the world's.
 std::vector<std::uint8_t> occupiedCells(const voxel::VoxelGrid& grid, const Particles& particles);
+/// The stores of that marking: over the particles, the cells of each one's
+/// reach (with repeats: the twin's marking kernel stores each).
+std::uint64_t reachedCellStores(const voxel::VoxelGrid& grid, const Particles& particles);
 
 /// The frame's VoxelParams (the grid in its coordinates, the settings, the
 /// camera): the CPU and the twin both make theirs here.

@@ -1,8 +1,9 @@
 // updateVoxelCache: every cell of the grid, voxel_cache_passes.h's body over
 // the CPU's bridge (an unoccupied cell is emptied). Counted as the twin runs
-// it: the occupied cells marked, a thread per particle (the record's item
-// threads), a thread per ray of each cell (its grid: launch x = cell x *
+// it: the occupied cells marked, a thread per particle storing each cell of
+// its reach (the record's item steps), a thread per ray of each cell (its grid: launch x = cell x *
 // rays + ray, y = the cell's row), then a kernel per cell summing them.
+#include "accretion/render/voxel_grid.h"
 #include "cpu_voxel_bridge.h"
 
 namespace accretion::voxel {
@@ -13,7 +14,7 @@ LightingCounters updateVoxelCache(const CpuFrame& f) {
     PassCounters* pc = f.in.counters ? &f.in.counters->add(Pass::updateVoxelCache, g.nx * rays, g.ny * g.nz) : nullptr;
     if (pc) {
         pc->dispatches = 3;  // the cells marked, their rays, the sums
-        pc->itemThreads = f.in.particles.size();  // the marking: a thread per particle
+        pc->itemSteps = reachedCellStores(g, f.in.particles);  // the marking: a thread per particle, a store per cell it reaches
     }
     return dispatchVoxel(f, [&]<Primitive P, bool Count>() {
         return forEachItem<P, Count>(f, g.count(), pc, [](auto& b, std::size_t c) { updateVoxelCell(b, std::uint32_t(c)); }, rays);
