@@ -375,12 +375,13 @@ step_near_ncu() {
 }
 
 # updateVoxelCache's three kernels at 100K and 1M (designs.txt's
-# vox_c32_r8_*): the cells marked (a thread per particle), the cells' rays
-# (an OptiX launch) and their sums, each kernel's time under Nsight Compute.
+# vox_c32_r8_*, or the configurations VOXEL_NCU names): the cells marked (a
+# thread per particle), the cells' rays (an OptiX launch) and their sums,
+# each kernel's time under Nsight Compute.
 step_voxel_ncu() {
     local t="$W/voxel_ncu" n
     mkdir -p "$t"
-    for n in vox_c32_r8_100k vox_c32_r8_1m; do
+    for n in ${VOXEL_NCU:-vox_c32_r8_100k vox_c32_r8_1m}; do
         ncu_config "$t" "$n" bench/gpu/designs.txt "$n" "" gpu__time_duration.sum raw 'markVoxelCells|sumVoxelRays|optixLaunch'
     done
 }
