@@ -1,9 +1,11 @@
 #include "accretion/render/voxel_grid.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <functional>
+#include <vector>
 
 #include <fmt/format.h>
 #include <tbb/blocked_range.h>
@@ -82,14 +84,33 @@ std::vector<std::uint8_t> occupiedCells(const voxel::VoxelGrid& grid, const Part
     return occupied;
 }
 
-std::uint64_t reachedCellStores(const voxel::VoxelGrid& grid, const Particles& particles) {
+std::uint64_t markingSectorSteps(const voxel::VoxelGrid& grid, const Particles& particles, std::uint32_t warpSize) {
+    const std::size_t warps = (particles.size() + warpSize - 1) / warpSize;
     return tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, particles.size(), 4096), std::uint64_t(0),
+        tbb::blocked_range<std::size_t>(0, warps, 64), std::uint64_t(0),
         [&](const auto& r, std::uint64_t n) {
-            for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                std::uint32_t lo[3], hi[3];
-                grid.reach(particles.position[i], voxel::particleReach(particles.radius[i]), lo, hi);
-                n += std::uint64_t(hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1);
+            std::vector<std::array<std::uint32_t, 6>> lanes;
+            std::vector<std::uint32_t> sectors;
+            for (std::size_t w = r.begin(); w != r.end(); ++w) {
+                lanes.clear();
+                std::uint64_t most = 0;
+                for (std::size_t i = w * warpSize; i < std::min(particles.size(), (w + 1) * warpSize); ++i) {
+                    std::uint32_t lo[3], hi[3];
+                    grid.reach(particles.position[i], voxel::particleReach(particles.radius[i]), lo, hi);
+                    lanes.push_back({lo[0], lo[1], lo[2], hi[0] - lo[0] + 1, hi[1] - lo[1] + 1, hi[2] - lo[2] + 1});
+                    most = std::max<std::uint64_t>(most, std::uint64_t(lanes.back()[3]) * lanes.back()[4] * lanes.back()[5]);
+                }
+                for (std::uint64_t k = 0; k < most; ++k) {  // the k-th store of every lane that has one: x fastest, then y, then z
+                    sectors.clear();
+                    for (const auto& l : lanes) {
+                        if (k >= std::uint64_t(l[3]) * l[4] * l[5]) continue;
+                        const std::uint32_t x = l[0] + std::uint32_t(k % l[3]), y = l[1] + std::uint32_t(k / l[3] % l[4]),
+                                            z = l[2] + std::uint32_t(k / (std::uint64_t(l[3]) * l[4]));
+                        sectors.push_back(grid.index(x, y, z) / 32u);
+                    }
+                    std::sort(sectors.begin(), sectors.end());
+                    n += std::uint64_t(std::unique(sectors.begin(), sectors.end()) - sectors.begin());
+                }
             }
             return n;
         },

@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
+#include <vector>
 
 #include "accretion/gpu/cost_model.h"
 #include "accretion/gpu/gpu_report.h"
@@ -181,6 +183,25 @@ TEST_CASE("voxel_cache: a receiver lit by its own light alone is dark (i != j)",
     REQUIRE(hits > 100);
 }
 
+/// The cells particle i's marking thread stores, in its loop's order (x
+/// fastest): its reach, 1.5 r around its centre widened to the trilinear
+/// stencils of its ends and clamped into the grid, computed in doubles.
+std::vector<std::uint64_t> reachCells(const voxel::VoxelGrid& g, const Particles& ps, std::size_t i) {
+    const std::int64_t n[3] = {g.nx, g.ny, g.nz};
+    std::int64_t lo[3], hi[3];
+    for (int k = 0; k < 3; ++k) {
+        const double reach = 1.5 * double(ps.radius[i]), p = double(ps.position[i][k]);
+        const auto cell = [&](double v) { return std::int64_t(std::floor((v - double(g.lower[k])) / double(g.cellSize) - 0.5)); };
+        lo[k] = std::clamp<std::int64_t>(cell(p - reach), 0, n[k] - 1);
+        hi[k] = std::clamp<std::int64_t>(cell(p + reach) + 1, 0, n[k] - 1);
+    }
+    std::vector<std::uint64_t> out;
+    for (std::int64_t z = lo[2]; z <= hi[2]; ++z)
+        for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
+            for (std::int64_t x = lo[0]; x <= hi[0]; ++x) out.push_back(std::uint64_t((z * n[1] + y) * n[0] + x));
+    return out;
+}
+
 TEST_CASE("voxel_cache: updateVoxelCache is counted as the twin runs it, a thread per ray of each cell", "[voxel][counters]") {
     // The twin marks the occupied cells, traces a thread per ray of each
     // (launch x = cell x * rays + ray, y = the cell's row) and sums each
@@ -210,27 +231,38 @@ TEST_CASE("voxel_cache: updateVoxelCache is counted as the twin runs it, a threa
     CHECK(most == 1);
     CHECK(unoccupied == 0);
     // The marking kernel, a thread per particle storing every cell of its
-    // reach (1.5 r around its centre, widened to the trilinear stencils of
-    // its ends, clamped into the grid), is the record's item steps, and
-    // the cost model's item_steps feature of the pass: counted here in
-    // doubles, per axis.
-    std::uint64_t stores = 0;
-    for (std::size_t i = 0; i < s.particles.size(); ++i) {
-        std::uint64_t cells = 1;
-        const std::int64_t n[3] = {g.nx, g.ny, g.nz};
-        for (int k = 0; k < 3; ++k) {
-            const double reach = 1.5 * double(s.particles.radius[i]), p = double(s.particles.position[i][k]);
-            const auto cell = [&](double v) { return std::int64_t(std::floor((v - double(g.lower[k])) / double(g.cellSize) - 0.5)); };
-            const std::int64_t lo = std::clamp<std::int64_t>(cell(p - reach), 0, n[k] - 1);
-            const std::int64_t hi = std::clamp<std::int64_t>(cell(p + reach) + 1, 0, n[k] - 1);
-            cells *= std::uint64_t(hi - lo + 1);
-        }
-        stores += cells;
+    // reach, is the record's item steps as a warp issues its stores: per
+    // store, the distinct 32-byte sectors of its lanes (reachCells, counted
+    // in doubles; the two particles are one warp).
+    const std::vector<std::uint64_t> cells0 = reachCells(g, s.particles, 0), cells1 = reachCells(g, s.particles, 1);
+    std::uint64_t steps = 0;
+    for (std::size_t k = 0; k < std::max(cells0.size(), cells1.size()); ++k) {
+        std::set<std::uint64_t> sectors;
+        for (const auto* c : {&cells0, &cells1})
+            if (k < c->size()) sectors.insert((*c)[k] / 32);
+        steps += sectors.size();
     }
-    REQUIRE(stores >= s.particles.size());
-    CHECK(pc->itemSteps == stores);
+    REQUIRE(cells0.size() > 8);  // the big particle reaches many cells
+    CHECK(pc->itemSteps == steps);
     const GpuReport report = makeGpuReport(img.counters, s.settings, 0);
     for (const PassReport& p : report.passes)
         CHECK(costFeatures(p, kDefaultCacheBytes)[CostFeature::item_steps] ==
-              (p.pass.pass == Pass::updateVoxelCache ? double(stores) : 0.0));
+              (p.pass.pass == Pass::updateVoxelCache ? double(steps) : 0.0));
+}
+
+TEST_CASE("voxel_cache: the marking's sector steps: a warp of one point stores one sector a step", "[voxel][counters]") {
+    // 64 particles at one point (two full warps whose lanes store the same
+    // cell at every step: one sector each), then two at opposite corners
+    // (a warp of two lanes: two sectors a step while both store, one after).
+    Particles ps;
+    for (int i = 0; i < 64; ++i) ps.push(Vec3(0.3f, -0.2f, 0.1f), 0.2f, Vec3(1.0f), Vec3(0.5f));
+    ps.push(Vec3(-4.0f, -4.0f, -1.0f), 0.5f, Vec3(1.0f), Vec3(0.5f));
+    ps.push(Vec3(4.0f, 4.0f, 1.0f), 0.1f, Vec3(1.0f), Vec3(0.5f));
+    const voxel::VoxelGrid g = placeVoxelGrid(ps, Vec3(0.0f), 48).inFrame(Vec3(0.0f));
+    const std::uint64_t point = reachCells(g, ps, 0).size(), a = reachCells(g, ps, 64).size(), b = reachCells(g, ps, 65).size();
+    REQUIRE(point > 1);
+    REQUIRE(a != b);
+    CHECK(markingSectorSteps(g, ps, 32) == 2 * point + 2 * std::min(a, b) + (std::max(a, b) - std::min(a, b)));
+    // Warps of one lane: every store its own step.
+    CHECK(markingSectorSteps(g, ps, 1) == 64 * point + a + b);
 }

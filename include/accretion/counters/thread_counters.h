@@ -147,9 +147,9 @@ struct PassCounters {
     /// over those kernels: a step per item of a kernel that does one thing
     /// an item (gatherParticleTexels' select over every particle, its keys,
     /// sort and texels), and per loop trip of one that loops
-    /// (updateVoxelCache's marking: a thread per particle, a store per cell
-    /// of its reach). Their time grows with the particles where the grid's
-    /// does not.
+    /// (updateVoxelCache's marking: a thread per particle storing each cell
+    /// of its reach, a step per 32-byte sector a warp's store touches).
+    /// Their time grows with the particles where the grid's does not.
     std::uint64_t itemSteps = 0;
 
     PassCounters() = default;

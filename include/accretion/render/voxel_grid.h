@@ -38,9 +38,11 @@ inline constexpr std::uint64_t kMaxVoxelCells = std::uint64_t(1) << 25;  ///< 2 
 /// The cells some particle's reach covers: those updateVoxelCache updates
 /// (1) and empties (0). The same for every view: the cache is the world's.
 std::vector<std::uint8_t> occupiedCells(const voxel::VoxelGrid& grid, const Particles& particles);
-/// The stores of that marking: over the particles, the cells of each one's
-/// reach (with repeats: the twin's marking kernel stores each).
-std::uint64_t reachedCellStores(const voxel::VoxelGrid& grid, const Particles& particles);
+/// The stores of that marking (a thread per particle storing each cell of
+/// its reach, x fastest) as warps of `warpSize` consecutive particles issue
+/// them: per store, the distinct 32-byte sectors of its lanes, summed over
+/// the stores and the warps (updateVoxelCache's item steps).
+std::uint64_t markingSectorSteps(const voxel::VoxelGrid& grid, const Particles& particles, std::uint32_t warpSize);
 
 /// The frame's VoxelParams (the grid in its coordinates, the settings, the
 /// camera): the CPU and the twin both make theirs here.
