@@ -1,7 +1,6 @@
 #include "accretion/render/voxel_grid.h"
 
 #include <algorithm>
-#include <array>
 #include <atomic>
 #include <cmath>
 #include <functional>
@@ -84,12 +83,25 @@ std::vector<std::uint8_t> occupiedCells(const voxel::VoxelGrid& grid, const Part
     return occupied;
 }
 
+namespace {
+/// One marking thread's cells: the box lo + [0, n) per axis, stored x fastest.
+struct ReachBox {
+    std::uint32_t lo[3], n[3];
+    std::uint64_t stores() const { return std::uint64_t(n[0]) * n[1] * n[2]; }
+    /// The cell of its k-th store.
+    std::uint32_t cell(const voxel::VoxelGrid& g, std::uint64_t k) const {
+        return g.index(lo[0] + std::uint32_t(k % n[0]), lo[1] + std::uint32_t(k / n[0] % n[1]),
+                       lo[2] + std::uint32_t(k / (std::uint64_t(n[0]) * n[1])));
+    }
+};
+}  // namespace
+
 std::uint64_t markingSectorSteps(const voxel::VoxelGrid& grid, const Particles& particles, std::uint32_t warpSize) {
     const std::size_t warps = (particles.size() + warpSize - 1) / warpSize;
     return tbb::parallel_reduce(
         tbb::blocked_range<std::size_t>(0, warps, 64), std::uint64_t(0),
-        [&](const auto& r, std::uint64_t n) {
-            std::vector<std::array<std::uint32_t, 6>> lanes;
+        [&](const auto& r, std::uint64_t steps) {
+            std::vector<ReachBox> lanes;
             std::vector<std::uint32_t> sectors;
             for (std::size_t w = r.begin(); w != r.end(); ++w) {
                 lanes.clear();
@@ -97,22 +109,18 @@ std::uint64_t markingSectorSteps(const voxel::VoxelGrid& grid, const Particles& 
                 for (std::size_t i = w * warpSize; i < std::min(particles.size(), (w + 1) * warpSize); ++i) {
                     std::uint32_t lo[3], hi[3];
                     grid.reach(particles.position[i], voxel::particleReach(particles.radius[i]), lo, hi);
-                    lanes.push_back({lo[0], lo[1], lo[2], hi[0] - lo[0] + 1, hi[1] - lo[1] + 1, hi[2] - lo[2] + 1});
-                    most = std::max<std::uint64_t>(most, std::uint64_t(lanes.back()[3]) * lanes.back()[4] * lanes.back()[5]);
+                    lanes.push_back({{lo[0], lo[1], lo[2]}, {hi[0] - lo[0] + 1, hi[1] - lo[1] + 1, hi[2] - lo[2] + 1}});
+                    most = std::max(most, lanes.back().stores());
                 }
-                for (std::uint64_t k = 0; k < most; ++k) {  // the k-th store of every lane that has one: x fastest, then y, then z
+                for (std::uint64_t k = 0; k < most; ++k) {  // the warp's k-th store: the lanes that have one
                     sectors.clear();
-                    for (const auto& l : lanes) {
-                        if (k >= std::uint64_t(l[3]) * l[4] * l[5]) continue;
-                        const std::uint32_t x = l[0] + std::uint32_t(k % l[3]), y = l[1] + std::uint32_t(k / l[3] % l[4]),
-                                            z = l[2] + std::uint32_t(k / (std::uint64_t(l[3]) * l[4]));
-                        sectors.push_back(grid.index(x, y, z) / 32u);
-                    }
+                    for (const ReachBox& l : lanes)
+                        if (k < l.stores()) sectors.push_back(l.cell(grid, k) / 32u);  // a 32-byte sector of byte flags
                     std::sort(sectors.begin(), sectors.end());
-                    n += std::uint64_t(std::unique(sectors.begin(), sectors.end()) - sectors.begin());
+                    steps += std::uint64_t(std::unique(sectors.begin(), sectors.end()) - sectors.begin());
                 }
             }
-            return n;
+            return steps;
         },
         std::plus<>());
 }
