@@ -2,7 +2,7 @@
 # libFuzzer runs of the scene parser, the particle readers, the PLY header,
 # the accumulation reader and the batch jobs file (clang from
 # Debian, AddressSanitizer + UBSan), seeded from tests/fuzz/corpus_*.
-#   scripts/fuzz.sh [seconds per target]    (CI: 6; a longer run: 3600)
+#   scripts/fuzz.sh [seconds per target]    (CI: 4; a longer run: 3600)
 # New inputs go to build-fuzz/corpus_*; a crash leaves build-fuzz/crash-* and fails.
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -10,10 +10,10 @@
 #   3. the suite again under AddressSanitizer and UBSan (scripts/sanitize.sh);
 #   4. libFuzzer on every input reader (scripts/fuzz.sh, SECONDS per target).
 # Each stage's wall time goes to stderr; the first failure stops the run.
-#   scripts/test.sh [SECONDS]      (default 6)
+#   scripts/test.sh [SECONDS]      (default 4)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-fuzz_seconds=${1:-6}
+fuzz_seconds=${1:-4}
 start=$SECONDS
 
 stage() {

@@ -574,18 +574,22 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
     // share of the error, mostly between 0 and 100% (one shadow ray a pixel
     // is noise of its own). --designs particle_restir: its 8 alone (restir's
     // anatomy at the operating point is bench/operating_point.sh's; 34 more
-    // bias runs here cost CI a minute under ASan).
-    REQUIRE(runCommand(cmd + " --anatomy --designs particle_restir -q", out) == 0);
-    const nlohmann::json an = nlohmann::json::parse(slurp(dir / "t.json"));
-    CHECK(an["unshadowed_references"].size() == crops);
-    CHECK(an.at("lighting").size() == 8);
-    CHECK_FALSE(an.at("best_per_design").contains("restir"));
-    std::vector<double> shares;
-    for (const auto& p : an.at("lighting")) shares.push_back(p["visibility_share_pct"].get<double>());
-    std::sort(shares.begin(), shares.end());
-    const double median = shares[shares.size() / 2];
-    INFO("visibility's share of the error, median over the configurations: " << median << "%");
-    CHECK((median > 0.0 && median < 100.0));
+    // bias runs here cost CI a minute under ASan). In the Release stage only:
+    // its bias runs are the ones above with every light visible, and under
+    // ASan they took 9 s of a stage at CI's limit.
+    if (whole) {
+        REQUIRE(runCommand(cmd + " --anatomy --designs particle_restir -q", out) == 0);
+        const nlohmann::json an = nlohmann::json::parse(slurp(dir / "t.json"));
+        CHECK(an["unshadowed_references"].size() == crops);
+        CHECK(an.at("lighting").size() == 8);
+        CHECK_FALSE(an.at("best_per_design").contains("restir"));
+        std::vector<double> shares;
+        for (const auto& p : an.at("lighting")) shares.push_back(p["visibility_share_pct"].get<double>());
+        std::sort(shares.begin(), shares.end());
+        const double median = shares[shares.size() / 2];
+        INFO("visibility's share of the error, median over the configurations: " << median << "%");
+        CHECK((median > 0.0 && median < 100.0));
+    }
 
     // Bad input: one clear error each, exit 1, nothing written.
     CHECK(runCommand(kBin + " tune " + tinyScene() + " --budget-ms 0 -o " + (dir / "bad").string(), out) == 1);
