@@ -40,7 +40,7 @@ ParticleTexels gatherParticleTexels(const GBuffer& gbuffer, const Particles& par
 /// visible flags, the ids, the select, the keys, the sort's histogram, scan
 /// and digit passes, the slots and the texels (kGatherDispatches). On the
 /// H200 (no RT cores; bench/gpu/run.sh gather_ncu) the digit passes take
-/// 13 us each whatever the keys, the texels 0.08 ns each, the rest less.
+/// 13 us each whatever the keys, the texels 0.10-0.12 ns each, the rest less.
 inline constexpr std::uint64_t kSortDigitPasses = 8;
 inline constexpr std::uint64_t kGatherDispatches = 10 + kSortDigitPasses;
 std::uint64_t gatherItemSteps(std::size_t particles, const ParticleTexels& texels);
