@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include <tbb/parallel_for.h>
@@ -55,20 +56,42 @@ std::vector<DVec3> cieTable() {
 
 Vec3 blackbodyColor(double kelvin) { return blackbodyFromCie(kelvin, cieTable()); }
 
-BlackbodyTable::BlackbodyTable(double minKelvin, double maxKelvin, int entries)
-    : logMin_(std::log(minKelvin)), logMax_(std::log(maxKelvin)), table_(entries) {
-    const std::vector<DVec3> cie = cieTable();
-    tbb::parallel_for(0, entries, [&](int i) {
-        table_[i] = blackbodyFromCie(std::exp(logMin_ + (logMax_ - logMin_) * i / (entries - 1)), cie);
+namespace {
+
+constexpr int kEntries = 2048;
+const double kLogMin = std::log(500.0), kLogMax = std::log(1e6);
+
+/// The grid's position of a temperature: entry index plus fraction, clamped to the grid.
+double gridPosition(double kelvin) {
+    const double u = (std::log(kelvin) - kLogMin) / (kLogMax - kLogMin) * double(kEntries - 1);
+    return std::clamp(u, 0.0, double(kEntries - 1));
+}
+
+}  // namespace
+
+BlackbodyTable::BlackbodyTable() : BlackbodyTable(0.0, std::numeric_limits<double>::infinity()) {}
+
+BlackbodyTable::BlackbodyTable(double loKelvin, double hiKelvin) : cie_(cieTable()) {
+    const double lo = loKelvin > 0.0 ? gridPosition(loKelvin) : 0.0, hi = gridPosition(hiKelvin);
+    first_ = std::min(static_cast<std::size_t>(lo), std::size_t(kEntries - 2));
+    const std::size_t last = std::min(static_cast<std::size_t>(hi) + 1, std::size_t(kEntries - 1));
+    table_.resize(last + 1 - first_);
+    tbb::parallel_for(std::size_t(0), table_.size(), [&](std::size_t i) {
+        table_[i] = blackbodyFromCie(std::exp(kLogMin + (kLogMax - kLogMin) * double(first_ + i) / (kEntries - 1)), cie_);
     });
 }
 
+Vec3 BlackbodyTable::entry(std::size_t i) const {
+    return i >= first_ && i - first_ < table_.size()
+               ? table_[i - first_]
+               : blackbodyFromCie(std::exp(kLogMin + (kLogMax - kLogMin) * double(i) / (kEntries - 1)), cie_);
+}
+
 Vec3 BlackbodyTable::operator()(double kelvin) const {
-    const double u = (std::log(kelvin) - logMin_) / (logMax_ - logMin_) * double(table_.size() - 1);
-    const double c = std::clamp(u, 0.0, double(table_.size() - 1));
-    const std::size_t i = std::min(static_cast<std::size_t>(c), table_.size() - 2);
+    const double c = gridPosition(kelvin);
+    const std::size_t i = std::min(static_cast<std::size_t>(c), std::size_t(kEntries - 2));
     const float f = static_cast<float>(c - double(i));
-    return table_[i] * (1.0f - f) + table_[i + 1] * f;
+    return entry(i) * (1.0f - f) + entry(i + 1) * f;
 }
 
 }  // namespace accretion

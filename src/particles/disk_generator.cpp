@@ -15,6 +15,11 @@ double diskTemperature(const ParticleSettings& s, double r) {
     return s.inner_temperature * std::pow(r / s.inner_radius, -s.temperature_exponent);
 }
 
+std::pair<double, double> diskTemperatureRange(const ParticleSettings& s) {
+    const double inner = diskTemperature(s, s.inner_radius), outer = diskTemperature(s, s.outer_radius);
+    return {std::min(inner, outer), std::max(inner, outer)};
+}
+
 std::uint8_t temperatureType(const ParticleSettings& s, double kelvin) {
     const auto it = std::upper_bound(s.type_bands.begin(), s.type_bands.end(), kelvin);
     return static_cast<std::uint8_t>(it - s.type_bands.begin());
@@ -24,7 +29,10 @@ Particles generateDisk(const ParticleSettings& s, std::uint32_t frame, const Bla
     Particles out;
     out.resize(s.count);
     std::optional<BlackbodyTable> own;
-    if (!table) table = &own.emplace();
+    if (!table) {
+        const auto [lo, hi] = diskTemperatureRange(s);
+        table = &own.emplace(lo, hi);
+    }
     const BlackbodyTable& blackbody = *table;
     const double t = double(frame) * s.time_step;
     const double rIn2 = s.inner_radius * s.inner_radius, rOut2 = s.outer_radius * s.outer_radius;

@@ -13,7 +13,10 @@ namespace accretion {
 
 ParticleSource::ParticleSource(const Settings& settings)
     : particles_(settings.particles), albedo_(settings.shading.albedo) {
-    if (particles_.file.empty()) blackbody_ = std::make_shared<const BlackbodyTable>();
+    if (particles_.file.empty()) {
+        const auto [lo, hi] = diskTemperatureRange(particles_);
+        blackbody_ = std::make_shared<const BlackbodyTable>(lo, hi);
+    }
 }
 
 ParticleSource ParticleSource::fixed(Particles particles) {

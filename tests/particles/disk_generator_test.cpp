@@ -70,6 +70,17 @@ TEST_CASE("temperature profile, types by band, blackbody colours", "[particles]"
         const Vec3 a = table(T), b = blackbodyColor(T);
         for (int c = 0; c < 3; ++c) REQUIRE(a[c] == Approx(b[c]).epsilon(1e-2).margin(1e-3));
     }
+    // A table of a disk's range reads as the whole table, bit for bit, inside
+    // the range and outside it (where its entries are computed when asked).
+    const auto [lo, hi] = diskTemperatureRange(s);
+    REQUIRE(lo == Approx(diskTemperature(s, s.outer_radius)));
+    REQUIRE(hi == Approx(s.inner_temperature));
+    const BlackbodyTable part(lo, hi);
+    for (double T : {100.0, 500.0, 1000.0, 0.999 * lo, lo, std::sqrt(lo * hi), hi, 1.001 * hi, 30000.0, 1e6, 2e6}) {
+        INFO(T);
+        const Vec3 a = part(T), b = table(T);
+        for (int c = 0; c < 3; ++c) REQUIRE(a[c] == b[c]);
+    }
     // Emission luminance follows luminosity (T/T_in)^4.
     s.count = 50;
     const Particles p = generateDisk(s, 0);
