@@ -6,10 +6,8 @@
 // them. Internal to src/render/.
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 
-#include <tbb/blocked_range.h>
-#include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
 
 #include "accretion/counters/gpu_layouts.h"
 #include "accretion/counters/thread_counters.h"
@@ -44,19 +42,20 @@ const GBufferTexel& recordedTexel(Recorder<Count>& rec, const GBufferTexel& g, c
     return g;
 }
 
+/// The item passes' one parallel loop, compiled once (cpu_passes.cpp):
+/// range(begin, end, counters) over [0, n) in tasks of `grain` items on
+/// every core, each thread with its own counters; returns them summed
+/// (integers: the same whatever the threads).
+LightingCounters runItemRanges(std::size_t n, std::size_t grain,
+                               const std::function<void(std::size_t, std::size_t, LightingCounters&)>& range);
+
 /// item(k, counters) for k in [0, n) on every core, `grain` items a task,
-/// each thread adding to its own counters; returns them summed (integers:
-/// the same whatever the threads).
+/// each thread adding to its own counters; returns them summed.
 template <class Item>
 LightingCounters forEachItemParallel(std::size_t n, std::size_t grain, Item&& item) {
-    tbb::enumerable_thread_specific<LightingCounters> counters;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, grain), [&](const auto& r) {
-        LightingCounters& c = counters.local();
-        for (std::size_t k = r.begin(); k != r.end(); ++k) item(k, c);
+    return runItemRanges(n, grain, [&](std::size_t begin, std::size_t end, LightingCounters& c) {
+        for (std::size_t k = begin; k != end; ++k) item(k, c);
     });
-    LightingCounters total;
-    for (const LightingCounters& c : counters) total += c;
-    return total;
 }
 
 /// fn.template operator()<P, Count>() for the primitive and counting mode.

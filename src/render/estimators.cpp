@@ -4,6 +4,7 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <ranges>
@@ -325,6 +326,32 @@ void finishGroup(const Sweep& s, GroupPixel* pix, std::uint32_t n, LightingCount
     }
 }
 
+/// What a sweep's thread keeps: its counters and its near-field cache.
+struct SweepThread {
+    LightingCounters counters;
+    std::unique_ptr<NearFieldCache> nearCache;
+};
+
+/// A sweep's tile: columns [x0, x1), rows [y0, y1).
+struct SweepTile {
+    std::uint32_t x0, x1, y0, y1;
+};
+
+/// The sweeps' one parallel loop, compiled once rather than in each of the
+/// 12 kernels (shading model x primitive x counting): tile(t, thread) over
+/// rows [row0, row1) and columns [x0, x1) in 8x8 tiles on every core;
+/// returns the threads' counters summed (integers: the same whatever the threads).
+LightingCounters runSweepTiles(std::uint32_t row0, std::uint32_t row1, std::uint32_t x0, std::uint32_t x1,
+                               const std::function<void(const SweepTile&, SweepThread&)>& tile) {
+    tbb::enumerable_thread_specific<SweepThread> threads;
+    tbb::parallel_for(tbb::blocked_range2d<std::uint32_t>(row0, row1, 8, x0, x1, 8), [&](const tbb::blocked_range2d<std::uint32_t>& r) {
+        tile(SweepTile{r.cols().begin(), r.cols().end(), r.rows().begin(), r.rows().end()}, threads.local());
+    });
+    LightingCounters total;
+    for (const SweepThread& t : threads) total += t.counters;
+    return total;
+}
+
 /// Runs chunks [c0, c1) over every pixel of `area` (exact: of its rows that
 /// the chunks are; a part of the G-buffer's window, whose layout `acc` and
 /// `out` share) in one parallel sweep, each pixel's sums in registers:
@@ -340,32 +367,30 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
     const GBuffer& gb = in.gbuffer;
     ACC_CHECK(gb.window.contains(area) && (!acc || acc->window == gb.window) && (acc || out->Lr.size() == gb.texels.size()));
     const Sweep s{in, L, plan, acc, out, c0, c1, VisibilityOptions::from(in.render), in.shading.visibility};
-    tbb::enumerable_thread_specific<LightingCounters> counters;
-    tbb::enumerable_thread_specific<std::unique_ptr<NearFieldCache>> nearCaches;
     const auto rows = [&](std::uint64_t c, std::uint32_t whole) {
         return plan.exact ? static_cast<std::uint32_t>(std::clamp<std::uint64_t>(c * LightingPlan::kChunkRows, area.y0, area.y1))
                           : whole;
     };
     const std::uint32_t row0 = rows(c0, area.y0), row1 = rows(c1, area.y1);
     if (row0 >= row1 || area.x0 >= area.x1) return {};
-    tbb::parallel_for(tbb::blocked_range2d<std::uint32_t>(row0, row1, 8, area.x0, area.x1, 8), [&](const auto& r) {
-        LightingCounters& c = counters.local();
+    return runSweepTiles(row0, row1, area.x0, area.x1, [&](const SweepTile& r, SweepThread& thread) {
+        LightingCounters& c = thread.counters;
         GroupPixel pix[kGroupPixels];
         std::uint64_t hitPixels = 0;
-        for (std::uint32_t y = r.rows().begin(); y != r.rows().end(); ++y) {
-            for (std::uint32_t x0 = r.cols().begin(); x0 < r.cols().end(); x0 += kGroupPixels) {
-                const std::uint32_t x1 = std::min(r.cols().end(), x0 + kGroupPixels);
+        for (std::uint32_t y = r.y0; y != r.y1; ++y) {
+            for (std::uint32_t x0 = r.x0; x0 < r.x1; x0 += kGroupPixels) {
+                const std::uint32_t x1 = std::min(r.x1, x0 + kGroupPixels);
                 // The next group's texels (the next row's at a row's end) are
                 // read soon: a range's rows are short runs of the G-buffer.
                 const std::size_t rowSlot = gb.window.index(x0, y) - x0;
-                const std::size_t next = x1 < r.cols().end() ? rowSlot + x1 : rowSlot + gb.window.width() + r.cols().begin();
+                const std::size_t next = x1 < r.x1 ? rowSlot + x1 : rowSlot + gb.window.width() + r.x0;
                 if (next + kGroupPixels <= gb.texels.size())
                     for (std::size_t b = 0; b < kGroupPixels * sizeof(GBufferTexel); b += 64)
                         __builtin_prefetch(reinterpret_cast<const char*>(&gb.texels[next]) + b);
                 const std::uint32_t n = beginGroup<Count>(s, y, x0, x1, pix);
                 if (n == 0) continue;
                 hitPixels += n;
-                lightGroup<M, P, Count>(s, pix, n, nearCaches.local());
+                lightGroup<M, P, Count>(s, pix, n, thread.nearCache);
                 finishGroup<Count>(s, pix, n, c);
             }
         }
@@ -373,9 +398,6 @@ LightingCounters sweep(const LightingInputs& in, const LightArrays& L, const Lig
         // same count for every hit pixel); misses cost next to nothing.
         if (progress) progress->advance(hitPixels * (plan.exact ? 1 : c1 - c0));
     });
-    LightingCounters total;
-    for (const auto& c : counters) total += c;
-    return total;
 }
 
 /// How long a band of a Monte Carlo sweep should take: what a stop request

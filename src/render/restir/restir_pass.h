@@ -3,12 +3,10 @@
 // context, the offers a pass resamples, pixel loops and counting helpers.
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <type_traits>
 #include <vector>
 
-#include <tbb/blocked_range2d.h>
-#include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
 
 #include "accretion/core/rng.h"
 #include "accretion/counters/gpu_layouts.h"
@@ -58,29 +56,34 @@ struct Scratch {
     std::vector<Offer> offers;
 };
 
+/// A tile of a pass's grid: columns [x0, x1), rows [y0, y1).
+struct PixelTile {
+    std::uint32_t x0, x1, y0, y1;
+};
+
+/// The pixel passes' one parallel loop, compiled once (pixel_tiles.cpp):
+/// tile(t, counters, scratch) over the w x h grid in 8x8 tiles on every
+/// core, each thread with its own counters and scratch; returns the
+/// counters summed (integers: the same whatever the threads). Instantiated
+/// in each of the 60 kernels of a pass file, TBB's loop and thread-local
+/// state had been two fifths of their code and compile time.
+LightingCounters runPixelTiles(std::uint32_t w, std::uint32_t h,
+                               const std::function<void(const PixelTile&, LightingCounters&, Scratch&)>& tile);
+
 /// Runs body(px, x, y, counters) or body(px, x, y, counters, scratch) over
 /// the pixels of a w x h grid in 8x8 tiles; counters and scratch are the
 /// running thread's.
 template <class Body>
 LightingCounters forEachPixel(std::uint32_t w, std::uint32_t h, Body&& body) {
-    struct ThreadState {
-        LightingCounters counters;
-        Scratch scratch;
-    };
-    tbb::enumerable_thread_specific<ThreadState> state;
-    tbb::parallel_for(tbb::blocked_range2d<std::uint32_t>(0, h, 8, 0, w, 8), [&](const auto& r) {
-        ThreadState& ts = state.local();
-        for (std::uint32_t y = r.rows().begin(); y != r.rows().end(); ++y)
-            for (std::uint32_t x = r.cols().begin(); x != r.cols().end(); ++x) {
+    return runPixelTiles(w, h, [&](const PixelTile& t, LightingCounters& c, Scratch& s) {
+        for (std::uint32_t y = t.y0; y != t.y1; ++y)
+            for (std::uint32_t x = t.x0; x != t.x1; ++x) {
                 if constexpr (std::is_invocable_v<Body&, std::size_t, std::uint32_t, std::uint32_t, LightingCounters&, Scratch&>)
-                    body(std::size_t(y) * w + x, x, y, ts.counters, ts.scratch);
+                    body(std::size_t(y) * w + x, x, y, c, s);
                 else
-                    body(std::size_t(y) * w + x, x, y, ts.counters);
+                    body(std::size_t(y) * w + x, x, y, c);
             }
     });
-    LightingCounters total;
-    for (const auto& ts : state) total += ts.counters;
-    return total;
 }
 
 struct FrameContext {

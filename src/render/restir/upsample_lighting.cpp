@@ -1,4 +1,7 @@
 // upsampleLighting: Lr from the reduced lighting grid to every image pixel.
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "restir_pass.h"
 
 #include "accretion/render/upsample_pixel.h"
