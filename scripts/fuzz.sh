@@ -7,7 +7,10 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-30}
-CXX=clang++ CC=clang cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DACCRETION_FUZZ=ON \
+# -O1 with line tables (libFuzzer's usual flags): the base's unity batches
+# compile in about 34 s instead of 40 at -O2 -g, and a stack trace keeps its lines.
+CXX=clang++ CC=clang cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only -DNDEBUG" -DACCRETION_FUZZ=ON \
   -DACCRETION_BUILD_TESTS=OFF -DACCRETION_BUILD_BENCH=OFF >/dev/null
 targets="scene particles ply_header accumulation jobs"
 cmake --build build-fuzz --target $(for t in $targets; do printf "fuzz_%s " $t; done)
