@@ -115,8 +115,9 @@ done
 same_pixels "$WORK/out/merged.exr" "$WORK/out/single.exr"
 say "PASS: the merged job array equals a single run bit for bit"
 
-# Signal, requeue, resume: one task with enough samples to be stopped mid-frame.
-export SPP=131072 SHARDS=1 OUT=$WORK/out/requeue
+# Signal, requeue, resume: one task with enough samples to be stopped mid-frame
+# (65536 a pixel: about 13 s on 2 cores, signalled about 3 s in).
+export SPP=65536 SHARDS=1 OUT=$WORK/out/requeue
 JOB=$(sbatch --parsable --requeue --array=0-0 --cpus-per-task=$CPUS --time=10 "$WORK/reference.sbatch")
 LOG=slurm-${JOB}_0.out
 for _ in $(seq 120); do grep -q "accretion: frame 0" "$LOG" 2>/dev/null && break; sleep 0.5; done
@@ -153,6 +154,6 @@ wait_job "$JOB"
 # Band-major sweeps: part-way down the frame (rows done) or past its first chunk.
 grep -qE "resuming .* at frame 0, chunk ([1-9]|0, pixels before row [0-9]+ column [0-9]+ done)" "$LOG" || fail "the requeued task did not resume from its checkpoint: $(grep -i resum "$LOG" || tail -n 5 "$LOG")"
 grep -q "^stats:" "$LOG" || fail "the requeued task did not finish: $(tail -n 5 "$LOG")"
-"$BIN" render "$SCENE" "${SCENE_ARGS[@]}" --quiet --estimator tree --spp 131072 --frames 0 -o "$WORK/out/uninterrupted.exr" >/dev/null
+"$BIN" render "$SCENE" "${SCENE_ARGS[@]}" --quiet --estimator tree --spp 65536 --frames 0 -o "$WORK/out/uninterrupted.exr" >/dev/null
 same_pixels "$OUT/quickstart.0000.exr" "$WORK/out/uninterrupted.exr"
 say "PASS: scancel --signal=TERM, requeue, resume: $(grep -o 'resuming .*' "$LOG" | head -1); image equals an uninterrupted run bit for bit"
