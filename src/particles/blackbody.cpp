@@ -67,6 +67,9 @@ double gridPosition(double kelvin) {
     return std::clamp(u, 0.0, double(kEntries - 1));
 }
 
+/// The temperature of entry i of the grid.
+double gridKelvin(std::size_t i) { return std::exp(kLogMin + (kLogMax - kLogMin) * double(i) / (kEntries - 1)); }
+
 }  // namespace
 
 BlackbodyTable::BlackbodyTable() : BlackbodyTable(0.0, std::numeric_limits<double>::infinity()) {}
@@ -77,14 +80,14 @@ BlackbodyTable::BlackbodyTable(double loKelvin, double hiKelvin) : cie_(cieTable
     const std::size_t last = std::min(static_cast<std::size_t>(hi) + 1, std::size_t(kEntries - 1));
     table_.resize(last + 1 - first_);
     tbb::parallel_for(std::size_t(0), table_.size(), [&](std::size_t i) {
-        table_[i] = blackbodyFromCie(std::exp(kLogMin + (kLogMax - kLogMin) * double(first_ + i) / (kEntries - 1)), cie_);
+        table_[i] = blackbodyFromCie(gridKelvin(first_ + i), cie_);
     });
 }
 
 Vec3 BlackbodyTable::entry(std::size_t i) const {
     return i >= first_ && i - first_ < table_.size()
                ? table_[i - first_]
-               : blackbodyFromCie(std::exp(kLogMin + (kLogMax - kLogMin) * double(i) / (kEntries - 1)), cie_);
+               : blackbodyFromCie(gridKelvin(i), cie_);
 }
 
 Vec3 BlackbodyTable::operator()(double kelvin) const {

@@ -8,7 +8,6 @@
 #include <cstdint>
 #include <functional>
 
-
 #include "accretion/counters/gpu_layouts.h"
 #include "accretion/counters/thread_counters.h"
 #include "accretion/geometry/particle_bvh.h"
