@@ -462,7 +462,7 @@ void ParticleAccel::buildTlas(const DeviceParticles& particles, cudaStream_t str
     // moved); every other layout rebuilds its (small) TLAS.
     const bool updatable = instanced() && options_.build == BuildPolicy::refit;
     const bool update = updatable && tlas_ != 0;
-    const OptixAccelBuildOptions opts{OPTIX_BUILD_FLAG_PREFER_FAST_BUILD | (updatable ? OPTIX_BUILD_FLAG_ALLOW_UPDATE : 0u),
+    const OptixAccelBuildOptions opts{OPTIX_BUILD_FLAG_PREFER_FAST_BUILD | (updatable ? unsigned(OPTIX_BUILD_FLAG_ALLOW_UPDATE) : 0u),
                                       update ? OPTIX_BUILD_OPERATION_UPDATE : OPTIX_BUILD_OPERATION_BUILD, {}};
     OptixAccelBufferSizes s{};
     OPTIX_CHECK(optixAccelComputeMemoryUsage(context_, &opts, &in, 1, &s));

@@ -62,7 +62,7 @@ std::string difference(const std::map<std::string, std::string>& before, const s
 
 TEST_CASE("the bad-input corpus: exact errors, exit 1, nothing written, inputs untouched", "[cli][bad_input][long]") {
     const fs::path corpus = fs::path(ACCRETION_SOURCE_DIR) / "tests" / "bad_input";
-    const std::string bin = ACCRETION_BINARY;
+    const std::string bin = accretion::test::programPath();
     // The cases run in a copy (links kept as links): a defect that writes over
     // an input is caught by the snapshots and never reaches the repository.
     const fs::path work = accretion::test::scratchDir("bad_input_corpus");

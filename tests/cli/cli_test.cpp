@@ -148,20 +148,20 @@ TEST_CASE("particles command: the GPU buffer renders the same image as the gener
 TEST_CASE("accretion plan prints every pass, the skipped ones with their reason", "[cli][plan]") {
     std::string out;
     const std::string scene = std::string(ACCRETION_SOURCE_DIR) + "/scenes/quickstart.toml";
-    REQUIRE(accretion::test::runCommand(std::string(ACCRETION_BINARY) + " plan " + scene +
+    REQUIRE(accretion::test::runCommand(accretion::test::programPath() + " plan " + scene +
                                             " -D geometry.alpha=\\\"disc\\\" -D shading.visibility=false", out) == 0);
     CHECK_THAT(out, Catch::Matches("(.|\n)*alpha filter callbacks +runs +disc alpha(.|\n)*"));
     CHECK_THAT(out, Catch::Matches("(.|\n)*shadow rays +skipped +visibility off: no shadow rays(.|\n)*"));
-    REQUIRE(accretion::test::runCommand(std::string(ACCRETION_BINARY) + " plan " + scene +
+    REQUIRE(accretion::test::runCommand(accretion::test::programPath() + " plan " + scene +
                                             " -D render.estimator=\\\"restir\\\" --frames 0:1", out) == 0);
     CHECK_THAT(out, Catch::Matches("(.|\n)*temporalResampling +skipped +one frame: no history buffers or motion(.|\n)*"));
-    CHECK(accretion::test::runCommand(std::string(ACCRETION_BINARY) + " plan no_such_scene.toml", out) == 1);
+    CHECK(accretion::test::runCommand(accretion::test::programPath() + " plan no_such_scene.toml", out) == 1);
     CHECK_THAT(out, Catch::Contains("no_such_scene.toml"));
 }
 
 TEST_CASE("docs/rendering.md carries the estimator table accretion estimators prints", "[cli][docs]") {
     std::string out;
-    REQUIRE(accretion::test::runCommand(std::string(ACCRETION_BINARY) + " estimators", out) == 0);
+    REQUIRE(accretion::test::runCommand(accretion::test::programPath() + " estimators", out) == 0);
     std::ifstream docs(std::string(ACCRETION_SOURCE_DIR) + "/docs/rendering.md");
     REQUIRE(docs);
     const std::string text((std::istreambuf_iterator<char>(docs)), std::istreambuf_iterator<char>());

@@ -16,7 +16,7 @@ using Catch::Matchers::Contains;
 namespace {
 
 std::string render(const fs::path& exr) {
-    return std::string(ACCRETION_BINARY) + " render " + ACCRETION_SOURCE_DIR +
+    return accretion::test::programPath() + " render " + ACCRETION_SOURCE_DIR +
            "/scenes/quickstart.toml --quiet --frames 0:1 -D camera.width=320 -D camera.height=180 "
            "-D particles.count=500 -D render.samples=2 -o " + exr.string();
 }
@@ -57,7 +57,7 @@ TEST_CASE("an output directory that cannot exist: a clear error and exit 1", "[c
 TEST_CASE("two runs to one output: the second is refused naming the first's PID, the checkpoint survives",
           "[cli][fault][lock]") {
     const fs::path dir = accretion::test::scratchDir("fault_two_runs");
-    const std::string slow = std::string(ACCRETION_BINARY) + " render " + ACCRETION_SOURCE_DIR +
+    const std::string slow = accretion::test::programPath() + " render " + ACCRETION_SOURCE_DIR +
                              "/scenes/quickstart.toml --quiet --frames 0:1 -D camera.width=320 -D camera.height=180 "
                              "-D particles.count=20000 --estimator uniform --spp 2048 --checkpoint-every 0 -o " +
                              (dir / "x.exr").string();
@@ -96,7 +96,7 @@ TEST_CASE("restir stopped by SIGTERM or SIGINT: the frames done are whole with t
     const std::string signal = GENERATE("TERM", "INT");
     const fs::path dir = accretion::test::scratchDir("fault_restir_" + signal);
     // Many frames: the signal comes once frame 0 is written, long before the last.
-    const std::string run = std::string(ACCRETION_BINARY) + " render " + ACCRETION_SOURCE_DIR +
+    const std::string run = accretion::test::programPath() + " render " + ACCRETION_SOURCE_DIR +
                             "/scenes/quickstart.toml --quiet --frames 0:400 -D camera.width=160 -D camera.height=90 "
                             "-D particles.count=5000 --estimator restir -o " + (dir / "r.{frame}.exr").string();
     const std::string script = run + " > /dev/null 2> " + (dir / "err").string() + " & P=$!\n" +

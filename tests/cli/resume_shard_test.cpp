@@ -36,7 +36,7 @@ namespace {
 /// chunks a frame (4096 samples: about 0.8 s on 2 cores).
 std::string renderCommand(const fs::path& dir, const std::string& extra = "", int spp = 4096,
                           const std::string& estimator = "uniform") {
-    return std::string(ACCRETION_BINARY) + " render " + ACCRETION_SOURCE_DIR +
+    return accretion::test::programPath() + " render " + ACCRETION_SOURCE_DIR +
            "/scenes/quickstart.toml --quiet --frames 0:2 -D camera.width=160 -D camera.height=90 "
            "-D particles.count=2000 --estimator " + estimator + " --spp " + std::to_string(spp) + " -o " +
            (dir / "{scene}.{frame}.exr").string() + " " + extra;
@@ -290,7 +290,7 @@ TEST_CASE("shards run with GNU parallel merge into the image of one run", "[cli]
     const std::string scene = std::string(ACCRETION_SOURCE_DIR) + "/scenes/quickstart.toml";
     for (const char* estimator : {"exact", "uniform", "ris"}) {
         INFO(estimator);
-        const std::string common = std::string(ACCRETION_BINARY) + " render " + scene +
+        const std::string common = accretion::test::programPath() + " render " + scene +
                                    " --quiet --frames 1 -D camera.width=96 -D camera.height=54 -D particles.count=1500 "
                                    "--spp 64 --estimator " + estimator;
         const fs::path one = dir / (std::string(estimator) + ".one.exr");
@@ -301,7 +301,7 @@ TEST_CASE("shards run with GNU parallel merge into the image of one run", "[cli]
         const fs::path merged = dir / (std::string(estimator) + ".merged.exr");
         // Named as --shard I/3 gives them (shard0of3..shard2of3); given out of order: the merge sums in shard order.
         const auto shard = [&](int i) { return (dir / (std::string(estimator) + ".0001.shard" + std::to_string(i) + "of3.exr")).string(); };
-        REQUIRE(runCommand(std::string(ACCRETION_BINARY) + " merge " + shard(2) + " " + shard(0) + " " + shard(1) + " -o " + merged.string(), out) == 0);
+        REQUIRE(runCommand(accretion::test::programPath() + " merge " + shard(2) + " " + shard(0) + " " + shard(1) + " -o " + merged.string(), out) == 0);
         INFO(out);
         CHECK(sameImage(one, merged));
         // Beside it, the settings the shards were rendered with (what compare's
@@ -312,9 +312,9 @@ TEST_CASE("shards run with GNU parallel merge into the image of one run", "[cli]
               accretion::test::readFile(dir / (std::string(estimator) + ".shard0of3.settings.toml")));
 
         // A missing or repeated shard is refused.
-        CHECK(runCommand(std::string(ACCRETION_BINARY) + " merge " + shard(0) + " " + shard(1) + " -o " + (dir / "x.exr").string(), out) == 1);
+        CHECK(runCommand(accretion::test::programPath() + " merge " + shard(0) + " " + shard(1) + " -o " + (dir / "x.exr").string(), out) == 1);
         CHECK_THAT(out, Contains("shard(s) 2/3 missing"));
-        CHECK(runCommand(std::string(ACCRETION_BINARY) + " merge " + shard(0) + " " + shard(0) + " " + shard(1) + " -o " + (dir / "x.exr").string(), out) == 1);
+        CHECK(runCommand(accretion::test::programPath() + " merge " + shard(0) + " " + shard(0) + " " + shard(1) + " -o " + (dir / "x.exr").string(), out) == 1);
         CHECK_THAT(out, Contains("given twice"));
         CHECK_FALSE(fs::exists(dir / "x.exr"));
     }

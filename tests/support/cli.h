@@ -13,7 +13,7 @@ using Catch::Matchers::Contains;
 
 namespace accretion::test {
 
-inline const std::string kBin = ACCRETION_BINARY;
+inline const std::string kBin = programPath();
 inline const std::string kScenes = std::string(ACCRETION_SOURCE_DIR) + "/scenes";
 
 /// The small disk scene's text.

@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <sys/wait.h>
@@ -74,6 +75,14 @@ std::string readFile(const std::filesystem::path& file) {
     std::stringstream ss;
     ss << in.rdbuf();
     return ss.str();
+}
+
+const std::string& programPath() {
+    static const std::string path = [] {
+        const char* program = std::getenv("ACCRETION_PROGRAM");
+        return std::string(program && *program ? program : ACCRETION_BINARY);
+    }();
+    return path;
 }
 
 int runCommand(const std::string& command, std::string& output) {

@@ -48,6 +48,11 @@ std::string smallDiskScene();
 /// A whole file's bytes.
 std::string readFile(const std::filesystem::path& file);
 
+/// The `accretion` program the command-line tests run: this build's, or the
+/// environment's ACCRETION_PROGRAM (the sanitizer stage runs the Release
+/// build's command-line tests against its instrumented program).
+const std::string& programPath();
+
 /// Run a shell command; returns its exit status, stdout+stderr in `output`.
 int runCommand(const std::string& command, std::string& output);
 
