@@ -5,9 +5,11 @@
 #   2. the OptiX twin's compile without a GPU (scripts/compile_twin.sh),
 #      and the one-node Slurm cluster's job-array and requeue test
 #      (scripts/slurm/cluster_test.sh), which starts beside stage 1's ctest:
-#      it mostly waits on daemons and sleeps (30 s of CPU in 45), which
-#      alone left a core idle for most of its stage;
-#   3. the suite again under AddressSanitizer and UBSan (scripts/sanitize.sh);
+#      alone it takes 43-45 s and about 60 s of CPU, and its waits on
+#      daemons and sleeps left a core idle in a stage of its own;
+#   3. the suite again under AddressSanitizer and UBSan (scripts/sanitize.sh;
+#      the command-line tests from stage 1's harness, run against the
+#      instrumented program);
 #   4. libFuzzer on every input reader (scripts/fuzz.sh, SECONDS per target).
 # Each stage's wall time goes to stderr; the first failure stops the run.
 #   scripts/test.sh [SECONDS]      (default 4)
