@@ -262,6 +262,15 @@ struct ProbeContext {
     std::uint32_t exclude[2];
 };
 
+/// Whether o + t d hits particle i's primitive (its sphere, or its
+/// billboard with the alpha test) within [tnear, tfar], and where.
+bool hitProbePrimitive(const ProbeData& probe, unsigned i, const Vec3& o, const Vec3& d, float tnear, float tfar, float& t) {
+    const BoxPrimitive& b = probe.prims[i];
+    Vec2 uv;
+    return probe.sphere ? hitSphere(o, d, tnear, tfar, b.p, b.r, t)
+                        : intersectBillboard(o, d, tnear, tfar, b.p, b.r, probe.frames[i], probe.disc, t, uv);
+}
+
 void probeBounds(const RTCBoundsFunctionArguments* args) {
     *args->bounds_o = static_cast<const ProbeData*>(args->geometryUserPtr)->boxes[args->primID];
 }
@@ -283,12 +292,8 @@ void probeIntersect(const RTCIntersectFunctionNArguments* args) {
         return;
     }
     if (i == context->exclude[0] || i == context->exclude[1]) return;
-    const Vec3 o(org[0], org[1], org[2]), d(dir[0], dir[1], dir[2]);
-    const BoxPrimitive& b = probe.prims[i];
     float t;
-    Vec2 uv;
-    if (!(probe.sphere ? hitSphere(o, d, ray.tnear, ray.tfar, b.p, b.r, t)
-                       : intersectBillboard(o, d, ray.tnear, ray.tfar, b.p, b.r, probe.frames[i], probe.disc, t, uv)))
+    if (!hitProbePrimitive(probe, i, Vec3(org[0], org[1], org[2]), Vec3(dir[0], dir[1], dir[2]), ray.tnear, ray.tfar, t))
         return;
     rh->ray.tfar = t;
     rh->hit.geomID = 0;
@@ -465,7 +470,7 @@ void ParticleBvh::buildCountingTlas() {
     rtcCommitScene(countingTlas_);
 }
 
-void ParticleBvh::buildProbe(const Particles& particles) {
+void ParticleBvh::buildProbe(const Particles& particles, bool refit) {
     const std::size_t n = particles.size();
     probeBoxes_.resize(n);
     probePrims_.resize(n);
@@ -493,6 +498,8 @@ void ParticleBvh::buildProbe(const Particles& particles) {
     rtcAttachGeometryByID(probe_, g, 0);
     rtcReleaseGeometry(g);
     rtcCommitScene(probe_);
+    if (refit && traversal_.primitives() == n) traversal_.refit(probeBoxes_);
+    else traversal_.build(device_.get(), probeBoxes_);
 }
 
 BoxesCrossed ParticleBvh::boxesAlong(const Vec3& o, const Vec3& d, float tnear, float tfar, const Exclusion* occlusion) const {
@@ -575,7 +582,7 @@ void ParticleBvh::build(const Particles& particles, const Camera& camera) {
     if (counting_) buildCountingTlas();
     device_.check("buildClusters (TLAS)");
     stats_.tlasSeconds = secondsSince(t0);
-    if (counting_) buildProbe(particles);  // counting's own structure: not the GPU's build, not timed as one
+    if (counting_) buildProbe(particles, refit);  // counting's own structure: not the GPU's build, not timed as one
 
     stats_.refitted = refit;
     stats_.partial = keep && settings_.build == BuildPolicy::partial;
@@ -598,6 +605,9 @@ bool ParticleBvh::intersect(const Vec3& o, const Vec3& d, float tfar, SurfaceHit
         const BoxesCrossed n = boxesAlong(o, d, 0.0f, rh.ray.tfar);  // up to the hit: no blocker search
         counters->segmentBoxes += n.untilBlocker;
         counters->wholeSegmentBoxes += n.whole;
+        counters->nodeVisits += traversal_.closestHit(o, d, 0.0f, tfar, [&](unsigned i, float t0, float t1, float& t) {
+            return hitProbePrimitive(probeData_, i, o, d, t0, t1, t);
+        });
     }
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
     const std::uint32_t c = rh.hit.instID[0];
@@ -657,6 +667,9 @@ bool ParticleBvh::occluded(const Vec3& o, const Vec3& d, float tnear, float tfar
         const BoxesCrossed n = boxesAlong(o, d, tnear, tfar, &exclude);
         counters->segmentBoxes += n.untilBlocker;
         counters->wholeSegmentBoxes += n.whole;
+        counters->nodeVisits += traversal_.anyHit(o, d, tnear, tfar, [&](unsigned i, float t0, float t1, float& t) {
+            return i != exclude.receiver && i != exclude.light && hitProbePrimitive(probeData_, i, o, d, t0, t1, t);
+        });
     }
     return ray.tfar < 0.0f;
 }

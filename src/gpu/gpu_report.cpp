@@ -154,6 +154,7 @@ nlohmann::json toJson(const PassReport& p) {
                         {"tlas_instances", p.build.tlasInstances},
                         {"tlas_instances_32k", p.build.tlasInstancesMid},
                         {"warp_segment_boxes", p.ser.traversalBefore.steps},
+                        {"warp_node_visits", p.ser.nodesBefore.steps},
                         {"warp_gathers", p.ser.gathersBefore.steps},
                         {"hit_warps", p.ser.hitsBefore.warps},
                         {"footprint_bytes", p.footprintBytes},

@@ -121,7 +121,7 @@ SerReport serReport(const PassCounters& pass, const WarpLayout& layout, const Se
                     double reorderCost) {
     const std::size_t n = pass.threads.size();
     std::vector<std::uint64_t> branchKey(n), sortKey(n), one(n, 0);
-    std::vector<std::uint32_t> branchWork(n), trips(n), boxes(n), gathers(n), hits(n);
+    std::vector<std::uint32_t> branchWork(n), trips(n), boxes(n), nodes(n), gathers(n), hits(n);
     std::size_t active = 0;
     for (std::size_t i = 0; i < n; ++i) {
         const ThreadCounters& t = pass.threads[i];
@@ -130,6 +130,7 @@ SerReport serReport(const PassCounters& pass, const WarpLayout& layout, const Se
         branchWork[i] = t.active;
         trips[i] = t.trips;
         boxes[i] = t.segmentBoxes;
+        nodes[i] = t.nodeVisits;
         gathers[i] = t.gathers;
         hits[i] = t.hit;
         active += t.active;
@@ -143,6 +144,7 @@ SerReport serReport(const PassCounters& pass, const WarpLayout& layout, const Se
     r.loopBefore = simtStats(before, one, trips, layout.warpSize);
     r.loopAfter = simtStats(after, one, trips, layout.warpSize);
     r.traversalBefore = simtStats(before, one, boxes, layout.warpSize);
+    r.nodesBefore = simtStats(before, one, nodes, layout.warpSize);
     r.gathersBefore = simtStats(before, one, gathers, layout.warpSize);
     r.hitsBefore = simtStats(before, one, hits, layout.warpSize);
     r.distinctSortKeysBefore = simtStats(before, sortKey, branchWork, layout.warpSize).distinctKeysPerWarp;

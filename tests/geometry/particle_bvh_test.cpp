@@ -242,6 +242,52 @@ TEST_CASE("counting queries: same answers, BLAS entries bounded by the overlappe
     }
 }
 
+TEST_CASE("the traversal model's nodes: a refit of unmoved particles visits what a build does", "[geometry][bvh][gpu]") {
+    // The refit policy keeps the first frame's topology and recomputes its
+    // boxes; over the same particles they are the build's boxes, so every
+    // ray visits the same nodes, ray by ray. Moved, the refit's topology is
+    // the first frame's, which is not the one a build would choose.
+    const auto [ps, cs] = accretion::test::smallView(400, 3.0, 0.1, Vec3(0.0f, 3.0f, 6.0f), 40, 30);
+    EmbreeDevice device;
+    GpuSettings gpu;
+    gpu.counters = true;
+    GeometrySettings rebuilt, refitted;
+    rebuilt.build = BuildPolicy::rebuild;
+    refitted.build = BuildPolicy::refit;
+    ParticleBvh a(device, rebuilt, gpu), b(device, refitted, gpu);
+    const Particles p0 = generateDisk(ps, 0), p5 = generateDisk(ps, 5);
+    const Camera cam = Camera::atFrame(cs, 0);
+    a.build(p0, cam);
+    b.build(p5, cam);  // the refit's topology: frame 5's
+    b.build(p0, cam);  // refitted onto frame 0's particles
+    REQUIRE(b.stats().refitted);
+    std::uint64_t sumA = 0, sumB = 0, differ = 0;
+    forEachPixelRay(cam, [&](std::uint32_t, std::uint32_t, const Vec3& d) {
+        SurfaceHit ha, hb;
+        RayCounters ra, rb;
+        REQUIRE(a.intersect(cam.position, d, 1e30f, ha, &ra) == b.intersect(cam.position, d, 1e30f, hb, &rb));
+        sumA += ra.nodeVisits;
+        sumB += rb.nodeVisits;
+        differ += ra.nodeVisits != rb.nodeVisits;
+    });
+    REQUIRE(sumA > 0);
+    REQUIRE(differ > 0);  // another topology, other nodes
+    ParticleBvh c(device, refitted, gpu);
+    c.build(p0, cam);
+    c.build(p0, cam);  // refitted onto the particles it was built on
+    REQUIRE(c.stats().refitted);
+    std::uint64_t sumC = 0;
+    forEachPixelRay(cam, [&](std::uint32_t, std::uint32_t, const Vec3& d) {
+        SurfaceHit ha, hc;
+        RayCounters ra, rc;
+        a.intersect(cam.position, d, 1e30f, ha, &ra);
+        c.intersect(cam.position, d, 1e30f, hc, &rc);
+        REQUIRE(rc.nodeVisits == ra.nodeVisits);
+        sumC += rc.nodeVisits;
+    });
+    REQUIRE(sumC == sumA);
+}
+
 TEST_CASE("box primitives: an instance entered per box is an intersection program per box", "[geometry][bvh][gpu]") {
     // The instances layout counts a BLAS entry per box a ray enters; the aabbs
     // layout of one BLAS runs its intersection program per box entered. Over
@@ -315,7 +361,7 @@ TEST_CASE("segment boxes: the particles' boxes a ray crosses, whatever the layou
     for (std::uint32_t i = 0; i < p.size(); ++i) frames[i] = bvhs[0]->frame(i);
     std::uint64_t primary = 0, shadow = 0, blockedRays = 0, shadowRays = 0, disagree = 0;
     forEachPixelRay(cam, [&](std::uint32_t x, std::uint32_t y, const Vec3& d) {
-        std::uint32_t first = 0;
+        std::uint32_t first = 0, firstVisits = 0;
         for (std::size_t b = 0; b < bvhs.size(); ++b) {
             SurfaceHit h;
             RayCounters rc;
@@ -323,8 +369,13 @@ TEST_CASE("segment boxes: the particles' boxes a ray crosses, whatever the layou
             const float t = hit ? h.t : 1e30f;
             REQUIRE(rc.segmentBoxes <= crossed(cam.position, d, 0.0f, t * (1.0f + 1e-4f), 1e-4f));
             REQUIRE(rc.segmentBoxes >= crossed(cam.position, d, 0.0f, t * (1.0f - 1e-4f), -1e-4f));
-            if (b == 0) first = rc.segmentBoxes;
+            if (b == 0) first = rc.segmentBoxes, firstVisits = rc.nodeVisits;
             REQUIRE(rc.segmentBoxes == first);
+            // The traversal model's nodes, too: a ray that enters a box went
+            // through the root; no ray visits more than the n - 1 inner nodes.
+            REQUIRE(rc.nodeVisits == firstVisits);
+            if (rc.segmentBoxes > 0) REQUIRE(rc.nodeVisits >= 1);
+            REQUIRE(rc.nodeVisits < p.size());
             REQUIRE(rc.wholeSegmentBoxes == rc.segmentBoxes);  // a primary ray's segment ends at its hit
             if (!hit || b) continue;
             primary += rc.segmentBoxes;
@@ -343,6 +394,8 @@ TEST_CASE("segment boxes: the particles' boxes a ray crosses, whatever the layou
             REQUIRE(sc.segmentBoxes <= crossed(o, to, t0 * (1.0f - 1e-4f), first * (1.0f + 1e-4f), 1e-4f));
             REQUIRE(sc.segmentBoxes >= crossed(o, to, t0 * (1.0f + 1e-4f), first * (1.0f - 1e-4f), -1e-4f));
             REQUIRE(sc.segmentBoxes <= sc.wholeSegmentBoxes);
+            if (sc.segmentBoxes > 0) REQUIRE(sc.nodeVisits >= 1);
+            REQUIRE(sc.nodeVisits < p.size());
             if (!(first < t1)) REQUIRE(sc.segmentBoxes == sc.wholeSegmentBoxes);
             blockedRays += blocked;
             ++shadowRays;

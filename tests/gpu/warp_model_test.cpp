@@ -89,9 +89,16 @@ TEST_CASE("SER report on a pass: keys from hit and type, gain net of the reorder
         t.hit = (i % 4) != 0;      // every 4th lane misses
         t.type = (i % 4) == 3;     // types 0 and 1 among the hits
         t.trips = t.hit ? 4 : 0;
+        t.segmentBoxes = std::uint32_t(i % 5);
+        t.nodeVisits = std::uint32_t(i % 32 == 7 ? 40 + i / 32 : 3);  // one long traversal a warp
     }
     const SerKey key = SerKey::parse("hit,type", 0, "test");
     const SerReport r = serReport(p, WarpLayout{32, 1, 32}, key, 256, 0.0);
+    // A warp lasts its longest lane's traversal: boxes 4 in each of 8 warps;
+    // nodes 40 + w in warp w, 8 x 40 + 28 steps, whatever its other lanes visit.
+    CHECK(r.traversalBefore.steps == 8 * 4);
+    CHECK(r.nodesBefore.steps == 8 * 40 + 28);
+    CHECK(r.nodesBefore.warps == 8);
     // Before: 3 keys per warp (miss, type 0, type 1): 32 lanes over 3 steps.
     CHECK(r.branchBefore.distinctKeysPerWarp == 3.0);
     CHECK(r.branchBefore.efficiency == Approx(1.0 / 3.0));

@@ -26,7 +26,10 @@ namespace accretion {
     X(misses, "misses", "1 when the query found nothing (a shadow ray unblocked): it traversed its whole segment")       \
     X(segmentBoxes, "segment_boxes", "particles' boxes the ray crosses up to its hit or first blocker (where a "         \
                                      "terminate-on-first-hit traversal may stop)")                                       \
-    X(wholeSegmentBoxes, "whole_segment_boxes", "the same over its whole segment (where it may have to look)")
+    X(wholeSegmentBoxes, "whole_segment_boxes", "the same over its whole segment (where it may have to look)")      \
+    X(nodeVisits, "node_visits", "inner BVH nodes its traversal visits (geometry/traversal_model.h: a binary BVH "      \
+                                 "over the particles' boxes, nearer child first, stopping at a shadow ray's first "    \
+                                 "blocker)")
 
 /// What a thread records of its own work, summed over a pass's threads.
 #define ACC_THREAD_COUNTERS(X)                                                                                           \

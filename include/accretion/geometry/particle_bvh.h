@@ -12,6 +12,7 @@
 #include "accretion/geometry/exclusion.h"
 #include "accretion/geometry/embree_device.h"
 #include "accretion/geometry/opacity_micromap.h"
+#include "accretion/geometry/traversal_model.h"
 #include "accretion/counters/thread_counters.h"
 #include "accretion/particles/particles.h"
 #include "accretion/scene/settings.h"
@@ -164,7 +165,8 @@ private:
     void writePrimitives(std::size_t c, const Particles& particles, bool create);
     void buildTlas();
     void buildCountingTlas();
-    void buildProbe(const Particles& particles);
+    /// refit: the GPU refits its BVH, and the traversal model keeps its topology.
+    void buildProbe(const Particles& particles, bool refit);
     /// The particles' boxes that o + t d, t in [tnear, tfar], passes through
     /// (the probe: every particle's box in one BVH, whatever the layout),
     /// and for an occlusion query those entered before its first blocker
@@ -192,6 +194,7 @@ private:
     std::vector<RTCBounds> probeBoxes_;  ///< per particle, its primitive's world box
     std::vector<BoxPrimitive> probePrims_;  ///< per particle, its centre and radius
     ProbeData probeData_{};                 ///< the probe geometry's user data
+    TraversalModel traversal_;              ///< counting: the GPU traversal's nodes (RayCounters::nodeVisits)
     /// particle -> (cluster << 32 | its primitive in the cluster's BLAS): the
     /// key an occlusion query's filter compares with Embree's (instID, primID)
     std::vector<std::uint64_t> where_;

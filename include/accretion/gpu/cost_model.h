@@ -54,16 +54,22 @@ double coldWork(double rays, double bytes, double workingSetBytes, double cacheB
 /// per such warp at 10K, 100K and 1M particles, whose warps hold 6, 20 and
 /// 31 hit lanes). footprint_bytes: the distinct bytes of the grids read at
 /// other threads' texels (the lighting grid of upsampling: 1.5x the time at
-/// scale 0.75 as at 0.5, for the same bytes asked). Counter CSVs without a
-/// column read it as 0.
+/// scale 0.75 as at 0.5, for the same bytes asked). item_steps: the steps
+/// of a pass's kernels over other items than its grid. node_visits: the
+/// inner BVH nodes the rays' traversals visit (geometry/traversal_model.h:
+/// a ray through the gaps of a dense volume visits nodes whose particles it
+/// never crosses), and warp_node_visits, per warp its longest lane's (a
+/// GPU that traverses in software, as the H100, runs a warp's traversal
+/// loop until its last lane is done). Counter CSVs without a column read it
+/// as 0.
 enum class CostFeature : std::uint8_t {
     threads, warp_steps, rays, blas_entries, any_hits, bytes, blas_levels, omm_lookups, dispatches, build_launches,
     refit_launches, cold_work, accel_elements, accel_elements_1k, accel_elements_32k, build_primitives, build_primitives_1k,
     build_primitives_32k, custom_builds, intersections, tlas_levels, misses, segment_boxes, gathers, sphere_refits,
     warp_segment_boxes, dispatch_path, whole_segment_boxes, warp_gathers, hit_warps, footprint_bytes, tlas_instances_32k,
-    item_steps,
+    item_steps, node_visits, warp_node_visits,
 };
-inline constexpr std::size_t kCostFeatureCount = std::size_t(CostFeature::item_steps) + 1;
+inline constexpr std::size_t kCostFeatureCount = std::size_t(CostFeature::warp_node_visits) + 1;
 
 /// One row of the cost model's feature table: everything about a feature
 /// that the model, the counter CSVs, the coefficient files and calibrate read.
@@ -132,6 +138,9 @@ inline constexpr std::array<CostFeatureInfo, kCostFeatureCount> kCostFeatureTabl
     {CostFeature::tlas_instances_32k, "tlas_instances_32k", false, true, false,
      [](detail::P p, double) { return double(p.build.tlasInstancesMid); }},
     {CostFeature::item_steps, "item_steps", false, false, false, [](detail::P p, double) { return double(p.itemSteps); }},
+    {CostFeature::node_visits, "node_visits", false, false, false, [](detail::P p, double) { return double(p.nodeVisits); }},
+    {CostFeature::warp_node_visits, "warp_node_visits", false, false, false,
+     [](detail::P p, double) { return double(p.ser.nodesBefore.steps); }},
 }};
 
 namespace detail {

@@ -75,6 +75,10 @@ struct SerReport {
     /// lane's rays cross (segment boxes): a warp lasts as long as its
     /// longest lane's traversal.
     SimtStats traversalBefore;
+    /// The same with work = the BVH nodes a lane's rays visit (the
+    /// traversal model's): on a GPU that traverses in software a warp loops
+    /// until its longest lane's traversal ends.
+    SimtStats nodesBefore;
     /// In dispatch order, work = a lane's gathers (reads at a drawn index,
     /// each waiting for the last): a warp waits for its longest chain.
     SimtStats gathersBefore;
