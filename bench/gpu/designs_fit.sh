@@ -10,6 +10,9 @@
 # coefficients_h100.json, the fit of them all. The sweep's timings are
 # SWEEP_TIMINGS (results/sweep_timings_d37668c.csv: the twin at d37668c149,
 # whose spatial pass costs 0.69x of results/sweep_timings.csv's).
+# SWEEP_COUNTERS: the sweep's counters (results/sweep_counters.csv by
+# default; results/sweep_counters_feb5ed5.csv holds the timed 70 counted
+# again with the traversal model's node_visits).
 # SIZES: the designs' sizes fitted ("100k cluster" by default; "100k cluster
 # 1m" adds the 1M configurations, results/designs_fit_all: a fit of 100K and
 # the cluster alone extrapolates badly to 1M, docs/designs.md).
@@ -25,7 +28,7 @@ trap 'rm -rf "$T"' EXIT
 { cat "${SWEEP_TIMINGS:-bench/gpu/results/sweep_timings_d37668c.csv}"
   python3 bench/gpu/designs_timings.py "_($(IFS='|'; echo "${sizes[*]}"))\$"
 } > "$T/timings.csv"
-counters=(bench/gpu/results/sweep_counters.csv)
+counters=("${SWEEP_COUNTERS:-bench/gpu/results/sweep_counters.csv}")
 for s in "${sizes[@]}"; do counters+=("$costs"/cost_*_"$s".csv); done
 for seed in $(seq 1 12); do
     "$A" calibrate "${counters[@]}" "$T/timings.csv" --form per_pass --holdout 0.5 \

@@ -1,7 +1,7 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine, from the repository root:
 #   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
-#                                      layout_images layouts streams front identity shared_core ab designs resample near_ncu voxel_ncu gather_ncu voxels splits iterations split_anatomy split_ncu split_stalls ray_launch split_order
+#                                      layout_images layouts streams front identity shared_core ab designs resample near_ncu voxel_ncu gather_ncu voxels splits iterations split_anatomy split_ncu split_stalls ray_launch split_order gbuffer_ncu
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -342,19 +342,19 @@ step_iterations() {
 step_split_anatomy() { time_configs split_anatomy bench/gpu/split_anatomy.txt 5; }
 
 # Nsight Compute of configuration N of LIST (its line "N overrides...") on
-# disk_100k, frames 0-1, its OptiX launches only (or the kernels KERNEL, a
+# disk_100k (or SCENE), frames 0-1, its OptiX launches only (or the kernels KERNEL, a
 # regex, matches): `ncu ARGS` (and --metrics
 # M where M is not empty) logged to FOLDER/STEM.log, the run's output to
 # STEM.run.log; then each of PAGES (raw, details) imported as CSV, with
 # --metrics M: STEM.csv where PAGES is one page, else STEM.PAGE.csv. The
 # report and the frames are removed.
-#   ncu_config FOLDER STEM LIST N "ARGS" M "PAGES" [KERNEL]
+#   ncu_config FOLDER STEM LIST N "ARGS" M "PAGES" [KERNEL] [SCENE]
 ncu_config() {
-    local t=$1 stem=$2 list=$3 n=$4 args=$5 m=$6 pages=$7 kernel=${8:-optixLaunch} p csv sel=()
+    local t=$1 stem=$2 list=$3 n=$4 args=$5 m=$6 pages=$7 kernel=${8:-optixLaunch} scene=${9:-scenes/disk_100k.toml} p csv sel=()
     [ -z "$m" ] || sel=(--metrics "$m")
     # shellcheck disable=SC2046,SC2086  # the ncu arguments and the overrides are words
     timeout 240 ncu $args "${sel[@]}" --kernel-name regex:"$kernel" --log-file "$t/$stem.log" -o "$t/$stem" \
-        $BIN scenes/disk_100k.toml $(grep "^$n " "$list" | sed 's/ *#.*//' | cut -d' ' -f2-) \
+        $BIN "$scene" $(grep "^$n " "$list" | sed 's/ *#.*//' | cut -d' ' -f2-) \
         --frames 0:2 --repeat 1 -q -o "$t/$stem.{frame}.exr" > "$t/$stem.run.log" 2>&1
     for p in $pages; do
         csv="$t/$stem.$p.csv"
@@ -398,6 +398,20 @@ step_gather_ncu() {
         ncu_config "$t" "$n" bench/gpu/designs.txt "$n" "" gpu__time_duration.sum,launch__grid_size,launch__block_size raw \
             'markVisible|iotaKernel|mortonKeys|writeSlots|writeTexels|Select|Radix|Onesweep|Scan'
     done
+}
+
+# The traversal model's check (node_visits, docs/designs.md): Nsight Compute
+# of restir M=8's OptiX launches (the G-buffer, then the shadow rays, of
+# frames 0 and 1) at 100K, 1M and on cluster_150k: time, warp instructions
+# and SIMT efficiency. The H100 traverses in software, so a launch's warp
+# instructions follow its warps' traversal loops.
+step_gbuffer_ncu() {
+    local t="$W/gbuffer_ncu" m=gpu__time_duration.sum,smsp__inst_executed.sum,smsp__thread_inst_executed_per_inst_executed.ratio n
+    mkdir -p "$t"
+    for n in restir_m8_t_pairwise_1x_100k restir_m8_t_pairwise_1x_1m; do ncu_config "$t" "$n" bench/gpu/designs.txt "$n" "" "$m" raw; done
+    python3 scenes/cluster/make_cluster.py 3
+    ncu_config "$t" restir_m8_t_pairwise_1x_cluster bench/gpu/designs_cluster.txt restir_m8_t_pairwise_1x_cluster "" "$m" raw \
+        optixLaunch scenes/cluster_150k.toml
 }
 
 # Nsight Compute of particle_split's ray launch (shadeSplitTexels) at 8 and
