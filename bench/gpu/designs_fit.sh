@@ -13,6 +13,8 @@
 # SWEEP_COUNTERS: the sweep's counters (results/sweep_counters.csv by
 # default; results/sweep_counters_feb5ed5.csv holds the timed 70 counted
 # again with the traversal model's node_visits).
+# DROP: counters set to 0 in every CSV before fitting (bench/gpu/zero_counters.py:
+# the same counts without them, the control of a new counter).
 # SIZES: the designs' sizes fitted ("100k cluster" by default; "100k cluster
 # 1m" adds the 1M configurations, results/designs_fit_all: a fit of 100K and
 # the cluster alone extrapolates badly to 1M, docs/designs.md).
@@ -30,6 +32,10 @@ trap 'rm -rf "$T"' EXIT
 } > "$T/timings.csv"
 counters=("${SWEEP_COUNTERS:-bench/gpu/results/sweep_counters.csv}")
 for s in "${sizes[@]}"; do counters+=("$costs"/cost_*_"$s".csv); done
+if [ -n "${DROP:-}" ]; then
+    python3 bench/gpu/zero_counters.py "$DROP" "$T/counters" "${counters[@]}"
+    mapfile -t counters < <(for c in "${counters[@]}"; do echo "$T/counters/$(basename "$c")"; done)
+fi
 for seed in $(seq 1 12); do
     "$A" calibrate "${counters[@]}" "$T/timings.csv" --form per_pass --holdout 0.5 \
         --split-seed $seed -o "$T/c$seed.json" | sed -n '/^held out/,$p' | grep -v '^coefficients:' > "$out/holdout_seed$seed.txt"

@@ -401,10 +401,12 @@ step_gather_ncu() {
 }
 
 # The traversal model's check (node_visits, docs/designs.md): Nsight Compute
-# of restir M=8's OptiX launches (the G-buffer, then the shadow rays, of
-# frames 0 and 1) at 100K, 1M and on cluster_150k: time, warp instructions
-# and SIMT efficiency. The H100 traverses in software, so a launch's warp
-# instructions follow its warps' traversal loops.
+# of the G-buffer launch at 100K, 1M and on cluster_150k (the camera and
+# geometry of restir_m8_t_pairwise_1x_*, whose lines name no estimator: the
+# twin's default, power, lights them, so launches 0 and 2 are frames 0 and
+# 1's G-buffer, 1 and 3 the power estimator's): time, warp instructions and
+# SIMT efficiency. The H100 and H200 traverse in software, so a launch's
+# warp instructions follow its warps' traversal loops.
 step_gbuffer_ncu() {
     local t="$W/gbuffer_ncu" m=gpu__time_duration.sum,smsp__inst_executed.sum,smsp__thread_inst_executed_per_inst_executed.ratio n
     mkdir -p "$t"

@@ -48,7 +48,7 @@ std::optional<std::pair<std::uint32_t, float>> nearestBox(const std::vector<RTCB
 
 }  // namespace
 
-TEST_CASE("a ray through a row of boxes it never hits visits every inner node; a ray beside it none", "[traversal]") {
+TEST_CASE("a ray through a row of boxes it never hits visits every inner node, a ray beside it none", "[traversal]") {
     EmbreeDevice device;
     for (const std::uint32_t n : {1u, 2u, 3u, 17u, 256u, 1000u}) {
         std::vector<RTCBounds> row;
