@@ -1,7 +1,7 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine, from the repository root:
 #   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
-#                                      layout_images layouts streams front identity shared_core ab designs resample near_ncu voxel_ncu gather_ncu voxels splits iterations split_anatomy split_ncu split_stalls ray_launch split_order gbuffer_ncu
+#                                      layout_images layouts streams front identity shared_core ab designs resample near_ncu voxel_ncu gather_ncu voxels splits iterations split_anatomy split_ncu split_stalls ray_launch split_order gbuffer_ncu near_cluster_ncu
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -372,6 +372,21 @@ step_near_ncu() {
     local t="$W/near_ncu" m=gpu__time_duration.sum,lts__t_sector_hit_rate.pct,l1tex__t_sector_hit_rate.pct,dram__bytes_read.sum,lts__t_bytes.sum n
     mkdir -p "$t"
     for n in ps_n8_f4_c8_h75_100k ps_n8_f4_c8_h75_1m; do ncu_config "$t" "$n" bench/gpu/designs.txt "$n" "" "$m" raw findNearLightsKernel; done
+}
+
+# Why the cluster's near search costs more per counted step than the
+# disk's (docs/designs.md, node visits: findNearLights -43% on the cluster
+# in the fit of every configuration): findNearLightsKernel of
+# ps_n8_f4_c8_h75 at 100K and on cluster_150k, its time, warp instructions,
+# SIMT efficiency, L1 and L2 hit rates and DRAM bytes under Nsight Compute.
+step_near_cluster_ncu() {
+    local t="$W/near_cluster_ncu" m=gpu__time_duration.sum,smsp__inst_executed.sum,smsp__thread_inst_executed_per_inst_executed.ratio
+    m=$m,lts__t_sector_hit_rate.pct,l1tex__t_sector_hit_rate.pct,dram__bytes_read.sum,smsp__average_warp_latency_per_inst_issued.ratio
+    mkdir -p "$t"
+    ncu_config "$t" ps_n8_f4_c8_h75_100k bench/gpu/designs.txt ps_n8_f4_c8_h75_100k "" "$m" raw findNearLightsKernel
+    python3 scenes/cluster/make_cluster.py 3
+    ncu_config "$t" ps_n8_f4_c8_h75_cluster bench/gpu/designs_cluster.txt ps_n8_f4_c8_h75_cluster "" "$m" raw \
+        findNearLightsKernel scenes/cluster_150k.toml
 }
 
 # updateVoxelCache's three kernels at 100K and 1M (designs.txt's
