@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <numeric>
 
-#include "accretion/gpu/cost_model.h"
 #include "accretion/gpu/warp_model.h"
 
 using namespace accretion;
@@ -100,13 +99,6 @@ TEST_CASE("SER report on a pass: keys from hit and type, gain net of the reorder
     CHECK(r.traversalBefore.steps == 8 * 4);
     CHECK(r.nodesBefore.steps == 8 * 40 + 28);
     CHECK(r.nodesBefore.warps == 8);
-    // The warps' path: 2 dispatches of the mean warp's 3 + 4 steps.
-    PassReport report;
-    report.ser = r;
-    report.dispatches = 2;
-    CHECK(report.warpSteps() == 56u);
-    CHECK(costFeatures(report, kDefaultCacheBytes)[CostFeature::warp_path] == 2.0 * 56.0 / 8.0);
-    CHECK(costFeatures(PassReport{}, kDefaultCacheBytes)[CostFeature::warp_path] == 0.0);  // no warp ran
     // Before: 3 keys per warp (miss, type 0, type 1): 32 lanes over 3 steps.
     CHECK(r.branchBefore.distinctKeysPerWarp == 3.0);
     CHECK(r.branchBefore.efficiency == Approx(1.0 / 3.0));

@@ -60,20 +60,16 @@ double coldWork(double rays, double bytes, double workingSetBytes, double cacheB
 /// a ray through the gaps of a dense volume visits nodes whose particles it
 /// never crosses), and warp_node_visits, per warp its longest lane's (a
 /// GPU that traverses in software, as the H100, runs a warp's traversal
-/// loop until its last lane is done). warp_path: the dispatches times the
-/// mean warp's steps; a launch of fewer warps than the GPU runs at once
-/// lasts as long as its warps' loops, not their sum (findNearLights on
-/// cluster_150k: 1420 warps of 269 steps take 1.6x the time of 100K's 2471
-/// warps of 193, for fewer instructions). Counter CSVs without a column read
-/// it as 0.
+/// loop until its last lane is done). Counter CSVs without a column read it
+/// as 0.
 enum class CostFeature : std::uint8_t {
     threads, warp_steps, rays, blas_entries, any_hits, bytes, blas_levels, omm_lookups, dispatches, build_launches,
     refit_launches, cold_work, accel_elements, accel_elements_1k, accel_elements_32k, build_primitives, build_primitives_1k,
     build_primitives_32k, custom_builds, intersections, tlas_levels, misses, segment_boxes, gathers, sphere_refits,
     warp_segment_boxes, dispatch_path, whole_segment_boxes, warp_gathers, hit_warps, footprint_bytes, tlas_instances_32k,
-    item_steps, node_visits, warp_node_visits, warp_path,
+    item_steps, node_visits, warp_node_visits,
 };
-inline constexpr std::size_t kCostFeatureCount = std::size_t(CostFeature::warp_path) + 1;
+inline constexpr std::size_t kCostFeatureCount = std::size_t(CostFeature::warp_node_visits) + 1;
 
 /// One row of the cost model's feature table: everything about a feature
 /// that the model, the counter CSVs, the coefficient files and calibrate read.
@@ -99,11 +95,6 @@ struct CostFeatureInfo {
 namespace detail {
 using P = const PassReport&;
 inline double bytesOf(P p) { return double(p.bytesRead + p.bytesWritten); }
-/// The dispatches times the mean warp's steps (warp_steps over the warps that run).
-inline double warpPath(P p) {
-    const std::uint64_t warps = p.ser.branchBefore.warps;
-    return warps ? double(p.dispatches) * double(p.warpSteps()) / double(warps) : 0.0;
-}
 }  // namespace detail
 
 inline constexpr std::array<CostFeatureInfo, kCostFeatureCount> kCostFeatureTable = {{
@@ -150,7 +141,6 @@ inline constexpr std::array<CostFeatureInfo, kCostFeatureCount> kCostFeatureTabl
     {CostFeature::node_visits, "node_visits", false, false, false, [](detail::P p, double) { return double(p.nodeVisits); }},
     {CostFeature::warp_node_visits, "warp_node_visits", false, false, false,
      [](detail::P p, double) { return double(p.ser.nodesBefore.steps); }},
-    {CostFeature::warp_path, "warp_path", false, false, false, [](detail::P p, double) { return detail::warpPath(p); }},
 }};
 
 namespace detail {
