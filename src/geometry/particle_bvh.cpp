@@ -107,17 +107,10 @@ void instanceBounds(const RTCBoundsFunctionArguments* args) {
 /// `entry`, when given, receives where the ray enters the box (tnear if inside).
 bool overlapsBounds(const RTCBounds& b, const float org[3], const float dir[3], float tnear, float tfar,
                     float* entry = nullptr) {
-    const float lo[3] = {b.lower_x, b.lower_y, b.lower_z}, hi[3] = {b.upper_x, b.upper_y, b.upper_z};
-    float t0 = tnear, t1 = tfar;
-    for (int k = 0; k < 3; ++k) {
-        const float inv = 1.0f / dir[k];
-        float a = (lo[k] - org[k]) * inv, c = (hi[k] - org[k]) * inv;
-        if (a > c) std::swap(a, c);
-        t0 = std::max(t0, a);
-        t1 = std::min(t1, c * (1.0f + 2e-7f * 3.0f));  // conservative, as in robust slab tests
-        if (t0 > t1) return false;
-    }
-    if (entry) *entry = t0;
+    float t;
+    if (!boxEntry(b, Vec3(org[0], org[1], org[2]), Vec3(1.0f / dir[0], 1.0f / dir[1], 1.0f / dir[2]), tnear, tfar, t))
+        return false;
+    if (entry) *entry = t;
     return true;
 }
 

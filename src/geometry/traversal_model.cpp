@@ -101,7 +101,7 @@ void TraversalModel::refit(std::span<const RTCBounds> boxes) {
     // Children come after their parent: from the last node back, each
     // child's box is final when its parent reads it.
     auto boxOf = [&](std::int32_t child) {
-        if (child < 0) return boxes[std::size_t(-1 - child)];
+        if (child < 0) return boxes[primOf(child)];
         const Node& c = nodes_[std::size_t(child)];
         return merged(c.box[0], c.box[1]);
     };

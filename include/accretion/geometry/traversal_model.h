@@ -10,6 +10,24 @@
 
 namespace accretion {
 
+/// Where o + t d enters box b within [tnear, tfar] (tnear when it starts
+/// inside), given inv = 1 / d per axis, or false when it misses: the slab
+/// test, conservative at the far planes as robust ones (and GPU box tests)
+/// are. The counting queries' box tests and the traversal model's.
+inline bool boxEntry(const RTCBounds& b, const Vec3& o, const Vec3& inv, float tnear, float tfar, float& entry) {
+    float t0 = tnear, t1 = tfar;
+    const float lo[3] = {b.lower_x, b.lower_y, b.lower_z}, hi[3] = {b.upper_x, b.upper_y, b.upper_z};
+    for (int k = 0; k < 3; ++k) {
+        float a = (lo[k] - o[k]) * inv[k], c = (hi[k] - o[k]) * inv[k];
+        if (a > c) std::swap(a, c);
+        t0 = std::max(t0, a);
+        t1 = std::min(t1, c * (1.0f + 6e-7f));
+        if (t0 > t1) return false;
+    }
+    entry = t0;
+    return true;
+}
+
 /// The BVH nodes a GPU's traversal visits, modelled for the cost model
 /// (RayCounters::nodeVisits). Embree's own traversal cannot be counted from
 /// outside, and the GPU's is not Embree's: this is a binary BVH over the
@@ -52,20 +70,7 @@ private:
         std::int32_t child[2];
     };
     static constexpr std::int32_t leafOf(std::uint32_t prim) { return -1 - std::int32_t(prim); }
-
-    /// Where the ray enters b within [tnear, tfar], or false.
-    static bool enters(const RTCBounds& b, const Vec3& o, const Vec3& inv, float tnear, float tfar, float& entry) {
-        float t0 = tnear, t1 = tfar;
-        const float lo[3] = {b.lower_x, b.lower_y, b.lower_z}, hi[3] = {b.upper_x, b.upper_y, b.upper_z};
-        for (int k = 0; k < 3; ++k) {
-            float a = (lo[k] - o[k]) * inv[k], c = (hi[k] - o[k]) * inv[k];
-            if (a > c) std::swap(a, c);
-            t0 = std::max(t0, a);
-            t1 = std::min(t1, c * (1.0f + 6e-7f));  // conservative, as robust slab tests are
-        }
-        entry = t0;
-        return t0 <= t1;
-    }
+    static constexpr std::uint32_t primOf(std::int32_t leaf) { return std::uint32_t(-1 - leaf); }
 
     template <bool AnyHit, class Hit>
     std::uint32_t traverse(const Vec3& o, const Vec3& d, float tnear, float tfar, Hit& hit) const {
@@ -73,10 +78,10 @@ private:
         const Vec3 inv(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
         float entry;
         if (nodes_.empty()) {  // one primitive: the root is its leaf
-            if (enters(rootBox_, o, inv, tnear, tfar, entry)) hit(0u, tnear, tfar, entry);
+            if (boxEntry(rootBox_, o, inv, tnear, tfar, entry)) hit(0u, tnear, tfar, entry);
             return 0;
         }
-        if (!enters(rootBox_, o, inv, tnear, tfar, entry)) return 0;
+        if (!boxEntry(rootBox_, o, inv, tnear, tfar, entry)) return 0;
         struct Entry {
             std::int32_t child;
             float t;
@@ -90,7 +95,7 @@ private:
             if (e.t > tfar) continue;  // a closer hit was found since it was pushed
             if (e.child < 0) {
                 float t;
-                if (hit(std::uint32_t(-1 - e.child), tnear, tfar, t)) {
+                if (hit(primOf(e.child), tnear, tfar, t)) {
                     if constexpr (AnyHit) return visits;
                     tfar = t;
                 }
@@ -99,8 +104,8 @@ private:
             ++visits;
             const Node& n = nodes_[std::size_t(e.child)];
             float t0, t1;
-            const bool in0 = enters(n.box[0], o, inv, tnear, tfar, t0);
-            const bool in1 = enters(n.box[1], o, inv, tnear, tfar, t1);
+            const bool in0 = boxEntry(n.box[0], o, inv, tnear, tfar, t0);
+            const bool in1 = boxEntry(n.box[1], o, inv, tnear, tfar, t1);
             if (in0 && in1) {  // the farther first on the stack, the nearer popped next
                 const bool firstNear = t0 <= t1;
                 stack[top++] = firstNear ? Entry{n.child[1], t1} : Entry{n.child[0], t0};
