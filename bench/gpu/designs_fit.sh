@@ -15,6 +15,8 @@
 # again with the traversal model's node_visits).
 # DROP: counters set to 0 in every CSV before fitting (bench/gpu/zero_counters.py:
 # the same counts without them, the control of a new counter).
+# GPU, MEASURED_AT: what the coefficients file records of the timings (calibrate
+# --gpu, --measured-at; by default the H100 and the files fitted).
 # SIZES: the designs' sizes fitted ("100k cluster" by default; "100k cluster
 # 1m" adds the 1M configurations, results/designs_fit_all: a fit of 100K and
 # the cluster alone extrapolates badly to 1M, docs/designs.md).
@@ -42,5 +44,7 @@ for seed in $(seq 1 12); do
 done
 python3 bench/gpu/designs_holdout.py "$T"/c*.json > "$out/summary.txt"
 # The fit of every configuration (no hold-out): coefficients calibrate writes, for `-D gpu.coefficients=`.
-"$A" calibrate "${counters[@]}" "$T/timings.csv" --form per_pass -o "$out/coefficients_h100.json" > /dev/null
+"$A" calibrate "${counters[@]}" "$T/timings.csv" --form per_pass -o "$out/coefficients_h100.json" \
+    --gpu "${GPU:-NVIDIA H100 80GB HBM3 (no RT cores: software traversal)}" \
+    --measured-at "${MEASURED_AT:-timings: ${SWEEP_TIMINGS:-bench/gpu/results/sweep_timings_d37668c.csv} and the H100 rows of bench/gpu/results/designs.csv (each with its commit); counters: ${counters[0]} and $costs}" > /dev/null
 cat "$out"/holdout_seed*.txt "$out/summary.txt"

@@ -26,6 +26,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <tuple>
 
 #include <CLI/CLI.hpp>
@@ -73,6 +74,7 @@ struct TuneArgs : SceneArgs {
     bool anatomy = false;          ///< also the error with every light visible: visibility's share
     double biasBoundPct = 1.0;     ///< the energy bias a verdict of "unbiased" must be able to see
     std::uint32_t maxSeeds = 48;   ///< the most seeds tune spends on one configuration to see it
+    std::string errorsFrom;        ///< --errors-from: a previous tune's JSON whose error measurements are reused
 };
 
 /// One point of the space: its label and the settings it overrides.
@@ -563,6 +565,109 @@ ErrorRow measureMoreSeeds(TuneContext& t, const LightingChoice& o, const ErrorRo
     return measureErrorSeeds(t, o, needed);
 }
 
+/// --errors-from: a previous tune's error measurements (its JSON), reused
+/// by configuration label so that a new calibration prices them without
+/// the hours of bias runs they took. Only a run at the same operating point
+/// may lend them: the same scene settings (the [gpu] section aside: it
+/// changes the price, not the image), frame, history, crops, seeds and
+/// bias bound; each configuration's verdict is the one that run left.
+struct PreviousErrors {
+    std::string file, version, coefficients;
+    std::map<std::string, ErrorRow> rows;  ///< by LightingChoice::label()
+
+    const ErrorRow& row(const std::string& label) const {
+        const auto it = rows.find(label);
+        if (it == rows.end())
+            throw InputError(fmt::format("{}: no error measurement of '{}': that run searched other configurations (its --space "
+                                         "and --designs must cover this run's)", file, label));
+        return it->second;
+    }
+};
+
+/// The scene's settings as TOML without its [gpu] section: what an error
+/// measurement depends on (the GPU settings change prices, not images).
+std::string settingsWithoutGpu(const Settings& s) {
+    const std::string toml = settingsToToml(s);
+    const std::size_t gpu = toml.find("[gpu]\n");
+    if (gpu == std::string::npos) return toml;
+    const std::size_t next = toml.find("\n[", gpu + 1);
+    return toml.substr(0, gpu) + (next == std::string::npos ? std::string() : toml.substr(next + 1));
+}
+
+/// Where two settings documents first differ: "[section] its line there, this run's here".
+std::string firstDifference(const std::string& theirs, const std::string& ours) {
+    std::istringstream a(theirs), b(ours);
+    std::string section, x, y;
+    for (;;) {
+        const bool gotA = bool(std::getline(a, x)), gotB = bool(std::getline(b, y));
+        if (!gotA && !gotB) return "the same settings";
+        if (!gotA || !gotB || x != y)
+            return fmt::format("{} '{}' there, '{}' here", section, gotA ? x : "(end)", gotB ? y : "(end)");
+        if (x.starts_with("[")) section = x;
+    }
+}
+
+/// A JSON number, NaN where the table wrote null (a value it had not).
+double numberOrNan(const nlohmann::json& j, const char* key) {
+    const nlohmann::json& v = j.at(key);
+    return v.is_null() ? std::nan("") : v.get<double>();
+}
+
+/// Reads --errors-from and checks that it measured this run's operating
+/// point (InputError naming the file and what differs).
+PreviousErrors readPreviousErrors(const TuneContext& t, const Settings& scene) {
+    const TuneArgs& a = t.args;
+    PreviousErrors prev{a.errorsFrom};
+    try {
+        const nlohmann::json j = nlohmann::json::parse(readWholeFile(a.errorsFrom, "--errors-from"));
+        if (!j.is_object() || j.value("command", "") != "tune")
+            throw InputError(fmt::format("{}: not the JSON of a tune run (-o PREFIX writes PREFIX.json)", a.errorsFrom));
+        prev.version = j.at("version").get<std::string>();
+        prev.coefficients = j.at("coefficients").get<std::string>();
+        const auto differs = [&](const char* what, const nlohmann::json& theirs, const nlohmann::json& ours) {
+            if (theirs != ours)
+                throw InputError(fmt::format("{}: measured at another operating point: {} {} there, {} here", a.errorsFrom, what,
+                                             theirs.dump(), ours.dump()));
+        };
+        differs("frame", j.at("frame"), t.frame);
+        differs("history_frames", j.at("history_frames"), t.history);
+        differs("error_crops", j.at("error_crops"), a.errorCrops);
+        differs("crop_size", j.at("crop_size"), a.cropSize);
+        differs("crop_margin", j.at("crop_margin"), a.cropMargin);
+        differs("crops", j.at("crops"), windowsJson(t.crops));
+        differs("seeds", j.at("seeds"), a.seeds);
+        differs("bias_bound_pct", j.at("bias_bound_pct"), a.biasBoundPct);
+        differs("max_seeds", j.at("max_seeds"), a.maxSeeds);
+        differs("anatomy", !j.at("unshadowed_references").empty(), a.anatomy);
+        const std::string theirs = settingsWithoutGpu(parseScene(j.at("settings").get<std::string>(), a.errorsFrom + " settings"));
+        if (const std::string ours = settingsWithoutGpu(scene); theirs != ours)
+            throw InputError(fmt::format("{}: measured another scene: {}", a.errorsFrom, firstDifference(theirs, ours)));
+        const nlohmann::json& reuse = j.at("reuse");
+        for (const nlohmann::json& r : j.at("lighting")) {
+            ErrorRow e;
+            const std::string label = r.at("lighting").get<std::string>();
+            e.relMse = r.at("rel_mse").get<double>();
+            e.t = numberOrNan(r, "t");
+            e.energyLossPct = numberOrNan(r, "energy_loss_pct");
+            e.detectablePct = numberOrNan(r, "detectable_bias_pct");
+            e.cpuSecondsPerFrame = numberOrNan(r, "cpu_s");
+            e.visibilitySharePct = numberOrNan(r, "visibility_share_pct");
+            e.seeds = r.at("seeds").get<std::uint32_t>();
+            const std::string verdict = r.at("bias_verdict").get<std::string>();
+            if (verdict == verdictName(BiasVerdict::unbiased)) e.verdict = BiasVerdict::unbiased;
+            else if (verdict == verdictName(BiasVerdict::biased)) e.verdict = BiasVerdict::biased;
+            else if (verdict == verdictName(BiasVerdict::unknown)) e.verdict = BiasVerdict::unknown;
+            else throw InputError(fmt::format("{}: '{}': bias_verdict '{}' is not unbiased, biased or unknown", a.errorsFrom, label, verdict));
+            if (reuse.contains(label)) e.reuse = reuse.at(label);
+            if (!prev.rows.emplace(label, std::move(e)).second)
+                throw InputError(fmt::format("{}: '{}' measured twice", a.errorsFrom, label));
+        }
+    } catch (const nlohmann::json::exception& e) {
+        throw InputError(fmt::format("{}: not the JSON of a tune run: {}", a.errorsFrom, e.what()));
+    }
+    return prev;
+}
+
 /// A reference of `frame`, crop `w` of the scene's view: its
 /// size, data window and view (frame and scene-defining settings), its
 /// pixels readable (InputError naming the file).
@@ -720,6 +825,7 @@ void prepareTune(TuneContext& t, const Settings& scene, const std::string& prefi
     const std::uint32_t first = t.frame - t.history, end = t.frame + 1;  // the history and the measured frame
     OutputGuard guard = sceneInputs(scene, first, end);
     for (const std::string& r : a.references) guard.addInput(r);
+    if (!a.errorsFrom.empty()) guard.addInput(a.errorsFrom);
     checkOutputs(guard, prefix, {".csv", ".json", ".png"}, "-o");
     for (std::size_t k = 0; k < a.references.size(); ++k) {
         if (!std::filesystem::is_regular_file(a.references[k]))
@@ -803,7 +909,8 @@ void verifyCandidates(TuneContext& t, std::vector<ParetoPoint>& points) {
 /// The lighting choices on the chosen geometry: error on the CPU (--seeds,
 /// then more where the recommendation needs them), GPU time priced; the
 /// Pareto front marked, sorted by time.
-std::vector<ParetoPoint> measureLighting(TuneContext& t, const GeometryChoice& chosen, const std::vector<LightingChoice>& lighting) {
+std::vector<ParetoPoint> measureLighting(TuneContext& t, const GeometryChoice& chosen, const std::vector<LightingChoice>& lighting,
+                                         const PreviousErrors* previous) {
     std::vector<ParetoPoint> points;
     for (const LightingChoice& l : lighting) {
         ParetoPoint p{l};
@@ -811,10 +918,10 @@ std::vector<ParetoPoint> measureLighting(TuneContext& t, const GeometryChoice& c
         const std::vector<std::string> own = l.defines();
         defines.insert(defines.end(), own.begin(), own.end());
         p.ms = total(predictMs(t, defines, l.label()));
-        p.error = measureErrorSeeds(t, l, t.args.seeds);
+        p.error = previous ? previous->row(l.label()) : measureErrorSeeds(t, l, t.args.seeds);
         points.push_back(std::move(p));
     }
-    verifyCandidates(t, points);
+    if (!previous) verifyCandidates(t, points);  // --errors-from: the verdicts that run left
     markFront(points);
     std::sort(points.begin(), points.end(), [](const ParetoPoint& p, const ParetoPoint& q) { return p.ms < q.ms; });
     return points;
@@ -827,6 +934,7 @@ struct TuneResult {
     const PricedGeometry* triangles = nullptr;  ///< the fastest of triangles (not boxes)
     std::vector<ParetoPoint> points;
     const ParetoPoint* best = nullptr;
+    std::optional<PreviousErrors> previous;  ///< --errors-from
 };
 
 Table geometryTable(const TuneResult& r) {
@@ -888,6 +996,9 @@ void printTune(const TuneArgs& a, const Settings& scene, const TuneContext& t, c
     const GeometryChoice& chosen = r.chosen->choice;
     fmt::print("geometry: {} ({:.3f} ms predicted at {}x{}, the scene's lighting)\nGPU time: {}\n", chosen.label(),
                total(r.chosen->ms), scene.camera.width, scene.camera.height, t.coefficients.source);
+    if (r.previous)
+        fmt::print("error: read from {} (accretion {}, priced there by {}); no error measured, each verdict as that run left it\n",
+                   r.previous->file, r.previous->version, r.previous->coefficients);
     // Procedural boxes beat triangles only where traversal is software: on
     // RT cores every box entered calls the intersection program on the SM
     // (docs/layouts.md). Name the fastest triangle layout beside them.
@@ -946,7 +1057,10 @@ void writeTuneJson(const std::string& prefix, const TuneArgs& a, const Settings&
                                  {"unshadowed_references", t.unshadowedReferences},
                                  {"space", a.space}, {"coefficients", t.coefficients.source}, {"geometry", gt.json()},
                                  {"fastest_triangle_geometry", r.triangles->choice.label()}, {"chosen_geometry", chosen.label()},
-                                 {"lighting", lt.json()}, {"reuse", reuse}, {"recommended", recommended}, {"best_per_design", designs}, {"time", spentJson(t)}});
+                                 {"lighting", lt.json()}, {"reuse", reuse}, {"recommended", recommended}, {"best_per_design", designs}, {"time", spentJson(t)},
+                                 {"errors_from", r.previous ? nlohmann::json{{"file", r.previous->file}, {"version", r.previous->version},
+                                                                             {"coefficients", r.previous->coefficients}}
+                                                            : nlohmann::json()}});
 }
 
 /// PREFIX.png: the configurations' error against predicted GPU ms by bias
@@ -1003,20 +1117,28 @@ void runTune(const TuneArgs& a) {
     if (!a.references.empty() && a.references.size() != t.crops.size())  // before anything is made
         throw InputError(fmt::format("command line --reference: {} given, one per crop of --error-crops {} ({})", a.references.size(),
                                      a.errorCrops, t.crops.size()));
+    // --errors-from: read and checked before anything is made.
+    std::optional<PreviousErrors> previous;
+    if (!a.errorsFrom.empty()) previous = readPreviousErrors(t, scene);
     prepareTune(t, scene, prefix);
     const OutputLock lock(t.cache / "tune.lock");  // one tune per cache: a measurement is made once
     removeStaleTemporaries(t.cache);                 // what a measurement killed mid-write left
     const StopSignal stop;                           // forwarded to the running measurement (measure)
     t.stop = &stop;
-    t.steps = geometry.size() + 2 * lighting.size() + (a.references.empty() ? t.crops.size() : 0) + (a.anatomy ? t.crops.size() : 0);
+    TuneResult r;
     const std::size_t particles = ParticleSource(scene).frame(t.frame).size();
-    t.references = ensureReferences(t, particles);
-    if (a.anatomy) t.unshadowedReferences = ensureReferences(t, particles, false);
-    for (const std::string& r : t.references) t.referencesKey += "\nreference " + cacheKey(readWholeFile(r, "tune"));
-    for (const std::string& r : t.unshadowedReferences) t.referencesKey += "\nunshadowed " + cacheKey(readWholeFile(r, "tune"));
+    if (previous) {  // the errors of a previous run: no reference, no bias run
+        r.previous = std::move(previous);
+        t.steps = geometry.size() + lighting.size();
+    } else {
+        t.steps = geometry.size() + 2 * lighting.size() + (a.references.empty() ? t.crops.size() : 0) + (a.anatomy ? t.crops.size() : 0);
+        t.references = ensureReferences(t, particles);
+        if (a.anatomy) t.unshadowedReferences = ensureReferences(t, particles, false);
+        for (const std::string& ref : t.references) t.referencesKey += "\nreference " + cacheKey(readWholeFile(ref, "tune"));
+        for (const std::string& ref : t.unshadowedReferences) t.referencesKey += "\nunshadowed " + cacheKey(readWholeFile(ref, "tune"));
+    }
 
     // Geometry: the same image whatever it is; the fastest predicted frame.
-    TuneResult r;
     for (const GeometryChoice& g : geometry) r.geometry.push_back({g, predictMs(t, g.defines(), g.label())});
     const auto faster = [](const PricedGeometry& p, const PricedGeometry& q) { return total(p.ms) < total(q.ms); };
     r.chosen = &*std::min_element(r.geometry.begin(), r.geometry.end(), faster);
@@ -1025,7 +1147,7 @@ void runTune(const TuneArgs& a) {
         return pb != qb ? qb : faster(p, q);
     });
     // Lighting: error on the CPU, GPU time on the chosen geometry.
-    r.points = measureLighting(t, r.chosen->choice, lighting);
+    r.points = measureLighting(t, r.chosen->choice, lighting, r.previous ? &*r.previous : nullptr);
     r.best = recommend(a, r.points);
 
     const Table gt = geometryTable(r), lt = lightingTable(a, r);
@@ -1061,10 +1183,15 @@ void addTuneCommand(CLI::App& app) {
         ->delimiter(',');
     cmd->add_option("--space", args->space,
                     fmt::format("quick ({} configurations) or full ({}: hours)", spaceSizes("quick"), spaceSizes("full")));
+    CLI::Option* errorsFrom = cmd->add_option(
+        "--errors-from", args->errorsFrom,
+        "A previous tune's JSON at the same operating point (scene, frame, crops, seeds): its error measurements and bias "
+        "verdicts are reused, by configuration, and only the GPU time is priced (a new calibration in minutes, not hours)");
     cmd->add_option("--reference", args->references,
                     "Reference EXRs of --frame, one per crop in stratum order, row by row (default: rendered once, exact up to 20K "
                     "particles, else split)")
-        ->allow_extra_args(false);
+        ->allow_extra_args(false)
+        ->excludes(errorsFrom);
     cmd->add_option("--reference-spp", args->referenceSpp, "split's samples per pixel for the rendered reference")
         ->check(CLI::Range(1u, 1u << 20));
     cmd->add_option("--cache", args->cache, "Folder of cached measurements (default out/tune_cache/<scene>)");

@@ -178,8 +178,9 @@ struct CostFeatures : std::array<double, kCostFeatureCount> {
     double operator[](CostFeature f) const { return (*this)[std::size_t(f)]; }
 };
 
-/// The committed calibration (compiled in from this file of the source tree).
-inline constexpr const char* kDefaultCoefficientsFile = "bench/gpu/results/fit/coefficients_h100.json";
+/// The committed calibration (compiled in from this file of the source tree,
+/// which CMakeLists.txt names).
+inline constexpr const char* kDefaultCoefficientsFile = ACCRETION_DEFAULT_COEFFICIENTS_FILE;
 /// Its text (generated/default_coefficients.cpp).
 const char* defaultCoefficientsJson();
 
