@@ -522,6 +522,74 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
         CHECK(again[kind]["cached_seconds"].get<double>() == Approx(firstTime[kind]["seconds"].get<double>()).margin(1e-3 * 50));
     }
 
+    // --errors-from: another calibration prices the same measurements
+    // without a reference or a bias run. Every coefficient of the committed
+    // calibration doubled (the model is linear in them, and the cache of
+    // cold_work is the same): every price doubles, and each configuration's
+    // error, seeds and verdict are the first run's.
+    std::filesystem::copy_file(dir / "t.json", dir / "first.json");
+    nlohmann::json doubled = CostCoefficients::committed().toJson();
+    for (auto& [feature, ns] : doubled.at("coefficients_ns").items()) ns = 2.0 * ns.get<double>();
+    for (auto& [pass, features] : doubled.at("per_pass_ns").items())
+        for (auto& [feature, ns] : features.items()) ns = 2.0 * ns.get<double>();
+    {
+        std::ofstream(dir / "doubled.json") << doubled.dump(1);
+    }
+    // A command with one of its options changed: "--seeds 3" -> "--seeds 4".
+    const auto with = [](std::string c, const std::string& option, const std::string& value) {
+        const std::size_t at = c.find(" " + option + " ");
+        const std::size_t end = c.find(' ', at + option.size() + 2);
+        return c.replace(at, (end == std::string::npos ? c.size() : end) - at, " " + option + " " + value);
+    };
+    const std::string fromFirst = " --max-seeds 3 --errors-from " + (dir / "first.json").string();
+    const std::string doubledCalibration = " -D 'gpu.coefficients=\"" + (dir / "doubled.json").string() + "\"'";
+    REQUIRE(runCommand(with(base, "-o", (dir / "re").string()) + fromFirst + doubledCalibration, out) == 0);
+    {
+        const nlohmann::json re = nlohmann::json::parse(slurp(dir / "re.json"));
+        CHECK(re.at("errors_from").at("file") == (dir / "first.json").string());
+        CHECK(re.at("errors_from").at("version") == j.at("version"));
+        for (const char* kind : {"references", "error (bias)"}) {
+            INFO(kind);
+            CHECK(re.at("time").at(kind).at("runs") == 0);
+            CHECK(re.at("time").at(kind).at("cached") == 0);
+        }
+        CHECK(re.at("time").at("GPU time (cost)").at("cached") == 12 + quick);  // the counts are the cache's: only their price is new
+        std::map<std::string, nlohmann::json> was;
+        for (const auto& p : rows) was[p["lighting"]] = p;
+        REQUIRE(re.at("lighting").size() == quick);
+        for (const auto& p : re.at("lighting")) {
+            const nlohmann::json& w = was.at(p["lighting"]);
+            INFO(p["lighting"]);
+            CHECK(p["gpu_ms"].get<double>() == Approx(2.0 * w["gpu_ms"].get<double>()).epsilon(1e-9));
+            for (const char* same : {"rel_mse", "seeds", "bias_verdict", "detectable_bias_pct", "energy_loss_pct", "temporal_kept_pct"})
+                CHECK(p[same] == w[same]);
+        }
+        for (std::size_t g = 0; g < j.at("geometry").size(); ++g)
+            CHECK(re["geometry"][g]["frame_ms"].get<double>() == Approx(2.0 * j["geometry"][g]["frame_ms"].get<double>()).epsilon(1e-9));
+        // The same recommendation: every price scaled alike, under a budget scaled alike.
+        REQUIRE(runCommand(with(with(base, "-o", (dir / "re100").string()), "--budget-ms", "100") + fromFirst +
+                               doubledCalibration, out) == 0);
+        CHECK(nlohmann::json::parse(slurp(dir / "re100.json")).at("recommended").at("lighting") == r.at("lighting"));
+    }
+    // ... from a run at this operating point only, naming what differs; nothing written.
+    const std::string bad = with(base, "-o", (dir / "bad").string()), from = bad + " --max-seeds 3 --errors-from ";
+    CHECK(runCommand(with(bad, "--seeds", "4") + fromFirst, out) == 1);
+    CHECK_THAT(out, Contains("measured at another operating point: seeds 3 there, 4 here"));
+    CHECK(runCommand(from + (dir / "first.json").string() + " -D particles.seed=77", out) == 1);
+    CHECK_THAT(out, Contains("measured another scene: [particles]"));
+    CHECK_THAT(out, Contains("'seed = 77' here"));
+    CHECK(runCommand(from + (dir / "doubled.json").string(), out) == 1);
+    CHECK_THAT(out, Contains("doubled.json: not the JSON of a tune run"));
+    {
+        nlohmann::json fewer = nlohmann::json::parse(slurp(dir / "first.json"));
+        const std::string dropped = fewer.at("lighting").at(0).at("lighting");
+        fewer.at("lighting").erase(0);
+        std::ofstream(dir / "fewer.json") << fewer.dump();
+        CHECK(runCommand(from + (dir / "fewer.json").string(), out) == 1);
+        CHECK_THAT(out, Contains("fewer.json: no error measurement of '" + dropped + "'"));
+    }
+    CHECK_FALSE(std::filesystem::exists(dir / "bad.json"));
+
     // Where a bias of --bias-bound could hide in 3 seeds' verdict, tune runs
     // the fewest seeds that would see it when --max-seeds allows, in the
     // order the recommendation ranks the configurations (by error), until one
