@@ -647,7 +647,7 @@ PreviousErrors readPreviousErrors(const TuneContext& t, const Settings& scene) {
             ErrorRow e;
             const std::string label = r.at("lighting").get<std::string>();
             e.relMse = r.at("rel_mse").get<double>();
-            e.t = numberOrNan(r, "t");
+            e.t = numberOrNan(r, r.contains("t") ? "t" : "z");  // runs before Student's t named the statistic z
             e.energyLossPct = numberOrNan(r, "energy_loss_pct");
             e.detectablePct = numberOrNan(r, "detectable_bias_pct");
             e.cpuSecondsPerFrame = numberOrNan(r, "cpu_s");
