@@ -573,6 +573,7 @@ ErrorRow measureMoreSeeds(TuneContext& t, const LightingChoice& o, const ErrorRo
 /// bias bound; each configuration's verdict is the one that run left.
 struct PreviousErrors {
     std::string file, version, coefficients;
+    std::vector<std::string> references, unshadowedReferences;  ///< what its errors were measured against
     std::map<std::string, ErrorRow> rows;  ///< by LightingChoice::label()
 
     const ErrorRow& row(const std::string& label) const {
@@ -624,6 +625,8 @@ PreviousErrors readPreviousErrors(const TuneContext& t, const Settings& scene) {
             throw InputError(fmt::format("{}: not the JSON of a tune run (-o PREFIX writes PREFIX.json)", a.errorsFrom));
         prev.version = j.at("version").get<std::string>();
         prev.coefficients = j.at("coefficients").get<std::string>();
+        prev.references = j.at("references").get<std::vector<std::string>>();
+        prev.unshadowedReferences = j.at("unshadowed_references").get<std::vector<std::string>>();
         const auto differs = [&](const char* what, const nlohmann::json& theirs, const nlohmann::json& ours) {
             if (theirs != ours)
                 throw InputError(fmt::format("{}: measured at another operating point: {} {} there, {} here", a.errorsFrom, what,
@@ -1127,7 +1130,9 @@ void runTune(const TuneArgs& a) {
     t.stop = &stop;
     TuneResult r;
     const std::size_t particles = ParticleSource(scene).frame(t.frame).size();
-    if (previous) {  // the errors of a previous run: no reference, no bias run
+    if (previous) {  // the errors of a previous run: no reference, no bias run; its references recorded as its errors' own
+        t.references = previous->references;
+        t.unshadowedReferences = previous->unshadowedReferences;
         r.previous = std::move(previous);
         t.steps = geometry.size() + lighting.size();
     } else {

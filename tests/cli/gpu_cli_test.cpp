@@ -548,6 +548,7 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
         const nlohmann::json re = nlohmann::json::parse(slurp(dir / "re.json"));
         CHECK(re.at("errors_from").at("file") == (dir / "first.json").string());
         CHECK(re.at("errors_from").at("version") == j.at("version"));
+        CHECK(re.at("references") == j.at("references"));  // what its errors were measured against
         for (const char* kind : {"references", "error (bias)"}) {
             INFO(kind);
             CHECK(re.at("time").at(kind).at("runs") == 0);
