@@ -479,6 +479,12 @@ enum class BiasVerdict { unbiased, biased, unknown };
 constexpr const char* verdictName(BiasVerdict v) {
     return v == BiasVerdict::unbiased ? "unbiased" : v == BiasVerdict::biased ? "biased" : "unknown";
 }
+/// The verdict verdictName names, or nullopt.
+std::optional<BiasVerdict> parseVerdict(const std::string& name) {
+    for (const BiasVerdict v : {BiasVerdict::unbiased, BiasVerdict::biased, BiasVerdict::unknown})
+        if (name == verdictName(v)) return v;
+    return std::nullopt;
+}
 
 /// One lighting configuration's error: bias's row (relMSE of one frame less
 /// the reference's noise, the mean signed error's t statistic, the energy loss, the
@@ -656,11 +662,11 @@ PreviousErrors readPreviousErrors(const TuneContext& t, const Settings& scene) {
             e.cpuSecondsPerFrame = numberOrNan(r, "cpu_s");
             e.visibilitySharePct = numberOrNan(r, "visibility_share_pct");
             e.seeds = r.at("seeds").get<std::uint32_t>();
-            const std::string verdict = r.at("bias_verdict").get<std::string>();
-            if (verdict == verdictName(BiasVerdict::unbiased)) e.verdict = BiasVerdict::unbiased;
-            else if (verdict == verdictName(BiasVerdict::biased)) e.verdict = BiasVerdict::biased;
-            else if (verdict == verdictName(BiasVerdict::unknown)) e.verdict = BiasVerdict::unknown;
-            else throw InputError(fmt::format("{}: '{}': bias_verdict '{}' is not unbiased, biased or unknown", a.errorsFrom, label, verdict));
+            const std::optional<BiasVerdict> v = parseVerdict(r.at("bias_verdict").get<std::string>());
+            if (!v)
+                throw InputError(fmt::format("{}: '{}': bias_verdict '{}' is not unbiased, biased or unknown", a.errorsFrom, label,
+                                             r.at("bias_verdict").get<std::string>()));
+            e.verdict = *v;
             if (reuse.contains(label)) e.reuse = reuse.at(label);
             if (!prev.rows.emplace(label, std::move(e)).second)
                 throw InputError(fmt::format("{}: '{}' measured twice", a.errorsFrom, label));
