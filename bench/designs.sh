@@ -8,7 +8,9 @@
 # are bench/gpu/designs.txt's lighting (the geometry changes the time, not
 # the image). PARTICLES "cluster": cluster_150k (raw buffers from
 # scenes/cluster/make_cluster.py, made here when absent) and the
-# configurations of bench/gpu/designs_cluster.txt.
+# configurations of bench/gpu/designs_cluster.txt. FRAME=48 measures frame
+# 48 instead (its references in OUT, which must then be another folder):
+# the steady state of a texel history longer than 20 frames.
 #   bash bench/designs.sh [PARTICLES|cluster] [SEEDS] [OUT] [NAME...]   (100000, 8, bench/results/operating_point_<N>; all)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -40,7 +42,7 @@ print(":".join([est] + [x for x in lighting if not x.startswith("render.estimato
 PY
 )
     t0=$SECONDS
-    "$A" bias $scene "${D[@]}" "${refs[@]}" "${unshadowed[@]}" --frame 20 --seeds "$seeds" --estimators "$spec" -q \
+    "$A" bias $scene "${D[@]}" "${refs[@]}" "${unshadowed[@]}" --frame "${FRAME:-20}" --seeds "$seeds" --estimators "$spec" -q \
         -o "$out/design_$base" > "$out/design_$base.txt"
     echo "design_$base: $((SECONDS - t0)) s ($seeds seeds)" | tee -a "$out/times.txt"
 done

@@ -18,7 +18,7 @@ mkdir -p "$out"
 source bench/operating_point_refs.sh
 run() {  # NAME SPEC
     local t0=$SECONDS
-    "$A" bias $scene "${D[@]}" "${refs[@]}" "${unshadowed[@]}" --frame 20 --seeds "$seeds" --estimators "$2" -q -o "$out/$1" \
+    "$A" bias $scene "${D[@]}" "${refs[@]}" "${unshadowed[@]}" --frame "${FRAME:-20}" --seeds "$seeds" --estimators "$2" -q -o "$out/$1" \
         > "$out/$1.txt"
     echo "$1: $((SECONDS - t0)) s" | tee -a "$out/times.txt"
 }

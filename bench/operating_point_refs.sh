@@ -2,7 +2,8 @@
 # 160x90 crops of the 1920x1080 frame and their split references at 1024
 # spp, with and without visibility, made in $out when absent; sets refs and
 # unshadowed (bias's --reference and --unshadowed-reference arguments).
-# Needs A, scene, D (the scene's overrides) and out.
+# Needs A, scene, D (the scene's overrides) and out; FRAME (20) is the
+# measured frame, whose references these are.
 # tune's crops (cmd_tune.cpp errorCrops), printed by tune itself would need a
 # whole search: the same strata and hash here.
 crops=$(python3 - <<'PY'
@@ -27,7 +28,7 @@ for c in $crops; do
     for vis in true false; do
         f=$out/ref$k.$vis.exr
         [ -f "$f" ] || "$A" render $scene "${D[@]}" -D "render.crop=$c" -D shading.visibility=$vis --estimator split --spp 1024 \
-            --frames 20:21 -o "$f" --quiet > /dev/null
+            --frames ${FRAME:-20}:$((${FRAME:-20} + 1)) -o "$f" --quiet > /dev/null
     done
     refs+=(--reference "$out/ref$k.true.exr")
     unshadowed+=(--unshadowed-reference "$out/ref$k.false.exr")

@@ -1,7 +1,7 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine, from the repository root:
 #   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
-#                                      layout_images layouts streams front identity shared_core ab designs resample near_ncu voxel_ncu gather_ncu voxels splits iterations split_anatomy split_ncu split_stalls ray_launch split_order gbuffer_ncu near_cluster_ncu
+#                                      layout_images layouts streams front identity shared_core ab designs resample near_ncu voxel_ncu gather_ncu voxels splits iterations split_anatomy split_ncu split_stalls ray_launch split_order gbuffer_ncu near_cluster_ncu history
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -320,6 +320,15 @@ step_splits() {
     python3 scenes/cluster/make_cluster.py 3
     grep -E '^(ps_[a-z0-9_]*|restir_m32_t_basic_1x_cluster|prt_m8_k16_cluster) ' bench/gpu/designs_cluster.txt > "$W/splits_cluster.txt"
     time_configs splits/cluster "$W/splits_cluster.txt" 5 1/1 scenes/cluster_150k.toml
+}
+
+# The texel history's weight (particle_split.history: 0.75, 0.875, 0.9), a
+# scalar of the same kernels, timed side by side with today's
+# recommendations (restir M=32 at 0.5x and at 1x) on one GPU in one run.
+step_history() {
+    grep -E '^(ps_n8_f4_c8_h(75|875|90)_100k|ps_n16_f8_c8_h75_100k|ps_n8_f4_c4_h(75|90)_1m|restir_m32_t_pairwise_05x_(100k|1m)|restir_m32_t_basic_1x_100k) ' \
+        bench/gpu/designs.txt > "$W/history.txt"
+    time_configs history "$W/history.txt" 5
 }
 
 # The spatial passes run once and twice, each iteration timed apart
