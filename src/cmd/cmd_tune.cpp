@@ -276,16 +276,19 @@ std::vector<LightingChoice> lightingChoices(const std::string& space) {
         d.near = near, d.far = far, d.farCandidates = candidates, d.history = history, d.texels = texels;
         return LightingChoice{LightSource::tree, 0, 0, 1, basic, false, 1.0, d};
     };
-    // The quick space's three: the cheapest, the twin's fastest under 10 ms
-    // and under 16 ms at 100K (designs.md).
-    const std::vector<std::pair<std::uint32_t, std::uint32_t>> quickSplits{{16, 8}, {8, 4}, {16, 16}};
-    for (const auto& [near, far] : quickSplits) designs.push_back(split(near, far, 8, 0.75));
+    // The quick space's five: the cheapest, the twin's fastest under 10 ms
+    // and under 16 ms at 100K (designs.md), and the first two with a longer
+    // texel history (h = 0.9: about 19 frames averaged instead of 7, the
+    // same kernels; its steady state moves tune's frame to 44).
+    const std::vector<std::tuple<std::uint32_t, std::uint32_t, double>> quickSplits{
+        {16, 8, 0.75}, {8, 4, 0.75}, {16, 16, 0.75}, {8, 4, 0.9}, {16, 8, 0.9}};
+    for (const auto& [near, far, h] : quickSplits) designs.push_back(split(near, far, 8, h));
     if (space == "full")
         for (std::uint32_t near : {4u, 8u, 16u, 32u})
             for (std::uint32_t far : {4u, 8u, 16u})
                 for (std::uint32_t c : {1u, 4u, 8u, 16u})
-                    for (const double h : {0.0, 0.5, 0.75})
-                        if (!(c == 8 && h == 0.75 && std::find(quickSplits.begin(), quickSplits.end(), std::pair{near, far}) != quickSplits.end()))
+                    for (const double h : {0.0, 0.5, 0.75, 0.9})
+                        if (!(c == 8 && std::find(quickSplits.begin(), quickSplits.end(), std::tuple{near, far, h}) != quickSplits.end()))
                             designs.push_back(split(near, far, c, h));
     out.insert(out.end(), designs.begin(), designs.end());
     return out;
@@ -339,7 +342,20 @@ struct TuneContext {
     std::vector<std::string> unshadowedReferences;  ///< --anatomy: the references with shading.visibility = false
     std::string referencesKey;  ///< the references' contents, hashed once: part of every error measurement's key
     std::uint32_t frame = 0;    ///< the measured frame
-    std::uint32_t history = 0;  ///< frames before it: restir's steady state (steadyStateHistory)
+    std::uint32_t history = 0;  ///< frames before it: restir's steady state (steadyStateHistory), every configuration's least
+    /// A configuration's own history where its steady state is longer
+    /// (particle_split.history 0.9: 44 frames), by label (historyOf).
+    std::map<std::string, std::uint32_t> longerHistories;
+    std::uint32_t historyOf(const LightingChoice& o) const {
+        const auto it = longerHistories.find(o.label());
+        return it == longerHistories.end() ? history : it->second;
+    }
+    /// The longest: the frames every measurement's renders may need before the measured one.
+    std::uint32_t longestHistory() const {
+        std::uint32_t h = history;
+        for (const auto& [label, frames] : longerHistories) h = std::max(h, frames);
+        return h;
+    }
     const StopSignal* stop = nullptr;  ///< SIGINT and SIGTERM: forwarded to the running measurement, then tune stops
     /// The history of the GPU-time counts: the frame counted needs its
     /// temporal pass running, not a saturated M cap. Measured on disk_100k at
@@ -542,15 +558,16 @@ ErrorRow measureErrorSeeds(TuneContext& t, const LightingChoice& o, std::uint32_
     std::string spec(enumName(o.design.estimator));  // restir's specs as before: their cache keys hold
     for (const std::string& d : o.defines())
         if (!d.starts_with("render.estimator=")) spec += ":" + d;
+    const std::uint32_t history = t.historyOf(o);
     std::string key = t.sceneText + fmt::format("\nbias {} seeds {} frame {} history {} crop margin {}", spec, seeds, t.frame,
-                                                t.history, t.args.cropMargin);
+                                                history, t.args.cropMargin);
     key += t.referencesKey;
     const std::filesystem::path prefix = t.cache / (cacheKey(key) + ".bias");
     std::vector<std::string> argv = sceneArgv(t, "bias", {});
     for (const std::string& r : t.references) argv.insert(argv.end(), {"--reference", r});
     for (const std::string& r : t.unshadowedReferences) argv.insert(argv.end(), {"--unshadowed-reference", r});
     argv.insert(argv.end(), {"--crop-margin", std::to_string(t.args.cropMargin), "--estimators", spec, "--seeds",
-                             std::to_string(seeds), "--frame", std::to_string(t.frame), "--history", std::to_string(t.history), "-q",
+                             std::to_string(seeds), "--frame", std::to_string(t.frame), "--history", std::to_string(history), "-q",
                              "-o", prefix.string()});
     const std::string file = prefix.string() + ".json", what = fmt::format("error of {} ({} seeds)", o.label(), seeds);
     measure(t, MeasureKind::error, argv, file, what);
@@ -640,6 +657,7 @@ PreviousErrors readPreviousErrors(const TuneContext& t, const Settings& scene) {
         };
         differs("frame", j.at("frame"), t.frame);
         differs("history_frames", j.at("history_frames"), t.history);
+        differs("longer_histories", j.value("longer_histories", nlohmann::json::object()), nlohmann::json(t.longerHistories));
         differs("error_crops", j.at("error_crops"), a.errorCrops);
         differs("crop_size", j.at("crop_size"), a.cropSize);
         differs("crop_margin", j.at("crop_margin"), a.cropMargin);
@@ -831,7 +849,7 @@ void prepareTune(TuneContext& t, const Settings& scene, const std::string& prefi
     t.cache = a.cache.empty() ? std::filesystem::path("out") / "tune_cache" / scene.sceneName : std::filesystem::path(a.cache);
     checkFolder(t.cache, "--cache");
     checkPrefix(prefix, "-o");
-    const std::uint32_t first = t.frame - t.history, end = t.frame + 1;  // the history and the measured frame
+    const std::uint32_t first = t.frame - t.longestHistory(), end = t.frame + 1;  // the histories and the measured frame
     OutputGuard guard = sceneInputs(scene, first, end);
     for (const std::string& r : a.references) guard.addInput(r);
     if (!a.errorsFrom.empty()) guard.addInput(a.errorsFrom);
@@ -1002,6 +1020,8 @@ void printTune(const TuneArgs& a, const Settings& scene, const TuneContext& t, c
                "at {}x{} on {} crops of {} ({} strata; restir with {} pixels of margin); GPU time counted after {}\n",
                t.frame, t.history, scene.restir.m_cap, scene.camera.width, scene.camera.height, t.crops.size(), a.cropSize,
                a.errorCrops, a.cropMargin, t.costHistory());
+    for (const auto& [label, frames] : t.longerHistories)
+        fmt::print("  {}: after {} history frames (its own steady state)\n", label, frames);
     const GeometryChoice& chosen = r.chosen->choice;
     fmt::print("geometry: {} ({:.3f} ms predicted at {}x{}, the scene's lighting)\nGPU time: {}\n", chosen.label(),
                total(r.chosen->ms), scene.camera.width, scene.camera.height, t.coefficients.source);
@@ -1061,7 +1081,7 @@ void writeTuneJson(const std::string& prefix, const TuneArgs& a, const Settings&
     writeJson(prefix + ".json", {{"version", std::string(version())}, {"command", "tune"}, {"scene", scene.scenePath},
                                  {"defines", a.defines}, {"settings", settingsToToml(scene)}, {"seed", scene.render.seed},
                                  {"budget_ms", a.budgetMs}, {"bias_bound_pct", a.biasBoundPct}, {"max_seeds", a.maxSeeds}, {"max_error", a.maxError ? nlohmann::json(*a.maxError) : nlohmann::json()},
-                                 {"seeds", a.seeds}, {"frame", t.frame}, {"history_frames", t.history}, {"cost_history_frames", t.costHistory()}, {"error_crops", a.errorCrops}, {"crop_size", a.cropSize},
+                                 {"seeds", a.seeds}, {"frame", t.frame}, {"history_frames", t.history}, {"longer_histories", t.longerHistories}, {"cost_history_frames", t.costHistory()}, {"error_crops", a.errorCrops}, {"crop_size", a.cropSize},
                                  {"crop_margin", a.cropMargin}, {"crops", windowsJson(t.crops)}, {"references", t.references},
                                  {"unshadowed_references", t.unshadowedReferences},
                                  {"space", a.space}, {"coefficients", t.coefficients.source}, {"geometry", gt.json()},
@@ -1104,23 +1124,44 @@ void plotTune(const std::string& prefix, const TuneArgs& a, const Settings& scen
     plotPng(prefix + ".png", script);
 }
 
+/// The frames before the measured one that bring configuration `o` to its
+/// own steady state (steadyStateHistory of the scene with its settings).
+std::uint32_t steadyHistoryOf(const TuneArgs& a, const LightingChoice& o) {
+    SceneArgs with = a;
+    with.defines.push_back("render.estimator=restir");  // as its measurements' child processes (sceneArgv)
+    for (const std::string& d : o.defines()) with.defines.push_back(d);
+    return steadyStateHistory(loadSceneArgs(with, {}));
+}
+
 void runTune(const TuneArgs& a) {
     const Settings scene = loadSceneArgs(a, {{"render.estimator", "tune (restir)", [](Settings& s) { s.render.estimator = EstimatorKind::restir; }}});
     requireWholeImage(scene, "tune");
     TuneContext t = checkTuneArgs(a);
     // The engine's operating point: the frame after the history that brings
-    // temporal reuse to its M cap (every lighting choice shares it).
+    // temporal reuse to its M cap, and each configuration whose own steady
+    // state is longer (a texel history) to its own.
     t.history = steadyStateHistory(scene);
-    const std::uint64_t frame = a.frame ? *a.frame : std::uint64_t(scene.render.frame_start) + t.history;
+    const std::vector<GeometryChoice> geometry = geometryChoices(scene);
+    const std::vector<LightingChoice> lighting = designChoices(lightingChoices(a.space), a.designs);
+    const LightingChoice* longest = nullptr;
+    for (const LightingChoice& o : lighting)
+        if (const std::uint32_t h = steadyHistoryOf(a, o); h > t.history) {
+            t.longerHistories[o.label()] = h;
+            if (!longest || h > t.historyOf(*longest)) longest = &o;
+        }
+    const std::uint32_t needed = t.longestHistory();
+    const std::uint64_t frame = a.frame ? *a.frame : std::uint64_t(scene.render.frame_start) + needed;
     if (frame >= 0xffffffffull)  // tune renders frame + 1's end
-        throw InputError(fmt::format("command line --frame {}: expected a frame from {} to 4294967294", frame, t.history));
+        throw InputError(fmt::format("command line --frame {}: expected a frame from {} to 4294967294", frame, needed));
     t.frame = std::uint32_t(frame);
     if (t.history > t.frame)  // tune has no --history: its frame must come after the whole history
         throw InputError(fmt::format("command line --frame {}: tune measures restir at steady state, after {} history frames "
                                      "(temporal reuse to its M cap of {:g}, at least 8): measure frame {} or later",
                                      t.frame, t.history, scene.restir.m_cap, t.history));
-    const std::vector<GeometryChoice> geometry = geometryChoices(scene);
-    const std::vector<LightingChoice> lighting = designChoices(lightingChoices(a.space), a.designs);
+    if (needed > t.frame)
+        throw InputError(fmt::format("command line --frame {}: {} needs {} history frames (its steady state), and frames start at 0: "
+                                     "measure frame {} or later, or leave it out of --space/--designs",
+                                     t.frame, longest->label(), needed, needed));
     const std::string prefix = a.out.empty() ? "out/" + scene.sceneName + ".tune" : a.out;
     t.crops = errorCrops(a, scene);
     if (!a.references.empty() && a.references.size() != t.crops.size())  // before anything is made

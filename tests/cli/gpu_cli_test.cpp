@@ -398,7 +398,7 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
     const nlohmann::json j = nlohmann::json::parse(slurp(dir / "t.json"));
     // Every measured point: the front is exactly the set no other point beats on both axes.
     const nlohmann::json& rows = j.at("lighting");
-    const std::size_t quick = 34 + 8 + 2 + 3;  // restir, particle_restir, voxel_cache, particle_split
+    const std::size_t quick = 34 + 8 + 2 + 5;  // restir, particle_restir, voxel_cache, particle_split
     REQUIRE(rows.size() == quick);
     for (const auto& p : rows) {
         bool dominated = false;
@@ -440,8 +440,35 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
     for (const auto& [design, best] : designs.items()) CHECK(best["rel_mse"].get<double>() >= r["rel_mse"].get<double>());
     // Reuse per configuration, at the steady state it was measured at: no
     // spatial pass without neighbours; every offer of the passes that ran counted.
-    CHECK(j["frame"] == 8);
+    // Each configuration after its own steady state, the frame after the
+    // longest: restir's and particle_restir's M cap of 8 frames; the voxel
+    // cache's running mean to voxel.history = 16; particle_split's texel
+    // average until its first frame weighs under 1% (0.75^17 < 0.01 <=
+    // 0.75^16, 0.9^44 < 0.01 <= 0.9^43).
+    const auto historyOf = [](const std::string& spec) {
+        return spec.find("particle_split.history=0.9:") != std::string::npos    ? 44
+               : spec.find("particle_split.history=0.75:") != std::string::npos ? 17
+               : spec.starts_with("voxel_cache")                                 ? 16
+                                                                                 : 8;
+    };
+    const nlohmann::json longer = {{"split near=8 far=4 C=8 h=0.9 1x1", 44},  {"split near=16 far=8 C=8 h=0.9 1x1", 44},
+                                   {"split near=8 far=4 C=8 h=0.75 1x1", 17}, {"split near=16 far=8 C=8 h=0.75 1x1", 17},
+                                   {"split near=16 far=16 C=8 h=0.75 1x1", 17}, {"voxels tree cells=32 rays=8 camera", 16},
+                                   {"voxels tree cells=64 rays=8 camera", 16}};
+    CHECK(j["frame"] == 44);
     CHECK(j["history_frames"] == 8);
+    CHECK(j["longer_histories"] == longer);
+    std::size_t biasRuns = 0;  // and each bias run rendered its own history before frame 44
+    for (const auto& e : std::filesystem::directory_iterator(dir / "cache"))
+        if (e.path().string().ends_with(".bias.json")) {
+            const nlohmann::json run = nlohmann::json::parse(slurp(e.path()));
+            const std::string spec = run.at("rows").at(0).at("estimator");
+            INFO(spec);
+            CHECK(run.at("frame") == 44);
+            CHECK(run.at("rows").at(0).at("history_frames") == historyOf(spec));
+            ++biasRuns;
+        }
+    CHECK(biasRuns == quick);
     CHECK(j["cost_history_frames"] == 2);  // the counted frame's temporal pass runs; its price does not need the M cap
     for (const auto& p : rows) {
         const std::string label = p["lighting"];
