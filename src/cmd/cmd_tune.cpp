@@ -1224,7 +1224,8 @@ void addTuneCommand(CLI::App& app) {
     cmd->add_option("--seeds", args->seeds, "Seeds of every lighting configuration's first error and bias measurement (more where they decide the recommendation, up to --max-seeds)")->check(CLI::Range(2u, 100000u));
     cmd->add_option("--frame", args->frame,
                     "The measured frame, after the history that brings temporal reuse to steady state (ceil(restir.m_cap) "
-                    "frames, at least 8; default: render.frame_start + that history)");
+                    "frames, at least 8) and each configuration with a longer one to its own (a texel history: 44 frames at "
+                    "particle_split.history 0.9); default: render.frame_start + the longest");
     cmd->add_option("--error-crops", args->errorCrops,
                     "Where the error is measured, at the scene's resolution: the frame cut into COLUMNSxROWS strata, one crop "
                     "each (1x1 with --crop-size the frame's: the whole frame)");
