@@ -597,6 +597,9 @@ ErrorRow measureMoreSeeds(TuneContext& t, const LightingChoice& o, const ErrorRo
 struct PreviousErrors {
     std::string file, version, coefficients;
     std::vector<std::string> references, unshadowedReferences;  ///< what its errors were measured against
+    /// This search's configurations that run could not measure: their
+    /// steady state does not fit before its frame (label -> frames needed).
+    std::map<std::string, std::uint32_t> leftOut;
     std::map<std::string, ErrorRow> rows;  ///< by LightingChoice::label()
 
     const ErrorRow& row(const std::string& label) const {
@@ -639,13 +642,23 @@ double numberOrNan(const nlohmann::json& j, const char* key) {
 
 /// Reads --errors-from and checks that it measured this run's operating
 /// point (InputError naming the file and what differs).
-PreviousErrors readPreviousErrors(const TuneContext& t, const Settings& scene) {
+/// --errors-from's file, read once: a tune run's JSON and its frame (InputError naming the file).
+std::pair<nlohmann::json, std::uint32_t> readTuneJson(const std::string& file) {
+    try {
+        nlohmann::json j = nlohmann::json::parse(readWholeFile(file, "--errors-from"));
+        if (!j.is_object() || j.value("command", "") != "tune")
+            throw InputError(fmt::format("{}: not the JSON of a tune run (-o PREFIX writes PREFIX.json)", file));
+        const std::uint32_t frame = j.at("frame").get<std::uint32_t>();
+        return {std::move(j), frame};
+    } catch (const nlohmann::json::exception& e) {
+        throw InputError(fmt::format("{}: not the JSON of a tune run: {}", file, e.what()));
+    }
+}
+
+PreviousErrors readPreviousErrors(const TuneContext& t, const Settings& scene, const nlohmann::json& j) {
     const TuneArgs& a = t.args;
     PreviousErrors prev{a.errorsFrom};
     try {
-        const nlohmann::json j = nlohmann::json::parse(readWholeFile(a.errorsFrom, "--errors-from"));
-        if (!j.is_object() || j.value("command", "") != "tune")
-            throw InputError(fmt::format("{}: not the JSON of a tune run (-o PREFIX writes PREFIX.json)", a.errorsFrom));
         prev.version = j.at("version").get<std::string>();
         prev.coefficients = j.at("coefficients").get<std::string>();
         prev.references = j.at("references").get<std::vector<std::string>>();
@@ -1028,6 +1041,9 @@ void printTune(const TuneArgs& a, const Settings& scene, const TuneContext& t, c
     if (r.previous)
         fmt::print("error: read from {} (accretion {}, priced there by {}); no error measured, each verdict as that run left it\n",
                    r.previous->file, r.previous->version, r.previous->coefficients);
+    if (r.previous)
+        for (const auto& [label, frames] : r.previous->leftOut)
+            fmt::print("  left out: {} needs {} history frames, and {} measured frame {}\n", label, frames, r.previous->file, t.frame);
     // Procedural boxes beat triangles only where traversal is software: on
     // RT cores every box entered calls the intersection program on the SM
     // (docs/layouts.md). Name the fastest triangle layout beside them.
@@ -1088,7 +1104,8 @@ void writeTuneJson(const std::string& prefix, const TuneArgs& a, const Settings&
                                  {"fastest_triangle_geometry", r.triangles->choice.label()}, {"chosen_geometry", chosen.label()},
                                  {"lighting", lt.json()}, {"reuse", reuse}, {"recommended", recommended}, {"best_per_design", designs}, {"time", spentJson(t)},
                                  {"errors_from", r.previous ? nlohmann::json{{"file", r.previous->file}, {"version", r.previous->version},
-                                                                             {"coefficients", r.previous->coefficients}}
+                                                                             {"coefficients", r.previous->coefficients},
+                                                                             {"left_out", r.previous->leftOut}}
                                                             : nlohmann::json()}});
 }
 
@@ -1142,15 +1159,26 @@ void runTune(const TuneArgs& a) {
     // state is longer (a texel history) to its own.
     t.history = steadyStateHistory(scene);
     const std::vector<GeometryChoice> geometry = geometryChoices(scene);
-    const std::vector<LightingChoice> lighting = designChoices(lightingChoices(a.space), a.designs);
-    const LightingChoice* longest = nullptr;
-    for (const LightingChoice& o : lighting)
-        if (const std::uint32_t h = steadyHistoryOf(a, o); h > t.history) {
-            t.longerHistories[o.label()] = h;
-            if (!longest || h > t.historyOf(*longest)) longest = &o;
+    // --errors-from: that run's frame unless --frame says otherwise (then
+    // checked against it); this search's configurations whose steady state
+    // does not fit before it are left out, since that run could not have
+    // measured them (a space that grew since).
+    std::optional<std::pair<nlohmann::json, std::uint32_t>> previousRun;
+    if (!a.errorsFrom.empty()) previousRun = readTuneJson(a.errorsFrom);
+    const bool previousFrame = previousRun && !a.frame;
+    std::map<std::string, std::uint32_t> leftOut;
+    std::vector<LightingChoice> lighting;
+    for (const LightingChoice& o : designChoices(lightingChoices(a.space), a.designs)) {
+        const std::uint32_t h = steadyHistoryOf(a, o);
+        if (previousFrame && h > previousRun->second) {
+            leftOut[o.label()] = h;
+            continue;
         }
+        if (h > t.history) t.longerHistories[o.label()] = h;
+        lighting.push_back(o);
+    }
     const std::uint32_t needed = t.longestHistory();
-    const std::uint64_t frame = a.frame ? *a.frame : std::uint64_t(scene.render.frame_start) + needed;
+    const std::uint64_t frame = a.frame ? *a.frame : previousFrame ? previousRun->second : std::uint64_t(scene.render.frame_start) + needed;
     if (frame >= 0xffffffffull)  // tune renders frame + 1's end
         throw InputError(fmt::format("command line --frame {}: expected a frame from {} to 4294967294", frame, needed));
     t.frame = std::uint32_t(frame);
@@ -1158,10 +1186,13 @@ void runTune(const TuneArgs& a) {
         throw InputError(fmt::format("command line --frame {}: tune measures restir at steady state, after {} history frames "
                                      "(temporal reuse to its M cap of {:g}, at least 8): measure frame {} or later",
                                      t.frame, t.history, scene.restir.m_cap, t.history));
-    if (needed > t.frame)
+    if (needed > t.frame) {  // a longer history than restir's: name the (first) longest
+        const auto longest = std::max_element(t.longerHistories.begin(), t.longerHistories.end(),
+                                              [](const auto& x, const auto& y) { return x.second < y.second; });
         throw InputError(fmt::format("command line --frame {}: {} needs {} history frames (its steady state), and frames start at 0: "
                                      "measure frame {} or later, or leave it out of --space/--designs",
-                                     t.frame, longest->label(), needed, needed));
+                                     t.frame, longest->first, needed, needed));
+    }
     const std::string prefix = a.out.empty() ? "out/" + scene.sceneName + ".tune" : a.out;
     t.crops = errorCrops(a, scene);
     if (!a.references.empty() && a.references.size() != t.crops.size())  // before anything is made
@@ -1169,7 +1200,10 @@ void runTune(const TuneArgs& a) {
                                      a.errorCrops, t.crops.size()));
     // --errors-from: read and checked before anything is made.
     std::optional<PreviousErrors> previous;
-    if (!a.errorsFrom.empty()) previous = readPreviousErrors(t, scene);
+    if (previousRun) {
+        previous = readPreviousErrors(t, scene, previousRun->first);
+        previous->leftOut = std::move(leftOut);
+    }
     prepareTune(t, scene, prefix);
     const OutputLock lock(t.cache / "tune.lock");  // one tune per cache: a measurement is made once
     removeStaleTemporaries(t.cache);                 // what a measurement killed mid-write left

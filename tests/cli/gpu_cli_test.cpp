@@ -617,6 +617,37 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
         CHECK_THAT(out, Contains("fewer.json: no error measurement of '" + dropped + "'"));
     }
     CHECK_FALSE(std::filesystem::exists(dir / "bad.json"));
+    // A run from before the space grew, at frame 8 (no texel history longer
+    // than the M cap then): priced at its frame, the configurations that do
+    // not fit before it left out and named; with --frame 44 refused.
+    {
+        nlohmann::json before = nlohmann::json::parse(slurp(dir / "first.json"));
+        before["frame"] = 8;
+        before.erase("longer_histories");
+        std::ofstream(dir / "before.json") << before.dump();
+        const std::string fromBefore = with(base, "-o", (dir / "at8").string()) +
+                                       " --max-seeds 3 --designs particle_restir,particle_split --errors-from " + (dir / "before.json").string();
+        CHECK(runCommand(fromBefore + " --frame 44", out) == 1);
+        CHECK_THAT(out, Contains("before.json: measured at another operating point: frame 8 there, 44 here"));
+        REQUIRE(runCommand(fromBefore, out) == 0);
+        CHECK_THAT(out, Contains("left out: split near=8 far=4 C=8 h=0.9 1x1 needs 44 history frames"));
+        const nlohmann::json at8 = nlohmann::json::parse(slurp(dir / "at8.json"));
+        CHECK(at8.at("frame") == 8);
+        CHECK(at8.at("longer_histories") == nlohmann::json::object());
+        // particle_split's five need more than 8 frames (17 at h = 0.75, 44 at 0.9, as above).
+        const nlohmann::json leftOut = {{"split near=8 far=4 C=8 h=0.9 1x1", 44},  {"split near=16 far=8 C=8 h=0.9 1x1", 44},
+                                        {"split near=8 far=4 C=8 h=0.75 1x1", 17}, {"split near=16 far=8 C=8 h=0.75 1x1", 17},
+                                        {"split near=16 far=16 C=8 h=0.75 1x1", 17}};
+        CHECK(at8.at("errors_from").at("left_out") == leftOut);
+        std::map<std::string, nlohmann::json> was;
+        for (const auto& p : rows) was[p["lighting"]] = p;
+        REQUIRE(at8.at("lighting").size() == 8);  // particle_restir's, their errors the first run's
+        for (const auto& p : at8.at("lighting")) {
+            INFO(p["lighting"]);
+            CHECK(p["lighting"].get<std::string>().starts_with("particles"));
+            CHECK(p["rel_mse"] == was.at(p["lighting"])["rel_mse"]);
+        }
+    }
 
     // Where a bias of --bias-bound could hide in 3 seeds' verdict, tune runs
     // the fewest seeds that would see it when --max-seeds allows, in the
