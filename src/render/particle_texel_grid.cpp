@@ -14,7 +14,8 @@
 namespace accretion {
 
 ParticleTexels gatherParticleTexels(const GBuffer& gbuffer, const Particles& particles, const ParticleBvh& bvh,
-                                    const Camera& camera, ShadingModel model, std::uint32_t side, std::uint32_t layers) {
+                                    const Camera& camera, ShadingModel model, std::uint32_t side, std::uint32_t layers,
+                                    const TexelPointRule& points) {
     ParticleTexels t;
     t.side = side;
     t.layers = layers;
@@ -55,7 +56,8 @@ ParticleTexels gatherParticleTexels(const GBuffer& gbuffer, const Particles& par
         const std::uint32_t j = t.particleOf[v];
         const BillboardFrame& f = bvh.frame(j);
         for (std::uint32_t s = 0; s < perLayer; ++s) {
-            const GBufferTexel g = billboardPointTexel(camera, j, particles.position[j], particles.radius[j], f, texelUv(s, t.side), model);
+            const GBufferTexel g = billboardPointTexel(camera, j, particles.position[j], particles.radius[j], f,
+                                                          texelPointUv(j, s, t.side, points), model);
             for (std::uint32_t k = 0; k < t.layers; ++k) t.grid.texels[std::size_t(v) * per + k * perLayer + s] = g;
         }
     });

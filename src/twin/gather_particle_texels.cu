@@ -35,7 +35,7 @@ __global__ void writeSlotsKernel(const std::uint32_t* sortedIds, std::uint32_t n
 
 /// One thread per texel of the grid (its tail too: misses).
 __global__ void writeTexelsKernel(const LaunchParams p, const std::uint32_t* sortedIds, std::uint32_t visible, std::uint32_t side,
-                                  std::uint32_t layers, std::size_t gridTexels, GBufferTexel* texels) {
+                                  std::uint32_t layers, const TexelPointRule points, std::size_t gridTexels, GBufferTexel* texels) {
     const std::size_t t = std::size_t(blockIdx.x) * blockDim.x + threadIdx.x;
     if (t >= gridTexels) return;
     const std::uint32_t perLayer = side * side, per = perLayer * layers;
@@ -44,7 +44,8 @@ __global__ void writeTexelsKernel(const LaunchParams p, const std::uint32_t* sor
         return;
     }
     const std::uint32_t j = sortedIds[t / per], s = std::uint32_t(t % per) % perLayer;
-    texels[t] = billboardPointTexel(p.camera, j, p.position[j], p.radius[j], p.frames[j], texelUv(s, side), p.model);
+    texels[t] = billboardPointTexel(p.camera, j, p.position[j], p.radius[j], p.frames[j],
+                                    texelPointUv(j, s, side, points), p.model);
 }
 
 unsigned groups(std::size_t n) { return unsigned((n + 255) / 256); }
@@ -94,8 +95,9 @@ std::uint32_t findVisibleParticles(const LaunchParams& p, const MortonFrame& fra
 }
 
 void writeParticleTexels(const LaunchParams& p, const std::uint32_t* sortedIds, std::uint32_t visible, std::uint32_t side,
-                         std::uint32_t layers, std::size_t gridTexels, GBufferTexel* texels, cudaStream_t stream) {
-    writeTexelsKernel<<<groups(gridTexels), 256, 0, stream>>>(p, sortedIds, visible, side, layers, gridTexels, texels);
+                         std::uint32_t layers, const TexelPointRule& points, std::size_t gridTexels, GBufferTexel* texels,
+                         cudaStream_t stream) {
+    writeTexelsKernel<<<groups(gridTexels), 256, 0, stream>>>(p, sortedIds, visible, side, layers, points, gridTexels, texels);
     check(cudaGetLastError(), "writeParticleTexels");
 }
 

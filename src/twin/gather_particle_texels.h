@@ -31,8 +31,9 @@ std::size_t gatherTempBytes(std::uint32_t n);
 std::uint32_t findVisibleParticles(const LaunchParams& p, const MortonFrame& frame, const GatherArrays& a, cudaStream_t stream);
 
 /// Their texels (side x side x layers each, kTexelRowWidth a row, the last
-/// row's tail missing): `gridTexels` of them into `texels`.
+/// row's tail missing, where `points` puts them): `gridTexels` of them into `texels`.
 void writeParticleTexels(const LaunchParams& p, const std::uint32_t* sortedIds, std::uint32_t visible, std::uint32_t side,
-                         std::uint32_t layers, std::size_t gridTexels, GBufferTexel* texels, cudaStream_t stream);
+                         std::uint32_t layers, const TexelPointRule& points, std::size_t gridTexels, GBufferTexel* texels,
+                         cudaStream_t stream);
 
 }  // namespace accretion::twin

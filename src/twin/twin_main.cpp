@@ -175,7 +175,7 @@ private:
     void placeVoxels(const Particles& particles);
     void runVoxelCache(LaunchParams& lp);
     void launchRays(Raygen r, std::size_t threads, unsigned rowWidth);
-    std::uint32_t gatherTexels(const LaunchParams& lp, std::uint32_t side, std::uint32_t layers);
+    std::uint32_t gatherTexels(const LaunchParams& lp, std::uint32_t side, std::uint32_t layers, const TexelPointRule& points);
     void runParticleSplit(LaunchParams& lp);
     void keepSplitHistory(std::size_t n);
     StepTimes runPasses(const FramePlan& plan, LaunchParams& lp, const Clusters& clusters, bool recluster,
@@ -424,8 +424,9 @@ LaunchParams TwinRun::launchParams(const FramePlan& plan, const Camera& camera, 
 /// gatherParticleTexels (particle_restir and particle_split): the visible
 /// particles in Morton order into buf_.gatherSortedIds and their slots into
 /// buf_.slotOf, their side x side x layers texels into buf_.gridGbuffer,
-/// gridW_ x gridH_ (kTexelRowWidth a row). Returns how many are visible.
-std::uint32_t TwinRun::gatherTexels(const LaunchParams& lp, std::uint32_t side, std::uint32_t layers) {
+/// gridW_ x gridH_ (kTexelRowWidth a row), where `points` puts them.
+/// Returns how many are visible.
+std::uint32_t TwinRun::gatherTexels(const LaunchParams& lp, std::uint32_t side, std::uint32_t layers, const TexelPointRule& points) {
     const std::uint32_t n = lp.particleCount;
     buf_.gatherFlags.reserve(n);
     for (DeviceBuffer* b : {&buf_.gatherIds, &buf_.gatherSortedIds, &buf_.slotOf}) b->reserve(n * sizeof(std::uint32_t));
@@ -442,7 +443,7 @@ std::uint32_t TwinRun::gatherTexels(const LaunchParams& lp, std::uint32_t side, 
     gridH_ = std::max(1u, std::uint32_t((texels + kTexelRowWidth - 1) / kTexelRowWidth));  // one row of misses when none is seen
     const std::size_t grid = std::size_t(gridW_) * gridH_;
     buf_.gridGbuffer.reserve(grid * sizeof(GBufferTexel));
-    writeParticleTexels(lp, arrays.sortedIds, visible, side, layers, grid, buf_.gridGbuffer.as<GBufferTexel>(), stream_);
+    writeParticleTexels(lp, arrays.sortedIds, visible, side, layers, points, grid, buf_.gridGbuffer.as<GBufferTexel>(), stream_);
     return visible;
 }
 
@@ -466,7 +467,7 @@ void TwinRun::runParticleSplit(LaunchParams& lp) {
     GpuTimer& timer = *timer_;
     {
         GpuScope t(timer, Pass::gatherParticleTexels);
-        sl.params.visible = gatherTexels(lp, s_.particle_split.texels, 1);
+        sl.params.visible = gatherTexels(lp, s_.particle_split.texels, 1, psplit::texelPoints(s_, sl.params.frame, sl.params.seed));
     }
     const std::size_t grid = std::size_t(gridW_) * gridH_, visible = sl.params.visible;
     buf_.splitNear.reserve(std::max<std::size_t>(1, visible * sl.params.nearCount) * sizeof(std::uint32_t));
@@ -536,7 +537,7 @@ StoredReservoir* TwinRun::runRestir(const FramePlan& plan, LaunchParams& lp) {
     GpuTimer& timer = *timer_;
     if (plan.particleTexels) {  // the lighting grid: the visible particles' texels, kTexelRowWidth a row
         GpuScope t(timer, Pass::gatherParticleTexels);
-        const std::uint32_t visible = gatherTexels(lp, s_.restir.texels, s_.restir.texel_rays);
+        const std::uint32_t visible = gatherTexels(lp, s_.restir.texels, s_.restir.texel_rays, TexelPointRule{});
         const std::size_t grid = std::size_t(gridW_) * gridH_;
         buf_.resA.reserve(grid * sizeof(StoredReservoir));
         buf_.resB.reserve(grid * sizeof(StoredReservoir));

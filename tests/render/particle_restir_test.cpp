@@ -90,7 +90,8 @@ TEST_CASE("particle_restir: every particle a pixel sees has one slot and its tex
     const Particles& particles = f.particles;
     const ParticleBvh& bvh = f.bvh;
     const GBuffer& gbuffer = f.gbuffer;
-    const ParticleTexels t = gatherParticleTexels(gbuffer, particles, bvh, f.camera, s.shading.model, s.restir.texels, s.restir.texel_rays);
+    const ParticleTexels t = gatherParticleTexels(gbuffer, particles, bvh, f.camera, s.shading.model, s.restir.texels, s.restir.texel_rays,
+                                                  TexelPointRule{});
 
     std::vector<std::uint8_t> seen(particles.size(), 0);
     for (const GBufferTexel& g : gbuffer.texels)

@@ -92,6 +92,16 @@ inline SplitParams splitParams(const Settings& s, std::uint32_t visible, std::ui
     return p;
 }
 
+/// Where the frame's texels lie on their billboards (particle_split.texel_point).
+inline TexelPointRule texelPoints(const Settings& s, std::uint32_t frame, std::uint64_t seed) {
+    TexelPointRule r;
+    r.jitter = s.particle_split.texel_point == TexelPoint::jittered;
+    r.disc = s.geometry.alpha == AlphaMode::disc;
+    r.frame = frame;
+    r.seed = seed;
+    return r;
+}
+
 /// A step of nearestLights' search, as its visitor sees it: an inner node
 /// read (and its two children's bounds), a leaf read, or one swap of the
 /// heap of the k best (sifting an entry up or down, or sorting it at the end).

@@ -26,9 +26,11 @@ struct ParticleTexels {
 /// Morton order of their positions over the particles' bounding cube (ties
 /// by id), and their side x side x layers texels on the billboards `bvh`
 /// holds for the camera (particle_restir's restir.texels and texel_rays,
-/// particle_split's particle_split.texels and one layer).
+/// at their centres; particle_split's particle_split.texels and one layer,
+/// where `points` puts them: particle_split.texel_point).
 ParticleTexels gatherParticleTexels(const GBuffer& gbuffer, const Particles& particles, const ParticleBvh& bvh,
-                                    const Camera& camera, ShadingModel model, std::uint32_t side, std::uint32_t layers);
+                                    const Camera& camera, ShadingModel model, std::uint32_t side, std::uint32_t layers,
+                                    const TexelPointRule& points);
 
 /// The steps of gatherParticleTexels' kernels beside its grid of pixels
 /// (PassCounters::itemSteps), as the twin launches them, an item a step

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "accretion/core/math.h"
+#include "accretion/core/rng.h"
 #include "accretion/geometry/billboard.h"
 #include "accretion/geometry/camera.h"
 #include "accretion/render/gbuffer_texel.h"
@@ -64,6 +65,36 @@ inline MortonFrame mortonFrame(const Vec3* position, std::size_t n) {
 /// The uv centre of texel `sub` (its place in a layer: row-major) of a side x side billboard grid.
 ACC_HD inline Vec2 texelUv(std::uint32_t sub, std::uint32_t side) {
     return Vec2((float(sub % side) + 0.5f) / float(side), (float(sub / side) + 0.5f) / float(side));
+}
+
+/// Where a texel's receiver lies on its billboard in a frame: its centre
+/// (texelUv), or with `jitter` (particle_split.texel_point jittered) a
+/// point drawn afresh each frame, by particle id, texel and frame, uniform
+/// in the texel's square of the billboard and, with `disc` (alpha disc),
+/// inside the disc (the square's part in it: rejection, at most
+/// kTexelPointTries draws, then the centre). A texel averaged over frames
+/// then holds the mean of the light over that area, the area its pixels
+/// see, not the light at one point of it.
+struct TexelPointRule {
+    bool jitter = false;
+    bool disc = false;
+    std::uint32_t frame = 0;
+    std::uint64_t seed = 0;
+};
+inline constexpr std::uint32_t kTexelPointTries = 16;
+
+/// Texel `sub`'s receiver uv on particle j's side x side grid under `rule`.
+ACC_HD inline Vec2 texelPointUv(std::uint32_t j, std::uint32_t sub, std::uint32_t side, const TexelPointRule& rule) {
+    const Vec2 centre = texelUv(sub, side);
+    if (!rule.jitter) return centre;
+    PortableRng rng(std::uint64_t(j) * side * side + sub, rule.frame, RngPass::texelPoint, rule.seed);
+    const float x0 = float(sub % side), y0 = float(sub / side), inv = 1.0f / float(side);
+    for (std::uint32_t k = 0; k < kTexelPointTries; ++k) {
+        const float u = rng.uniform(), v = rng.uniform();
+        const Vec2 uv((x0 + u) * inv, (y0 + v) * inv);
+        if (!rule.disc || insideDisc(uv)) return uv;
+    }
+    return centre;
 }
 
 /// The receiver at billboard uv of particle j (at p, radius r, frame f) as

@@ -19,7 +19,8 @@ LightingCounters ParticleSplit::render(const ParticleSplitInputs& in, LightingIm
     ParticleTexels texels;
     {
         auto t = timer.scope(Pass::gatherParticleTexels);
-        texels = gatherParticleTexels(in.gbuffer, in.particles, in.bvh, in.camera, in.settings.shading.model, ps_.texels, 1);
+        texels = gatherParticleTexels(in.gbuffer, in.particles, in.bvh, in.camera, in.settings.shading.model, ps_.texels, 1,
+                                      psplit::texelPoints(in.settings, in.frame, in.settings.render.seed));
         if (in.counters)
             recordGatherParticleTexels(in.gbuffer, in.particles, in.bvh, texels,
                                        in.counters->add(Pass::gatherParticleTexels, in.gbuffer.width, in.gbuffer.height));

@@ -174,7 +174,8 @@ LightingCounters Restir::render(const RestirInputs& in, LightingImage& out, Rese
     ParticleTexels texels;  // particle_restir: the lighting grid is the visible particles' texels
     if (in.plan.particleTexels) {
         auto t = timer.scope(Pass::gatherParticleTexels);
-        texels = gatherParticleTexels(full, in.particles, in.bvh, in.camera, in.settings.shading.model, rs_.texels, rs_.texel_rays);
+        texels = gatherParticleTexels(full, in.particles, in.bvh, in.camera, in.settings.shading.model, rs_.texels, rs_.texel_rays,
+                                      TexelPointRule{});
         if (in.counters)
             recordGatherParticleTexels(full, in.particles, in.bvh, texels, in.counters->add(Pass::gatherParticleTexels, full.width, full.height));
         lg = &texels.grid;
