@@ -106,6 +106,10 @@ design_case voxel_cache vox_uniform_h1 -D render.source=uniform -D voxel.history
 design_case particle_split ps_n8_f4 -D particle_split.near=8 -D particle_split.far=4
 design_case particle_split ps_2x2_c4_h5 -D particle_split.texels=2 -D particle_split.candidates=4 -D particle_split.history=0.5
 design_case particle_split ps_n64_f0 -D particle_split.near=64 -D particle_split.far=0
+# particle_split.texel_point jittered and antithetic (run.sh texel_point): the opaque square and the disc.
+design_case particle_split ps_jit_c4_h5 -D particle_split.texel_point=jittered -D particle_split.candidates=4 -D particle_split.history=0.5
+design_case particle_split ps_2x2_jit_disc_h5 -D particle_split.texel_point=jittered -D particle_split.texels=2 -D particle_split.history=0.5 "${disc[@]}"
+design_case particle_split ps_2x2_anti_disc_h5 -D particle_split.texel_point=antithetic -D particle_split.texels=2 -D particle_split.history=0.5 "${disc[@]}"
 
 # uniform and power (one frame): Lr, its standard error and the samples taken.
 declare -A sampled=(

@@ -1,7 +1,7 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine, from the repository root:
 #   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
-#                                      layout_images layouts streams front identity shared_core ab designs resample near_ncu voxel_ncu gather_ncu voxels splits iterations split_anatomy split_ncu split_stalls ray_launch split_order gbuffer_ncu near_cluster_ncu history
+#                                      layout_images layouts streams front identity shared_core ab designs resample near_ncu voxel_ncu gather_ncu voxels splits iterations split_anatomy split_ncu split_stalls ray_launch split_order gbuffer_ncu near_cluster_ncu history texel_point
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -329,6 +329,24 @@ step_history() {
     grep -E '^(ps_n8_f4_c8_h(75|875|90)_100k|ps_n16_f8_c8_h75_100k|ps_n8_f4_c4_h(75|90)_1m|restir_m32_t_pairwise_05x_(100k|1m)|restir_m32_t_basic_1x_100k) ' \
         bench/gpu/designs.txt > "$W/history.txt"
     time_configs history "$W/history.txt" 5
+}
+
+# particle_split.texel_point jittered and antithetic (a texel's receiver
+# drawn afresh each frame in its square, or mirrored every other frame):
+# their frames on quickstart at 320x180 (frames 0-2) for the per-pixel
+# comparison with the CPU (compare_cpu.sh), in the opaque square and in the
+# disc; and designs.txt's _jit_ and _anti_ lines timed beside the same
+# configurations at their centres and today's recommendations, in one run.
+step_texel_point() {
+    quickstart_frames texel_point particle_split ps_jit_c4_h5 -D particle_split.texel_point=jittered -D particle_split.candidates=4 \
+        -D particle_split.history=0.5
+    quickstart_frames texel_point particle_split ps_2x2_jit_disc_h5 -D particle_split.texel_point=jittered -D particle_split.texels=2 \
+        -D particle_split.history=0.5 -D geometry.alpha=disc
+    quickstart_frames texel_point particle_split ps_2x2_anti_disc_h5 -D particle_split.texel_point=antithetic -D particle_split.texels=2 \
+        -D particle_split.history=0.5 -D geometry.alpha=disc
+    grep -E '^(ps_n8_f4_c8_h(75|90)(_jit|_anti)?_100k|ps_n16_f8_c8_h90(_jit|_anti)?_100k|ps_n8_f4_c4_h(75|90)(_jit|_anti)?_1m|restir_m32_t_pairwise_05x_(100k|1m)) ' \
+        bench/gpu/designs.txt > "$W/texel_point.txt"
+    time_configs texel_point "$W/texel_point.txt" 5
 }
 
 # The spatial passes run once and twice, each iteration timed apart

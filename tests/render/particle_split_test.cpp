@@ -12,8 +12,10 @@
 #include <utility>
 #include <vector>
 
+#include "accretion/geometry/billboard.h"
 #include "accretion/render/frame_plan.h"
 #include "accretion/render/particle_split_passes.h"
+#include "accretion/render/particle_texels.h"
 #include "support/statistics.h"
 #include "support/test_scenes.h"
 
@@ -21,15 +23,16 @@ using namespace accretion;
 
 namespace {
 
-/// Lr at particle j's centre from every other particle, by MODEL.md's
-/// formula written out here: isotropic, f = rho / (4 pi), no visibility;
-/// lambert, f = rho / pi with max(0, n . w), n given.
-DVec3 bruteForceLr(const Particles& ps, std::uint32_t j, const Settings& s, const Vec3& n) {
+/// Lr at point x of particle j (its centre by default) from every other
+/// particle, by MODEL.md's formula written out here: isotropic, f = rho /
+/// (4 pi), no visibility; lambert, f = rho / pi with max(0, n . w), n given.
+DVec3 bruteForceLr(const Particles& ps, std::uint32_t j, const Settings& s, const Vec3& n, const DVec3* at = nullptr) {
     const double dmin = s.shading.dmin;
+    const DVec3 x = at ? *at : DVec3(ps.position[j]);
     DVec3 sum(0.0);
     for (std::uint32_t i = 0; i < ps.size(); ++i) {
         if (i == j) continue;
-        const DVec3 d = DVec3(ps.position[i]) - DVec3(ps.position[j]);
+        const DVec3 d = DVec3(ps.position[i]) - x;
         const double d2 = glm::dot(d, d);
         double g = 1.0 / std::max(d2, std::max(dmin * dmin, 1e-30));
         if (s.shading.model == ShadingModel::lambert) g *= std::max(0.0, glm::dot(DVec3(n), d / std::sqrt(d2))) * 4.0;
@@ -293,6 +296,142 @@ TEST_CASE("particle_split: the texels' history stays unbiased in a static scene 
                                   << std::sqrt(biasVar));
     CHECK(varHistory < 0.3 * varNone);  // 1/7 expected; 0.3 leaves room for 20-40 seeds' noise
     CHECK(std::abs(bias) <= 4.0 * std::sqrt(biasVar));  // the same mean: no bias from the average
+}
+
+TEST_CASE("particle_split: a jittered texel point is uniform in its square, inside the disc with alpha disc, per frame; "
+          "an antithetic one mirrors it in the next frame",
+          "[particle_split]") {
+    // Pearson chi-square tests at 99.99% (p > 1e-4) over 20000 draws of
+    // particles and frames (antithetic: the even frames, whose points are
+    // independent): for the square, 4 x 4 equal cells of the texel; for the
+    // disc (side 1), r^2 / 0.25 and the angle, each uniform on [0, 1) in 8
+    // bins for a uniform point in the disc. Antithetic: the odd frame's
+    // point is the even one's mirror about the texel's centre (to rounding).
+    for (const TexelPoint mode : {TexelPoint::jittered, TexelPoint::antithetic}) {
+        for (const std::uint32_t side : {1u, 2u, 3u}) {
+            for (const bool disc : {false, true}) {
+                if (disc && side > 1) continue;
+                for (std::uint32_t sub = 0; sub < side * side; ++sub) {
+                    std::vector<double> cells(16, 0.0), r2(8, 0.0), angle(8, 0.0);
+                    const int n = 20000;
+                    for (int k = 0; k < n; ++k) {
+                        const bool pairs = mode == TexelPoint::antithetic;
+                        const int frames = pairs ? 25 : 50;  // each particle's frames (antithetic: the even ones)
+                        const std::uint32_t frame = std::uint32_t(k % frames) * (pairs ? 2u : 1u), j = std::uint32_t(k / frames) * 31u + 3u;
+                        const TexelPointRule rule{mode, disc, frame, 7};
+                        const Vec2 uv = texelPointUv(j, sub, side, rule);
+                        const Vec2 c = texelUv(sub, side);
+                        if (pairs) {
+                            const Vec2 mirror = texelPointUv(j, sub, side, TexelPointRule{mode, disc, frame + 1, 7});
+                            INFO("side " << side << " sub " << sub << " disc " << disc << " uv " << uv.x << " " << uv.y << " next frame " << mirror.x << " " << mirror.y);
+                            REQUIRE(std::abs(uv.x + mirror.x - 2.0f * c.x) <= 1e-6f);
+                            REQUIRE(std::abs(uv.y + mirror.y - 2.0f * c.y) <= 1e-6f);
+                            REQUIRE((!disc || insideDisc(mirror)));
+                        }
+                        const float half = 0.5f / float(side) + 1e-6f;  // the square, closed, and its edges' rounding
+                        INFO(enumName(mode) << " side " << side << " sub " << sub << " disc " << disc << " uv " << uv.x << " " << uv.y);
+                        REQUIRE(std::abs(uv.x - c.x) <= half);
+                        REQUIRE(std::abs(uv.y - c.y) <= half);
+                        if (disc) {
+                            REQUIRE(insideDisc(uv));
+                            const Vec2 d = uv - Vec2(0.5f);
+                            r2[std::min(7, int(8.0 * glm::dot(d, d) / 0.25))] += 1.0;
+                            angle[std::min(7, int(8.0 * (std::atan2(double(d.y), double(d.x)) / (2.0 * M_PI) + 0.5)))] += 1.0;
+                        } else {
+                            const float side1 = 1.0f / float(side);
+                            const int cx = std::clamp(int(4.0f * (uv.x - c.x) / side1 + 2.0f), 0, 3);
+                            const int cy = std::clamp(int(4.0f * (uv.y - c.y) / side1 + 2.0f), 0, 3);
+                            cells[cy * 4 + cx] += 1.0;
+                        }
+                    }
+                    INFO(enumName(mode) << " side " << side << " sub " << sub << " disc " << disc);
+                    if (disc) {
+                        CHECK(test::chiSquarePValue(r2, std::vector<double>(8, n / 8.0)) > 1e-4);
+                        CHECK(test::chiSquarePValue(angle, std::vector<double>(8, n / 8.0)) > 1e-4);
+                    } else {
+                        CHECK(test::chiSquarePValue(cells, std::vector<double>(16, n / 16.0)) > 1e-4);
+                    }
+                }
+            }
+        }
+    }
+    // The centre without jitter; a point of its own per frame and seed with it, the same for the same inputs.
+    const TexelPointRule centre{TexelPoint::centre, false, 5, 7};
+    CHECK(texelPointUv(9, 3, 2, centre) == texelUv(3, 2));
+    for (const TexelPoint mode : {TexelPoint::jittered, TexelPoint::antithetic}) {
+            const TexelPointRule a{mode, false, 4, 7}, b{mode, false, 6, 7}, c{mode, false, 4, 8};
+            CHECK(texelPointUv(9, 3, 2, a) == texelPointUv(9, 3, 2, a));
+            CHECK(texelPointUv(9, 3, 2, a) != texelPointUv(9, 3, 2, b));
+            CHECK(texelPointUv(9, 3, 2, a) != texelPointUv(9, 3, 2, c));
+    }
+}
+
+TEST_CASE("particle_split: jittered and antithetic texels are unbiased for the light averaged over the billboard, not at its centre",
+          "[particle_split][statistical]") {
+    // 400 lights, 1x1 texels on opaque billboards made large (radius 0.4,
+    // about the lights' spacing, so that the light varies across them),
+    // isotropic, no visibility, no history: over 400 seeds (frames of their
+    // own) each particle's mean is within 4.5 standard errors of the
+    // brute-force Lr averaged over its billboard square (a 64 x 64 midpoint
+    // rule; its own error bounded by the change from 32 x 32), the frame's
+    // total within 4 of its own. The centre's Lr, what texel_point centre
+    // estimates, is told apart: the sum over the N particles of its squared
+    // z-scores exceeds N + 10 sqrt(2 N), a chi-square of N degrees of freedom
+    // (which the area mean's z-scores are) far in its tail. Antithetic
+    // alternates frames 0 and 1, the point and its mirror (of another seed's).
+    Settings s = splitSettings(ShadingModel::isotropic, 400, 8, 2);
+    s.particles.radius = 0.4;
+    s.particles.radius_jitter = 0.0;
+    s.particle_split.candidates = 4;
+    const test::TracedFrame traced(s);
+    const Particles& ps = traced.particles;
+    const int kSeeds = int(test::statisticalSeeds(400, 50));
+    for (const TexelPoint mode : {TexelPoint::jittered, TexelPoint::antithetic}) {
+    s.particle_split.texel_point = mode;
+    std::map<std::uint32_t, std::pair<double, double>> sums;  // luminance: sum, sum of squares
+    for (int k = 0; k < kSeeds; ++k) {
+        s.render.seed = 3000 + k;
+        const std::uint32_t frame = mode == TexelPoint::antithetic ? std::uint32_t(k % 2) : 0u;
+        for (const auto& [j, v] : particleLr(test::renderParticles(s, ps, frame))) {
+            sums[j].first += v.first.y;
+            sums[j].second += v.first.y * v.first.y;
+        }
+    }
+    REQUIRE(sums.size() > 100);
+    const auto areaMean = [&](std::uint32_t j, int n) {
+        const BillboardFrame& f = traced.bvh.frame(j);
+        double sum = 0.0;
+        for (int a = 0; a < n; ++a)
+            for (int b = 0; b < n; ++b) {
+                const double u = (a + 0.5) / n, v = (b + 0.5) / n, r = ps.radius[j];
+                const DVec3 x = DVec3(ps.position[j]) + (2.0 * u - 1.0) * r * DVec3(f.right) + (2.0 * v - 1.0) * r * DVec3(f.up);
+                sum += bruteForceLr(ps, j, s, Vec3(0.0f, 0.0f, 1.0f), &x).y;
+            }
+        return sum / (double(n) * n);
+    };
+    double total = 0.0, totalExpect = 0.0, totalVar = 0.0;
+    double centreZ2 = 0.0, areaZ2 = 0.0;
+    for (const auto& [j, ss] : sums) {
+        const double mean = ss.first / kSeeds;
+        const double var = std::max(0.0, ss.second / kSeeds - mean * mean) / (kSeeds - 1);
+        const double expect = areaMean(j, 64), quadrature = std::abs(expect - areaMean(j, 32));
+        const double centre = bruteForceLr(ps, j, s, Vec3(0.0f, 0.0f, 1.0f)).y;
+        INFO("particle " << j << " mean " << mean << " area mean " << expect << " (quadrature " << quadrature << ") centre " << centre
+                         << " stderr " << std::sqrt(var));
+        CHECK(std::abs(mean - expect) <= 4.5 * std::sqrt(var) + quadrature + 1e-5 * expect);
+        centreZ2 += (mean - centre) * (mean - centre) / var;
+        areaZ2 += (mean - expect) * (mean - expect) / var;
+        total += mean;
+        totalExpect += expect;
+        totalVar += var;
+    }
+    const double N = double(sums.size());
+    INFO(enumName(mode) << ": total " << total << " expected " << totalExpect << "; squared z-scores summed over " << N << " particles: " << areaZ2
+                  << " from the area means, " << centreZ2 << " from the centres");
+    CHECK(std::abs(total - totalExpect) <= 4.0 * std::sqrt(totalVar) + 1e-5 * totalExpect);
+    CHECK(areaZ2 < N + 6.0 * std::sqrt(2.0 * N));
+    CHECK(centreZ2 > N + 10.0 * std::sqrt(2.0 * N));
+    }
 }
 
 TEST_CASE("particle_split: its frame runs its own passes, not restir's", "[particle_split][plan]") {

@@ -73,6 +73,20 @@ ACC_HD void reprojectCase(int k, const Camera& cam, const Vec3* points, Out& o) 
     o = Out{{std::uint32_t(ok), ok ? std::uint32_t(q) : 0u, ok ? bits(depth) : 0u, 0u, 0u, 0u, 0u, 0u}};
 }
 
+/// particle_split.texel_point: a texel's receiver uv, centre, jittered or antithetic,
+/// in the opaque square or the disc, on grids of side 1-4, over frames.
+constexpr int kTexelPoints = 4096;
+ACC_HD void texelPointCase(int k, Out& o) {
+    const std::uint32_t side = 1 + std::uint32_t(k) % 4, sub = (std::uint32_t(k) / 4) % (side * side);
+    TexelPointRule rule;
+    rule.mode = TexelPoint((k / 64) % 3);  // centre, jittered, antithetic
+    rule.disc = (k / 256) % 2 != 0;
+    rule.frame = std::uint32_t(k) % 13;
+    rule.seed = 11 + std::uint64_t(k) / 1024;
+    const Vec2 uv = texelPointUv(std::uint32_t(k) * 2654435761u, sub, side, rule);
+    o = Out{{bits(uv.x), bits(uv.y), side, sub, std::uint32_t(rule.mode), std::uint32_t(rule.disc), 0u, 0u}};
+}
+
 ACC_HD void capCase(int k, Out& o) {
     const std::uint32_t m = restir::capHistoryM(std::uint32_t(k) * 37u, std::uint32_t(k) % 9u, 0.5 + 0.25 * (k % 80));
     o = Out{{m, 0u, 0u, 0u, 0u, 0u, 0u, 0u}};
@@ -475,9 +489,9 @@ struct Inputs {
     psplit::SplitParams* split; ///< the near search; the three texel variants
 };
 
-enum class Step { neighbours, reprojections, caps, candidates, combines, shades, passes, loops, voxels, splits };
+enum class Step { neighbours, reprojections, caps, candidates, combines, shades, passes, loops, voxels, splits, texelPoints };
 constexpr Step kSteps[] = {Step::neighbours, Step::reprojections, Step::caps, Step::candidates, Step::combines, Step::shades,
-                           Step::passes, Step::loops, Step::voxels, Step::splits};
+                           Step::passes, Step::loops, Step::voxels, Step::splits, Step::texelPoints};
 
 ACC_HD int caseCount(Step s) {
     switch (s) {
@@ -491,6 +505,7 @@ ACC_HD int caseCount(Step s) {
         case Step::loops: return kLoopCases;
         case Step::voxels: return kVoxelCases;
         case Step::splits: return kSplitCases;
+        case Step::texelPoints: return kTexelPoints;
     }
     return 0;
 }
@@ -507,6 +522,7 @@ ACC_HD void runCase(Step s, int k, const Inputs& in, Out& o) {
         case Step::loops: loopCase(k, in.passes, o); break;
         case Step::voxels: voxelCase(k, in.passes, in.voxel, o); break;
         case Step::splits: splitCase(k, in.passes, in.tree, in.paths, in.split, o); break;
+        case Step::texelPoints: texelPointCase(k, o); break;
     }
 }
 
@@ -527,6 +543,7 @@ const char* stepName(Step s) {
         case Step::loops: return "exact and uniform loops (light_estimates.h)";
         case Step::voxels: return "the voxel cache's bodies (voxel_cache_passes.h)";
         case Step::splits: return "particle_split's bodies (particle_split_passes.h)";
+        case Step::texelPoints: return "texelPointUv (particle_texels.h)";
     }
     return "?";
 }

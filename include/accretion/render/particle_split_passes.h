@@ -95,7 +95,7 @@ inline SplitParams splitParams(const Settings& s, std::uint32_t visible, std::ui
 /// Where the frame's texels lie on their billboards (particle_split.texel_point).
 inline TexelPointRule texelPoints(const Settings& s, std::uint32_t frame, std::uint64_t seed) {
     TexelPointRule r;
-    r.jitter = s.particle_split.texel_point == TexelPoint::jittered;
+    r.mode = s.particle_split.texel_point;
     r.disc = s.geometry.alpha == AlphaMode::disc;
     r.frame = frame;
     r.seed = seed;

@@ -67,16 +67,20 @@ ACC_HD inline Vec2 texelUv(std::uint32_t sub, std::uint32_t side) {
     return Vec2((float(sub % side) + 0.5f) / float(side), (float(sub / side) + 0.5f) / float(side));
 }
 
-/// Where a texel's receiver lies on its billboard in a frame: its centre
-/// (texelUv), or with `jitter` (particle_split.texel_point jittered) a
-/// point drawn afresh each frame, by particle id, texel and frame, uniform
-/// in the texel's square of the billboard and, with `disc` (alpha disc),
-/// inside the disc (the square's part in it: rejection, at most
-/// kTexelPointTries draws, then the centre). A texel averaged over frames
-/// then holds the mean of the light over that area, the area its pixels
-/// see, not the light at one point of it.
+/// Where a texel's receiver lies on its billboard in a frame
+/// (particle_split.texel_point): its centre (texelUv); jittered, a point
+/// drawn afresh each frame, by particle id, texel and frame, uniform in the
+/// texel's square of the billboard and, with `disc` (alpha disc), inside
+/// the disc (the square's part in it: rejection, at most kTexelPointTries
+/// draws, then the centre); antithetic, such a point c + d in even frames
+/// and its mirror c - d about the texel's centre c in the next (d drawn
+/// once a pair of frames; with `disc` both inside it). A texel averaged
+/// over frames then holds the mean of the light over that area, the area
+/// its pixels see, not the light at one point of it; the mirrored pairs
+/// cancel the light's linear change across it, which the jittered points
+/// add as noise.
 struct TexelPointRule {
-    bool jitter = false;
+    TexelPoint mode = TexelPoint::centre;
     bool disc = false;
     std::uint32_t frame = 0;
     std::uint64_t seed = 0;
@@ -86,13 +90,14 @@ inline constexpr std::uint32_t kTexelPointTries = 16;
 /// Texel `sub`'s receiver uv on particle j's side x side grid under `rule`.
 ACC_HD inline Vec2 texelPointUv(std::uint32_t j, std::uint32_t sub, std::uint32_t side, const TexelPointRule& rule) {
     const Vec2 centre = texelUv(sub, side);
-    if (!rule.jitter) return centre;
-    PortableRng rng(std::uint64_t(j) * side * side + sub, rule.frame, RngPass::texelPoint, rule.seed);
-    const float x0 = float(sub % side), y0 = float(sub / side), inv = 1.0f / float(side);
+    if (rule.mode == TexelPoint::centre) return centre;
+    const bool pairs = rule.mode == TexelPoint::antithetic;
+    PortableRng rng(std::uint64_t(j) * side * side + sub, pairs ? rule.frame / 2 : rule.frame, RngPass::texelPoint, rule.seed);
+    const float inv = 1.0f / float(side), sign = pairs && (rule.frame & 1u) ? -1.0f : 1.0f;
     for (std::uint32_t k = 0; k < kTexelPointTries; ++k) {
-        const float u = rng.uniform(), v = rng.uniform();
-        const Vec2 uv((x0 + u) * inv, (y0 + v) * inv);
-        if (!rule.disc || insideDisc(uv)) return uv;
+        const Vec2 d((rng.uniform() - 0.5f) * inv, (rng.uniform() - 0.5f) * inv);
+        const Vec2 uv = centre + sign * d;
+        if (!rule.disc || (insideDisc(uv) && (!pairs || insideDisc(centre - sign * d)))) return uv;
     }
     return centre;
 }

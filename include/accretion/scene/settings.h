@@ -43,7 +43,7 @@ enum class CpuLayout { fastest, gpu };
 enum class ShadingModel { lambert, sphere, isotropic };
 enum class EstimatorKind { exact, uniform, power, ris, restir, tree, split, particle_restir, voxel_cache, particle_split };
 enum class PixelShading { interpolate, resample };
-enum class TexelPoint { centre, jittered };
+enum class TexelPoint { centre, jittered, antithetic };
 enum class VoxelBasis { l1, camera };
 enum class BiasCorrection { none, basic, pairwise };
 enum class ReservoirLayout { full, packed };
@@ -67,7 +67,7 @@ ACC_ENUM_NAMES(ShadingModel, "lambert", "sphere", "isotropic");
 ACC_ENUM_NAMES(EstimatorKind, "exact", "uniform", "power", "ris", "restir", "tree", "split", "particle_restir", "voxel_cache",
                "particle_split");
 ACC_ENUM_NAMES(PixelShading, "interpolate", "resample");
-ACC_ENUM_NAMES(TexelPoint, "centre", "jittered");
+ACC_ENUM_NAMES(TexelPoint, "centre", "jittered", "antithetic");
 ACC_ENUM_NAMES(VoxelBasis, "l1", "camera");
 ACC_ENUM_NAMES(BiasCorrection, "none", "basic", "pairwise");
 ACC_ENUM_NAMES(ReservoirLayout, "full", "packed");
@@ -381,7 +381,7 @@ struct ParticleSplitSettings {
         v.field("candidates", candidates, "particle_split: each far shadow ray's light is the one kept by RIS among this many far draws (the unshadowed term's luminance as target; 1: the draw itself)", Range{1, 256});
         v.field("texels", texels, "particle_split: texels per billboard side (1, 2, 3 or 4); the pixels interpolate them bilinearly", Range{1, 4});
         v.field("history", history, "particle_split: a texel's Lr is (1 - h) x this frame's + h x its own last frame's, found by particle id (an exponential average: biased where the light changes)", Range{0.0, 0.99});
-        v.field("texel_point", texel_point, "particle_split: centre (a texel's receiver is its centre every frame) or jittered (a point drawn afresh each frame, uniform in the texel's square of the billboard and inside the disc with alpha disc: with history the texel averages the light over the area its pixels see, not the light at its centre)");
+        v.field("texel_point", texel_point, "particle_split: centre (a texel's receiver is its centre every frame) jittered (a point drawn afresh each frame, uniform in the texel's square of the billboard and inside the disc with alpha disc: with history the texel averages the light over the area its pixels see, not the light at its centre) or antithetic (such a point in even frames, its mirror about the texel's centre in the next: the pairs cancel the light's linear change across the texel)");
     }
 };
 
