@@ -10,7 +10,8 @@
 # scenes/cluster/make_cluster.py, made here when absent) and the
 # configurations of bench/gpu/designs_cluster.txt. FRAME=48 measures frame
 # 48 instead (its references in OUT, which must then be another folder):
-# the steady state of a texel history longer than 20 frames.
+# the steady state of a texel history longer than 20 frames. REFS=DIR reads
+# the references from DIR (bench/operating_point_refs.sh).
 #   bash bench/designs.sh [PARTICLES|cluster] [SEEDS] [OUT] [NAME...]   (100000, 8, bench/results/operating_point_<N>; all)
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -3,7 +3,8 @@
 # spp, with and without visibility, made in $out when absent; sets refs and
 # unshadowed (bias's --reference and --unshadowed-reference arguments).
 # Needs A, scene, D (the scene's overrides) and out; FRAME (20) is the
-# measured frame, whose references these are.
+# measured frame, whose references these are. REFS=DIR takes (and makes)
+# them in DIR instead of out: more seeds of a run whose references exist.
 # tune's crops (cmd_tune.cpp errorCrops), printed by tune itself would need a
 # whole search: the same strata and hash here.
 crops=$(python3 - <<'PY'
@@ -26,11 +27,11 @@ PY
 refs=() unshadowed=() k=0
 for c in $crops; do
     for vis in true false; do
-        f=$out/ref$k.$vis.exr
+        f=${REFS:-$out}/ref$k.$vis.exr
         [ -f "$f" ] || "$A" render $scene "${D[@]}" -D "render.crop=$c" -D shading.visibility=$vis --estimator split --spp 1024 \
             --frames ${FRAME:-20}:$((${FRAME:-20} + 1)) -o "$f" --quiet > /dev/null
     done
-    refs+=(--reference "$out/ref$k.true.exr")
-    unshadowed+=(--unshadowed-reference "$out/ref$k.false.exr")
+    refs+=(--reference "${REFS:-$out}/ref$k.true.exr")
+    unshadowed+=(--unshadowed-reference "${REFS:-$out}/ref$k.false.exr")
     k=$((k + 1))
 done
