@@ -95,7 +95,9 @@ ACC_HD inline Vec2 texelPointUv(std::uint32_t j, std::uint32_t sub, std::uint32_
     PortableRng rng(std::uint64_t(j) * side * side + sub, pairs ? rule.frame / 2 : rule.frame, RngPass::texelPoint, rule.seed);
     const float inv = 1.0f / float(side), sign = pairs && (rule.frame & 1u) ? -1.0f : 1.0f;
     for (std::uint32_t k = 0; k < kTexelPointTries; ++k) {
-        const Vec2 d((rng.uniform() - 0.5f) * inv, (rng.uniform() - 0.5f) * inv);
+        const float u = rng.uniform();  // u before v: in one expression the host's and nvcc's orders differ
+        const float v = rng.uniform();
+        const Vec2 d((u - 0.5f) * inv, (v - 0.5f) * inv);
         const Vec2 uv = centre + sign * d;
         if (!rule.disc || (insideDisc(uv) && (!pairs || insideDisc(centre - sign * d)))) return uv;
     }
