@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """The table of bench/operating_point.sh: one row per configuration from its
-bias JSON (relMSE, with every light visible, visibility's share, energy
+bias JSON (relMSE with its standard error over the seeds where the run
+recorded one, with every light visible, visibility's share, energy
 loss and the bias the seeds could see, reuse kept and why refused)."""
 import json
 import pathlib
@@ -25,5 +26,7 @@ for f in sorted(out.glob("*.json"), key=lambda p: p.stat().st_mtime):
             s += f" ({100 * c['outcomes']['other_particle'] / c['accepted']:.0f}%)"
         return s
 
-    print(f"| {f.stem} | {r['rel_mse']:.3g} | {r['rel_mse_unshadowed']:.3g} | {r['visibility_share_pct']:.0f}% | "
+    se = r.get("rel_mse_stderr")
+    rel = f"{r['rel_mse']:.3g}" + (f" +- {se:.2g}" if isinstance(se, (int, float)) and se == se else "")
+    print(f"| {f.stem} | {rel} | {r['rel_mse_unshadowed']:.3g} | {r['visibility_share_pct']:.0f}% | "
           f"{r['energy_loss_pct']:+.1f}% | {r['detectable_bias_pct']:.2g}% | {kept('temporalResampling')} | {kept('spatialResampling')} |")

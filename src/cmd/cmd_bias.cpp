@@ -63,6 +63,7 @@ struct BiasRow {
     double secondsPerRender = 0.0;
     double secondsPerFrame = 0.0;  ///< the measured frame alone (restir: without its history frames)
     double relMse = 0.0;       ///< mean over seeds of one render's relMSE, less the reference's own noise
+    double relMseStderr = NAN; ///< its standard error, from the seeds' spread (NaN for one seed)
     bool biased = false;
     double detectablePct = 0.0;  ///< the smallest |energy bias| (%) this run detects with 80% probability
     PassReuse reuse;             ///< restir: the measured frames' reuse offers by outcome, summed over the seeds
@@ -277,7 +278,7 @@ BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vec
     const std::size_t pixels = ref.rgb.size();
     const double n = 3.0 * double(pixels);
     std::vector<DVec3> s1(pixels, DVec3(0.0)), s2(pixels, DVec3(0.0));
-    double e1 = 0.0, e2 = 0.0, seconds = 0.0, frameSeconds = 0.0, relMse = 0.0;
+    double e1 = 0.0, e2 = 0.0, seconds = 0.0, frameSeconds = 0.0, relMse = 0.0, relMse2 = 0.0;
     PassReuse reuse;
     Progress progress("bias " + spec.label + " (seeds)", a.seeds, a.quiet);
     auto add = [&](const ExperimentRender& r) {
@@ -294,6 +295,7 @@ BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vec
         e /= n;
         const ErrorMetrics m = computeErrors(r.image.lighting.Lr, ref.rgb, ref.stderr.empty() ? nullptr : &ref.stderr);
         relMse += m.relMSE - m.relMSEFloor;
+        relMse2 += (m.relMSE - m.relMSEFloor) * (m.relMSE - m.relMSEFloor);
         e1 += e;
         e2 += e * e;
         progress.advance(1);
@@ -331,6 +333,9 @@ BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vec
     row.energyLossPct = ref.mean > 0.0 ? -100.0 * row.meanError / ref.mean : 0.0;
     row.secondsPerRender = seconds / S;
     row.relMse = relMse / S;
+    // A render's relMSE is heavy-tailed where rare bright samples land: its
+    // mean over a few seeds can move by a quarter (1M particles, 4 seeds).
+    if (a.seeds > 1) row.relMseStderr = std::sqrt(std::max(0.0, relMse2 / S - row.relMse * row.relMse) / (S - 1.0));
     row.secondsPerFrame = frameSeconds / S;
     row.biased = std::fabs(row.t) > row.critical;
     row.detectablePct = ref.mean > 0.0 ? 100.0 * test.detectable / ref.mean : std::numeric_limits<double>::infinity();
@@ -367,7 +372,7 @@ Table biasTable(const std::vector<BiasRow>& rows, double refMean, double zCritic
              hidden("energy_loss_pct", "{:.6g}"), hidden("energy_loss_stderr_pct", "{:.6g}"), {"", "energy loss %", 15},
              hidden("biased", "{}"), hidden("detectable_bias_pct", "{:.4g}"), {"seconds_per_render", "s/render", 9, "{:.3f}", "{:.6g}"},
              {"seconds_per_frame", "s/frame", 8, "{:.3f}", "{:.6g}"}, {"rel_mse", "relMSE", 10, "{:.4g}", "{:.6g}"},
-             {"rel_mse_unshadowed", "unshadowed", 11, "{:.4g}", "{:.6g}"}, {"visibility_share_pct", "vis share%", 11, "{:.0f}", "{:.4g}"},
+             {"rel_mse_stderr", "+-", 8, "{:.2g}", "{:.6g}"}, {"rel_mse_unshadowed", "unshadowed", 11, "{:.4g}", "{:.6g}"}, {"visibility_share_pct", "vis share%", 11, "{:.0f}", "{:.4g}"},
              {"light_selection_share_pct", "sel share%", 11, "{:.0f}", "{:.4g}"},
              {"", fmt::format("verdict (|t| above its critical value, {:.3g}% two-sided)", 100.0 * significance), 0, "{}", "{}", true, "  "}});
     for (const BiasRow& r : rows) {
@@ -375,7 +380,7 @@ Table biasTable(const std::vector<BiasRow>& rows, double refMean, double zCritic
         t.add({r.label, std::uint64_t(r.seeds), std::uint64_t(r.history), r.meanError, r.stderr, r.t, r.seedSd, r.dof, r.critical,
                r.energyLossPct, lossSe,
                fmt::format("{:>8.3f} +- {:<5.3f}", r.energyLossPct, lossSe), r.biased, r.detectablePct, r.secondsPerRender,
-               r.secondsPerFrame, r.relMse, r.relMseUnshadowed, 100.0 * (r.relMse - r.relMseUnshadowed) / r.relMse,
+               r.secondsPerFrame, r.relMse, r.relMseStderr, r.relMseUnshadowed, 100.0 * (r.relMse - r.relMseUnshadowed) / r.relMse,
                100.0 * r.relMseUnshadowed / r.relMse,
                r.biased ? "BIASED"
                         : fmt::format("no bias detected (a bias of {:.2g}% or more would show 4 times in 5)", r.detectablePct)});

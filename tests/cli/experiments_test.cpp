@@ -162,6 +162,48 @@ TEST_CASE("bias: 1/M restir is flagged, uniform Monte Carlo is not", "[cli][expe
     CHECK(std::filesystem::exists(dir / "b.png"));
 }
 
+TEST_CASE("bias: relMSE's standard error is the spread of the seeds' own relMSE", "[cli][experiments]") {
+    // Four seeds in one run (render.seed 100-103) against the same seeds in
+    // two runs of two: a run of two seeds a, b gives their mean m and
+    // standard error |a - b| / 2, so a, b = m -+ se. The four-seed run's
+    // relMSE is the mean of those four values and its standard error
+    // sd / sqrt(4), sd their sample standard deviation (closed forms of the
+    // two runs' figures; CSV's 6 digits).
+    const auto dir = accretion::test::scratchDir("bias_relmse_se");
+    std::string out;
+    REQUIRE(runCommand(kBin + " render " + tinyScene() + " --quiet --estimator exact -o " + (dir / "exact.exr").string(), out) == 0);
+    const auto run = [&](std::uint32_t seed, std::uint32_t seeds, const std::string& name) {
+        const std::string cmd = kBin + " bias " + tinyScene() + " -D render.samples=4 -D render.seed=" + std::to_string(seed) +
+                                " --quiet --reference " + (dir / "exact.exr").string() + " --frame 0 --estimators uniform --seeds " +
+                                std::to_string(seeds) + " -o " + (dir / name).string();
+        INFO(cmd << "\n" << out);
+        REQUIRE(runCommand(cmd, out) == 0);
+        const auto rows = readCsv(dir / (name + ".csv"));
+        REQUIRE(rows.size() == 2);
+        const auto col = [&](const char* c) {
+            const auto i = std::find(rows[0].begin(), rows[0].end(), c);
+            REQUIRE(i != rows[0].end());
+            return std::size_t(i - rows[0].begin());
+        };
+        return std::pair<double, double>(std::stod(rows[1][col("rel_mse")]), std::stod(rows[1][col("rel_mse_stderr")]));
+    };
+    const auto [all, se] = run(100, 4, "four");
+    std::vector<double> one;
+    for (const std::uint32_t first : {100u, 102u}) {
+        const auto [m, s] = run(first, 2, "two" + std::to_string(first));
+        CHECK(s > 0.0);
+        one.push_back(m - s);
+        one.push_back(m + s);
+    }
+    double mean = 0.0, ss = 0.0;
+    for (const double r : one) mean += r / 4.0;
+    for (const double r : one) ss += (r - mean) * (r - mean);
+    const double sd = std::sqrt(ss / 3.0);
+    INFO("relMSE " << all << " +- " << se << "; the seeds' " << one[0] << ", " << one[1] << ", " << one[2] << ", " << one[3]);
+    CHECK(all == Approx(mean).epsilon(1e-5));
+    CHECK(se == Approx(sd / 2.0).epsilon(1e-3));
+}
+
 TEST_CASE("experiment and restir input errors: one clear message, exit 1", "[cli][errors]") {
     const auto dir = accretion::test::scratchDir("experiment_errors");
     std::string out;
