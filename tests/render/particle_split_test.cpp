@@ -298,7 +298,7 @@ TEST_CASE("particle_split: the texels' history stays unbiased in a static scene 
     CHECK(std::abs(bias) <= 4.0 * std::sqrt(biasVar));  // the same mean: no bias from the average
 }
 
-TEST_CASE("particle_split: a jittered texel point is uniform in its square, inside the disc with alpha disc, per frame; "
+TEST_CASE("particle_split: a jittered texel point is uniform in its square, inside the disc with alpha disc, per frame, "
           "an antithetic one mirrors it in the next frame",
           "[particle_split]") {
     // Pearson chi-square tests at 99.99% (p > 1e-4) over 20000 draws of
