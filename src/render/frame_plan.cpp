@@ -161,7 +161,10 @@ void describe(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
     } else if (estimatorInfo(est).passes == LightingPasses::particleSplit) {
         const ParticleSplitSettings& ps = s.particle_split;
         step(Pass::gatherParticleTexels,
-             dark ? noLight : fmt::format("the visible particles in Morton order, {0}x{0} texels each", ps.texels));
+             dark ? noLight
+                  : fmt::format("the visible particles in Morton order, {0}x{0} texels each{1}", ps.texels,
+                                ps.texel_point == TexelPoint::centre ? ""
+                                : fmt::format(", at points of their squares drawn each frame ({})", enumName(ps.texel_point))));
         step(Pass::findNearLights,
              dark ? noLight : fmt::format("each visible particle's {} nearest lights on the light tree (no rays)", ps.near));
         step(Pass::shadeSplitTexels,

@@ -20,7 +20,7 @@ enum class RngPass : std::uint32_t {
     nearLightPilot = 9,    ///< split: the far samples of the pilot that picks k
     voxelCache = 10,       ///< voxel_cache: a cell's light draws
     particleSplit = 11,    ///< particle_split: a texel's far draws
-    texelPoint = 12,       ///< particle_split.texel_point jittered: a texel's receiver on its billboard
+    texelPoint = 12,       ///< particle_split.texel_point jittered and antithetic: a texel's receiver on its billboard
 };
 
 /// 64-bit finaliser (SplitMix64), a bijection with good avalanche.

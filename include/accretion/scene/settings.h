@@ -381,7 +381,7 @@ struct ParticleSplitSettings {
         v.field("candidates", candidates, "particle_split: each far shadow ray's light is the one kept by RIS among this many far draws (the unshadowed term's luminance as target; 1: the draw itself)", Range{1, 256});
         v.field("texels", texels, "particle_split: texels per billboard side (1, 2, 3 or 4); the pixels interpolate them bilinearly", Range{1, 4});
         v.field("history", history, "particle_split: a texel's Lr is (1 - h) x this frame's + h x its own last frame's, found by particle id (an exponential average: biased where the light changes)", Range{0.0, 0.99});
-        v.field("texel_point", texel_point, "particle_split: centre (a texel's receiver is its centre every frame) jittered (a point drawn afresh each frame, uniform in the texel's square of the billboard and inside the disc with alpha disc: with history the texel averages the light over the area its pixels see, not the light at its centre) or antithetic (such a point in even frames, its mirror about the texel's centre in the next: the pairs cancel the light's linear change across the texel)");
+        v.field("texel_point", texel_point, "particle_split: centre (a texel's receiver is its centre every frame), jittered (a point drawn afresh each frame, uniform in the texel's square of the billboard and inside the disc with alpha disc: with history the texel averages the light over the area its pixels see, not the light at its centre) or antithetic (such a point in even frames, its mirror about the texel's centre in the next: the pairs cancel the light's linear change across the texel)");
     }
 };
 
