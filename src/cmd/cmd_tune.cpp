@@ -640,8 +640,6 @@ double numberOrNan(const nlohmann::json& j, const char* key) {
     return v.is_null() ? std::nan("") : v.get<double>();
 }
 
-/// Reads --errors-from and checks that it measured this run's operating
-/// point (InputError naming the file and what differs).
 /// --errors-from's file, read once: a tune run's JSON and its frame (InputError naming the file).
 std::pair<nlohmann::json, std::uint32_t> readTuneJson(const std::string& file) {
     try {
@@ -655,6 +653,8 @@ std::pair<nlohmann::json, std::uint32_t> readTuneJson(const std::string& file) {
     }
 }
 
+/// --errors-from's errors, from its JSON j, checked to have measured this
+/// run's operating point (InputError naming the file and what differs).
 PreviousErrors readPreviousErrors(const TuneContext& t, const Settings& scene, const nlohmann::json& j) {
     const TuneArgs& a = t.args;
     PreviousErrors prev{a.errorsFrom};

@@ -383,8 +383,10 @@ TEST_CASE("particle_split: jittered and antithetic texels are unbiased for the l
     s.particles.radius = 0.4;
     s.particles.radius_jitter = 0.0;
     s.particle_split.candidates = 4;
+    REQUIRE(s.geometry.orientation == Orientation::view_plane);  // the billboards span the camera's right and up
     const test::TracedFrame traced(s);
     const Particles& ps = traced.particles;
+    const DVec3 right(traced.camera.right), up(traced.camera.up);
     const int kSeeds = int(test::statisticalSeeds(400, 50));
     for (const TexelPoint mode : {TexelPoint::jittered, TexelPoint::antithetic}) {
     s.particle_split.texel_point = mode;
@@ -399,12 +401,11 @@ TEST_CASE("particle_split: jittered and antithetic texels are unbiased for the l
     }
     REQUIRE(sums.size() > 100);
     const auto areaMean = [&](std::uint32_t j, int n) {
-        const BillboardFrame& f = traced.bvh.frame(j);
         double sum = 0.0;
         for (int a = 0; a < n; ++a)
             for (int b = 0; b < n; ++b) {
                 const double u = (a + 0.5) / n, v = (b + 0.5) / n, r = ps.radius[j];
-                const DVec3 x = DVec3(ps.position[j]) + (2.0 * u - 1.0) * r * DVec3(f.right) + (2.0 * v - 1.0) * r * DVec3(f.up);
+                const DVec3 x = DVec3(ps.position[j]) + (2.0 * u - 1.0) * r * right + (2.0 * v - 1.0) * r * up;
                 sum += bruteForceLr(ps, j, s, Vec3(0.0f, 0.0f, 1.0f), &x).y;
             }
         return sum / (double(n) * n);
@@ -446,6 +447,14 @@ TEST_CASE("particle_split: its frame runs its own passes, not restir's", "[parti
                          Pass::updateVoxelCache})
         CHECK(std::find(passes.begin(), passes.end(), p) == passes.end());
     REQUIRE(plan.sampler == LightSamplerKind::tree);
+    // The gather names where its texels lie when not at their centres.
+    const auto gatherWhy = [&](TexelPoint point) {
+        Settings t = s;
+        t.particle_split.texel_point = point;
+        return planFrame(t, FrameFacts{}).find(Pass::gatherParticleTexels)->why;
+    };
+    CHECK_THAT(gatherWhy(TexelPoint::centre), !Catch::Contains("drawn"));
+    CHECK_THAT(gatherWhy(TexelPoint::antithetic), Catch::Contains("drawn each frame (antithetic)"));
     // Counting mode: each pass's threads recorded, the texels' shadow rays among them.
     s.gpu.counters = true;
     const Particles ps = ParticleSource(s).frame(0);
