@@ -14,6 +14,7 @@
 #include <tbb/global_control.h>
 
 #include "accretion/analysis/bias_test.h"
+#include "accretion/analysis/error_anatomy.h"
 #include "accretion/analysis/experiment.h"
 #include "accretion/analysis/student_t.h"
 #include "accretion/analysis/image_metrics.h"
@@ -64,6 +65,7 @@ struct BiasRow {
     double secondsPerFrame = 0.0;  ///< the measured frame alone (restir: without its history frames)
     double relMse = 0.0;       ///< mean over seeds of one render's relMSE, less the reference's own noise
     double relMseStderr = NAN; ///< its standard error, from the seeds' spread (NaN for one seed)
+    ErrorAnatomy anatomy;      ///< relMse as the per-pixel bias the seeds share and the noise they do not
     bool biased = false;
     double detectablePct = 0.0;  ///< the smallest |energy bias| (%) this run detects with 80% probability
     PassReuse reuse;             ///< restir: the measured frames' reuse offers by outcome, summed over the seeds
@@ -83,6 +85,7 @@ struct BiasReference {
     std::vector<std::string> files;       ///< one per crop
     std::vector<Vec3> rgb;                ///< the crops' pixels, crop after crop, row by row
     std::vector<Vec3> stderr;             ///< the same; empty without Lr_stderr layers
+    std::vector<std::uint32_t> ids;       ///< the same, particle.id; empty unless every file has one
     double mean = 0.0, meanStderr = 0.0;
     bool whole() const { return crops.size() == 1 && crops[0].isWhole(width, height); }
     /// A per-pixel layer of the crops' pixels as the whole image, 0 outside them.
@@ -138,11 +141,14 @@ BiasReference loadBiasReference(const std::vector<std::string>& files, const Set
             r.stderr.insert(r.stderr.end(), se.begin(), se.end());
         }
         requireSceneView(readExrAttributes(file), file, FileRole::reference, scene, frame, strict);
+        const std::vector<std::uint32_t> ids = readExrUintChannel(file, "particle.id");
+        if (!ids.empty() && r.ids.size() == r.rgb.size()) r.ids.insert(r.ids.end(), ids.begin(), ids.end());
         r.rgb.insert(r.rgb.end(), image.rgb.begin(), image.rgb.end());
         r.crops.push_back(crop);
         r.files.push_back(file);
     }
     const std::size_t pixels = r.rgb.size();
+    if (r.ids.size() != pixels) r.ids.clear();
     const double n = 3.0 * double(pixels);
     double var = 0.0;
     for (std::size_t p = 0; p < pixels; ++p)
@@ -339,6 +345,7 @@ BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vec
     row.secondsPerFrame = frameSeconds / S;
     row.biased = std::fabs(row.t) > row.critical;
     row.detectablePct = ref.mean > 0.0 ? 100.0 * test.detectable / ref.mean : std::numeric_limits<double>::infinity();
+    row.anatomy = splitRelMse(s1, s2, S, ref.rgb, ref.stderr, kRelMseEpsilon);
     row.map = biasMap(s1, s2, S, ref);
     row.reuse = std::move(reuse);
     row.settingsToml = settingsToToml(specBase);
@@ -372,7 +379,8 @@ Table biasTable(const std::vector<BiasRow>& rows, double refMean, double zCritic
              hidden("energy_loss_pct", "{:.6g}"), hidden("energy_loss_stderr_pct", "{:.6g}"), {"", "energy loss %", 15},
              hidden("biased", "{}"), hidden("detectable_bias_pct", "{:.4g}"), {"seconds_per_render", "s/render", 9, "{:.3f}", "{:.6g}"},
              {"seconds_per_frame", "s/frame", 8, "{:.3f}", "{:.6g}"}, {"rel_mse", "relMSE", 10, "{:.4g}", "{:.6g}"},
-             {"rel_mse_stderr", "+-", 8, "{:.2g}", "{:.6g}"}, {"rel_mse_unshadowed", "unshadowed", 11, "{:.4g}", "{:.6g}"}, {"visibility_share_pct", "vis share%", 11, "{:.0f}", "{:.4g}"},
+             {"rel_mse_stderr", "+-", 8, "{:.2g}", "{:.6g}"}, {"rel_mse_persistent", "persistent", 11, "{:.4g}", "{:.6g}"},
+             {"rel_mse_noise", "noise", 10, "{:.4g}", "{:.6g}"}, {"rel_mse_unshadowed", "unshadowed", 11, "{:.4g}", "{:.6g}"}, {"visibility_share_pct", "vis share%", 11, "{:.0f}", "{:.4g}"},
              {"light_selection_share_pct", "sel share%", 11, "{:.0f}", "{:.4g}"},
              {"", fmt::format("verdict (|t| above its critical value, {:.3g}% two-sided)", 100.0 * significance), 0, "{}", "{}", true, "  "}});
     for (const BiasRow& r : rows) {
@@ -380,7 +388,7 @@ Table biasTable(const std::vector<BiasRow>& rows, double refMean, double zCritic
         t.add({r.label, std::uint64_t(r.seeds), std::uint64_t(r.history), r.meanError, r.stderr, r.t, r.seedSd, r.dof, r.critical,
                r.energyLossPct, lossSe,
                fmt::format("{:>8.3f} +- {:<5.3f}", r.energyLossPct, lossSe), r.biased, r.detectablePct, r.secondsPerRender,
-               r.secondsPerFrame, r.relMse, r.relMseStderr, r.relMseUnshadowed, 100.0 * (r.relMse - r.relMseUnshadowed) / r.relMse,
+               r.secondsPerFrame, r.relMse, r.relMseStderr, r.anatomy.persistent, r.anatomy.noise, r.relMseUnshadowed, 100.0 * (r.relMse - r.relMseUnshadowed) / r.relMse,
                100.0 * r.relMseUnshadowed / r.relMse,
                r.biased ? "BIASED"
                         : fmt::format("no bias detected (a bias of {:.2g}% or more would show 4 times in 5)", r.detectablePct)});
@@ -457,6 +465,15 @@ void runBias(const BiasArgs& a) {
 
     const Table table = biasTable(rows, ref.mean, a.zCritical);
     fmt::print("{}", table.console());
+    // What no design that shades one value a particle can go below: the
+    // references' own particle.id says which pixels share a particle.
+    nlohmann::json floorJson;
+    if (!ref.ids.empty()) {
+        const ParticleMeanFloor f = particleMeanFloor(ref.rgb, ref.ids, ref.stderr, kRelMseEpsilon);
+        fmt::print("one value a particle (each pixel its particle's mean reference Lr over the pixels measured): relMSE floor {:.4g}, "
+                   "{} particles, a median {:g} pixels each\n", f.relMSE, f.particles, f.medianPixels);
+        floorJson = {{"rel_mse", f.relMSE}, {"particles", f.particles}, {"median_pixels", f.medianPixels}};
+    }
     nlohmann::json reuse = nlohmann::json::object();
     for (const BiasRow& r : rows) {
         if (r.reuse.empty()) continue;
@@ -472,6 +489,7 @@ void runBias(const BiasArgs& a) {
                                  {"crop_margin", ref.whole() ? nlohmann::json() : nlohmann::json(a.cropMargin)},
                                  {"frame", frame}, {"history", a.history}, {"z_critical", a.zCritical},
                                  {"reference_mean", ref.mean}, {"reference_mean_stderr", ref.meanStderr},
+                                 {"particle_mean_floor", floorJson},
                                  {"settings", settingsToToml(scene)}, {"rows", table.json()}, {"reuse", reuse}});
     // Red bars: BIASED (|t| above its critical value); the title says what was measured.
     const std::size_t biased = table.csvColumn("biased"), loss = table.csvColumn("energy_loss_pct"),

@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <array>
 #include <map>
 
 #include <fstream>
@@ -466,4 +467,66 @@ TEST_CASE("bias over crops of the view: each pixel's figures are the whole frame
     CHECK(runCommand(common + crops + " --reference " + (dir / "a.exr").string() + " -o " + (dir / "bad").string(), out) == 1);
     CHECK_THAT(out, Contains("a.exr") && Contains("overlap"));
     CHECK_FALSE(std::filesystem::exists(dir / "bad.json"));
+}
+
+TEST_CASE("bias: relMSE's anatomy sums to it, and the floor of one value a particle is the reference's own", "[cli][experiments][anatomy]") {
+    const auto dir = accretion::test::scratchDir("bias_anatomy");
+    std::string out;
+    REQUIRE(runCommand(kBin + " render " + tinyScene() + " --quiet --estimator exact -o " + (dir / "exact.exr").string(), out) == 0);
+    const std::string cmd = kBin + " bias " + tinyScene() + " --quiet --reference " + (dir / "exact.exr").string() +
+                            " --frame 0 --estimators exact,uniform,particle_split --seeds 3 -o " + (dir / "b").string();
+    REQUIRE(runCommand(cmd, out) == 0);
+    INFO(cmd << "\n" << out);
+    const auto rows = readCsv(dir / "b.csv");
+    REQUIRE(rows.size() == 4);
+    const auto col = [&](const char* c) {
+        const auto i = std::find(rows[0].begin(), rows[0].end(), c);
+        REQUIRE(i != rows[0].end());
+        return std::size_t(i - rows[0].begin());
+    };
+    for (std::size_t r = 1; r < rows.size(); ++r) {
+        const double all = std::stod(rows[r][col("rel_mse")]), persistent = std::stod(rows[r][col("rel_mse_persistent")]),
+                     noise = std::stod(rows[r][col("rel_mse_noise")]);
+        INFO(rows[r][0]);
+        CHECK(persistent + noise == Approx(all).epsilon(1e-5).margin(1e-12));
+        if (rows[r][0] == "exact") {  // deterministic and the reference itself: neither part
+            CHECK(persistent == 0.0);
+            CHECK(noise == 0.0);
+        } else {
+            CHECK(noise > 0.0);
+        }
+    }
+    // The floor, recomputed here from the reference as OpenImageIO reads it.
+    auto in = OIIO::ImageInput::open((dir / "exact.exr").string());
+    REQUIRE(in);
+    const OIIO::ImageSpec& spec = in->spec();
+    const int lr = spec.channelindex("Lr.R"), id = spec.channelindex("particle.id");
+    REQUIRE((lr >= 0 && id >= 0));
+    const std::size_t pixels = std::size_t(spec.width) * spec.height;
+    std::vector<float> rgb(pixels * 3);
+    std::vector<std::uint32_t> ids(pixels);
+    REQUIRE(in->read_image(0, 0, lr, lr + 3, OIIO::TypeDesc::FLOAT, rgb.data()));
+    REQUIRE(in->read_image(0, 0, id, id + 1, OIIO::TypeDesc::UINT, ids.data()));
+    std::map<std::uint32_t, std::pair<std::array<double, 3>, int>> sums;
+    for (std::size_t p = 0; p < pixels; ++p) {
+        if (ids[p] == 0xffffffffu) continue;
+        auto& [s, n] = sums[ids[p]];
+        for (int c = 0; c < 3; ++c) s[c] += rgb[3 * p + c];
+        ++n;
+    }
+    double floor = 0.0;
+    for (std::size_t p = 0; p < pixels; ++p) {
+        if (ids[p] == 0xffffffffu) continue;
+        const auto& [s, n] = sums.at(ids[p]);
+        for (int c = 0; c < 3; ++c) {
+            const double r = rgb[3 * p + c], d = s[c] / n - r;
+            floor += d * d / (r * r + 1e-2);
+        }
+    }
+    floor /= 3.0 * double(pixels);
+    const nlohmann::json j = nlohmann::json::parse(readFile(dir / "b.json"));
+    CHECK(j.at("particle_mean_floor").at("rel_mse").get<double>() == Approx(floor).epsilon(1e-9));
+    CHECK(j.at("particle_mean_floor").at("particles").get<std::size_t>() == sums.size());
+    CHECK(floor > 0.0);
+    CHECK_THAT(out, Contains("relMSE floor"));
 }
