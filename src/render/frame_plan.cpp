@@ -172,7 +172,10 @@ void describe(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
                   : fmt::format("per texel: the near lights summed and {} far rays, each {} from the light tree, {}{}", ps.far,
                                 ps.candidates > 1 ? fmt::format("kept by RIS among {} draws", ps.candidates) : std::string("one draw"),
                                 plan.shadowRays ? "a shadow ray each" : "visibility off (V = 1)",
-                                ps.history > 0.0 ? fmt::format(", Lr averaged with last frame's (h = {})", ps.history) : ""));
+                                ps.history <= 0.0 ? std::string()
+                                : ps.history_of == HistoryOf::far
+                                    ? fmt::format(", the far mean averaged with last frame's (h = {}), the near sum this frame's", ps.history)
+                                    : fmt::format(", Lr averaged with last frame's (h = {})", ps.history)));
         step(Pass::shadeParticlePixels, dark ? noLight : "interpolate: bilinear over the pixel's particle's texels' Lr (biased)");
     } else if (estimatorInfo(est).passes == LightingPasses::voxelCache) {
         const VoxelSettings& v = s.voxel;

@@ -121,6 +121,8 @@ struct SplitLaunch {
     const std::uint32_t* prevSlotOf = nullptr;  ///< particle_split.history: last frame's slots
     std::uint32_t prevSlotCount = 0;            ///< particles prevSlotOf holds (0: no history)
     const Vec3* prevTexelLr = nullptr;
+    Vec3* texelFar = nullptr;                   ///< particle_split.history_of far: the texels' far means' average
+    const Vec3* prevTexelFar = nullptr;         ///< and last frame's
 };
 
 struct LaunchParams {

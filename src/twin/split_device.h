@@ -70,6 +70,8 @@ public:
     }
     __device__ Vec3 historyLr(std::size_t q) const { return s_.prevTexelLr[q]; }
     __device__ void writeTexelLr(std::size_t q, const Vec3& Lr) const { s_.texelLr[q] = Lr; }
+    __device__ Vec3 historyFar(std::size_t q) const { return s_.prevTexelFar[q]; }
+    __device__ void writeTexelFar(std::size_t q, const Vec3& far) const { s_.texelFar[q] = far; }
 
     // shadeParticlePixels
     __device__ GBufferTexel pixel(std::size_t px) const { return p_.gbuffer[px]; }

@@ -126,6 +126,7 @@ struct FrameBuffers {
     DeviceBuffer gridGbuffer, gridLr;  // restir.resolution_scale < 1 or particle_restir: the lighting grid
     DeviceBuffer gatherFlags, gatherIds, gatherSortedIds, gatherKeys, gatherSortedKeys, gatherCount, gatherTemp, slotOf;  // particle_restir
     DeviceBuffer prevSlotOf, prevTexelLr;
+    DeviceBuffer splitFar, prevSplitFar;  ///< particle_split.history_of far: the texels' far means' average, this frame's and last
     DeviceBuffer prevPosition, prevEmission, prevAlbedo, prevDmin2, prevGbuffer, prevReservoirs;
     DeviceBuffer aliasProb, aliasAlias, aliasPmf;  // power: the alias table
     DeviceBuffer treeNodes, treePaths;            // tree: the light tree's nodes; particle_split: each light's path
@@ -494,6 +495,11 @@ void TwinRun::runParticleSplit(LaunchParams& lp) {
     sl.prevSlotOf = buf_.prevSlotOf.as<std::uint32_t>();
     sl.prevSlotCount = splitHistory_ && sl.params.history > 0.0f ? prevCount_ : 0;
     sl.prevTexelLr = buf_.prevTexelLr.as<Vec3>();
+    if (sl.params.history > 0.0f && sl.params.historyOfFar) {
+        buf_.splitFar.reserve(grid * sizeof(Vec3));
+        sl.texelFar = buf_.splitFar.as<Vec3>();
+        sl.prevTexelFar = buf_.prevSplitFar.as<Vec3>();
+    }
     {
         GpuScope t(timer, Pass::findNearLights);
         findNearLights(lp, stream_);
@@ -522,6 +528,8 @@ void TwinRun::keepSplitHistory(std::size_t n) {
     if (s_.particle_split.history <= 0.0) return;
     copyDevice(buf_.prevSlotOf, buf_.slotOf, n * sizeof(std::uint32_t), stream_);
     copyDevice(buf_.prevTexelLr, buf_.gridLr, std::size_t(gridW_) * gridH_ * sizeof(Vec3), stream_);
+    if (s_.particle_split.history_of == HistoryOf::far)
+        copyDevice(buf_.prevSplitFar, buf_.splitFar, std::size_t(gridW_) * gridH_ * sizeof(Vec3), stream_);
     CUDA_CHECK(cudaStreamSynchronize(stream_));
     prevCount_ = static_cast<std::uint32_t>(n);
     splitHistory_ = true;

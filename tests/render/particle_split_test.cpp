@@ -530,3 +530,56 @@ TEST_CASE("particle_split: the ray threads' order visits every ray of every texe
         CHECK(std::count(seen.begin(), seen.end(), 1) == std::ptrdiff_t(seen.size()));
     }
 }
+
+TEST_CASE("particle_split: history_of far averages the far mean alone; the near sum is the frame's own", "[particle_split]") {
+    // Frames 0-5 of each configuration's sequence, the last one compared.
+    const auto lastFrame = [](const Settings& s, const ParticleSource& source) {
+        FrameRenderer renderer(s, source, RenderOptions{true});
+        FrameImage img;
+        for (std::uint32_t f = 0; f < 6; ++f) {
+            FrameStats st;
+            img = renderer.render(f, st);
+        }
+        return img;
+    };
+    SECTION("a static scene: the same light, so near + the far mean's average is the average of both, to rounding") {
+        // Lr_t = (1 - h) (N + F_t) + h Lr_t-1 with Lr_0 = N + F_0 is N + Fbar_t,
+        // Fbar_t = (1 - h) F_t + h Fbar_t-1, Fbar_0 = F_0: the same draws give the same image.
+        Settings s = splitSettings(ShadingModel::lambert, 400, 4, 2);
+        s.shading.visibility = true;
+        s.particles.gm = 0.0;
+        s.particle_split.history = 0.8;
+        s.render.frames = 6;
+        const ParticleSource source(s);
+        Settings far = s;
+        far.particle_split.history_of = HistoryOf::far;
+        const FrameImage a = lastFrame(s, source), b = lastFrame(far, source);
+        std::size_t lit = 0;
+        for (std::size_t px = 0; px < a.lighting.Lr.size(); ++px) {
+            if (a.particle[px] == kNoParticle) continue;
+            ++lit;
+            for (int c = 0; c < 3; ++c)
+                REQUIRE(b.lighting.Lr[px][c] == Approx(a.lighting.Lr[px][c]).epsilon(1e-5).margin(1e-9));
+        }
+        CHECK(lit > 500);
+    }
+    SECTION("a rotating disk, near lights only: history_of far is the frame without history, bit for bit; all lags") {
+        Settings s = splitSettings(ShadingModel::lambert, 400, 8, 0);
+        s.shading.visibility = true;
+        s.render.frames = 6;
+        const ParticleSource source(s);
+        Settings all = s, far = s;
+        all.particle_split.history = far.particle_split.history = 0.9;
+        far.particle_split.history_of = HistoryOf::far;
+        const FrameImage none = lastFrame(s, source), a = lastFrame(all, source), b = lastFrame(far, source);
+        std::size_t lit = 0, lagging = 0;
+        for (std::size_t px = 0; px < none.lighting.Lr.size(); ++px) {
+            if (none.particle[px] == kNoParticle) continue;
+            ++lit;
+            REQUIRE(b.lighting.Lr[px] == none.lighting.Lr[px]);
+            lagging += a.lighting.Lr[px] != none.lighting.Lr[px];
+        }
+        CHECK(lit > 500);
+        CHECK(lagging > lit / 2);
+    }
+}

@@ -43,6 +43,7 @@ private:
     ParticleSplitSettings ps_;
     std::vector<std::uint32_t> prevSlotOf_;  ///< last frame's slot of each particle (kNoSlot: not seen)
     std::vector<Vec3> prevTexelLr_;          ///< last frame's texels' Lr
+    std::vector<Vec3> prevTexelFar_;         ///< and their far means' average (history_of far)
 };
 
 }  // namespace accretion

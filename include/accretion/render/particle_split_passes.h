@@ -22,7 +22,9 @@
 // pdf, so the far sum is unbiased for the lights outside N, and the texel's
 // Lr is unbiased for the light at the texel. With particle_split.history h
 // a texel's Lr is (1 - h) x this frame's + h x its own last frame's (the
-// same texel of the same particle, by id). The pixels interpolate their
+// same texel of the same particle, by id); with particle_split.history_of
+// far only its far mean is so averaged (kept in a buffer of its own), and
+// the near sum is this frame's. The pixels interpolate their
 // particle's texels: biased by the light at the texels, not at the pixel.
 //
 // The bodies are the CPU's (src/render/particle_split/) and the twin's
@@ -43,6 +45,7 @@
 //                     bool shadows(); bool visible(sp, i, t)  a shadow ray (traced, counted)
 //                     void reject(q)          a far ray's non-finite value rejected (render.nonfinite)
 //                     bool historyTexelOf(j, sub, q); Vec3 historyLr(q); void writeTexelLr(q, Lr)
+//                     Vec3 historyFar(q); void writeTexelFar(q, far)  (history_of far)
 //   shadePixels:      GBufferTexel pixel(px); std::uint32_t slotOf(j); Vec2 pixelUv(g);
 //                     Vec3 texelLr(q); void writePixelLr(px, Lr)
 #include <cmath>
@@ -70,6 +73,7 @@ struct SplitParams {
     std::uint32_t candidates = 1;   ///< particle_split.candidates: C far draws resampled into each far shadow ray
     std::uint32_t side = 1;         ///< particle_split.texels: texels per billboard side
     float history = 0.0f;           ///< particle_split.history
+    bool historyOfFar = false;      ///< particle_split.history_of far: the history averages the far mean alone
     bool discardNonFinite = false;  ///< render.nonfinite discard: a non-finite far draw is not counted (else it counts as 0)
     std::uint32_t visible = 0;      ///< the frame's visible particles (slots)
     std::uint32_t frame = 0;
@@ -85,6 +89,7 @@ inline SplitParams splitParams(const Settings& s, std::uint32_t visible, std::ui
     p.candidates = s.particle_split.candidates;
     p.side = s.particle_split.texels;
     p.history = float(s.particle_split.history);
+    p.historyOfFar = s.particle_split.history_of == HistoryOf::far;
     p.discardNonFinite = s.render.nonfinite == NonFinitePolicy::discard;
     p.visible = visible;
     p.frame = frame;
@@ -344,6 +349,7 @@ ACC_HD_BODY void sumSplitTexel(B& b, std::size_t q) {
     const GBufferTexel g = b.texel(q);
     if (!g.hit()) {
         b.writeTexelLr(q, Vec3(0.0f));
+        if (p.history > 0.0f && p.historyOfFar) b.writeTexelFar(q, Vec3(0.0f));
         return;
     }
     Vec3 Lr(0.0f), far(0.0f);
@@ -357,9 +363,17 @@ ACC_HD_BODY void sumSplitTexel(B& b, std::size_t q) {
         }
         far += ray.value;
     }
-    if (counted > 0) Lr += far / float(counted);
     const std::uint32_t per = p.texelsPerParticle();
     std::size_t h = 0;
+    if (p.history > 0.0f && p.historyOfFar) {
+        Vec3 farMean = counted > 0 ? far / float(counted) : Vec3(0.0f);
+        if (b.historyTexelOf(g.particle, std::uint32_t(q % per), h))
+            farMean = (1.0f - p.history) * farMean + p.history * b.historyFar(h);
+        b.writeTexelFar(q, farMean);
+        b.writeTexelLr(q, Lr + farMean);
+        return;
+    }
+    if (counted > 0) Lr += far / float(counted);
     if (p.history > 0.0f && b.historyTexelOf(g.particle, std::uint32_t(q % per), h))
         Lr = (1.0f - p.history) * Lr + p.history * b.historyLr(h);
     b.writeTexelLr(q, Lr);

@@ -34,6 +34,8 @@ struct CpuFrame {
     const std::vector<std::uint32_t>& prevSlotOf;  ///< history: last frame's slots (empty: none)
     const std::vector<Vec3>& prevTexelLr;
     std::vector<Vec3>& texelLr;
+    const std::vector<Vec3>& prevTexelFar;         ///< history_of far: last frame's far means' average (else empty)
+    std::vector<Vec3>& texelFar;
     std::vector<std::uint32_t>& texelRejected;     ///< non-finite far draws per texel
     std::vector<Vec3>& Lr;                         ///< the pixels'
 };
@@ -135,6 +137,14 @@ public:
     void writeTexelLr(std::size_t q, const Vec3& Lr) {
         rec_.write(gpu_layout::kRadiance);
         f_.texelLr[q] = Lr;
+    }
+    Vec3 historyFar(std::size_t q) {
+        rec_.read(gpu_layout::kRadiance);
+        return f_.prevTexelFar[q];
+    }
+    void writeTexelFar(std::size_t q, const Vec3& far) {
+        rec_.write(gpu_layout::kRadiance);
+        f_.texelFar[q] = far;
     }
 
     // shadeParticlePixels
