@@ -406,7 +406,7 @@ ACC_HD void voxelCase(int k, const PassInputs* variants, const voxel::VoxelParam
 // RIS among 4 with a history (even particles: a fixed last Lr).
 // Visibility is a fixed function of (point, light).
 
-constexpr int kSplitVariants = 3;
+constexpr int kSplitVariants = 4;
 constexpr int kSplitCases = (1 + kSplitVariants) * int(kGridW * kGridH);
 
 struct SplitCheckBridge {
@@ -460,7 +460,18 @@ struct SplitCheckBridge {
         return j % 2u == 0u;
     }
     ACC_HD Vec3 historyLr(std::size_t q) const { return Vec3(0.1f * float(q % 7u), 0.2f, 0.05f * float(q % 3u)); }
-    ACC_HD void writeTexelLr(std::size_t, const Vec3& Lr) const { o = Out{{bits(Lr.x), bits(Lr.y), bits(Lr.z), 5u, 0u, 0u, 0u, 0u}}; }
+    ACC_HD void writeTexelLr(std::size_t, const Vec3& Lr) const {
+        o.w[0] = bits(Lr.x);
+        o.w[1] = bits(Lr.y);
+        o.w[2] = bits(Lr.z);
+        o.w[3] = 5u;
+    }
+    ACC_HD Vec3 historyFar(std::size_t q) const { return Vec3(0.03f * float(q % 5u), 0.07f, 0.02f * float(q % 4u)); }
+    ACC_HD void writeTexelFar(std::size_t, const Vec3& far) const {
+        o.w[5] = bits(far.x);
+        o.w[6] = bits(far.y);
+        o.w[7] = bits(far.z);
+    }
 };
 
 ACC_HD void splitCase(int k, const PassInputs* variants, const LightTreeView* tree, const std::uint64_t* paths,
@@ -486,7 +497,7 @@ struct Inputs {
     voxel::VoxelParams* voxel;  ///< l1, camera
     LightTreeView* tree;        ///< the light tree over the passes' lights
     std::uint64_t* paths;       ///< its lights' paths
-    psplit::SplitParams* split; ///< the near search; the three texel variants
+    psplit::SplitParams* split; ///< the near search; the four texel variants
 };
 
 enum class Step { neighbours, reprojections, caps, candidates, combines, shades, passes, loops, voxels, splits, texelPoints };
@@ -688,7 +699,7 @@ int main() {
         v.facesPlane = false;
     }
     // particle_split: the light tree over the passes' lights (lambert), one
-    // texel a particle; the near search's and the three texel variants' settings.
+    // texel a particle; the near search's and the four texel variants' settings.
     Particles lights;
     lights.position = centres;
     lights.emission = emission;
@@ -704,8 +715,9 @@ int main() {
         psplit::SplitParams& s = splits[v];
         s.nearCount = v <= 1 ? 16 : 8;
         s.farSamples = v <= 1 ? 0 : 4;
-        s.candidates = v == 3 ? 4 : 1;
-        s.history = v == 3 ? 0.6f : 0.0f;
+        s.candidates = v >= 3 ? 4 : 1;
+        s.history = v >= 3 ? 0.6f : 0.0f;
+        s.historyOfFar = v == 4;  // the far mean's history alone
         s.visible = texels;
         s.frame = 3;
         s.seed = 21;
