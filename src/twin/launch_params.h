@@ -123,6 +123,8 @@ struct SplitLaunch {
     const Vec3* prevTexelLr = nullptr;
     Vec3* texelFar = nullptr;                   ///< particle_split.history_of far: the texels' far means' average
     const Vec3* prevTexelFar = nullptr;         ///< and last frame's
+    std::uint32_t* texelAge = nullptr;          ///< particle_split.history_start mean: the frames each texel has been seen
+    const std::uint32_t* prevTexelAge = nullptr;  ///< and last frame's
 };
 
 struct LaunchParams {

@@ -72,6 +72,8 @@ public:
     __device__ void writeTexelLr(std::size_t q, const Vec3& Lr) const { s_.texelLr[q] = Lr; }
     __device__ Vec3 historyFar(std::size_t q) const { return s_.prevTexelFar[q]; }
     __device__ void writeTexelFar(std::size_t q, const Vec3& far) const { s_.texelFar[q] = far; }
+    __device__ std::uint32_t historyAge(std::size_t q) const { return s_.prevTexelAge[q]; }
+    __device__ void writeTexelAge(std::size_t q, std::uint32_t n) const { s_.texelAge[q] = n; }
 
     // shadeParticlePixels
     __device__ GBufferTexel pixel(std::size_t px) const { return p_.gbuffer[px]; }

@@ -127,6 +127,7 @@ struct FrameBuffers {
     DeviceBuffer gatherFlags, gatherIds, gatherSortedIds, gatherKeys, gatherSortedKeys, gatherCount, gatherTemp, slotOf;  // particle_restir
     DeviceBuffer prevSlotOf, prevTexelLr;
     DeviceBuffer splitFar, prevSplitFar;  ///< particle_split.history_of far: the texels' far means' average, this frame's and last
+    DeviceBuffer splitAge, prevSplitAge;  ///< particle_split.history_start mean: the frames each texel has been seen
     DeviceBuffer prevPosition, prevEmission, prevAlbedo, prevDmin2, prevGbuffer, prevReservoirs;
     DeviceBuffer aliasProb, aliasAlias, aliasPmf;  // power: the alias table
     DeviceBuffer treeNodes, treePaths;            // tree: the light tree's nodes; particle_split: each light's path
@@ -500,6 +501,11 @@ void TwinRun::runParticleSplit(LaunchParams& lp) {
         sl.texelFar = buf_.splitFar.as<Vec3>();
         sl.prevTexelFar = buf_.prevSplitFar.as<Vec3>();
     }
+    if (sl.params.history > 0.0f && sl.params.historyMean) {
+        buf_.splitAge.reserve(grid * sizeof(std::uint32_t));
+        sl.texelAge = buf_.splitAge.as<std::uint32_t>();
+        sl.prevTexelAge = buf_.prevSplitAge.as<std::uint32_t>();
+    }
     {
         GpuScope t(timer, Pass::findNearLights);
         findNearLights(lp, stream_);
@@ -530,6 +536,8 @@ void TwinRun::keepSplitHistory(std::size_t n) {
     copyDevice(buf_.prevTexelLr, buf_.gridLr, std::size_t(gridW_) * gridH_ * sizeof(Vec3), stream_);
     if (s_.particle_split.history_of == HistoryOf::far)
         copyDevice(buf_.prevSplitFar, buf_.splitFar, std::size_t(gridW_) * gridH_ * sizeof(Vec3), stream_);
+    if (s_.particle_split.history_start == HistoryStart::mean)
+        copyDevice(buf_.prevSplitAge, buf_.splitAge, std::size_t(gridW_) * gridH_ * sizeof(std::uint32_t), stream_);
     CUDA_CHECK(cudaStreamSynchronize(stream_));
     prevCount_ = static_cast<std::uint32_t>(n);
     splitHistory_ = true;

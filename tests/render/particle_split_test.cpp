@@ -583,3 +583,50 @@ TEST_CASE("particle_split: history_of far averages the far mean alone; the near 
         CHECK(lagging > lit / 2);
     }
 }
+
+TEST_CASE("particle_split: history_start mean is the running mean of a texel's frames, then the exponential average",
+          "[particle_split]") {
+    // A static scene: every frame's texel is a fresh estimate x_f of one
+    // light (the frame's own draws, as a render without history makes
+    // them). With h = 0.9 four frames are their mean (x0 + x1 + x2 + x3) / 4;
+    // with h = 0.5 the running mean stops at two frames, 1/n = 1 - h, and the
+    // exponential average goes on: ((x0 + x1) / 2 / 2 + x2 / 2) / 2 + x3 / 2.
+    // So with history_of all and far alike (the near sum is the same light).
+    Settings s = splitSettings(ShadingModel::lambert, 400, 4, 2);
+    s.shading.visibility = true;
+    s.particles.gm = 0.0;
+    s.render.frames = 4;
+    const ParticleSource source(s);
+    const auto frames = [&](const Settings& settings) {
+        FrameRenderer renderer(settings, source, RenderOptions{true});
+        std::vector<FrameImage> out;
+        for (std::uint32_t f = 0; f < 4; ++f) {
+            FrameStats st;
+            out.push_back(renderer.render(f, st));
+        }
+        return out;
+    };
+    const std::vector<FrameImage> fresh = frames(s);
+    for (const HistoryOf of : {HistoryOf::all, HistoryOf::far})
+        for (const double h : {0.9, 0.5}) {
+            INFO("history_of " << enumName(of) << ", h = " << h);
+            Settings m = s;
+            m.particle_split.history = h;
+            m.particle_split.history_of = of;
+            m.particle_split.history_start = HistoryStart::mean;
+            const FrameImage last = frames(m).back();
+            std::size_t lit = 0;
+            for (std::size_t px = 0; px < last.lighting.Lr.size(); ++px) {
+                if (last.particle[px] == kNoParticle) continue;
+                ++lit;
+                for (int c = 0; c < 3; ++c) {
+                    double x[4];
+                    for (int f = 0; f < 4; ++f) x[f] = fresh[f].lighting.Lr[px][c];
+                    const double expected = h == 0.9 ? (x[0] + x[1] + x[2] + x[3]) / 4.0
+                                                     : 0.5 * (0.5 * (x[0] + x[1]) / 2.0 + 0.5 * x[2]) + 0.5 * x[3];
+                    REQUIRE(double(last.lighting.Lr[px][c]) == Approx(expected).epsilon(1e-5).margin(1e-9));
+                }
+            }
+            CHECK(lit > 500);
+        }
+}

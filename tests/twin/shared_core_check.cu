@@ -406,7 +406,7 @@ ACC_HD void voxelCase(int k, const PassInputs* variants, const voxel::VoxelParam
 // RIS among 4 with a history (even particles: a fixed last Lr).
 // Visibility is a fixed function of (point, light).
 
-constexpr int kSplitVariants = 4;
+constexpr int kSplitVariants = 6;
 constexpr int kSplitCases = (1 + kSplitVariants) * int(kGridW * kGridH);
 
 struct SplitCheckBridge {
@@ -467,6 +467,8 @@ struct SplitCheckBridge {
         o.w[3] = 5u;
     }
     ACC_HD Vec3 historyFar(std::size_t q) const { return Vec3(0.03f * float(q % 5u), 0.07f, 0.02f * float(q % 4u)); }
+    ACC_HD std::uint32_t historyAge(std::size_t q) const { return q % 4u; }
+    ACC_HD void writeTexelAge(std::size_t, std::uint32_t n) const { o.w[4] = n; }
     ACC_HD void writeTexelFar(std::size_t, const Vec3& far) const {
         o.w[5] = bits(far.x);
         o.w[6] = bits(far.y);
@@ -497,7 +499,7 @@ struct Inputs {
     voxel::VoxelParams* voxel;  ///< l1, camera
     LightTreeView* tree;        ///< the light tree over the passes' lights
     std::uint64_t* paths;       ///< its lights' paths
-    psplit::SplitParams* split; ///< the near search; the four texel variants
+    psplit::SplitParams* split; ///< the near search; the six texel variants
 };
 
 enum class Step { neighbours, reprojections, caps, candidates, combines, shades, passes, loops, voxels, splits, texelPoints };
@@ -699,7 +701,7 @@ int main() {
         v.facesPlane = false;
     }
     // particle_split: the light tree over the passes' lights (lambert), one
-    // texel a particle; the near search's and the four texel variants' settings.
+    // texel a particle; the near search's and the six texel variants' settings.
     Particles lights;
     lights.position = centres;
     lights.emission = emission;
@@ -717,7 +719,8 @@ int main() {
         s.farSamples = v <= 1 ? 0 : 4;
         s.candidates = v >= 3 ? 4 : 1;
         s.history = v >= 3 ? 0.6f : 0.0f;
-        s.historyOfFar = v == 4;  // the far mean's history alone
+        s.historyOfFar = v == 4 || v == 6;  // the far mean's history alone
+        s.historyMean = v >= 5;             // a running mean over the texel's age first
         s.visible = texels;
         s.frame = 3;
         s.seed = 21;

@@ -44,6 +44,7 @@ private:
     std::vector<std::uint32_t> prevSlotOf_;  ///< last frame's slot of each particle (kNoSlot: not seen)
     std::vector<Vec3> prevTexelLr_;          ///< last frame's texels' Lr
     std::vector<Vec3> prevTexelFar_;         ///< and their far means' average (history_of far)
+    std::vector<std::uint32_t> prevTexelAge_;  ///< and the frames each has been seen (history_start mean)
 };
 
 }  // namespace accretion

@@ -24,7 +24,10 @@
 // a texel's Lr is (1 - h) x this frame's + h x its own last frame's (the
 // same texel of the same particle, by id); with particle_split.history_of
 // far only its far mean is so averaged (kept in a buffer of its own), and
-// the near sum is this frame's. The pixels interpolate their
+// the near sum is this frame's; with particle_split.history_start mean the
+// weight of this frame's is max(1 - h, 1/n), n the frames the texel has
+// been seen (its age, kept beside it): a running mean, then the
+// exponential average. The pixels interpolate their
 // particle's texels: biased by the light at the texels, not at the pixel.
 //
 // The bodies are the CPU's (src/render/particle_split/) and the twin's
@@ -46,6 +49,7 @@
 //                     void reject(q)          a far ray's non-finite value rejected (render.nonfinite)
 //                     bool historyTexelOf(j, sub, q); Vec3 historyLr(q); void writeTexelLr(q, Lr)
 //                     Vec3 historyFar(q); void writeTexelFar(q, far)  (history_of far)
+//                     std::uint32_t historyAge(q); void writeTexelAge(q, n)  (history_start mean)
 //   shadePixels:      GBufferTexel pixel(px); std::uint32_t slotOf(j); Vec2 pixelUv(g);
 //                     Vec3 texelLr(q); void writePixelLr(px, Lr)
 #include <cmath>
@@ -74,6 +78,7 @@ struct SplitParams {
     std::uint32_t side = 1;         ///< particle_split.texels: texels per billboard side
     float history = 0.0f;           ///< particle_split.history
     bool historyOfFar = false;      ///< particle_split.history_of far: the history averages the far mean alone
+    bool historyMean = false;       ///< particle_split.history_start mean: a running mean over the texel's age first
     bool discardNonFinite = false;  ///< render.nonfinite discard: a non-finite far draw is not counted (else it counts as 0)
     std::uint32_t visible = 0;      ///< the frame's visible particles (slots)
     std::uint32_t frame = 0;
@@ -90,6 +95,7 @@ inline SplitParams splitParams(const Settings& s, std::uint32_t visible, std::ui
     p.side = s.particle_split.texels;
     p.history = float(s.particle_split.history);
     p.historyOfFar = s.particle_split.history_of == HistoryOf::far;
+    p.historyMean = s.particle_split.history_start == HistoryStart::mean;
     p.discardNonFinite = s.render.nonfinite == NonFinitePolicy::discard;
     p.visible = visible;
     p.frame = frame;
@@ -340,6 +346,10 @@ ACC_HD_BODY SplitRay traceSplitRay(B& b, std::size_t q, std::uint32_t r) {
     return out;
 }
 
+/// A texel's age this frame from last frame's (history_start mean): one
+/// more, held at 2^20 (past any 1 / (1 - h) the settings allow).
+ACC_HD inline std::uint32_t historyAgeAfter(std::uint32_t last) { return last < (1u << 20) ? last + 1u : last; }
+
 /// shadeSplitTexels at texel q: its rays (b.splitRay: traceSplitRay's)
 /// summed in order, the near ones as they are and the far ones' mean, and
 /// with history the texel's last Lr.
@@ -347,9 +357,11 @@ template <class B>
 ACC_HD_BODY void sumSplitTexel(B& b, std::size_t q) {
     const SplitParams& p = b.params();
     const GBufferTexel g = b.texel(q);
+    const bool history = p.history > 0.0f;
     if (!g.hit()) {
         b.writeTexelLr(q, Vec3(0.0f));
-        if (p.history > 0.0f && p.historyOfFar) b.writeTexelFar(q, Vec3(0.0f));
+        if (history && p.historyOfFar) b.writeTexelFar(q, Vec3(0.0f));
+        if (history && p.historyMean) b.writeTexelAge(q, 0);
         return;
     }
     Vec3 Lr(0.0f), far(0.0f);
@@ -363,19 +375,24 @@ ACC_HD_BODY void sumSplitTexel(B& b, std::size_t q) {
         }
         far += ray.value;
     }
-    const std::uint32_t per = p.texelsPerParticle();
+    // The history: last frame's texel of the same particle, and the weight it keeps.
     std::size_t h = 0;
-    if (p.history > 0.0f && p.historyOfFar) {
+    const bool seen = history && b.historyTexelOf(g.particle, std::uint32_t(q % p.texelsPerParticle()), h);
+    float keep = p.history;
+    if (history && p.historyMean) {
+        const std::uint32_t age = seen ? historyAgeAfter(b.historyAge(h)) : 1u;
+        keep = fminf(p.history, 1.0f - 1.0f / float(age));
+        b.writeTexelAge(q, age);
+    }
+    if (history && p.historyOfFar) {
         Vec3 farMean = counted > 0 ? far / float(counted) : Vec3(0.0f);
-        if (b.historyTexelOf(g.particle, std::uint32_t(q % per), h))
-            farMean = (1.0f - p.history) * farMean + p.history * b.historyFar(h);
+        if (seen) farMean = (1.0f - keep) * farMean + keep * b.historyFar(h);
         b.writeTexelFar(q, farMean);
         b.writeTexelLr(q, Lr + farMean);
         return;
     }
     if (counted > 0) Lr += far / float(counted);
-    if (p.history > 0.0f && b.historyTexelOf(g.particle, std::uint32_t(q % per), h))
-        Lr = (1.0f - p.history) * Lr + p.history * b.historyLr(h);
+    if (seen) Lr = (1.0f - keep) * Lr + keep * b.historyLr(h);
     b.writeTexelLr(q, Lr);
 }
 

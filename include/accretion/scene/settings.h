@@ -46,6 +46,8 @@ enum class PixelShading { interpolate, resample };
 enum class TexelPoint { centre, jittered, antithetic };
 /// particle_split.history_of: which of a texel's terms its history averages.
 enum class HistoryOf { all, far };
+/// particle_split.history_start: how a texel's average starts.
+enum class HistoryStart { first, mean };
 enum class VoxelBasis { l1, camera };
 enum class BiasCorrection { none, basic, pairwise };
 enum class ReservoirLayout { full, packed };
@@ -71,6 +73,7 @@ ACC_ENUM_NAMES(EstimatorKind, "exact", "uniform", "power", "ris", "restir", "tre
 ACC_ENUM_NAMES(PixelShading, "interpolate", "resample");
 ACC_ENUM_NAMES(TexelPoint, "centre", "jittered", "antithetic");
 ACC_ENUM_NAMES(HistoryOf, "all", "far");
+ACC_ENUM_NAMES(HistoryStart, "first", "mean");
 ACC_ENUM_NAMES(VoxelBasis, "l1", "camera");
 ACC_ENUM_NAMES(BiasCorrection, "none", "basic", "pairwise");
 ACC_ENUM_NAMES(ReservoirLayout, "full", "packed");
@@ -379,6 +382,7 @@ struct ParticleSplitSettings {
     double history = 0.0;          ///< weight of a texel's last Lr in its new one
     TexelPoint texel_point = TexelPoint::centre;  ///< where a texel's receiver lies on its billboard each frame
     HistoryOf history_of = HistoryOf::all;        ///< the terms the history averages
+    HistoryStart history_start = HistoryStart::first;  ///< a new texel's average: from its first frame, or a running mean
     template <class V> void visit(V& v) {
         v.field("near", near, "particle_split: the lights nearest each visible particle's centre (on the light tree, no rays), summed exactly at each of its texels with a shadow ray each", Range{0, 64});
         v.field("far", far, "particle_split: lights drawn per texel and frame from the light tree at the texel, the near lights' ball taken out, one shadow ray each", Range{0, 1024});
@@ -387,6 +391,7 @@ struct ParticleSplitSettings {
         v.field("history", history, "particle_split: a texel's Lr is (1 - h) x this frame's + h x its own last frame's, found by particle id (an exponential average: biased where the light changes)", Range{0.0, 0.99});
         v.field("texel_point", texel_point, "particle_split: centre (a texel's receiver is its centre every frame), jittered (a point drawn afresh each frame, uniform in the texel's square of the billboard and inside the disc with alpha disc: with history the texel averages the light over the area its pixels see, not the light at its centre) or antithetic (such a point in even frames, its mirror about the texel's centre in the next: the pairs cancel the light's linear change across the texel)");
         v.field("history_of", history_of, "particle_split: all (the history averages the texel's whole Lr) or far (only the far lights' mean: the near sum, exact at the texel's point, is this frame's, so a long history lags the near light no more)");
+        v.field("history_start", history_start, "particle_split: first (a texel's average starts at its first frame's value, which then weighs h^n after n frames) or mean (the mean of the n frames it has been seen until 1/n falls to 1 - h, then the exponential average: a particle that has just come into view is averaged as well as its frames allow)");
     }
 };
 

@@ -36,6 +36,8 @@ struct CpuFrame {
     std::vector<Vec3>& texelLr;
     const std::vector<Vec3>& prevTexelFar;         ///< history_of far: last frame's far means' average (else empty)
     std::vector<Vec3>& texelFar;
+    const std::vector<std::uint32_t>& prevTexelAge;  ///< history_start mean: last frame's texels' ages (else empty)
+    std::vector<std::uint32_t>& texelAge;
     std::vector<std::uint32_t>& texelRejected;     ///< non-finite far draws per texel
     std::vector<Vec3>& Lr;                         ///< the pixels'
 };
@@ -145,6 +147,14 @@ public:
     void writeTexelFar(std::size_t q, const Vec3& far) {
         rec_.write(gpu_layout::kRadiance);
         f_.texelFar[q] = far;
+    }
+    std::uint32_t historyAge(std::size_t q) {
+        rec_.read(4);
+        return f_.prevTexelAge[q];
+    }
+    void writeTexelAge(std::size_t q, std::uint32_t n) {
+        rec_.write(4);
+        f_.texelAge[q] = n;
     }
 
     // shadeParticlePixels

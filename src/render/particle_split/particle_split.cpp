@@ -31,11 +31,12 @@ LightingCounters ParticleSplit::render(const ParticleSplitInputs& in, LightingIm
     std::vector<float> nearRadius2(texels.visible());
     std::vector<Vec3> texelLr(texels.grid.texels.size());
     std::vector<Vec3> texelFar(params.history > 0.0f && params.historyOfFar ? texels.grid.texels.size() : 0);
+    std::vector<std::uint32_t> texelAge(params.history > 0.0f && params.historyMean ? texels.grid.texels.size() : 0);
     std::vector<std::uint32_t> texelRejected(texels.grid.texels.size(), 0);
     const std::vector<std::uint64_t> paths = in.lightTree.paths();
     // Last frame's texels: kept only with a history, so empty without one.
     const psplit::CpuFrame f{in, params, L, in.lightTree.view(), paths, VisibilityOptions::from(in.settings.render), plan.shadowRays,
-                             texels, near, nearFound, nearRadius2, prevSlotOf_, prevTexelLr_, texelLr, prevTexelFar_, texelFar, texelRejected, out.Lr};
+                             texels, near, nearFound, nearRadius2, prevSlotOf_, prevTexelLr_, texelLr, prevTexelFar_, texelFar, prevTexelAge_, texelAge, texelRejected, out.Lr};
     LightingCounters counters;
     {
         auto t = timer.scope(Pass::findNearLights);
@@ -64,6 +65,7 @@ LightingCounters ParticleSplit::render(const ParticleSplitInputs& in, LightingIm
         prevSlotOf_ = std::move(texels.slotOf);
         prevTexelLr_ = std::move(texelLr);
         prevTexelFar_ = std::move(texelFar);
+        prevTexelAge_ = std::move(texelAge);
     }
     return counters;
 }
