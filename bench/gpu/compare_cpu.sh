@@ -111,6 +111,11 @@ design_case particle_split ps_jit_c4_h5 -D particle_split.texel_point=jittered -
 design_case particle_split ps_2x2_jit_disc_h5 -D particle_split.texel_point=jittered -D particle_split.texels=2 -D particle_split.history=0.5 "${disc[@]}"
 design_case particle_split ps_2x2_anti_disc_h5 -D particle_split.texel_point=antithetic -D particle_split.texels=2 -D particle_split.history=0.5 "${disc[@]}"
 
+# particle_split.history_start mean and history_of far (run.sh history_start).
+design_case particle_split ps_mean_c4_h9 -D particle_split.history_start=mean -D particle_split.candidates=4 -D particle_split.history=0.9
+design_case particle_split ps_mean_far_c4_h5 -D particle_split.history_start=mean -D particle_split.history_of=far -D particle_split.candidates=4 -D particle_split.history=0.5
+design_case particle_split ps_2x2_far_anti_disc_h5 -D particle_split.history_of=far -D particle_split.texels=2 -D particle_split.texel_point=antithetic -D particle_split.history=0.5 "${disc[@]}"
+
 # uniform and power (one frame): Lr, its standard error and the samples taken.
 declare -A sampled=(
     [power]="-D render.estimator=power -D render.samples=16"
