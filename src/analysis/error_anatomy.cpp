@@ -9,25 +9,36 @@
 
 namespace accretion {
 
-ErrorAnatomy splitRelMse(const std::vector<DVec3>& sum, const std::vector<DVec3>& sumSq, double seeds,
-                         const std::vector<Vec3>& ref, const std::vector<Vec3>& refStderr, double eps) {
-    ACC_CHECK(seeds >= 2.0 && sum.size() == ref.size() && sumSq.size() == ref.size());
+std::vector<ErrorAnatomy> splitRelMseByGroup(const std::vector<DVec3>& sum, const std::vector<DVec3>& sumSq, double seeds,
+                                             const std::vector<Vec3>& ref, const std::vector<Vec3>& refStderr, double eps,
+                                             const std::vector<std::uint32_t>& group, std::uint32_t groups) {
+    ACC_CHECK(seeds >= 2.0 && sum.size() == ref.size() && sumSq.size() == ref.size() && group.size() == ref.size());
     ACC_CHECK(refStderr.empty() || refStderr.size() == ref.size());
-    ErrorAnatomy a;
+    std::vector<ErrorAnatomy> a(groups);
     if (ref.empty()) return a;
-    for (std::size_t p = 0; p < ref.size(); ++p)
+    for (std::size_t p = 0; p < ref.size(); ++p) {
+        ACC_CHECK(group[p] < groups);
+        ErrorAnatomy& g = a[group[p]];
         for (int c = 0; c < 3; ++c) {
             const double w = 1.0 / (double(ref[p][c]) * ref[p][c] + eps);
             const double m = sum[p][c] / seeds;
             const double v = std::max(0.0, (sumSq[p][c] / seeds - m * m) * seeds / (seeds - 1.0));
             const double s = refStderr.empty() ? 0.0 : double(refStderr[p][c]);
-            a.noise += v * w;
-            a.persistent += (m * m - v / seeds - s * s) * w;
+            g.noise += v * w;
+            g.persistent += (m * m - v / seeds - s * s) * w;
         }
+    }
     const double n = 3.0 * double(ref.size());
-    a.noise /= n;
-    a.persistent /= n;
+    for (ErrorAnatomy& g : a) {
+        g.noise /= n;
+        g.persistent /= n;
+    }
     return a;
+}
+
+ErrorAnatomy splitRelMse(const std::vector<DVec3>& sum, const std::vector<DVec3>& sumSq, double seeds,
+                         const std::vector<Vec3>& ref, const std::vector<Vec3>& refStderr, double eps) {
+    return splitRelMseByGroup(sum, sumSq, seeds, ref, refStderr, eps, std::vector<std::uint32_t>(ref.size(), 0u), 1)[0];
 }
 
 ParticleMeanFloor particleMeanFloor(const std::vector<Vec3>& ref, const std::vector<std::uint32_t>& ids,

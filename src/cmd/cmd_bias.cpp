@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <unordered_set>
+#include <bit>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -30,6 +32,7 @@
 #include "accretion/io/plot.h"
 #include "accretion/io/report_table.h"
 #include "accretion/io/stats_writer.h"
+#include "accretion/render/frame_renderer.h"
 #include "accretion/render/pixel_window.h"
 #include "accretion/scene/estimator_table.h"
 #include "accretion/scene/scene_parser.h"
@@ -48,6 +51,7 @@ struct BiasArgs : ExperimentArgs {
     bool strict = false;      ///< a view check that cannot be performed is an error
     std::vector<std::string> unshadowedReferences;  ///< the view with shading.visibility = false: the error without visibility
     std::uint32_t cropMargin = 32;  ///< restir on a cropped reference: the pixels around each crop it renders for its reuse
+    std::uint32_t ageFrames = 0;    ///< --age-frames: the error by the frames each pixel's particle has been in view, up to this many before
 };
 
 struct BiasRow {
@@ -66,6 +70,7 @@ struct BiasRow {
     double relMse = 0.0;       ///< mean over seeds of one render's relMSE, less the reference's own noise
     double relMseStderr = NAN; ///< its standard error, from the seeds' spread (NaN for one seed)
     ErrorAnatomy anatomy;      ///< relMse as the per-pixel bias the seeds share and the noise they do not
+    std::vector<ErrorAnatomy> byAge;  ///< --age-frames: the same by ParticleAges' groups
     bool biased = false;
     double detectablePct = 0.0;  ///< the smallest |energy bias| (%) this run detects with 80% probability
     PassReuse reuse;             ///< restir: the measured frames' reuse offers by outcome, summed over the seeds
@@ -276,9 +281,67 @@ std::uint32_t seedsPerBatch(const BiasArgs& a, const BiasReference& ref) {
     return static_cast<std::uint32_t>(std::clamp(std::floor(kLanePixels / std::max(perSeed, 1.0)), 1.0, double(a.seeds)));
 }
 
+/// --age-frames N: each measured pixel's group by its particle's age, the
+/// frames it has been in view (anywhere in the whole frame, this one
+/// included: a texel history by particle id has as many): 1, 2-3, 4-7, ...
+/// up to N, then "more than N" (in view in each of the N frames before);
+/// pixels that see no particle apart. Texel designs' noise is largest in
+/// particles new to the view, whose history is short.
+struct ParticleAges {
+    std::vector<std::string> labels;   ///< per group
+    std::vector<std::uint32_t> group;  ///< per measured pixel (as ref.rgb)
+    std::vector<std::size_t> pixels;   ///< per group
+    std::uint32_t groups() const { return std::uint32_t(labels.size()); }
+};
+
+ParticleAges particleAges(const Settings& scene, const ParticleSource& source, std::uint32_t frame, std::uint32_t n,
+                          const BiasReference& ref, bool quiet) {
+    // The frames' views alone: one cheap light sample a pixel, no shadow rays; only the particle ids are read.
+    Settings s = scene;
+    s.render.estimator = EstimatorKind::uniform;
+    s.render.samples = 1;
+    s.render.crop = {};
+    s.shading.visibility = false;
+    FrameRenderer renderer(s, source, RenderOptions{true});
+    std::vector<std::unordered_set<std::uint32_t>> seen;  // frames frame - n .. frame - 1
+    std::vector<std::uint32_t> now;
+    Progress progress("bias --age-frames (the particles in view)", n + 1, quiet);
+    for (std::uint32_t f = frame - n; f <= frame; ++f) {
+        FrameStats stats;
+        FrameImage img = renderer.render(f, stats);
+        if (f < frame) seen.emplace_back(img.particle.begin(), img.particle.end());
+        else now = std::move(img.particle);
+        progress.advance(1);
+    }
+    progress.finish();
+    ParticleAges ages;
+    ages.labels = {"no particle"};
+    for (std::uint32_t lo = 1; lo <= n; lo *= 2)
+        ages.labels.push_back(lo == std::min(2 * lo - 1, n) ? std::to_string(lo) : fmt::format("{}-{}", lo, std::min(2 * lo - 1, n)));
+    ages.labels.push_back(fmt::format("more than {}", n));
+    auto groupOf = [&](std::uint32_t age) -> std::uint32_t {
+        if (age == 0) return 0;
+        if (age > n) return ages.groups() - 1;
+        return 1 + std::uint32_t(std::bit_width(age) - 1);
+    };
+    ages.pixels.assign(ages.groups(), 0);
+    for (const PixelWindow& w : ref.crops)
+        for (std::uint32_t y = w.y0; y < w.y1; ++y)
+            for (std::uint32_t x = w.x0; x < w.x1; ++x) {
+                const std::uint32_t id = now[std::size_t(y) * ref.width + x];
+                std::uint32_t age = 0;
+                if (id != kNoParticle)
+                    for (age = 1; age <= n && seen[n - age].count(id); ++age) {}
+                ages.group.push_back(groupOf(age));
+                ++ages.pixels[ages.group.back()];
+            }
+    return ages;
+}
+
 /// One estimator over the seeds: its row, and its bias map at prefix.<estimator>.exr.
 BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vector<FlagSetting>& base,
-                    const ParticleSource& source, std::uint32_t frame, const BiasReference& ref, const std::string& prefix) {
+                    const ParticleSource& source, std::uint32_t frame, const BiasReference& ref, const std::string& prefix,
+                    const ParticleAges* ages = nullptr) {
     const Settings specBase = specSettings(a.scene, a.defines, base, spec);
     const std::uint32_t history = historyBefore(HistoryChoice::parse(a.history), specBase, frame, spec.label);
     const std::size_t pixels = ref.rgb.size();
@@ -346,6 +409,7 @@ BiasRow measureBias(const BiasArgs& a, const EstimatorSpec& spec, const std::vec
     row.biased = std::fabs(row.t) > row.critical;
     row.detectablePct = ref.mean > 0.0 ? 100.0 * test.detectable / ref.mean : std::numeric_limits<double>::infinity();
     row.anatomy = splitRelMse(s1, s2, S, ref.rgb, ref.stderr, kRelMseEpsilon);
+    if (ages) row.byAge = splitRelMseByGroup(s1, s2, S, ref.rgb, ref.stderr, kRelMseEpsilon, ages->group, ages->groups());
     row.map = biasMap(s1, s2, S, ref);
     row.reuse = std::move(reuse);
     row.settingsToml = settingsToToml(specBase);
@@ -422,6 +486,10 @@ void runBias(const BiasArgs& a) {
     if (a.seeds < 2) throw InputError("command line --seeds: at least 2 seeds are needed for a standard error");
     const std::uint32_t frame = a.frame.value_or(scene.render.frame_start);
     requireHistories(a, base, specs, frame);
+    if (a.ageFrames > frame)
+        throw InputError(fmt::format("command line --age-frames {}: frame {} has only {} frames before it", a.ageFrames, frame, frame));
+    if (a.ageFrames > 0 && !a.gpuFrames.empty())
+        throw InputError("command line --age-frames: not with --gpu-frames (it renders the frames' views)");
     const auto threads = limitThreads(a.threads);
     const std::string prefix = a.out.empty() ? "out/" + scene.sceneName + ".bias" : a.out;
     OutputGuard guard = sceneInputs(scene);
@@ -439,9 +507,11 @@ void runBias(const BiasArgs& a) {
     std::vector<FlagSetting> unshadowed = base;
     const std::optional<BiasReference> refUnshadowed = loadUnshadowedReference(a, unshadowed, frame, ref);
     const ParticleSource source(scene);
+    std::optional<ParticleAges> ages;
+    if (a.ageFrames > 0) ages = particleAges(scene, source, frame, a.ageFrames, ref, a.quiet);
     std::vector<BiasRow> rows;
     for (const EstimatorSpec& spec : specs) {
-        rows.push_back(measureBias(a, spec, base, source, frame, ref, prefix));
+        rows.push_back(measureBias(a, spec, base, source, frame, ref, prefix, ages ? &*ages : nullptr));
         if (refUnshadowed) rows.back().relMseUnshadowed = measureBias(a, spec, unshadowed, source, frame, *refUnshadowed, prefix).relMse;
     }
 
@@ -483,13 +553,31 @@ void runBias(const BiasArgs& a) {
             reuse[r.label][std::string(passName(pass))] = reuseCountsJson(counts);
         }
     }
+    nlohmann::json byAge;
+    if (ages) {
+        const std::size_t all = ages->group.size();
+        for (const BiasRow& r : rows) {
+            fmt::print("{}: relMSE by the frames its pixels' particle has been in view (this one included):\n", r.label);
+            nlohmann::json groups = nlohmann::json::array();
+            for (std::uint32_t g = 0; g < ages->groups(); ++g) {
+                const ErrorAnatomy& e = r.byAge[g];
+                const double share = r.relMse != 0.0 ? 100.0 * (e.noise + e.persistent) / r.relMse : 0.0;
+                fmt::print("  {:>12}: {:5.1f}% of the pixels, relMSE {:.4g} ({:.0f}% of it): noise {:.4g}, persistent {:.4g}\n",
+                           ages->labels[g], 100.0 * double(ages->pixels[g]) / double(all), e.noise + e.persistent, share, e.noise,
+                           e.persistent);
+                groups.push_back({{"frames_in_view", ages->labels[g]}, {"pixels", ages->pixels[g]},
+                                  {"rel_mse_noise", e.noise}, {"rel_mse_persistent", e.persistent}});
+            }
+            byAge[r.label] = groups;
+        }
+    }
     writeFileAtomic(prefix + ".csv", table.csv());
     writeJson(prefix + ".json", {{"version", std::string(version())}, {"command", "bias"},
                                  {"scene", scene.scenePath}, {"reference", a.references}, {"crops", windowsJson(ref.crops)},
                                  {"crop_margin", ref.whole() ? nlohmann::json() : nlohmann::json(a.cropMargin)},
                                  {"frame", frame}, {"history", a.history}, {"z_critical", a.zCritical},
                                  {"reference_mean", ref.mean}, {"reference_mean_stderr", ref.meanStderr},
-                                 {"particle_mean_floor", floorJson},
+                                 {"particle_mean_floor", floorJson}, {"age_frames", a.ageFrames}, {"by_age", byAge},
                                  {"settings", settingsToToml(scene)}, {"rows", table.json()}, {"reuse", reuse}});
     // Red bars: BIASED (|t| above its critical value); the title says what was measured.
     const std::size_t biased = table.csvColumn("biased"), loss = table.csvColumn("energy_loss_pct"),
@@ -528,6 +616,10 @@ void addBiasCommand(CLI::App& app) {
                     "visible against it; its relMSE is light selection's error, the rest visibility's share (one per --reference, "
                     "the same crops)")
         ->allow_extra_args(false);
+    cmd->add_option("--age-frames", args->ageFrames,
+                    "Split each spec's relMSE (noise and persistent) by the frames its pixels' particle has been in view, up to "
+                    "this many before the measured one: a texel history by particle id is as long (renders the frames' views)")
+        ->check(CLI::Range(0u, 4096u));
     cmd->add_option("--z", args->zCritical, "The verdict's significance, as the normal's two-sided critical |z| (3.29: 99.9%); the test keeps it with Student's t at the seeds' degrees of freedom")->check(finiteIn(0.0, 1e6));
     cmd->add_option("--gpu-frames", args->gpuFrames,
                     "Read each seed's frame from the OptiX twin's .gpuframe files instead of rendering it: a pattern "

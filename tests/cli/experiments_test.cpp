@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <map>
+#include <set>
 
 #include <fstream>
 #include <regex>
@@ -529,4 +530,55 @@ TEST_CASE("bias: relMSE's anatomy sums to it, and the floor of one value a parti
     CHECK(j.at("particle_mean_floor").at("particles").get<std::size_t>() == sums.size());
     CHECK(floor > 0.0);
     CHECK_THAT(out, Contains("relMSE floor"));
+}
+
+TEST_CASE("bias --age-frames: the error by the frames each pixel's particle has been in view", "[cli][experiments][anatomy]") {
+    const auto dir = accretion::test::scratchDir("bias_age");
+    std::string out;
+    const std::string scene = tinyScene() + " --quiet";
+    // Frames 19 and 20 with their particle ids, as a user renders them.
+    REQUIRE(runCommand(kBin + " render " + scene + " --estimator exact --frames 19:21 -o " + (dir / "f.{frame}.exr").string(), out) == 0);
+    const std::string cmd = kBin + " bias " + scene + " --reference " + (dir / "f.0020.exr").string() +
+                            " --frame 20 --history 20 --seeds 3 --age-frames 4 --estimators particle_split:particle_split.history=0.8 -o " +
+                            (dir / "b").string();
+    REQUIRE(runCommand(cmd, out) == 0);
+    INFO(cmd << "\n" << out);
+    const nlohmann::json j = nlohmann::json::parse(readFile(dir / "b.json"));
+    const nlohmann::json& groups = j.at("by_age").at("particle_split:particle_split.history=0.8");
+    // No particle; 1; 2-3; 4; more than 4.
+    REQUIRE(groups.size() == 5);
+    CHECK(groups[1].at("frames_in_view") == "1");
+    CHECK(groups[2].at("frames_in_view") == "2-3");
+    CHECK(groups[4].at("frames_in_view") == "more than 4");
+    // The groups' parts are the row's, and their pixels every pixel measured.
+    const nlohmann::json& row = j.at("rows")[0];
+    double noise = 0.0, persistent = 0.0;
+    std::size_t pixels = 0;
+    for (const auto& g : groups) {
+        noise += g.at("rel_mse_noise").get<double>();
+        persistent += g.at("rel_mse_persistent").get<double>();
+        pixels += g.at("pixels").get<std::size_t>();
+    }
+    CHECK(noise == Approx(row.at("rel_mse_noise").get<double>()).epsilon(1e-9));
+    CHECK(persistent == Approx(row.at("rel_mse_persistent").get<double>()).epsilon(1e-9).margin(1e-15));
+    const std::vector<std::uint32_t> now = readExrUintChannel(dir / "f.0020.exr", "particle.id");
+    const std::vector<std::uint32_t> before = readExrUintChannel(dir / "f.0019.exr", "particle.id");
+    REQUIRE(now.size() == before.size());
+    CHECK(pixels == now.size());
+    // The pixels of group "1" are those whose particle frame 19 does not show,
+    // counted here from the two renders' files; those of no particle, the misses.
+    const std::set<std::uint32_t> shown(before.begin(), before.end());
+    std::size_t fresh = 0, misses = 0;
+    for (const std::uint32_t id : now) {
+        misses += id == 0xffffffffu;
+        fresh += id != 0xffffffffu && !shown.count(id);
+    }
+    CHECK(groups[0].at("pixels").get<std::size_t>() == misses);
+    CHECK(groups[1].at("pixels").get<std::size_t>() == fresh);
+    CHECK(fresh > 0);  // the disk turns: particles come into view
+    // Frame 2 has 2 frames before it, not 4: one clear error, nothing written.
+    CHECK(runCommand(kBin + " bias " + scene + " --reference " + (dir / "f.0020.exr").string() +
+                         " --frame 2 --seeds 3 --age-frames 4 --estimators uniform -o " + (dir / "bad").string(), out) != 0);
+    CHECK_THAT(out, Contains("--age-frames"));
+    CHECK_FALSE(std::filesystem::exists(dir / "bad.json"));
 }

@@ -30,6 +30,13 @@ struct ErrorAnatomy {
 ErrorAnatomy splitRelMse(const std::vector<DVec3>& sum, const std::vector<DVec3>& sumSq, double seeds,
                          const std::vector<Vec3>& ref, const std::vector<Vec3>& refStderr, double eps);
 
+/// The same split over groups of pixels (group[p] < groups; each group's
+/// parts are its pixels' share of the whole image's, so that the groups'
+/// parts sum to splitRelMse's).
+std::vector<ErrorAnatomy> splitRelMseByGroup(const std::vector<DVec3>& sum, const std::vector<DVec3>& sumSq, double seeds,
+                                             const std::vector<Vec3>& ref, const std::vector<Vec3>& refStderr, double eps,
+                                             const std::vector<std::uint32_t>& group, std::uint32_t groups);
+
 /// The floor of shading one value per visible particle: the relMSE of the
 /// image whose every pixel holds its particle's mean reference light over
 /// the pixels measured (ids: the reference's particle.id, kNoParticle
