@@ -11,7 +11,8 @@
 # configurations of bench/gpu/designs_cluster.txt. FRAME=48 measures frame
 # 48 instead (its references in OUT, which must then be another folder):
 # the steady state of a texel history longer than 20 frames. REFS=DIR reads
-# the references from DIR (bench/operating_point_refs.sh).
+# the references from DIR (bench/operating_point_refs.sh). BIAS_ARGS are
+# passed to each bias run as they are (e.g. "--age-frames 16").
 #   bash bench/designs.sh [PARTICLES|cluster] [SEEDS] [OUT] [NAME...]   (100000, 8, bench/results/operating_point_<N>; all)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -43,7 +44,7 @@ print(":".join([est] + [x for x in lighting if not x.startswith("render.estimato
 PY
 )
     t0=$SECONDS
-    "$A" bias $scene "${D[@]}" "${refs[@]}" "${unshadowed[@]}" --frame "${FRAME:-20}" --seeds "$seeds" --estimators "$spec" -q \
+    "$A" bias $scene "${D[@]}" "${refs[@]}" "${unshadowed[@]}" --frame "${FRAME:-20}" --seeds "$seeds" --estimators "$spec" ${BIAS_ARGS:-} -q \
         -o "$out/design_$base" > "$out/design_$base.txt"
     echo "design_$base: $((SECONDS - t0)) s ($seeds seeds)" | tee -a "$out/times.txt"
 done
