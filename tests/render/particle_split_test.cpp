@@ -531,7 +531,7 @@ TEST_CASE("particle_split: the ray threads' order visits every ray of every texe
     }
 }
 
-TEST_CASE("particle_split: history_of far averages the far mean alone; the near sum is the frame's own", "[particle_split]") {
+TEST_CASE("particle_split: history_of far averages the far mean alone, the near sum being the frame's own", "[particle_split]") {
     // Frames 0-5 of each configuration's sequence, the last one compared.
     const auto lastFrame = [](const Settings& s, const ParticleSource& source) {
         FrameRenderer renderer(s, source, RenderOptions{true});
