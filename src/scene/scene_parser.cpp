@@ -389,6 +389,13 @@ void validateLightingAndGeometry(const Settings& s, const RuleFailure& fail) {
                                           "draws its cells' lights from uniform, power or tree", enumName(s.render.source)));
     if (s.render.estimator == EstimatorKind::particle_split && s.particle_split.near == 0 && s.particle_split.far == 0)
         fail("particle_split.far", "particle_split.near and particle_split.far are both 0: no light reaches a texel");
+    if (s.render.estimator == EstimatorKind::particle_split && s.particle_split.far_new > 0) {
+        if (s.particle_split.history <= 0.0)
+            fail("particle_split.far_new", "far_new draws more far rays for a texel without history: set particle_split.history "
+                                           "(without one every texel draws far)");
+        if (s.particle_split.far_new < s.particle_split.far)
+            fail("particle_split.far_new", fmt::format("must be 0 or at least particle_split.far ({})", s.particle_split.far));
+    }
     if (static_cast<std::uint64_t>(s.restir.regir_cells) * s.restir.regir_cells * s.restir.regir_cells * s.restir.regir_lights_per_cell >
         (std::uint64_t(1) << 28))
         fail("restir.regir_lights_per_cell", fmt::format("{}^3 cells x {} lights is more than 2^28 slots", s.restir.regir_cells,

@@ -113,9 +113,10 @@ struct SplitLaunch {
     std::uint32_t* near = nullptr;              ///< slot v's near lights at v x params.nearCount (kNoNearLight past its count)
     std::uint32_t* nearFound = nullptr;
     float* nearRadius2 = nullptr;
-    psplit::SplitRay* rays = nullptr;           ///< texel q's ray r at r x rayStride + q (whichever thread traced it)
+    psplit::SplitRay* rays = nullptr;           ///< texel q's ray r at r x rayStride + q (whichever thread traced it; far_new's past near + far)
     std::size_t rayStride = 0;                  ///< the grid's texels: ray r of every texel at r x rayStride
     bool texelMajor = false;                    ///< threads texel by texel within each kind of ray (twin --ray-launch texels)
+    std::uint32_t* newTexels = nullptr;         ///< particle_split.far_new: the texels without history, in order (their extra rays' threads)
     Vec3* texelLr = nullptr;
     std::uint32_t* rejected = nullptr;          ///< per texel: non-finite far draws
     const std::uint32_t* prevSlotOf = nullptr;  ///< particle_split.history: last frame's slots
@@ -123,7 +124,7 @@ struct SplitLaunch {
     const Vec3* prevTexelLr = nullptr;
     Vec3* texelFar = nullptr;                   ///< particle_split.history_of far: the texels' far means' average
     const Vec3* prevTexelFar = nullptr;         ///< and last frame's
-    std::uint32_t* texelAge = nullptr;          ///< particle_split.history_start mean: the frames each texel has been seen
+    std::uint32_t* texelAge = nullptr;          ///< particle_split.history_start mean: the far rays (frames) each texel has averaged
     const std::uint32_t* prevTexelAge = nullptr;  ///< and last frame's
 };
 

@@ -251,8 +251,9 @@ __device__ void traceSplitRay() {
     const std::size_t L = rayThread();
     std::size_t q = L % s.rayStride;
     std::uint32_t r = std::uint32_t(L / s.rayStride);
-    if (s.texelMajor) {  // twin --ray-launch texels (the default, as the CPU counts it)
-        const psplit::SplitRayOfThread t = psplit::splitRayOfThread(s.params, s.rayStride, L);
+    // twin --ray-launch texels (the default, as the CPU counts it), and far_new's extra rays past every texel's own
+    if (s.texelMajor || r >= psplit::raysPerTexel(s.params)) {
+        const psplit::SplitRayOfThread t = psplit::splitRayOfThread(s.params, s.rayStride, L, s.newTexels);
         q = t.texel;
         r = t.ray;
     }

@@ -1,8 +1,14 @@
 // particle_split's CUDA kernels: particle_split_passes.h's bodies over the
 // twin's bridge (split_device.h). Errors are checked by the caller
 // (cudaGetLastError after the pass).
-#include "split_device.h"
 #include "split_kernels.h"
+
+#include <cub/device/device_select.cuh>
+
+#include <stdexcept>
+#include <string>
+
+#include "split_device.h"
 
 namespace accretion::twin {
 namespace {
@@ -12,6 +18,15 @@ __global__ void findNearLightsKernel(const __grid_constant__ LaunchParams p) {
     if (v >= p.split.params.visible) return;
     SplitBridge<ShadingModel::isotropic> b(p);  // no light term: the model does not matter
     psplit::findNearLightsOf(b, v);
+}
+
+__global__ void markNewSplitTexelsKernel(const __grid_constant__ LaunchParams p, std::size_t texels, std::uint8_t* flags,
+                                         std::uint32_t* ids) {
+    const std::size_t q = std::size_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (q >= texels) return;
+    SplitBridge<ShadingModel::isotropic> b(p);  // no light term: the model does not matter
+    flags[q] = psplit::newSplitTexel(b, q);
+    ids[q] = std::uint32_t(q);
 }
 
 __global__ void sumSplitTexelsKernel(const __grid_constant__ LaunchParams p, std::size_t texels) {
@@ -28,11 +43,35 @@ __global__ void interpolateSplitPixelsKernel(const __grid_constant__ LaunchParam
     psplit::interpolateSplitPixel(b, std::size_t(y) * p.camera.width + x);
 }
 
+void check(cudaError_t e, const char* what) {
+    if (e != cudaSuccess) throw std::runtime_error(std::string(what) + ": " + cudaGetErrorString(e));
+}
+
 }  // namespace
 
 void findNearLights(const LaunchParams& p, cudaStream_t stream) {
     const std::uint32_t n = p.split.params.visible;
     if (n) findNearLightsKernel<<<(n + 127) / 128, 128, 0, stream>>>(p);
+}
+
+std::size_t splitSelectTempBytes(std::size_t texels) {
+    std::size_t bytes = 0;
+    check(cub::DeviceSelect::Flagged(nullptr, bytes, static_cast<std::uint32_t*>(nullptr), static_cast<std::uint8_t*>(nullptr),
+                                     static_cast<std::uint32_t*>(nullptr), static_cast<std::uint32_t*>(nullptr), int(texels)),
+          "cub::DeviceSelect::Flagged");
+    return bytes;
+}
+
+std::size_t selectNewSplitTexels(const LaunchParams& p, std::size_t texels, const SplitSelectArrays& a, cudaStream_t stream) {
+    if (texels == 0) return 0;
+    markNewSplitTexelsKernel<<<unsigned((texels + 127) / 128), 128, 0, stream>>>(p, texels, a.flags, a.ids);
+    std::size_t bytes = a.tempBytes;
+    check(cub::DeviceSelect::Flagged(a.temp, bytes, a.ids, a.flags, p.split.newTexels, a.count, int(texels), stream),
+          "cub::DeviceSelect::Flagged");
+    std::uint32_t fresh = 0;
+    check(cudaMemcpyAsync(&fresh, a.count, sizeof fresh, cudaMemcpyDeviceToHost, stream), "cudaMemcpyAsync");
+    check(cudaStreamSynchronize(stream), "cudaStreamSynchronize");
+    return fresh;
 }
 
 void sumSplitTexels(const LaunchParams& p, std::size_t texels, cudaStream_t stream) {

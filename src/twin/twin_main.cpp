@@ -127,13 +127,14 @@ struct FrameBuffers {
     DeviceBuffer gatherFlags, gatherIds, gatherSortedIds, gatherKeys, gatherSortedKeys, gatherCount, gatherTemp, slotOf;  // particle_restir
     DeviceBuffer prevSlotOf, prevTexelLr;
     DeviceBuffer splitFar, prevSplitFar;  ///< particle_split.history_of far: the texels' far means' average, this frame's and last
-    DeviceBuffer splitAge, prevSplitAge;  ///< particle_split.history_start mean: the frames each texel has been seen
+    DeviceBuffer splitAge, prevSplitAge;  ///< particle_split.history_start mean: the far rays (frames) each texel has averaged
     DeviceBuffer prevPosition, prevEmission, prevAlbedo, prevDmin2, prevGbuffer, prevReservoirs;
     DeviceBuffer aliasProb, aliasAlias, aliasPmf;  // power: the alias table
     DeviceBuffer treeNodes, treePaths;            // tree: the light tree's nodes; particle_split: each light's path
     DeviceBuffer Lr_stderr, spp, rejectedSamples;  // uniform / power
     DeviceBuffer voxelCells[2], voxelOccupied, voxelRays;  // voxel_cache: last frame's cells and this frame's; the reached cells; their rays
     DeviceBuffer splitNear, splitNearFound, splitNearRadius2, splitRays;  // particle_split: each visible particle's near lights; the texels' rays
+    DeviceBuffer splitNewFlags, splitNewIds, splitNewTexels, splitNewCount, splitSelectTemp;  // particle_split.far_new's select
 };
 
 void copyDevice(DeviceBuffer& to, const DeviceBuffer& from, std::size_t bytes, cudaStream_t stream) {
@@ -475,10 +476,27 @@ void TwinRun::runParticleSplit(LaunchParams& lp) {
     buf_.splitNear.reserve(std::max<std::size_t>(1, visible * sl.params.nearCount) * sizeof(std::uint32_t));
     buf_.splitNearFound.reserve(std::max<std::size_t>(1, visible) * sizeof(std::uint32_t));
     buf_.splitNearRadius2.reserve(std::max<std::size_t>(1, visible) * sizeof(float));
-    const std::uint32_t rays = psplit::raysPerTexel(sl.params);
-    if (double(grid) * rays > double(1u << 30))
-        throw InputError(fmt::format("particle_split: {} texels x {} rays, more than an OptiX launch holds (2^30)", grid, rays));
-    buf_.splitRays.reserve(std::max<std::size_t>(1, grid * rays) * sizeof(psplit::SplitRay));
+    // Every texel's near and far rays; far_new's extra rays of the texels without history after them.
+    const std::uint32_t rays = psplit::raysPerTexel(sl.params), extra = psplit::extraNewRays(sl.params);
+    if (double(grid) * (rays + extra) > double(1u << 30))
+        throw InputError(fmt::format("particle_split: {} texels x {} rays, more than an OptiX launch holds (2^30)", grid, rays + extra));
+    if (extra && a_.rayLaunch == RayLaunch::rows)
+        throw InputError("particle_split.far_new: its extra rays are launched in one row (--ray-launch texels or linear, not rows)");
+    buf_.splitRays.reserve(std::max<std::size_t>(1, grid * (rays + extra)) * sizeof(psplit::SplitRay));
+    SplitSelectArrays select;
+    if (extra) {
+        buf_.splitNewFlags.reserve(grid);
+        buf_.splitNewIds.reserve(grid * sizeof(std::uint32_t));
+        buf_.splitNewTexels.reserve(grid * sizeof(std::uint32_t));
+        buf_.splitNewCount.reserve(sizeof(std::uint32_t));
+        select.tempBytes = splitSelectTempBytes(grid);
+        buf_.splitSelectTemp.reserve(std::max<std::size_t>(1, select.tempBytes));
+        select.flags = buf_.splitNewFlags.as<std::uint8_t>();
+        select.ids = buf_.splitNewIds.as<std::uint32_t>();
+        select.count = buf_.splitNewCount.as<std::uint32_t>();
+        select.temp = buf_.splitSelectTemp.as<void>();
+        sl.newTexels = buf_.splitNewTexels.as<std::uint32_t>();
+    }
     buf_.gridLr.reserve(grid * sizeof(Vec3));
     buf_.rejected.reserve(std::max(grid, std::size_t(W_) * H_) * sizeof(std::uint32_t));
     CUDA_CHECK(cudaMemsetAsync(buf_.rejected.as<void>(), 0, grid * sizeof(std::uint32_t), stream_));
@@ -518,7 +536,9 @@ void TwinRun::runParticleSplit(LaunchParams& lp) {
         // grid (linear, rows). OptiX maps a 2D launch (rows) onto warps and
         // blocks its own way: on the H100 (no RT cores) its warps stalled at
         // barriers, up to 2.7x slower (run.sh ray_launch, split_order).
-        if (rays > 0) launchRays(Raygen::shadeSplitTexels, grid * rays, unsigned(grid));
+        // far_new: the texels without history selected first, their extra rays launched after every texel's own.
+        const std::size_t fresh = extra ? selectNewSplitTexels(lp, grid, select, stream_) : 0;
+        if (grid * rays + fresh * extra > 0) launchRays(Raygen::shadeSplitTexels, grid * rays + fresh * extra, unsigned(grid));
         sumSplitTexels(lp, grid, stream_);
     }
     {

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <map>
 #include <set>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -629,4 +630,138 @@ TEST_CASE("particle_split: history_start mean is the running mean of a texel's f
             }
             CHECK(lit > 500);
         }
+}
+
+TEST_CASE("particle_split: far_new's extra rays are threads past every texel's own, in the order of their texels, and invert",
+          "[particle_split]") {
+    // With a history, the texels without one (here every third) draw far_new
+    // far rays: their extra rays' threads follow every texel's near and far
+    // rays, texel by texel in the select's order; the whole launch is a
+    // bijection onto [0, texels x (near + far) + new texels x extra).
+    for (const auto [near, far, farNew] : {std::tuple{8u, 4u, 16u}, std::tuple{16u, 8u, 9u}, std::tuple{1u, 0u, 3u}}) {
+        psplit::SplitParams p;
+        p.nearCount = near;
+        p.farSamples = far;
+        p.farNew = farNew;
+        p.history = 0.9f;
+        const std::uint32_t extra = psplit::extraNewRays(p);
+        REQUIRE(extra == farNew - far);
+        const std::size_t texels = 24;
+        std::vector<std::uint32_t> newTexels, newIndex(texels, kNoSlot);
+        for (std::size_t q = 0; q < texels; q += 3) {
+            newIndex[q] = std::uint32_t(newTexels.size());
+            newTexels.push_back(std::uint32_t(q));
+        }
+        INFO("near " << near << ", far " << far << ", far_new " << farNew);
+        std::vector<int> seen(texels * (near + far) + newTexels.size() * extra, 0);
+        for (std::size_t q = 0; q < texels; ++q)
+            for (std::uint32_t r = 0; r < near + far + (newIndex[q] != kNoSlot ? extra : 0); ++r) {
+                const std::size_t L = psplit::splitRayThread(p, texels, q, r, r >= near + far ? newIndex[q] : 0);
+                REQUIRE(L < seen.size());
+                ++seen[L];
+                CHECK((L >= texels * (near + far)) == (r >= near + far));
+                const psplit::SplitRayOfThread back = psplit::splitRayOfThread(p, texels, L, newTexels.data());
+                CHECK(back.texel == q);
+                CHECK(back.ray == r);
+            }
+        CHECK(std::count(seen.begin(), seen.end(), 1) == std::ptrdiff_t(seen.size()));
+        // Without a history no texel has one to lack: no extra rays.
+        p.history = 0.0f;
+        CHECK(psplit::extraNewRays(p) == 0);
+    }
+}
+
+TEST_CASE("particle_split: far_new draws a new texel's far rays as a render with far = far_new would, then weighs them as frames",
+          "[particle_split]") {
+    // A static scene. Frame 0: every texel is new and draws F = far_new far
+    // rays, from the streams a render without history and far = F draws: the
+    // same image, bit for bit. Later frames draw S = far, and with
+    // history_start mean the texel is the mean of all its far rays: at frame
+    // 2, (F x A0 + S x B1 + S x B2) / (F + 2 S), A0 the render with far = F
+    // and B the one with far = S (the near sum is the same light in all).
+    const std::uint32_t S = 2, F = 8;
+    Settings s = splitSettings(ShadingModel::lambert, 400, 4, S);
+    s.shading.visibility = true;
+    s.particles.gm = 0.0;
+    s.render.frames = 3;
+    const ParticleSource source(s);
+    const auto frames = [&](const Settings& settings) {
+        FrameRenderer renderer(settings, source, RenderOptions{true});
+        std::vector<FrameImage> out;
+        for (std::uint32_t f = 0; f < 3; ++f) {
+            FrameStats st;
+            out.push_back(renderer.render(f, st));
+        }
+        return out;
+    };
+    Settings wide = s;
+    wide.particle_split.far = F;
+    const std::vector<FrameImage> narrowFrames = frames(s), wideFrames = frames(wide);
+    for (const HistoryOf of : {HistoryOf::all, HistoryOf::far}) {
+        INFO("history_of " << enumName(of));
+        Settings m = s;
+        m.particle_split.history = 0.9;
+        m.particle_split.history_of = of;
+        m.particle_split.history_start = HistoryStart::mean;
+        m.particle_split.far_new = F;
+        const std::vector<FrameImage> got = frames(m);
+        std::size_t lit = 0;
+        for (std::size_t px = 0; px < got[0].lighting.Lr.size(); ++px) {
+            if (got[0].particle[px] == kNoParticle) continue;
+            ++lit;
+            REQUIRE(got[0].lighting.Lr[px] == wideFrames[0].lighting.Lr[px]);
+            for (int c = 0; c < 3; ++c) {
+                const double expected = (F * double(wideFrames[0].lighting.Lr[px][c]) + S * double(narrowFrames[1].lighting.Lr[px][c]) +
+                                         S * double(narrowFrames[2].lighting.Lr[px][c])) / double(F + 2 * S);
+                REQUIRE(double(got[2].lighting.Lr[px][c]) == Approx(expected).epsilon(1e-5).margin(1e-9));
+            }
+        }
+        CHECK(lit > 500);
+    }
+}
+
+TEST_CASE("particle_split: far_new's extra ray threads are those of the particles the last frame did not show", "[particle_split][gpu]") {
+    // A rotating disk seen from its side, counted: each frame's
+    // shadeSplitTexels launches texels x (near + far) threads plus extra
+    // for each texel without history, whose particle, by the two frames'
+    // own particle-id images, is visible now and was not last frame. Frame
+    // 0 has no history: every visible texel draws them.
+    Settings s = splitSettings(ShadingModel::lambert, 400, 4, 2);
+    s.shading.visibility = true;
+    s.gpu.counters = true;
+    s.render.frames = 4;
+    s.particle_split.history = 0.8;
+    s.particle_split.far_new = 10;
+    const std::uint32_t extra = 10 - 2;
+    const ParticleSource source(s);
+    FrameRenderer renderer(s, source, RenderOptions{true});
+    std::set<std::uint32_t> last;
+    std::size_t enteredTotal = 0;
+    for (std::uint32_t f = 0; f < 4; ++f) {
+        FrameStats st;
+        const FrameImage img = renderer.render(f, st);
+        std::set<std::uint32_t> visible;
+        for (const std::uint32_t j : img.particle)
+            if (j != kNoParticle) visible.insert(j);
+        std::size_t entered = 0;
+        for (const std::uint32_t j : visible) entered += !last.count(j);
+        const auto texels = std::find_if(img.counters.passes.begin(), img.counters.passes.end(),
+                                         [](const PassCounters& pc) { return pc.pass == Pass::shadeSplitTexels; });
+        REQUIRE(texels != img.counters.passes.end());
+        const std::size_t grid = (visible.size() + kTexelRowWidth - 1) / kTexelRowWidth * kTexelRowWidth;
+        INFO("frame " << f << ": " << visible.size() << " visible, " << entered << " new");
+        CHECK(texels->threads.size() == grid * (4 + 2) + entered * extra);
+        CHECK(texels->dispatches == 3);
+        // Each extra thread traces at most its one shadow ray, and some do.
+        std::uint64_t extraRays = 0, most = 0;
+        for (std::size_t k = grid * 6; k < texels->threads.size(); ++k) {
+            extraRays += texels->threads[k].rays;
+            most = std::max<std::uint64_t>(most, texels->threads[k].rays);
+        }
+        CHECK(most <= 1);
+        if (entered) CHECK(extraRays > 0);
+        if (f > 0) enteredTotal += entered;
+        last = std::move(visible);
+    }
+    CHECK(enteredTotal > 0);  // the disk's rotation brought particles into view
 }

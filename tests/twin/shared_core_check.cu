@@ -403,10 +403,12 @@ ACC_HD void voxelCase(int k, const PassInputs* variants, const voxel::VoxelParam
 // case k < texels searches light k's 16 nearest; the rest shade each texel
 // of the passes' grid (texel px: particle px, one texel each) with 16 near
 // and no far, 8 near and 4 far draws, and 8 near and 4 far each kept by
-// RIS among 4 with a history (even particles: a fixed last Lr).
+// RIS among 4 with a history (even particles: a fixed last Lr), its far
+// mean's alone, a running-mean start, and 12 far draws without history
+// (far_new: the odd particles).
 // Visibility is a fixed function of (point, light).
 
-constexpr int kSplitVariants = 6;
+constexpr int kSplitVariants = 7;
 constexpr int kSplitCases = (1 + kSplitVariants) * int(kGridW * kGridH);
 
 struct SplitCheckBridge {
@@ -499,7 +501,7 @@ struct Inputs {
     voxel::VoxelParams* voxel;  ///< l1, camera
     LightTreeView* tree;        ///< the light tree over the passes' lights
     std::uint64_t* paths;       ///< its lights' paths
-    psplit::SplitParams* split; ///< the near search; the six texel variants
+    psplit::SplitParams* split; ///< the near search; the seven texel variants
 };
 
 enum class Step { neighbours, reprojections, caps, candidates, combines, shades, passes, loops, voxels, splits, texelPoints };
@@ -701,7 +703,7 @@ int main() {
         v.facesPlane = false;
     }
     // particle_split: the light tree over the passes' lights (lambert), one
-    // texel a particle; the near search's and the six texel variants' settings.
+    // texel a particle; the near search's and the seven texel variants' settings.
     Particles lights;
     lights.position = centres;
     lights.emission = emission;
@@ -721,6 +723,7 @@ int main() {
         s.history = v >= 3 ? 0.6f : 0.0f;
         s.historyOfFar = v == 4 || v == 6;  // the far mean's history alone
         s.historyMean = v >= 5;             // a running mean over the texel's age first
+        s.farNew = v == 7 ? 12 : 0;         // far_new: a texel without history draws 12
         s.visible = texels;
         s.frame = 3;
         s.seed = 21;

@@ -27,8 +27,11 @@
 // the near sum is this frame's; with particle_split.history_start mean the
 // weight of this frame's is max(1 - h, 1/n), n the frames the texel has
 // been seen (its age, kept beside it): a running mean, then the
-// exponential average. The pixels interpolate their
-// particle's texels: biased by the light at the texels, not at the pixel.
+// exponential average. With particle_split.far_new F a texel without
+// history (its particle not in last frame's view) draws F far rays, not S,
+// and the running mean counts its age in far rays: that first frame
+// weighs F / S frames. The pixels interpolate their particle's texels:
+// biased by the light at the texels, not at the pixel.
 //
 // The bodies are the CPU's (src/render/particle_split/) and the twin's
 // (src/twin/), over a bridge B:
@@ -40,7 +43,8 @@
 //   shadeSplitTexels: GBufferTexel texel(q); ShadingPoint shadingPoint(g);
 //                     SplitRay splitRay(q, r)  texel q's ray r: traceSplitRay's (the CPU
 //                                             calls it; the twin's rays ran in a launch of
-//                                             their own, one a thread)
+//                                             their own, one a thread; r past near + far:
+//                                             far_new's, for a texel without history)
 //                     std::uint32_t nearLight(v, m)   slot v's near light m (kNoNearLight past its count)
 //                     std::uint32_t nearLights(v, light) (all of them; returns the count); float nearRadius2(v)
 //                     LightSample sampleFar(sp, rng, importance)  the tree's descent (counted)
@@ -74,6 +78,7 @@ inline constexpr std::uint32_t kNoNearLight = 0xffffffffu;
 struct SplitParams {
     std::uint32_t nearCount = 16;   ///< particle_split.near: k
     std::uint32_t farSamples = 8;   ///< particle_split.far: S
+    std::uint32_t farNew = 0;       ///< particle_split.far_new: far draws of a texel without history (0: S)
     std::uint32_t candidates = 1;   ///< particle_split.candidates: C far draws resampled into each far shadow ray
     std::uint32_t side = 1;         ///< particle_split.texels: texels per billboard side
     float history = 0.0f;           ///< particle_split.history
@@ -91,6 +96,7 @@ inline SplitParams splitParams(const Settings& s, std::uint32_t visible, std::ui
     SplitParams p;
     p.nearCount = s.particle_split.near;
     p.farSamples = s.particle_split.far;
+    p.farNew = s.particle_split.far_new;
     p.candidates = s.particle_split.candidates;
     p.side = s.particle_split.texels;
     p.history = float(s.particle_split.history);
@@ -277,25 +283,53 @@ struct SplitRay {
 /// The rays of a texel: params.nearCount near slots, then params.farSamples far draws.
 ACC_HD inline std::uint32_t raysPerTexel(const SplitParams& p) { return p.nearCount + p.farSamples; }
 
+/// The far rays a texel without history draws beyond params.farSamples
+/// (particle_split.far_new; 0 without a history, where no texel has one).
+ACC_HD inline std::uint32_t extraNewRays(const SplitParams& p) {
+    return p.history > 0.0f && p.farNew > p.farSamples ? p.farNew - p.farSamples : 0u;
+}
+
+/// Whether texel q is drawn particle_split.far_new far rays: a history is
+/// kept and the texel's particle was not in last frame's view.
+template <class B>
+ACC_HD_BODY bool newSplitTexel(B& b, std::size_t q) {
+    const SplitParams& p = b.params();
+    if (!(p.history > 0.0f)) return false;
+    const GBufferTexel g = b.texel(q);
+    std::size_t last = 0;
+    return g.hit() && !b.historyTexelOf(g.particle, std::uint32_t(q % p.texelsPerParticle()), last);
+}
+
 /// shadeSplitTexels' thread of ray r of texel q, of `texels`: the near rays
-/// texel by texel (q x nearCount + r), then the far draws texel by texel.
-/// A warp traces one kind of ray for a few texels, which share their
-/// shading point, near lights and tree descents. On the H100 (no RT cores)
-/// warps of one ray of 32 texels took 4-19% longer, and OptiX's 2D launch
-/// of texels by rays up to 2.7x longer (bench/gpu run.sh split_order).
-ACC_HD inline std::size_t splitRayThread(const SplitParams& p, std::size_t texels, std::size_t q, std::uint32_t r) {
+/// texel by texel (q x nearCount + r), then the far draws texel by texel,
+/// then far_new's extra draws of the texels without history, in their order
+/// (`newIndex`: texel q's place among them). A warp traces one kind of ray
+/// for a few texels, which share their shading point, near lights and tree
+/// descents. On the H100 (no RT cores) warps of one ray of 32 texels took
+/// 4-19% longer, and OptiX's 2D launch of texels by rays up to 2.7x longer
+/// (bench/gpu run.sh split_order).
+ACC_HD inline std::size_t splitRayThread(const SplitParams& p, std::size_t texels, std::size_t q, std::uint32_t r,
+                                         std::size_t newIndex = 0) {
+    const std::uint32_t base = raysPerTexel(p);
+    if (r >= base) return texels * base + newIndex * extraNewRays(p) + (r - base);
     return r < p.nearCount ? q * p.nearCount + r : texels * p.nearCount + q * p.farSamples + (r - p.nearCount);
 }
 
-/// The texel and ray of shadeSplitTexels' thread L (splitRayThread's inverse).
+/// The texel and ray of shadeSplitTexels' thread L (splitRayThread's
+/// inverse); `newTexels`: the texels without history, in order (read only
+/// past the texels' own near and far rays, where extraNewRays).
 struct SplitRayOfThread {
     std::size_t texel;
     std::uint32_t ray;
 };
-ACC_HD inline SplitRayOfThread splitRayOfThread(const SplitParams& p, std::size_t texels, std::size_t L) {
-    const std::size_t nearThreads = texels * p.nearCount;
+ACC_HD inline SplitRayOfThread splitRayOfThread(const SplitParams& p, std::size_t texels, std::size_t L,
+                                                const std::uint32_t* newTexels = nullptr) {
+    const std::uint32_t base = raysPerTexel(p);
+    const std::size_t nearThreads = texels * p.nearCount, baseThreads = texels * base;
     if (L < nearThreads) return {L / p.nearCount, std::uint32_t(L % p.nearCount)};
-    return {(L - nearThreads) / p.farSamples, p.nearCount + std::uint32_t((L - nearThreads) % p.farSamples)};
+    if (L < baseThreads) return {(L - nearThreads) / p.farSamples, p.nearCount + std::uint32_t((L - nearThreads) % p.farSamples)};
+    const std::uint32_t extra = extraNewRays(p);
+    return {newTexels[(L - baseThreads) / extra], base + std::uint32_t((L - baseThreads) % extra)};
 }
 
 /// Ray r of texel q: for r < nearCount its particle's near light r (none
@@ -346,13 +380,18 @@ ACC_HD_BODY SplitRay traceSplitRay(B& b, std::size_t q, std::uint32_t r) {
     return out;
 }
 
-/// A texel's age this frame from last frame's (history_start mean): one
-/// more, held at 2^20 (past any 1 / (1 - h) the settings allow).
-ACC_HD inline std::uint32_t historyAgeAfter(std::uint32_t last) { return last < (1u << 20) ? last + 1u : last; }
+/// A texel's age (history_start mean) counts the far rays it has averaged
+/// (its frames, where it draws none), held at 2^24 (past any 1 / (1 - h)
+/// the settings allow, and exact as a float): this frame's from last
+/// frame's, `units` this frame's rays.
+inline constexpr std::uint32_t kMaxHistoryAge = 1u << 24;
+ACC_HD inline std::uint32_t historyAgeAfter(std::uint32_t last, std::uint32_t units) {
+    return last < kMaxHistoryAge - units ? last + units : kMaxHistoryAge;
+}
 
 /// shadeSplitTexels at texel q: its rays (b.splitRay: traceSplitRay's)
-/// summed in order, the near ones as they are and the far ones' mean, and
-/// with history the texel's last Lr.
+/// summed in order, the near ones as they are and the far ones' mean (far_new
+/// of them without history), and with history the texel's last Lr.
 template <class B>
 ACC_HD_BODY void sumSplitTexel(B& b, std::size_t q) {
     const SplitParams& p = b.params();
@@ -364,10 +403,14 @@ ACC_HD_BODY void sumSplitTexel(B& b, std::size_t q) {
         if (history && p.historyMean) b.writeTexelAge(q, 0);
         return;
     }
+    // The history: last frame's texel of the same particle, and the weight it keeps.
+    std::size_t h = 0;
+    const bool seen = history && b.historyTexelOf(g.particle, std::uint32_t(q % p.texelsPerParticle()), h);
+    const std::uint32_t farRays = p.farSamples + (history && !seen ? extraNewRays(p) : 0u);
     Vec3 Lr(0.0f), far(0.0f);
     for (std::uint32_t r = 0; r < p.nearCount; ++r) Lr += b.splitRay(q, r).value;
-    std::uint32_t counted = p.farSamples;
-    for (std::uint32_t s = 0; s < p.farSamples; ++s) {
+    std::uint32_t counted = farRays;
+    for (std::uint32_t s = 0; s < farRays; ++s) {
         const SplitRay ray = b.splitRay(q, p.nearCount + s);
         if (ray.rejected) {
             b.reject(q);
@@ -375,13 +418,11 @@ ACC_HD_BODY void sumSplitTexel(B& b, std::size_t q) {
         }
         far += ray.value;
     }
-    // The history: last frame's texel of the same particle, and the weight it keeps.
-    std::size_t h = 0;
-    const bool seen = history && b.historyTexelOf(g.particle, std::uint32_t(q % p.texelsPerParticle()), h);
     float keep = p.history;
-    if (history && p.historyMean) {
-        const std::uint32_t age = seen ? historyAgeAfter(b.historyAge(h)) : 1u;
-        keep = fminf(p.history, 1.0f - 1.0f / float(age));
+    if (history && p.historyMean) {  // this frame weighs units / age: 1 / n after n frames of S far rays
+        const std::uint32_t units = farRays > 0 ? farRays : 1u;
+        const std::uint32_t age = seen ? historyAgeAfter(b.historyAge(h), units) : units;
+        keep = fminf(p.history, 1.0f - float(units) / float(age));
         b.writeTexelAge(q, age);
     }
     if (history && p.historyOfFar) {

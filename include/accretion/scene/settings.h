@@ -383,6 +383,7 @@ struct ParticleSplitSettings {
     TexelPoint texel_point = TexelPoint::centre;  ///< where a texel's receiver lies on its billboard each frame
     HistoryOf history_of = HistoryOf::all;        ///< the terms the history averages
     HistoryStart history_start = HistoryStart::first;  ///< a new texel's average: from its first frame, or a running mean
+    std::uint32_t far_new = 0;     ///< far draws of a texel without history (0: far)
     template <class V> void visit(V& v) {
         v.field("near", near, "particle_split: the lights nearest each visible particle's centre (on the light tree, no rays), summed exactly at each of its texels with a shadow ray each", Range{0, 64});
         v.field("far", far, "particle_split: lights drawn per texel and frame from the light tree at the texel, the near lights' ball taken out, one shadow ray each", Range{0, 1024});
@@ -392,6 +393,7 @@ struct ParticleSplitSettings {
         v.field("texel_point", texel_point, "particle_split: centre (a texel's receiver is its centre every frame), jittered (a point drawn afresh each frame, uniform in the texel's square of the billboard and inside the disc with alpha disc: with history the texel averages the light over the area its pixels see, not the light at its centre) or antithetic (such a point in even frames, its mirror about the texel's centre in the next: the pairs cancel the light's linear change across the texel)");
         v.field("history_of", history_of, "particle_split: all (the history averages the texel's whole Lr) or far (only the far lights' mean: the near sum, exact at the texel's point, is this frame's, so a long history lags the near light no more)");
         v.field("history_start", history_start, "particle_split: first (a texel's average starts at its first frame's value, which then weighs h^n after n frames) or mean (the mean of the n frames it has been seen until 1/n falls to 1 - h, then the exponential average: a particle that has just come into view is averaged as well as its frames allow)");
+        v.field("far_new", far_new, "particle_split: far rays for a texel without history (its particle not in last frame's view: a history has nothing to average it with), at least far; 0: far. With history_start mean its age counts far rays, so that first frame weighs far_new / far frames", Range{0, 1024});
     }
 };
 

@@ -39,6 +39,7 @@ struct CpuFrame {
     const std::vector<std::uint32_t>& prevTexelAge;  ///< history_start mean: last frame's texels' ages (else empty)
     std::vector<std::uint32_t>& texelAge;
     std::vector<std::uint32_t>& texelRejected;     ///< non-finite far draws per texel
+    std::vector<std::uint32_t>& newIndex;          ///< far_new: each texel's place among those without history (kNoSlot: it has one)
     std::vector<Vec3>& Lr;                         ///< the pixels'
 };
 
@@ -90,7 +91,8 @@ public:
     /// kernel per texel) is record q's too, as its dispatch is the pass's second.
     SplitRay splitRay(std::size_t q, std::uint32_t r) {
         if constexpr (Count) {
-            CpuSplitBridge ray(f_, &pc_->threads[splitRayThread(f_.params, f_.texels.grid.texels.size(), q, r)], c_, pc_);
+            const std::size_t newIndex = r >= raysPerTexel(f_.params) ? f_.newIndex[q] : 0;
+            CpuSplitBridge ray(f_, &pc_->threads[splitRayThread(f_.params, f_.texels.grid.texels.size(), q, r, newIndex)], c_, pc_);
             const SplitRay out = traceSplitRay(ray, q, r);
             ray.rec_.write(sizeof(SplitRay));
             rec_.read(sizeof(SplitRay));

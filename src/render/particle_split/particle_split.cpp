@@ -33,10 +33,11 @@ LightingCounters ParticleSplit::render(const ParticleSplitInputs& in, LightingIm
     std::vector<Vec3> texelFar(params.history > 0.0f && params.historyOfFar ? texels.grid.texels.size() : 0);
     std::vector<std::uint32_t> texelAge(params.history > 0.0f && params.historyMean ? texels.grid.texels.size() : 0);
     std::vector<std::uint32_t> texelRejected(texels.grid.texels.size(), 0);
+    std::vector<std::uint32_t> newIndex;  // far_new's texels without history (shadeSplitTexels)
     const std::vector<std::uint64_t> paths = in.lightTree.paths();
     // Last frame's texels: kept only with a history, so empty without one.
     const psplit::CpuFrame f{in, params, L, in.lightTree.view(), paths, VisibilityOptions::from(in.settings.render), plan.shadowRays,
-                             texels, near, nearFound, nearRadius2, prevSlotOf_, prevTexelLr_, texelLr, prevTexelFar_, texelFar, prevTexelAge_, texelAge, texelRejected, out.Lr};
+                             texels, near, nearFound, nearRadius2, prevSlotOf_, prevTexelLr_, texelLr, prevTexelFar_, texelFar, prevTexelAge_, texelAge, texelRejected, newIndex, out.Lr};
     LightingCounters counters;
     {
         auto t = timer.scope(Pass::findNearLights);
