@@ -116,6 +116,10 @@ design_case particle_split ps_mean_c4_h9 -D particle_split.history_start=mean -D
 design_case particle_split ps_mean_far_c4_h5 -D particle_split.history_start=mean -D particle_split.history_of=far -D particle_split.candidates=4 -D particle_split.history=0.5
 design_case particle_split ps_2x2_far_anti_disc_h5 -D particle_split.history_of=far -D particle_split.texels=2 -D particle_split.texel_point=antithetic -D particle_split.history=0.5 "${disc[@]}"
 
+# particle_split.far_new (run.sh far_new): a texel without history draws more far rays (frame 0: every texel).
+design_case particle_split ps_new12_mean_c4_h9 -D particle_split.far_new=12 -D particle_split.history_start=mean -D particle_split.candidates=4 -D particle_split.history=0.9
+design_case particle_split ps_new9_far_anti_h5 -D particle_split.far_new=9 -D particle_split.history_of=far -D particle_split.texel_point=antithetic -D particle_split.history=0.5
+
 # uniform and power (one frame): Lr, its standard error and the samples taken.
 declare -A sampled=(
     [power]="-D render.estimator=power -D render.samples=16"

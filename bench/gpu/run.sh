@@ -1,7 +1,7 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine, from the repository root:
 #   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
-#                                      layout_images layouts streams front identity shared_core ab designs resample near_ncu voxel_ncu gather_ncu voxels splits iterations split_anatomy split_ncu split_stalls ray_launch split_order gbuffer_ncu near_cluster_ncu history texel_point history_start
+#                                      layout_images layouts streams front identity shared_core ab designs resample near_ncu voxel_ncu gather_ncu voxels splits iterations split_anatomy split_ncu split_stalls ray_launch split_order gbuffer_ncu near_cluster_ncu history texel_point history_start far_new
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -364,6 +364,21 @@ step_history_start() {
     grep -E '^(ps_n8_f4_c8_h90(_mean|_mean_far)?_100k|ps_n8_f4_c8_h95_mean_far_100k|ps_n8_f4_c4_h90_anti(_mean)?_1m|ps_n8_f4_c4_h95_(anti_mean|anti_mean_far|mean_far)_1m|restir_m32_t_pairwise_05x_(100k|1m)) ' \
         bench/gpu/designs.txt > "$W/history_start.txt"
     time_configs history_start "$W/history_start.txt" 5
+}
+
+# particle_split.far_new (more far rays for a texel without history: a
+# select of those texels, then their extra rays in the same launch): its
+# frames on quickstart at 320x180 (frames 0-2) for the per-pixel comparison
+# with the CPU (compare_cpu.sh), and designs.txt's _new lines timed beside
+# the same configurations without it and today's recommendations, in one run.
+step_far_new() {
+    quickstart_frames far_new particle_split ps_new12_mean_c4_h9 -D particle_split.far_new=12 -D particle_split.history_start=mean \
+        -D particle_split.candidates=4 -D particle_split.history=0.9
+    quickstart_frames far_new particle_split ps_new9_far_anti_h5 -D particle_split.far_new=9 -D particle_split.history_of=far \
+        -D particle_split.texel_point=antithetic -D particle_split.history=0.5
+    grep -E '^(ps_n8_f4_c8_h95_mean_far(_new16)?_100k|ps_n8_f4_c4_h95_anti_mean_far(_new(8|16|32))?_1m|restir_m32_t_pairwise_05x_(100k|1m)) ' \
+        bench/gpu/designs.txt > "$W/far_new.txt"
+    time_configs far_new "$W/far_new.txt" 5
 }
 
 # The spatial passes run once and twice, each iteration timed apart
