@@ -119,6 +119,8 @@ design_case particle_split ps_2x2_far_anti_disc_h5 -D particle_split.history_of=
 # particle_split.far_new (run.sh far_new): a texel without history draws more far rays (frame 0: every texel).
 design_case particle_split ps_new12_mean_c4_h9 -D particle_split.far_new=12 -D particle_split.history_start=mean -D particle_split.candidates=4 -D particle_split.history=0.9
 design_case particle_split ps_new9_far_anti_h5 -D particle_split.far_new=9 -D particle_split.history_of=far -D particle_split.texel_point=antithetic -D particle_split.history=0.5
+# particle_split.far_prior (run.sh far_prior): a new texel started from its near lights' far means.
+design_case particle_split ps_prior8_mean_far_c4_h9 -D particle_split.far_prior=8 -D particle_split.history_of=far -D particle_split.history_start=mean -D particle_split.candidates=4 -D particle_split.history=0.9
 
 # uniform and power (one frame): Lr, its standard error and the samples taken.
 declare -A sampled=(

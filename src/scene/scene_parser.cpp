@@ -396,6 +396,13 @@ void validateLightingAndGeometry(const Settings& s, const RuleFailure& fail) {
         if (s.particle_split.far_new < s.particle_split.far)
             fail("particle_split.far_new", fmt::format("must be 0 or at least particle_split.far ({})", s.particle_split.far));
     }
+    if (s.render.estimator == EstimatorKind::particle_split && s.particle_split.far_prior > 0) {
+        if (s.particle_split.history <= 0.0 || s.particle_split.history_of != HistoryOf::far)
+            fail("particle_split.far_prior", "far_prior starts a new texel's far mean from its neighbours' far histories: set "
+                                             "particle_split.history and history_of = \"far\"");
+        if (s.particle_split.far == 0 && s.particle_split.far_new == 0)
+            fail("particle_split.far_prior", "far_prior weighs a prior against a texel's far rays: particle_split.far is 0");
+    }
     if (static_cast<std::uint64_t>(s.restir.regir_cells) * s.restir.regir_cells * s.restir.regir_cells * s.restir.regir_lights_per_cell >
         (std::uint64_t(1) << 28))
         fail("restir.regir_lights_per_cell", fmt::format("{}^3 cells x {} lights is more than 2^28 slots", s.restir.regir_cells,

@@ -765,3 +765,117 @@ TEST_CASE("particle_split: far_new's extra ray threads are those of the particle
     }
     CHECK(enteredTotal > 0);  // the disk's rotation brought particles into view
 }
+
+namespace {
+
+/// sumSplitTexel's bridge over plain arrays: texel q is particle q's (one
+/// texel each), its rays the fixed values of `ray`, its near lights
+/// `near`, last frame's texels those of `lastSlot` (particle -> texel, or
+/// kNoSlot) with far means `lastFar` and ages `lastAge`.
+struct PriorBridge {
+    psplit::SplitParams p;
+    std::vector<std::vector<std::uint32_t>> near;
+    std::vector<std::uint32_t> lastSlot;
+    std::vector<Vec3> lastFar;
+    std::vector<std::uint32_t> lastAge;
+    std::vector<Vec3> ray;  ///< ray r's value, every texel
+    Vec3 Lr{0.0f}, far{0.0f};
+    std::uint32_t age = 0;
+    const psplit::SplitParams& params() const { return p; }
+    GBufferTexel texel(std::size_t q) const {
+        GBufferTexel g;
+        g.particle = std::uint32_t(q);
+        return g;
+    }
+    psplit::SplitRay splitRay(std::size_t, std::uint32_t r) const { return {ray[r], 0}; }
+    void reject(std::size_t) const {}
+    std::uint32_t nearLights(std::uint32_t v, std::uint32_t* light) const {
+        std::copy(near[v].begin(), near[v].end(), light);
+        return std::uint32_t(near[v].size());
+    }
+    bool historyTexelOf(std::uint32_t j, std::uint32_t, std::size_t& q) const {
+        if (j >= lastSlot.size() || lastSlot[j] == kNoSlot) return false;
+        q = lastSlot[j];
+        return true;
+    }
+    Vec3 historyFar(std::size_t q) const { return lastFar[q]; }
+    Vec3 historyLr(std::size_t) const { return Vec3(1e9f); }  // never read with history_of far
+    std::uint32_t historyAge(std::size_t q) const { return lastAge[q]; }
+    void writeTexelAge(std::size_t, std::uint32_t n) { age = n; }
+    void writeTexelFar(std::size_t, const Vec3& f) { far = f; }
+    void writeTexelLr(std::size_t, const Vec3& L) { Lr = L; }
+};
+
+}  // namespace
+
+TEST_CASE("particle_split: far_prior starts a new texel's far mean from its near lights' far means of last frame, in closed form",
+          "[particle_split]") {
+    // Near 2, far 2, far_prior 6: texel 0 (particle 0, new) has near lights
+    // 5, 6 and 7, of which 5 and 7 were in view with far means a and b. Its
+    // far mean is 2/8 of its own rays' mean and 6/8 of (a + b) / 2, its age
+    // 8 far rays; its Lr the near sum plus that.
+    PriorBridge b;
+    b.p.nearCount = 2;
+    b.p.farSamples = 2;
+    b.p.history = 0.9f;
+    b.p.historyOfFar = true;
+    b.p.historyMean = true;
+    b.p.farPrior = 6;
+    b.near = {{5, 6, 7}, {7}, {6}};
+    b.lastSlot.assign(8, kNoSlot);
+    b.lastSlot[5] = 0;
+    b.lastSlot[7] = 1;
+    b.lastSlot[1] = 2;  // particle 1 was in view: not new
+    b.lastFar = {Vec3(1.0f, 2.0f, 3.0f), Vec3(3.0f, 2.0f, 5.0f), Vec3(0.5f)};
+    b.lastAge = {20, 20, 20};
+    b.ray = {Vec3(0.25f), Vec3(0.5f), Vec3(4.0f, 0.0f, 2.0f), Vec3(2.0f, 8.0f, 0.0f)};
+    const Vec3 nearSum(0.75f), own(3.0f, 4.0f, 1.0f), prior(2.0f, 2.0f, 4.0f);
+    SECTION("a new texel with neighbours in view") {
+        psplit::sumSplitTexel(b, 0);
+        for (int c = 0; c < 3; ++c) {
+            const float expected = 0.25f * own[c] + 0.75f * prior[c];
+            CHECK(b.far[c] == Approx(expected).epsilon(1e-6));
+            CHECK(b.Lr[c] == Approx(nearSum[c] + expected).epsilon(1e-6));
+        }
+        CHECK(b.age == 8);
+    }
+    SECTION("a texel with a history of its own: the prior is not read") {
+        psplit::sumSplitTexel(b, 1);
+        for (int c = 0; c < 3; ++c) CHECK(b.far[c] == Approx(0.1f * own[c] + 0.9f * 0.5f).epsilon(1e-6));
+        CHECK(b.age == 22);
+    }
+    SECTION("a new texel whose near lights were not in view: its own rays alone") {
+        psplit::sumSplitTexel(b, 2);
+        CHECK(b.far == own);
+        CHECK(b.age == 2);
+    }
+    SECTION("history_start first: the same blend, no age") {
+        b.p.historyMean = false;
+        b.age = 99;
+        psplit::sumSplitTexel(b, 0);
+        for (int c = 0; c < 3; ++c) CHECK(b.far[c] == Approx(0.25f * own[c] + 0.75f * prior[c]).epsilon(1e-6));
+        CHECK(b.age == 99);
+    }
+}
+
+TEST_CASE("particle_split: far_prior changes nothing where no particle comes into view", "[particle_split]") {
+    // A static disk and camera: frame 0 has no history (no neighbour's far
+    // mean to start from), and later frames no new texel. The frames are
+    // those without far_prior, bit for bit.
+    Settings s = splitSettings(ShadingModel::lambert, 400, 4, 2);
+    s.shading.visibility = true;
+    s.particles.gm = 0.0;
+    s.render.frames = 4;
+    s.particle_split.history = 0.9;
+    s.particle_split.history_of = HistoryOf::far;
+    s.particle_split.history_start = HistoryStart::mean;
+    const ParticleSource source(s);
+    Settings prior = s;
+    prior.particle_split.far_prior = 8;
+    FrameRenderer a(s, source, RenderOptions{true}), b(prior, source, RenderOptions{true});
+    for (std::uint32_t f = 0; f < 4; ++f) {
+        FrameStats sa, sb;
+        const FrameImage x = a.render(f, sa), y = b.render(f, sb);
+        REQUIRE(x.lighting.Lr == y.lighting.Lr);
+    }
+}

@@ -404,11 +404,12 @@ ACC_HD void voxelCase(int k, const PassInputs* variants, const voxel::VoxelParam
 // of the passes' grid (texel px: particle px, one texel each) with 16 near
 // and no far, 8 near and 4 far draws, and 8 near and 4 far each kept by
 // RIS among 4 with a history (even particles: a fixed last Lr), its far
-// mean's alone, a running-mean start, and 12 far draws without history
-// (far_new: the odd particles).
+// mean's alone, a running-mean start, 12 far draws without history
+// (far_new: the odd particles), and a new texel started from its near
+// lights' far means (far_prior).
 // Visibility is a fixed function of (point, light).
 
-constexpr int kSplitVariants = 7;
+constexpr int kSplitVariants = 8;
 constexpr int kSplitCases = (1 + kSplitVariants) * int(kGridW * kGridH);
 
 struct SplitCheckBridge {
@@ -501,7 +502,7 @@ struct Inputs {
     voxel::VoxelParams* voxel;  ///< l1, camera
     LightTreeView* tree;        ///< the light tree over the passes' lights
     std::uint64_t* paths;       ///< its lights' paths
-    psplit::SplitParams* split; ///< the near search; the seven texel variants
+    psplit::SplitParams* split; ///< the near search; the eight texel variants
 };
 
 enum class Step { neighbours, reprojections, caps, candidates, combines, shades, passes, loops, voxels, splits, texelPoints };
@@ -703,7 +704,7 @@ int main() {
         v.facesPlane = false;
     }
     // particle_split: the light tree over the passes' lights (lambert), one
-    // texel a particle; the near search's and the seven texel variants' settings.
+    // texel a particle; the near search's and the eight texel variants' settings.
     Particles lights;
     lights.position = centres;
     lights.emission = emission;
@@ -721,9 +722,10 @@ int main() {
         s.farSamples = v <= 1 ? 0 : 4;
         s.candidates = v >= 3 ? 4 : 1;
         s.history = v >= 3 ? 0.6f : 0.0f;
-        s.historyOfFar = v == 4 || v == 6;  // the far mean's history alone
+        s.historyOfFar = v == 4 || v == 6 || v == 8;  // the far mean's history alone
         s.historyMean = v >= 5;             // a running mean over the texel's age first
         s.farNew = v == 7 ? 12 : 0;         // far_new: a texel without history draws 12
+        s.farPrior = v == 8 ? 8 : 0;        // far_prior: and starts from its near lights' far means
         s.visible = texels;
         s.frame = 3;
         s.seed = 21;

@@ -30,7 +30,10 @@
 // exponential average. With particle_split.far_new F a texel without
 // history (its particle not in last frame's view) draws F far rays, not S,
 // and the running mean counts its age in far rays: that first frame
-// weighs F / S frames. The pixels interpolate their particle's texels:
+// weighs F / S frames. With particle_split.far_prior P (and history_of
+// far) such a texel's far mean starts as the mean of its near lights' far
+// means of last frame (those in view then), worth P far rays: a particle
+// new to the view starts from its world-space neighbours' far light. The pixels interpolate their particle's texels:
 // biased by the light at the texels, not at the pixel.
 //
 // The bodies are the CPU's (src/render/particle_split/) and the twin's
@@ -79,6 +82,7 @@ struct SplitParams {
     std::uint32_t nearCount = 16;   ///< particle_split.near: k
     std::uint32_t farSamples = 8;   ///< particle_split.far: S
     std::uint32_t farNew = 0;       ///< particle_split.far_new: far draws of a texel without history (0: S)
+    std::uint32_t farPrior = 0;     ///< particle_split.far_prior: far rays' worth of a new texel's near lights' far means (0: none)
     std::uint32_t candidates = 1;   ///< particle_split.candidates: C far draws resampled into each far shadow ray
     std::uint32_t side = 1;         ///< particle_split.texels: texels per billboard side
     float history = 0.0f;           ///< particle_split.history
@@ -97,6 +101,7 @@ inline SplitParams splitParams(const Settings& s, std::uint32_t visible, std::ui
     p.nearCount = s.particle_split.near;
     p.farSamples = s.particle_split.far;
     p.farNew = s.particle_split.far_new;
+    p.farPrior = s.particle_split.far_prior;
     p.candidates = s.particle_split.candidates;
     p.side = s.particle_split.texels;
     p.history = float(s.particle_split.history);
@@ -418,16 +423,40 @@ ACC_HD_BODY void sumSplitTexel(B& b, std::size_t q) {
         }
         far += ray.value;
     }
+    // far_prior: a texel without history starts from the mean of the far
+    // means its particle's near lights' same texels kept last frame (those
+    // that were in view), worth farPrior far rays.
+    const std::uint32_t units = farRays > 0 ? farRays : 1u;
+    Vec3 prior(0.0f);
+    std::uint32_t priorUnits = 0;
+    if (history && p.historyOfFar && !seen && p.farPrior > 0) {
+        std::uint32_t near[kMaxNear];
+        const std::uint32_t k = b.nearLights(std::uint32_t(q / p.texelsPerParticle()), near);
+        std::uint32_t found = 0;
+        for (std::uint32_t m = 0; m < k; ++m) {
+            std::size_t hq = 0;
+            if (!b.historyTexelOf(near[m], std::uint32_t(q % p.texelsPerParticle()), hq)) continue;
+            prior += b.historyFar(hq);
+            ++found;
+        }
+        if (found > 0) {
+            prior = prior / float(found);
+            priorUnits = p.farPrior;
+        }
+    }
     float keep = p.history;
     if (history && p.historyMean) {  // this frame weighs units / age: 1 / n after n frames of S far rays
-        const std::uint32_t units = farRays > 0 ? farRays : 1u;
-        const std::uint32_t age = seen ? historyAgeAfter(b.historyAge(h), units) : units;
+        const std::uint32_t age = seen ? historyAgeAfter(b.historyAge(h), units) : units + priorUnits;
         keep = fminf(p.history, 1.0f - float(units) / float(age));
         b.writeTexelAge(q, age);
     }
     if (history && p.historyOfFar) {
         Vec3 farMean = counted > 0 ? far / float(counted) : Vec3(0.0f);
         if (seen) farMean = (1.0f - keep) * farMean + keep * b.historyFar(h);
+        else if (priorUnits > 0) {
+            const float own = float(units) / float(units + priorUnits);
+            farMean = own * farMean + (1.0f - own) * prior;
+        }
         b.writeTexelFar(q, farMean);
         b.writeTexelLr(q, Lr + farMean);
         return;
