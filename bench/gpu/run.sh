@@ -1,7 +1,7 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine, from the repository root:
 #   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
-#                                      layout_images layouts streams front identity shared_core ab designs resample near_ncu voxel_ncu gather_ncu voxels splits iterations split_anatomy split_ncu split_stalls ray_launch split_order gbuffer_ncu near_cluster_ncu history texel_point history_start far_new far_prior
+#                                      layout_images layouts streams front identity shared_core ab designs resample near_ncu voxel_ncu gather_ncu voxels splits iterations split_anatomy split_ncu split_stalls ray_launch split_order gbuffer_ncu near_cluster_ncu history texel_point history_start far_new far_prior far_share
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -392,6 +392,19 @@ step_far_prior() {
     grep -E '^(ps_n8_f4_c8_h95_mean_far(_prior32)?_100k|ps_n8_f4_c4_h95_anti_mean_far(_new8|_prior8|_prior32|_new8_prior32)?_1m|restir_m32_t_pairwise_05x_(100k|1m)) ' \
         bench/gpu/designs.txt > "$W/far_prior.txt"
     time_configs far_prior "$W/far_prior.txt" 5
+}
+
+# particle_split.far_share (every texel's far mean shown blended with its
+# near lights' of last frame): its frames on quickstart for compare_cpu.sh,
+# and designs.txt's _share lines timed beside the same configurations
+# without it and today's recommendations, in one run.
+step_far_share() {
+    quickstart_frames far_share particle_split ps_share24_prior8_mean_far_c4_h9 -D particle_split.far_share=24 \
+        -D particle_split.far_prior=8 -D particle_split.history_of=far -D particle_split.history_start=mean \
+        -D particle_split.candidates=4 -D particle_split.history=0.9
+    grep -E '^(ps_n8_f4_c8_h95_mean_far_prior32(_share(64|256))?_100k|ps_n8_f4_c4_h95_anti_mean_far_prior32(_share(64|256))?_1m|restir_m32_t_pairwise_05x_(100k|1m)) ' \
+        bench/gpu/designs.txt > "$W/far_share.txt"
+    time_configs far_share "$W/far_share.txt" 5
 }
 
 # The spatial passes run once and twice, each iteration timed apart

@@ -173,13 +173,14 @@ void describe(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
                                 ps.candidates > 1 ? fmt::format("kept by RIS among {} draws", ps.candidates) : std::string("one draw"),
                                 plan.shadowRays ? "a shadow ray each" : "visibility off (V = 1)",
                                 ps.history <= 0.0 ? std::string()
-                                : fmt::format("{}{}{}{}",
+                                : fmt::format("{}{}{}{}{}",
                                               ps.history_of == HistoryOf::far
                                                   ? fmt::format(", the far mean averaged with last frame's (h = {}), the near sum this frame's", ps.history)
                                                   : fmt::format(", Lr averaged with last frame's (h = {})", ps.history),
                                               ps.history_start == HistoryStart::mean ? ", a running mean over a texel's first frames" : "",
                                               ps.far_new > ps.far ? fmt::format(", {} far rays for a texel without history (a second launch over those texels)", ps.far_new) : "",
-                                              ps.far_prior > 0 && ps.history_of == HistoryOf::far ? fmt::format(", a texel without history started from its near lights' far means (worth {} far rays)", ps.far_prior) : "")));
+                                              ps.far_prior > 0 && ps.history_of == HistoryOf::far ? fmt::format(", a texel without history started from its near lights' far means (worth {} far rays)", ps.far_prior) : "",
+                                              ps.far_share > 0 && ps.history_of == HistoryOf::far ? fmt::format(", every texel's far mean shown blended with its near lights' (worth {} far rays)", ps.far_share) : "")));
         step(Pass::shadeParticlePixels, dark ? noLight : "interpolate: bilinear over the pixel's particle's texels' Lr (biased)");
     } else if (estimatorInfo(est).passes == LightingPasses::voxelCache) {
         const VoxelSettings& v = s.voxel;

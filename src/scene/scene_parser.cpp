@@ -396,6 +396,10 @@ void validateLightingAndGeometry(const Settings& s, const RuleFailure& fail) {
         if (s.particle_split.far_new < s.particle_split.far)
             fail("particle_split.far_new", fmt::format("must be 0 or at least particle_split.far ({})", s.particle_split.far));
     }
+    if (s.render.estimator == EstimatorKind::particle_split && s.particle_split.far_share > 0 &&
+        (s.particle_split.history <= 0.0 || s.particle_split.history_of != HistoryOf::far))
+        fail("particle_split.far_share", "far_share blends a texel's far mean with its neighbours' far histories: set "
+                                         "particle_split.history and history_of = \"far\"");
     if (s.render.estimator == EstimatorKind::particle_split && s.particle_split.far_prior > 0) {
         if (s.particle_split.history <= 0.0 || s.particle_split.history_of != HistoryOf::far)
             fail("particle_split.far_prior", "far_prior starts a new texel's far mean from its neighbours' far histories: set "

@@ -849,6 +849,31 @@ TEST_CASE("particle_split: far_prior starts a new texel's far mean from its near
         CHECK(b.far == own);
         CHECK(b.age == 2);
     }
+    SECTION("far_share: every texel shows its far mean blended with its neighbours', its history keeping its own") {
+        // Texel 1 (in view last frame, age 20 + 2 far rays): its own far
+        // mean f = 0.1 own + 0.9 x 0.5, weighed by its age 22 (less than
+        // S (1 + h) / (1 - h) = 38) against far_share 11: Lr shows 2/3 f +
+        // 1/3 of its one near light's far mean b; the history keeps f.
+        b.p.farShare = 11;
+        psplit::sumSplitTexel(b, 1);
+        for (int c = 0; c < 3; ++c) {
+            const float f = 0.1f * own[c] + 0.9f * 0.5f;
+            CHECK(b.far[c] == Approx(f).epsilon(1e-6));
+            CHECK(b.Lr[c] == Approx(nearSum[c] + (2.0f * f + b.lastFar[1][c]) / 3.0f).epsilon(1e-6));
+        }
+        // Without the running mean's age its own far mean stands for the
+        // exponential average's 38 rays: 38 / 49 of it.
+        b.p.historyMean = false;
+        psplit::sumSplitTexel(b, 1);
+        for (int c = 0; c < 3; ++c) {
+            const float f = 0.1f * own[c] + 0.9f * 0.5f;
+            CHECK(b.Lr[c] == Approx(nearSum[c] + (38.0f * f + 11.0f * b.lastFar[1][c]) / 49.0f).epsilon(1e-5));
+        }
+        // A texel none of whose near lights was in view shows its own.
+        b.p.historyMean = true;
+        psplit::sumSplitTexel(b, 2);
+        CHECK(b.Lr == nearSum + own);
+    }
     SECTION("history_start first: the same blend, no age") {
         b.p.historyMean = false;
         b.age = 99;

@@ -406,10 +406,11 @@ ACC_HD void voxelCase(int k, const PassInputs* variants, const voxel::VoxelParam
 // RIS among 4 with a history (even particles: a fixed last Lr), its far
 // mean's alone, a running-mean start, 12 far draws without history
 // (far_new: the odd particles), and a new texel started from its near
-// lights' far means (far_prior).
+// lights' far means (far_prior), and every texel's far mean shown blended
+// with theirs (far_share).
 // Visibility is a fixed function of (point, light).
 
-constexpr int kSplitVariants = 8;
+constexpr int kSplitVariants = 9;
 constexpr int kSplitCases = (1 + kSplitVariants) * int(kGridW * kGridH);
 
 struct SplitCheckBridge {
@@ -502,7 +503,7 @@ struct Inputs {
     voxel::VoxelParams* voxel;  ///< l1, camera
     LightTreeView* tree;        ///< the light tree over the passes' lights
     std::uint64_t* paths;       ///< its lights' paths
-    psplit::SplitParams* split; ///< the near search; the eight texel variants
+    psplit::SplitParams* split; ///< the near search; the nine texel variants
 };
 
 enum class Step { neighbours, reprojections, caps, candidates, combines, shades, passes, loops, voxels, splits, texelPoints };
@@ -704,7 +705,7 @@ int main() {
         v.facesPlane = false;
     }
     // particle_split: the light tree over the passes' lights (lambert), one
-    // texel a particle; the near search's and the eight texel variants' settings.
+    // texel a particle; the near search's and the nine texel variants' settings.
     Particles lights;
     lights.position = centres;
     lights.emission = emission;
@@ -722,10 +723,11 @@ int main() {
         s.farSamples = v <= 1 ? 0 : 4;
         s.candidates = v >= 3 ? 4 : 1;
         s.history = v >= 3 ? 0.6f : 0.0f;
-        s.historyOfFar = v == 4 || v == 6 || v == 8;  // the far mean's history alone
+        s.historyOfFar = v == 4 || v == 6 || v >= 8;  // the far mean's history alone
         s.historyMean = v >= 5;             // a running mean over the texel's age first
         s.farNew = v == 7 ? 12 : 0;         // far_new: a texel without history draws 12
         s.farPrior = v == 8 ? 8 : 0;        // far_prior: and starts from its near lights' far means
+        s.farShare = v == 9 ? 24 : 0;       // far_share: every texel shown blended with them
         s.visible = texels;
         s.frame = 3;
         s.seed = 21;

@@ -33,7 +33,9 @@
 // weighs F / S frames. With particle_split.far_prior P (and history_of
 // far) such a texel's far mean starts as the mean of its near lights' far
 // means of last frame (those in view then), worth P far rays: a particle
-// new to the view starts from its world-space neighbours' far light. The pixels interpolate their particle's texels:
+// new to the view starts from its world-space neighbours' far light. With
+// particle_split.far_share every texel's Lr so blends its far mean with
+// its neighbours' (its history keeping its own). The pixels interpolate their particle's texels:
 // biased by the light at the texels, not at the pixel.
 //
 // The bodies are the CPU's (src/render/particle_split/) and the twin's
@@ -83,6 +85,7 @@ struct SplitParams {
     std::uint32_t farSamples = 8;   ///< particle_split.far: S
     std::uint32_t farNew = 0;       ///< particle_split.far_new: far draws of a texel without history (0: S)
     std::uint32_t farPrior = 0;     ///< particle_split.far_prior: far rays' worth of a new texel's near lights' far means (0: none)
+    std::uint32_t farShare = 0;     ///< particle_split.far_share: far rays' worth of every texel's near lights' far means in its Lr (0: none)
     std::uint32_t candidates = 1;   ///< particle_split.candidates: C far draws resampled into each far shadow ray
     std::uint32_t side = 1;         ///< particle_split.texels: texels per billboard side
     float history = 0.0f;           ///< particle_split.history
@@ -102,6 +105,7 @@ inline SplitParams splitParams(const Settings& s, std::uint32_t visible, std::ui
     p.farSamples = s.particle_split.far;
     p.farNew = s.particle_split.far_new;
     p.farPrior = s.particle_split.far_prior;
+    p.farShare = s.particle_split.far_share;
     p.candidates = s.particle_split.candidates;
     p.side = s.particle_split.texels;
     p.history = float(s.particle_split.history);
@@ -385,6 +389,26 @@ ACC_HD_BODY SplitRay traceSplitRay(B& b, std::size_t q, std::uint32_t r) {
     return out;
 }
 
+/// The mean of the far means that texel q's particle's near lights' same
+/// texels kept last frame (history_of far; those then in view): its
+/// world-space neighbours' far light. False where none was in view.
+template <class B>
+ACC_HD_BODY bool neighbourFarMean(B& b, std::size_t q, Vec3& mean) {
+    const SplitParams& p = b.params();
+    std::uint32_t near[kMaxNear];
+    const std::uint32_t k = b.nearLights(std::uint32_t(q / p.texelsPerParticle()), near);
+    Vec3 sum(0.0f);
+    std::uint32_t found = 0;
+    for (std::uint32_t m = 0; m < k; ++m) {
+        std::size_t hq = 0;
+        if (!b.historyTexelOf(near[m], std::uint32_t(q % p.texelsPerParticle()), hq)) continue;
+        sum += b.historyFar(hq);
+        ++found;
+    }
+    if (found > 0) mean = sum / float(found);
+    return found > 0;
+}
+
 /// A texel's age (history_start mean) counts the far rays it has averaged
 /// (its frames, where it draws none), held at 2^24 (past any 1 / (1 - h)
 /// the settings allow, and exact as a float): this frame's from last
@@ -423,30 +447,16 @@ ACC_HD_BODY void sumSplitTexel(B& b, std::size_t q) {
         }
         far += ray.value;
     }
-    // far_prior: a texel without history starts from the mean of the far
-    // means its particle's near lights' same texels kept last frame (those
-    // that were in view), worth farPrior far rays.
+    // far_prior: a texel without history starts from its neighbours' far
+    // light (neighbourFarMean), worth farPrior far rays.
     const std::uint32_t units = farRays > 0 ? farRays : 1u;
     Vec3 prior(0.0f);
     std::uint32_t priorUnits = 0;
-    if (history && p.historyOfFar && !seen && p.farPrior > 0) {
-        std::uint32_t near[kMaxNear];
-        const std::uint32_t k = b.nearLights(std::uint32_t(q / p.texelsPerParticle()), near);
-        std::uint32_t found = 0;
-        for (std::uint32_t m = 0; m < k; ++m) {
-            std::size_t hq = 0;
-            if (!b.historyTexelOf(near[m], std::uint32_t(q % p.texelsPerParticle()), hq)) continue;
-            prior += b.historyFar(hq);
-            ++found;
-        }
-        if (found > 0) {
-            prior = prior / float(found);
-            priorUnits = p.farPrior;
-        }
-    }
+    if (history && p.historyOfFar && !seen && p.farPrior > 0 && neighbourFarMean(b, q, prior)) priorUnits = p.farPrior;
     float keep = p.history;
+    std::uint32_t age = 0;
     if (history && p.historyMean) {  // this frame weighs units / age: 1 / n after n frames of S far rays
-        const std::uint32_t age = seen ? historyAgeAfter(b.historyAge(h), units) : units + priorUnits;
+        age = seen ? historyAgeAfter(b.historyAge(h), units) : units + priorUnits;
         keep = fminf(p.history, 1.0f - float(units) / float(age));
         b.writeTexelAge(q, age);
     }
@@ -458,6 +468,17 @@ ACC_HD_BODY void sumSplitTexel(B& b, std::size_t q) {
             farMean = own * farMean + (1.0f - own) * prior;
         }
         b.writeTexelFar(q, farMean);
+        // far_share: the texel shows its far mean blended with its
+        // neighbours' (the history keeps its own), each weighed by the far
+        // rays it stands for: its own by its age (or the exponential
+        // average's S (1 + h) / (1 - h), whichever is less), theirs as farShare.
+        Vec3 neighbours(0.0f);
+        if (p.farShare > 0 && neighbourFarMean(b, q, neighbours)) {
+            const float steady = float(units) * (1.0f + p.history) / (1.0f - p.history);
+            const float own = p.historyMean ? fminf(float(age), steady) : steady;
+            const float w = own / (own + float(p.farShare));
+            farMean = w * farMean + (1.0f - w) * neighbours;
+        }
         b.writeTexelLr(q, Lr + farMean);
         return;
     }
