@@ -179,8 +179,8 @@ void describe(const Settings& s, const FrameFacts& facts, FramePlan& plan) {
                                                   : fmt::format(", Lr averaged with last frame's (h = {})", ps.history),
                                               ps.history_start == HistoryStart::mean ? ", a running mean over a texel's first frames" : "",
                                               ps.far_new > ps.far ? fmt::format(", {} far rays for a texel without history (a second launch over those texels)", ps.far_new) : "",
-                                              ps.far_prior > 0 && ps.history_of == HistoryOf::far ? fmt::format(", a texel without history started from its near lights' far means (worth {} far rays)", ps.far_prior) : "",
-                                              ps.far_share > 0 && ps.history_of == HistoryOf::far ? fmt::format(", every texel's far mean shown blended with its near lights' (worth {} far rays)", ps.far_share) : "")));
+                                              ps.far_prior > 0 ? fmt::format(", a texel without history started from its near lights' far means (worth {} far rays)", ps.far_prior) : "",
+                                              ps.far_share > 0 ? fmt::format(", every texel's far mean shown blended with its near lights' (worth {} far rays)", ps.far_share) : "")));
         step(Pass::shadeParticlePixels, dark ? noLight : "interpolate: bilinear over the pixel's particle's texels' Lr (biased)");
     } else if (estimatorInfo(est).passes == LightingPasses::voxelCache) {
         const VoxelSettings& v = s.voxel;

@@ -4,8 +4,8 @@
 #include <cub/device/device_select.cuh>
 
 #include <algorithm>
-#include <stdexcept>
-#include <string>
+
+#include "cuda_error.h"
 
 namespace accretion::twin {
 namespace {
@@ -50,20 +50,14 @@ __global__ void writeTexelsKernel(const LaunchParams p, const std::uint32_t* sor
 
 unsigned groups(std::size_t n) { return unsigned((n + 255) / 256); }
 
-void check(cudaError_t e, const char* what) {
-    if (e != cudaSuccess) throw std::runtime_error(std::string(what) + ": " + cudaGetErrorString(e));
-}
-
 }  // namespace
 
 std::size_t gatherTempBytes(std::uint32_t n) {
     std::size_t selectBytes = 0, sortBytes = 0;
-    check(cub::DeviceSelect::Flagged(nullptr, selectBytes, static_cast<std::uint32_t*>(nullptr), static_cast<std::uint8_t*>(nullptr),
-                                     static_cast<std::uint32_t*>(nullptr), static_cast<std::uint32_t*>(nullptr), int(n)),
-          "cub::DeviceSelect::Flagged");
-    check(cub::DeviceRadixSort::SortPairs(nullptr, sortBytes, static_cast<std::uint64_t*>(nullptr), static_cast<std::uint64_t*>(nullptr),
-                                          static_cast<std::uint32_t*>(nullptr), static_cast<std::uint32_t*>(nullptr), int(n), 0, 63),
-          "cub::DeviceRadixSort::SortPairs");
+    CUDA_CHECK(cub::DeviceSelect::Flagged(nullptr, selectBytes, static_cast<std::uint32_t*>(nullptr), static_cast<std::uint8_t*>(nullptr),
+                                          static_cast<std::uint32_t*>(nullptr), static_cast<std::uint32_t*>(nullptr), int(n)));
+    CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, sortBytes, static_cast<std::uint64_t*>(nullptr), static_cast<std::uint64_t*>(nullptr),
+                                               static_cast<std::uint32_t*>(nullptr), static_cast<std::uint32_t*>(nullptr), int(n), 0, 63));
     return std::max(selectBytes, sortBytes);
 }
 
@@ -71,26 +65,25 @@ std::uint32_t findVisibleParticles(const LaunchParams& p, const MortonFrame& fra
     const std::uint32_t n = p.particleCount;
     const std::size_t pixels = std::size_t(p.camera.width) * p.camera.height;
     if (n == 0) return 0;
-    check(cudaMemsetAsync(a.flags, 0, n, stream), "cudaMemsetAsync");
+    CUDA_CHECK(cudaMemsetAsync(a.flags, 0, n, stream));
     markVisibleKernel<<<groups(pixels), 256, 0, stream>>>(p.gbuffer, pixels, a.flags);
     iotaKernel<<<groups(n), 256, 0, stream>>>(a.sortedIds, n);
 
     // The visible ids, in id order.
     std::size_t bytes = a.tempBytes;
-    check(cub::DeviceSelect::Flagged(a.temp, bytes, a.sortedIds, a.flags, a.ids, a.count, int(n), stream), "cub::DeviceSelect::Flagged");
+    CUDA_CHECK(cub::DeviceSelect::Flagged(a.temp, bytes, a.sortedIds, a.flags, a.ids, a.count, int(n), stream));
     std::uint32_t visible = 0;
-    check(cudaMemcpyAsync(&visible, a.count, sizeof visible, cudaMemcpyDeviceToHost, stream), "cudaMemcpyAsync");
-    check(cudaStreamSynchronize(stream), "cudaStreamSynchronize");
+    CUDA_CHECK(cudaMemcpyAsync(&visible, a.count, sizeof visible, cudaMemcpyDeviceToHost, stream));
+    CUDA_CHECK(cudaStreamSynchronize(stream));
 
-    check(cudaMemsetAsync(a.slotOf, 0xff, n * sizeof(std::uint32_t), stream), "cudaMemsetAsync");
+    CUDA_CHECK(cudaMemsetAsync(a.slotOf, 0xff, n * sizeof(std::uint32_t), stream));
     if (visible == 0) return 0;
     // Morton order, ties by id: the radix sort is stable and its input in id order.
     mortonKeysKernel<<<groups(visible), 256, 0, stream>>>(p.position, a.ids, visible, frame, a.keys);
     bytes = a.tempBytes;
-    check(cub::DeviceRadixSort::SortPairs(a.temp, bytes, a.keys, a.sortedKeys, a.ids, a.sortedIds, int(visible), 0, 63, stream),
-          "cub::DeviceRadixSort::SortPairs");
+    CUDA_CHECK(cub::DeviceRadixSort::SortPairs(a.temp, bytes, a.keys, a.sortedKeys, a.ids, a.sortedIds, int(visible), 0, 63, stream));
     writeSlotsKernel<<<groups(visible), 256, 0, stream>>>(a.sortedIds, visible, a.slotOf);
-    check(cudaGetLastError(), "findVisibleParticles");
+    CUDA_CHECK(cudaGetLastError());
     return visible;
 }
 
@@ -98,7 +91,7 @@ void writeParticleTexels(const LaunchParams& p, const std::uint32_t* sortedIds, 
                          std::uint32_t layers, const TexelPointRule& points, std::size_t gridTexels, GBufferTexel* texels,
                          cudaStream_t stream) {
     writeTexelsKernel<<<groups(gridTexels), 256, 0, stream>>>(p, sortedIds, visible, side, layers, points, gridTexels, texels);
-    check(cudaGetLastError(), "writeParticleTexels");
+    CUDA_CHECK(cudaGetLastError());
 }
 
 }  // namespace accretion::twin

@@ -1,13 +1,12 @@
 // particle_split's CUDA kernels: particle_split_passes.h's bodies over the
-// twin's bridge (split_device.h). Errors are checked by the caller
-// (cudaGetLastError after the pass).
+// twin's bridge (split_device.h). The launches' errors are checked by the
+// caller (cudaGetLastError after the pass); far_new's select checks its
+// CUB and copy calls itself.
 #include "split_kernels.h"
 
 #include <cub/device/device_select.cuh>
 
-#include <stdexcept>
-#include <string>
-
+#include "cuda_error.h"
 #include "split_device.h"
 
 namespace accretion::twin {
@@ -43,10 +42,6 @@ __global__ void interpolateSplitPixelsKernel(const __grid_constant__ LaunchParam
     psplit::interpolateSplitPixel(b, std::size_t(y) * p.camera.width + x);
 }
 
-void check(cudaError_t e, const char* what) {
-    if (e != cudaSuccess) throw std::runtime_error(std::string(what) + ": " + cudaGetErrorString(e));
-}
-
 }  // namespace
 
 void findNearLights(const LaunchParams& p, cudaStream_t stream) {
@@ -56,9 +51,8 @@ void findNearLights(const LaunchParams& p, cudaStream_t stream) {
 
 std::size_t splitSelectTempBytes(std::size_t texels) {
     std::size_t bytes = 0;
-    check(cub::DeviceSelect::Flagged(nullptr, bytes, static_cast<std::uint32_t*>(nullptr), static_cast<std::uint8_t*>(nullptr),
-                                     static_cast<std::uint32_t*>(nullptr), static_cast<std::uint32_t*>(nullptr), int(texels)),
-          "cub::DeviceSelect::Flagged");
+    CUDA_CHECK(cub::DeviceSelect::Flagged(nullptr, bytes, static_cast<std::uint32_t*>(nullptr), static_cast<std::uint8_t*>(nullptr),
+                                          static_cast<std::uint32_t*>(nullptr), static_cast<std::uint32_t*>(nullptr), int(texels)));
     return bytes;
 }
 
@@ -66,11 +60,10 @@ std::size_t selectNewSplitTexels(const LaunchParams& p, std::size_t texels, cons
     if (texels == 0) return 0;
     markNewSplitTexelsKernel<<<unsigned((texels + 127) / 128), 128, 0, stream>>>(p, texels, a.flags, a.ids);
     std::size_t bytes = a.tempBytes;
-    check(cub::DeviceSelect::Flagged(a.temp, bytes, a.ids, a.flags, p.split.newTexels, a.count, int(texels), stream),
-          "cub::DeviceSelect::Flagged");
+    CUDA_CHECK(cub::DeviceSelect::Flagged(a.temp, bytes, a.ids, a.flags, p.split.newTexels, a.count, int(texels), stream));
     std::uint32_t fresh = 0;
-    check(cudaMemcpyAsync(&fresh, a.count, sizeof fresh, cudaMemcpyDeviceToHost, stream), "cudaMemcpyAsync");
-    check(cudaStreamSynchronize(stream), "cudaStreamSynchronize");
+    CUDA_CHECK(cudaMemcpyAsync(&fresh, a.count, sizeof fresh, cudaMemcpyDeviceToHost, stream));
+    CUDA_CHECK(cudaStreamSynchronize(stream));
     return fresh;
 }
 

@@ -26,8 +26,9 @@ LightingCounters shadeSplitTexels(const CpuFrame& f) {
                    : &f.in.counters->add(Pass::shadeSplitTexels, std::uint32_t(texels), raysPerTexel(f.params));
         pc->dispatches = extra ? 3 : 2;
     }
-    return forEachItem(f, texels, pc, [extra](auto& b, std::size_t q) {
-        if (extra) newSplitTexel(b, q);  // the select's reads: record q's, as the sum's
+    const bool countSelect = extra && pc;
+    return forEachItem(f, texels, pc, [countSelect](auto& b, std::size_t q) {
+        if (countSelect) newSplitTexel(b, q);  // counting: the select's reads, record q's as the sum's
         sumSplitTexel(b, q);
     });
 }
