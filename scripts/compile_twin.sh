@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Compiles the OptiX twin (src/twin) without a GPU, as CI does: the OptiX
 # programs to OptiX-IR, the CUDA kernels and the host code to objects, and
-# links accretion-optix against the Release build's accretion_base. Then the
-# check of the ReSTIR steps the CPU and the twin share (restir_steps.h) on
-# the GPU against the CPU (tests/twin/shared_core_check.cu) is compiled, and
-# run when this machine has a GPU. GPU runs stay on a GPU machine
+# links accretion-optix against the Release build's accretion_base. Beside
+# them the check of the steps the CPU and the twin share (restir_steps.h,
+# particle_split_passes.h, ...) on the GPU against the CPU
+# (tests/twin/shared_core_check.cu) is compiled; it runs when this machine
+# has a GPU. GPU runs stay on a GPU machine
 # (bench/gpu/run.sh).
 #   scripts/compile_twin.sh [BUILD_DIR]      (default build: the Release build)
 # nvcc: $NVCC, else nvcc on PATH, else /usr/local/cuda, else CUDA 13's
@@ -62,7 +63,14 @@ cuflags=(-std=c++20 -O3 -fmad=false --expt-relaxed-constexpr -diag-suppress=2001
          -Iinclude -Isrc/twin -I"$optix" -I"$build/generated" -I"$cuda_inc")
 cxxflags=(-std=c++20 -O2 -Wall -Wextra -Wno-unused-parameter -Iinclude -Isrc/twin -I"$optix" -I"$cuda_inc")
 
+cudart=$(find "$cuda" "$(dirname "$cuda_inc")" \( -name 'libcudart.so*' -o -name 'libcudart_static.a' \) 2>/dev/null | head -1)
 pids=()
+# The shared steps checked where they run: on the GPU against the CPU
+# (tests/twin/shared_core_check.cu). Compiled on every run, beside the twin's
+# files (alone after them it kept one core idle for 11 s); run below only
+# where there is a GPU (bench/gpu/run.sh shared_core on the lent one).
+"$nvcc" "${cuflags[@]}" tests/twin/shared_core_check.cu "$build/libaccretion_base.a" -L"$(dirname "$cudart")" -ltomlplusplus -ltbb \
+    -lfmt -ldl -lpthread -o "$out/shared_core_check" & pids+=($!)  # the library: particle_split's step builds a LightTree
 "$nvcc" "${cuflags[@]}" -optix-ir -c src/twin/programs.cu -o "$out/programs.optixir" & pids+=($!)
 for f in kernels restir_kernels gather_particle_texels voxel_kernels split_kernels; do
     "$nvcc" "${cuflags[@]}" -c src/twin/$f.cu -o "$out/$f.o" & pids+=($!)
@@ -71,16 +79,10 @@ for f in twin_main optix_pipeline particle_accel; do
     g++ "${cxxflags[@]}" -DACCRETION_TWIN_PROGRAMS="\"$out/programs.optixir\"" -c src/twin/$f.cpp -o "$out/$f.o" & pids+=($!)
 done
 for p in "${pids[@]}"; do wait "$p"; done
-cudart=$(find "$cuda" "$(dirname "$cuda_inc")" \( -name 'libcudart.so*' -o -name 'libcudart_static.a' \) 2>/dev/null | head -1)
 "$nvcc" -arch=sm_90 "$out"/{twin_main,optix_pipeline,particle_accel,kernels,restir_kernels,gather_particle_texels,voxel_kernels,split_kernels}.o \
     "$build/libaccretion_base.a" -L"$(dirname "$cudart")" -ltomlplusplus -ltbb -lfmt -ldl -lpthread -o "$out/accretion-optix"
 echo "compile_twin: $out/accretion-optix and $out/programs.optixir" >&2
 
-# The shared steps checked where they run: on the GPU against the CPU
-# (tests/twin/shared_core_check.cu). Compiled on every run; run only where
-# there is a GPU (bench/gpu/run.sh shared_core on the lent one).
-"$nvcc" "${cuflags[@]}" tests/twin/shared_core_check.cu "$build/libaccretion_base.a" -L"$(dirname "$cudart")" -ltomlplusplus -ltbb \
-    -lfmt -ldl -lpthread -o "$out/shared_core_check"  # the library: particle_split's step builds a LightTree
 if command -v nvidia-smi >/dev/null 2>&1 && nvidia-smi -L >/dev/null 2>&1; then
     "$out/shared_core_check"
 else

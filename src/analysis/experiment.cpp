@@ -64,9 +64,24 @@ std::uint32_t steadyStateHistory(const Settings& settings) {
     const LightingPasses passes = estimatorInfo(settings.render.estimator).passes;
     if (passes == LightingPasses::voxelCache)  // the cells' running mean to its cap
         return settings.voxel.history > 1.0 ? std::max(kAtLeast, static_cast<std::uint32_t>(std::ceil(settings.voxel.history))) : 0;
-    if (passes == LightingPasses::particleSplit) {  // the texels' exponential average, until the first frame weighs under 1%
-        const double h = settings.particle_split.history;
-        return h > 0.0 ? std::max(kAtLeast, static_cast<std::uint32_t>(std::ceil(std::log(0.01) / std::log(h)))) : 0;
+    if (passes == LightingPasses::particleSplit) {  // the texels' average, until the first frame weighs under 1%
+        const ParticleSplitSettings& p = settings.particle_split;
+        const double h = p.history;
+        if (h <= 0.0) return 0;
+        if (p.history_start == HistoryStart::first)  // h^n
+            return std::max(kAtLeast, static_cast<std::uint32_t>(std::ceil(std::log(0.01) / std::log(h))));
+        // A running mean (sumSplitTexel): a frame of S far rays weighs
+        // max(1 - h, S / age) where age counts the far rays averaged, the
+        // first frame's far_new of them if set. Frame 0 has no last frame,
+        // so far_prior adds nothing to it.
+        const double S = std::max(p.far, 1u);
+        double age = p.far_new > 0 ? p.far_new : S, first = 1.0;
+        std::uint32_t n = 0;
+        for (; first >= 0.01; ++n) {
+            age += S;
+            first *= 1.0 - std::max(1.0 - h, S / age);
+        }
+        return std::max(kAtLeast, n);
     }
     if (!estimatorInfo(settings.render.estimator).reuse || !settings.restir.temporal) return 0;
     return std::max(kAtLeast, static_cast<std::uint32_t>(std::ceil(settings.restir.m_cap)));

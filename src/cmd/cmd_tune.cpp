@@ -26,6 +26,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <tuple>
 
@@ -124,6 +125,39 @@ std::vector<GeometryChoice> geometryChoices(const Settings& s) {
     return out;
 }
 
+/// particle_split's texel history and how a particle new to the view
+/// starts (docs/designs.md): the settings of [particle_split] past its
+/// rays, each at its default unless set.
+struct SplitHistory {
+    TexelPoint point = TexelPoint::centre;
+    HistoryStart start = HistoryStart::first;
+    HistoryOf of = HistoryOf::all;
+    std::uint32_t farNew = 0, farPrior = 0, farShare = 0;
+
+    /// " anti mean far-only prior32 share256": the settings not at their defaults.
+    std::string label() const {
+        std::string l;
+        if (point != TexelPoint::centre) l += point == TexelPoint::antithetic ? " anti" : " jitter";
+        if (start == HistoryStart::mean) l += " mean";
+        if (of == HistoryOf::far) l += " far-only";
+        if (farNew) l += fmt::format(" new{}", farNew);
+        if (farPrior) l += fmt::format(" prior{}", farPrior);
+        if (farShare) l += fmt::format(" share{}", farShare);
+        return l;
+    }
+    /// The -D overrides of the settings not at their defaults.
+    std::vector<std::string> defines() const {
+        std::vector<std::string> d;
+        if (point != TexelPoint::centre) d.push_back(fmt::format("particle_split.texel_point={}", enumName(point)));
+        if (start != HistoryStart::first) d.push_back(fmt::format("particle_split.history_start={}", enumName(start)));
+        if (of != HistoryOf::all) d.push_back(fmt::format("particle_split.history_of={}", enumName(of)));
+        if (farNew) d.push_back(fmt::format("particle_split.far_new={}", farNew));
+        if (farPrior) d.push_back(fmt::format("particle_split.far_prior={}", farPrior));
+        if (farShare) d.push_back(fmt::format("particle_split.far_share={}", farShare));
+        return d;
+    }
+};
+
 /// The design a lighting choice runs: restir per pixel, particle_restir
 /// per particle texel (texels per side, reservoirs a texel, how the pixels
 /// read them), voxel_cache in world cells (cells along the longest side,
@@ -137,6 +171,7 @@ struct Design {
     VoxelBasis basis = VoxelBasis::camera;
     std::uint32_t near = 16, far = 8, farCandidates = 8;
     double history = 0.75;
+    SplitHistory splitHistory{};
 };
 
 /// A lighting choice: its design (restir or particle_restir), candidate
@@ -157,8 +192,8 @@ struct LightingChoice {
     bool split() const { return design.estimator == EstimatorKind::particle_split; }
     std::string label() const {
         if (split())
-            return fmt::format("split near={} far={} C={} h={:g} {}x{}", design.near, design.far, design.farCandidates, design.history,
-                               design.texels, design.texels);
+            return fmt::format("split near={} far={} C={} h={:g} {}x{}{}", design.near, design.far, design.farCandidates, design.history,
+                               design.texels, design.texels, design.splitHistory.label());
         if (voxels())
             return fmt::format("voxels {} cells={} rays={} {}", enumName(source), design.cells, design.cellRays, enumName(design.basis));
         if (particles())
@@ -174,10 +209,15 @@ struct LightingChoice {
             return {"render.estimator=voxel_cache", fmt::format("render.source={}", enumName(source)),
                     fmt::format("voxel.cells={}", design.cells), fmt::format("voxel.rays={}", design.cellRays),
                     fmt::format("voxel.basis={}", enumName(design.basis))};
-        if (split())  // its own settings alone, as the voxel cache's
-            return {"render.estimator=particle_split", fmt::format("particle_split.near={}", design.near),
-                    fmt::format("particle_split.far={}", design.far), fmt::format("particle_split.candidates={}", design.farCandidates),
-                    fmt::format("particle_split.history={:g}", design.history), fmt::format("particle_split.texels={}", design.texels)};
+        if (split()) {  // its own settings alone, as the voxel cache's
+            std::vector<std::string> d = {"render.estimator=particle_split", fmt::format("particle_split.near={}", design.near),
+                                          fmt::format("particle_split.far={}", design.far),
+                                          fmt::format("particle_split.candidates={}", design.farCandidates),
+                                          fmt::format("particle_split.history={:g}", design.history),
+                                          fmt::format("particle_split.texels={}", design.texels)};
+            for (std::string& o : design.splitHistory.defines()) d.push_back(std::move(o));
+            return d;
+        }
         std::vector<std::string> d = restirDefines();
         if (particles()) {
             d.front() = "render.estimator=particle_restir";
@@ -203,7 +243,7 @@ private:
 };
 
 /// The lighting choices of `space`: quick, 34 restir points around the GPU
-/// team's settings, 8 of particle_restir, 2 of voxel_cache and 3 of
+/// team's settings, 8 of particle_restir, 2 of voxel_cache and 10 of
 /// particle_split; full, the whole grids (hours).
 std::vector<LightingChoice> lightingChoices(const std::string& space) {
     struct Axes {
@@ -290,7 +330,37 @@ std::vector<LightingChoice> lightingChoices(const std::string& space) {
                     for (const double h : {0.0, 0.5, 0.75, 0.9})
                         if (!(c == 8 && std::find(quickSplits.begin(), quickSplits.end(), std::tuple{near, far, h}) != quickSplits.end()))
                             designs.push_back(split(near, far, c, h));
+    // The long history of designs.md's answer: h = 0.95 averaging the far
+    // light alone, from a running mean (steady after 51 frames, which moves
+    // tune's frame there); a particle new to the view started from its near
+    // lights' far means (far_prior) and every texel's shown blended with
+    // them (far_share). The quick space holds designs.md's 100K answer and
+    // its less biased form (far_share 64), the answer without them, the 1M
+    // answer (4 candidates, antithetic texel points) and near 16, far 8.
+    const auto longSplit = [&](std::uint32_t near, std::uint32_t far, std::uint32_t candidates, TexelPoint point,
+                               std::uint32_t prior, std::uint32_t share) {
+        LightingChoice c = split(near, far, candidates, 0.95);
+        c.design.splitHistory = {point, HistoryStart::mean, HistoryOf::far, 0, prior, share};
+        return c;
+    };
+    using enum TexelPoint;
+    designs.push_back(longSplit(8, 4, 8, centre, 0, 0));
+    designs.push_back(longSplit(8, 4, 8, centre, 32, 64));
+    designs.push_back(longSplit(8, 4, 8, centre, 32, 256));
+    designs.push_back(longSplit(8, 4, 4, antithetic, 32, 256));
+    designs.push_back(longSplit(16, 8, 8, centre, 32, 256));
+    if (space == "full")  // the options across the answer's neighbourhood
+        for (std::uint32_t near : {8u, 16u})
+            for (std::uint32_t far : {4u, 8u})
+                for (std::uint32_t c : {4u, 8u})
+                    for (const TexelPoint point : {centre, antithetic})
+                        for (const auto& [prior, share] : std::vector<std::pair<std::uint32_t, std::uint32_t>>{
+                                 {0, 0}, {32, 0}, {32, 64}, {32, 256}, {32, 1024}})
+                            designs.push_back(longSplit(near, far, c, point, prior, share));
     out.insert(out.end(), designs.begin(), designs.end());
+    // A grid point the quick space also lists is measured once: the first kept.
+    std::set<std::string> labels;
+    std::erase_if(out, [&](const LightingChoice& c) { return !labels.insert(c.label()).second; });
     return out;
 }
 

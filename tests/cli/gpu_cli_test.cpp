@@ -380,13 +380,14 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
     // An M cap of 8: the steady state's history is 8 frames (the least it
     // may be), so each bias run renders 9 frames, not 21 (minutes under ASan).
     // Under the sanitizers (a seed divisor) the same configurations on a
-    // frame half as wide and high, measured on one crop instead of four:
-    // every path of tune runs, on a sixteenth of the pixels (the whole run
-    // took 174 s of CI under ASan).
+    // frame half as wide and high, measured on one crop instead of four, of
+    // half the particles: every path of tune runs, on a sixteenth of the
+    // pixels (the whole run took 174 s of CI under ASan; with 800 particles
+    // and particle_split's ten, 89 s alone, with 400 59 s).
     const bool whole = fullStatisticalPower();
     const std::uint32_t width = whole ? 96 : 48, height = whole ? 64 : 32, cropW = width / 3, cropH = height * 3 / 8, strata = whole ? 2 : 1;
     const std::size_t crops = strata * strata;
-    const std::string frame = whole ? std::string() : " -D camera.width=48 -D camera.height=32";
+    const std::string frame = whole ? std::string() : " -D camera.width=48 -D camera.height=32 -D particles.count=400";
     const std::string base = kBin + " tune " + tinyScene() + frame + " -D restir.m_cap=8 --error-crops " + std::to_string(strata) + "x" +
                              std::to_string(strata) + " --crop-size " + std::to_string(cropW) + "x" + std::to_string(cropH) + " --crop-margin " +
                              std::to_string(cropH / 3) + " --seeds 3 --cache " + (dir / "cache").string() + " -o " + (dir / "t").string() +
@@ -398,7 +399,7 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
     const nlohmann::json j = nlohmann::json::parse(slurp(dir / "t.json"));
     // Every measured point: the front is exactly the set no other point beats on both axes.
     const nlohmann::json& rows = j.at("lighting");
-    const std::size_t quick = 34 + 8 + 2 + 5;  // restir, particle_restir, voxel_cache, particle_split
+    const std::size_t quick = 34 + 8 + 2 + 10;  // restir, particle_restir, voxel_cache, particle_split
     REQUIRE(rows.size() == quick);
     for (const auto& p : rows) {
         bool dominated = false;
@@ -444,9 +445,11 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
     // longest: restir's and particle_restir's M cap of 8 frames; the voxel
     // cache's running mean to voxel.history = 16; particle_split's texel
     // average until its first frame weighs under 1% (0.75^17 < 0.01 <=
-    // 0.75^16, 0.9^44 < 0.01 <= 0.9^43).
+    // 0.75^16, 0.9^44 < 0.01 <= 0.9^43; from a running mean at h = 0.95,
+    // 1/20 after 19 frames, then 0.05 x 0.95^32 < 0.01 <= 0.05 x 0.95^31).
     const auto historyOf = [](const std::string& spec) {
-        return spec.find("particle_split.history=0.9:") != std::string::npos    ? 44
+        return spec.find("particle_split.history=0.95:") != std::string::npos   ? 51
+               : spec.find("particle_split.history=0.9:") != std::string::npos  ? 44
                : spec.find("particle_split.history=0.75:") != std::string::npos ? 17
                : spec.starts_with("voxel_cache")                                 ? 16
                                                                                  : 8;
@@ -454,17 +457,22 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
     const nlohmann::json longer = {{"split near=8 far=4 C=8 h=0.9 1x1", 44},  {"split near=16 far=8 C=8 h=0.9 1x1", 44},
                                    {"split near=8 far=4 C=8 h=0.75 1x1", 17}, {"split near=16 far=8 C=8 h=0.75 1x1", 17},
                                    {"split near=16 far=16 C=8 h=0.75 1x1", 17}, {"voxels tree cells=32 rays=8 camera", 16},
-                                   {"voxels tree cells=64 rays=8 camera", 16}};
-    CHECK(j["frame"] == 44);
+                                   {"voxels tree cells=64 rays=8 camera", 16},
+                                   {"split near=8 far=4 C=8 h=0.95 1x1 mean far-only", 51},
+                                   {"split near=8 far=4 C=8 h=0.95 1x1 mean far-only prior32 share64", 51},
+                                   {"split near=8 far=4 C=8 h=0.95 1x1 mean far-only prior32 share256", 51},
+                                   {"split near=8 far=4 C=4 h=0.95 1x1 anti mean far-only prior32 share256", 51},
+                                   {"split near=16 far=8 C=8 h=0.95 1x1 mean far-only prior32 share256", 51}};
+    CHECK(j["frame"] == 51);
     CHECK(j["history_frames"] == 8);
     CHECK(j["longer_histories"] == longer);
-    std::size_t biasRuns = 0;  // and each bias run rendered its own history before frame 44
+    std::size_t biasRuns = 0;  // and each bias run rendered its own history before frame 51
     for (const auto& e : std::filesystem::directory_iterator(dir / "cache"))
         if (e.path().string().ends_with(".bias.json")) {
             const nlohmann::json run = nlohmann::json::parse(slurp(e.path()));
             const std::string spec = run.at("rows").at(0).at("estimator");
             INFO(spec);
-            CHECK(run.at("frame") == 44);
+            CHECK(run.at("frame") == 51);
             CHECK(run.at("rows").at(0).at("history_frames") == historyOf(spec));
             ++biasRuns;
         }
@@ -619,7 +627,7 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
     CHECK_FALSE(std::filesystem::exists(dir / "bad.json"));
     // A run from before the space grew, at frame 8 (no texel history longer
     // than the M cap then): priced at its frame, the configurations that do
-    // not fit before it left out and named; with --frame 44 refused.
+    // not fit before it left out and named; with --frame 51 refused.
     {
         nlohmann::json before = nlohmann::json::parse(slurp(dir / "first.json"));
         before["frame"] = 8;
@@ -627,17 +635,17 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
         std::ofstream(dir / "before.json") << before.dump();
         const std::string fromBefore = with(base, "-o", (dir / "at8").string()) +
                                        " --max-seeds 3 --designs particle_restir,particle_split --errors-from " + (dir / "before.json").string();
-        CHECK(runCommand(fromBefore + " --frame 44", out) == 1);
-        CHECK_THAT(out, Contains("before.json: measured at another operating point: frame 8 there, 44 here"));
+        CHECK(runCommand(fromBefore + " --frame 51", out) == 1);
+        CHECK_THAT(out, Contains("before.json: measured at another operating point: frame 8 there, 51 here"));
         REQUIRE(runCommand(fromBefore, out) == 0);
         CHECK_THAT(out, Contains("left out: split near=8 far=4 C=8 h=0.9 1x1 needs 44 history frames"));
         const nlohmann::json at8 = nlohmann::json::parse(slurp(dir / "at8.json"));
         CHECK(at8.at("frame") == 8);
         CHECK(at8.at("longer_histories") == nlohmann::json::object());
-        // particle_split's five need more than 8 frames (17 at h = 0.75, 44 at 0.9, as above).
-        const nlohmann::json leftOut = {{"split near=8 far=4 C=8 h=0.9 1x1", 44},  {"split near=16 far=8 C=8 h=0.9 1x1", 44},
-                                        {"split near=8 far=4 C=8 h=0.75 1x1", 17}, {"split near=16 far=8 C=8 h=0.75 1x1", 17},
-                                        {"split near=16 far=16 C=8 h=0.75 1x1", 17}};
+        // particle_split's ten need more than 8 frames (17 at h = 0.75, 44 at 0.9, 51 at 0.95 from a running mean, as above).
+        nlohmann::json leftOut = longer;
+        leftOut.erase("voxels tree cells=32 rays=8 camera");
+        leftOut.erase("voxels tree cells=64 rays=8 camera");
         CHECK(at8.at("errors_from").at("left_out") == leftOut);
         std::map<std::string, nlohmann::json> was;
         for (const auto& p : rows) was[p["lighting"]] = p;
@@ -661,10 +669,10 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
     // bounds of 7% and more with 3 seeds) need more seeds to be told.
     // Under the sanitizers particle_restir's 8 alone (--designs): the same
     // escalation, without the voxel cache's 11 seeds and particle_split's 6
-    // (21 of its 23 s under ASan), at the first run's frame (44: its
-    // particle_split at h = 0.9), which particle_restir alone would not move to.
+    // (21 of its 23 s under ASan), at the first run's frame (51: its
+    // particle_split at h = 0.95), which particle_restir alone would not move to.
     const double boundPct = 5.0;
-    REQUIRE(runCommand(base + " --bias-bound 5 --max-seeds 12 -q" + (whole ? "" : " --designs particle_restir --frame 44"), out) == 0);
+    REQUIRE(runCommand(base + " --bias-bound 5 --max-seeds 12 -q" + (whole ? "" : " --designs particle_restir --frame 51"), out) == 0);
     const nlohmann::json k = nlohmann::json::parse(slurp(dir / "t.json"));
     std::map<std::string, nlohmann::json> first3;
     for (const auto& p : rows) first3[p["lighting"]] = p;

@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "accretion/analysis/experiment.h"
 #include "accretion/geometry/billboard.h"
 #include "accretion/render/frame_plan.h"
 #include "accretion/render/particle_split_passes.h"
@@ -389,6 +390,9 @@ TEST_CASE("particle_split: jittered and antithetic texels are unbiased for the l
     const Particles& ps = traced.particles;
     const DVec3 right(traced.camera.right), up(traced.camera.up);
     const int kSeeds = int(test::statisticalSeeds(400, 50));
+    // Each particle's area mean at 64 x 64 and 32 x 32, once for both modes
+    // (the brute-force sums are most of the test's time).
+    std::map<std::uint32_t, std::pair<double, double>> areaMeans;
     for (const TexelPoint mode : {TexelPoint::jittered, TexelPoint::antithetic}) {
     s.particle_split.texel_point = mode;
     std::map<std::uint32_t, std::pair<double, double>> sums;  // luminance: sum, sum of squares
@@ -416,7 +420,9 @@ TEST_CASE("particle_split: jittered and antithetic texels are unbiased for the l
     for (const auto& [j, ss] : sums) {
         const double mean = ss.first / kSeeds;
         const double var = std::max(0.0, ss.second / kSeeds - mean * mean) / (kSeeds - 1);
-        const double expect = areaMean(j, 64), quadrature = std::abs(expect - areaMean(j, 32));
+        auto known = areaMeans.find(j);
+        if (known == areaMeans.end()) known = areaMeans.emplace(j, std::pair{areaMean(j, 64), areaMean(j, 32)}).first;
+        const double expect = known->second.first, quadrature = std::abs(expect - known->second.second);
         const double centre = bruteForceLr(ps, j, s, Vec3(0.0f, 0.0f, 1.0f)).y;
         INFO("particle " << j << " mean " << mean << " area mean " << expect << " (quadrature " << quadrature << ") centre " << centre
                          << " stderr " << std::sqrt(var));
@@ -903,4 +909,35 @@ TEST_CASE("particle_split: far_prior changes nothing where no particle comes int
         const FrameImage x = a.render(f, sa), y = b.render(f, sb);
         REQUIRE(x.lighting.Lr == y.lighting.Lr);
     }
+}
+
+TEST_CASE("particle_split: the steady state is the frames after which the first weighs under 1%, in closed form", "[particle_split]") {
+    Settings s = splitSettings(ShadingModel::lambert, 400, 4, 2);
+    s.render.estimator = EstimatorKind::particle_split;
+    s.particle_split.history = 0.95;
+    // From the first frame: it weighs 0.95^n, 0.95^90 < 0.01 <= 0.95^89.
+    CHECK(steadyStateHistory(s) == 90);
+    // A running mean: after n frames the first weighs 1/(n+1) until that
+    // falls to 1 - h = 1/20 (n = 19), then 0.95 less each frame:
+    // 0.05 x 0.95^32 < 0.01 <= 0.05 x 0.95^31, so 19 + 32. The same for any
+    // number of far rays a frame, and far_prior adds nothing to frame 0.
+    s.particle_split.history_start = HistoryStart::mean;
+    for (const std::uint32_t far : {1u, 4u, 8u}) {
+        s.particle_split.far = far;
+        CHECK(steadyStateHistory(s) == 51);
+    }
+    s.particle_split.far_prior = 32;
+    CHECK(steadyStateHistory(s) == 51);
+    // far_new 16 of far 4: the first frame weighs 16 of the 16 + 4n rays
+    // until 4 / (16 + 4n) falls to 1/20 (n = 16, 16/80), then 0.95^m:
+    // 0.2 x 0.95^59 < 0.01 <= 0.2 x 0.95^58, so 16 + 59.
+    s.particle_split.far = 4;
+    s.particle_split.far_new = 16;
+    CHECK(steadyStateHistory(s) == 75);
+    // Never under 8 frames, none without a history.
+    s.particle_split.far_new = 0;
+    s.particle_split.history = 0.5;
+    CHECK(steadyStateHistory(s) == 8);
+    s.particle_split.history = 0.0;
+    CHECK(steadyStateHistory(s) == 0);
 }
