@@ -1,7 +1,7 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine, from the repository root:
 #   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
-#                                      layout_images layouts streams front identity shared_core ab designs resample near_ncu voxel_ncu gather_ncu voxels splits iterations split_anatomy split_ncu split_stalls ray_launch split_order gbuffer_ncu near_cluster_ncu history texel_point history_start far_new far_prior far_share
+#                                      layout_images layouts streams front identity shared_core ab designs resample near_ncu voxel_ncu gather_ncu voxels splits iterations split_anatomy split_ncu split_stalls ray_launch split_order gbuffer_ncu near_cluster_ncu history texel_point history_start far_new far_prior far_share tune_h95
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -405,6 +405,16 @@ step_far_share() {
     grep -E '^(ps_n8_f4_c8_h95_mean_far_prior32(_share(64|256))?_100k|ps_n8_f4_c4_h95_anti_mean_far_prior32(_share(64|256))?_1m|restir_m32_t_pairwise_05x_(100k|1m)) ' \
         bench/gpu/designs.txt > "$W/far_share.txt"
     time_configs far_share "$W/far_share.txt" 5
+}
+
+# tune's quick space at h = 0.95 (its five particle_split configurations
+# with the long history, cmd_tune.cpp) at 100K, beside its earlier
+# recommendation (near 16, far 16 of 8, h = 0.75) and restir's best, in one
+# run: the twin's times of what tune priced with the cost model.
+step_tune_h95() {
+    grep -E '^(ps_n8_f4_c8_h95_mean_far(_prior32_share(64|256))?|ps_n8_f4_c4_h95_anti_mean_far_prior32_share256|ps_n16_f8_c8_h95_mean_far_prior32_share256|ps_n16_f16_c8_h75|restir_m32_t_pairwise_05x)_100k ' \
+        bench/gpu/designs.txt > "$W/tune_h95.txt"
+    time_configs tune_h95 "$W/tune_h95.txt" 5
 }
 
 # The spatial passes run once and twice, each iteration timed apart
