@@ -338,9 +338,9 @@ std::vector<LightingChoice> lightingChoices(const std::string& space) {
     // its less biased form (far_share 64), the answer without them, the 1M
     // answer (4 candidates, antithetic texel points) and near 16, far 8.
     const auto longSplit = [&](std::uint32_t near, std::uint32_t far, std::uint32_t candidates, TexelPoint point,
-                               std::uint32_t prior, std::uint32_t share) {
+                               std::uint32_t prior, std::uint32_t share, std::uint32_t farNew = 0) {
         LightingChoice c = split(near, far, candidates, 0.95);
-        c.design.splitHistory = {point, HistoryStart::mean, HistoryOf::far, 0, prior, share};
+        c.design.splitHistory = {point, HistoryStart::mean, HistoryOf::far, farNew, prior, share};
         return c;
     };
     using enum TexelPoint;
@@ -349,14 +349,15 @@ std::vector<LightingChoice> lightingChoices(const std::string& space) {
     designs.push_back(longSplit(8, 4, 8, centre, 32, 256));
     designs.push_back(longSplit(8, 4, 4, antithetic, 32, 256));
     designs.push_back(longSplit(16, 8, 8, centre, 32, 256));
-    if (space == "full")  // the options across the answer's neighbourhood
+    if (space == "full")  // the options across the answer's neighbourhood, and 16 far rays for a new particle's texels
         for (std::uint32_t near : {8u, 16u})
             for (std::uint32_t far : {4u, 8u})
                 for (std::uint32_t c : {4u, 8u})
                     for (const TexelPoint point : {centre, antithetic})
                         for (const auto& [prior, share] : std::vector<std::pair<std::uint32_t, std::uint32_t>>{
                                  {0, 0}, {32, 0}, {32, 64}, {32, 256}, {32, 1024}})
-                            designs.push_back(longSplit(near, far, c, point, prior, share));
+                            for (const std::uint32_t farNew : {0u, 16u})
+                                designs.push_back(longSplit(near, far, c, point, prior, share, farNew));
     out.insert(out.end(), designs.begin(), designs.end());
     // A grid point the quick space also lists is measured once: the first kept.
     std::set<std::string> labels;
@@ -1125,10 +1126,16 @@ void printTune(const TuneArgs& a, const Settings& scene, const TuneContext& t, c
                    a.maxError ? fmt::format(" and relMSE {:g}", *a.maxError) : "", chosen.label(), best->lighting.label(), best->ms,
                    best->error.relMse, best->error.seeds,
                    best->error.label().empty() ? fmt::format("unbiased to {:.2g}%", best->error.detectablePct) : best->error.label());
-    // Which design and why: each design's lowest error under the budget (biased ones aside unless allowed).
+    // Which design and why: each design's lowest error under the budget
+    // (biased ones aside unless allowed), and how many times the
+    // recommendation's error and GPU time it is.
     for (const auto& [design, p] : bestPerDesign(a, r))
         fmt::print("  best {} under {:g} ms: {} at {:.3f} ms, relMSE {:.4g}{}\n", design, a.budgetMs, p->lighting.label(), p->ms,
-                   p->error.relMse, p == r.best ? " (recommended)" : "");
+                   p->error.relMse,
+                   p == r.best ? std::string(" (recommended)")
+                   : r.best    ? fmt::format(" ({:.3g}x the recommendation's error in {:.2f}x its time)", p->error.relMse / r.best->error.relMse,
+                                             p->ms / r.best->ms)
+                               : std::string());
     if (!r.best)
         fmt::print("no {}configuration is under {:g} ms{}\n", a.allowBiased ? "" : "unbiased ", a.budgetMs,
                    a.maxError ? fmt::format(" with relMSE <= {:g}", *a.maxError) : "");
@@ -1160,7 +1167,8 @@ void writeTuneJson(const std::string& prefix, const TuneArgs& a, const Settings&
     }
     nlohmann::json designs = nlohmann::json::object();  // each design's best under the budget
     for (const auto& [design, p] : bestPerDesign(a, r))
-        designs[design] = {{"lighting", p->lighting.label()}, {"gpu_ms", p->ms}, {"rel_mse", p->error.relMse}};
+        designs[design] = {{"lighting", p->lighting.label()}, {"gpu_ms", p->ms}, {"rel_mse", p->error.relMse},
+                           {"error_vs_recommended", r.best ? nlohmann::json(p->error.relMse / r.best->error.relMse) : nlohmann::json()}};
     nlohmann::json reuse = nlohmann::json::object();  // per lighting configuration, per pass: the offers by outcome
     for (const ParetoPoint& p : r.points)
         if (!p.error.reuse.is_null()) reuse[p.lighting.label()] = p.error.reuse;

@@ -438,7 +438,10 @@ TEST_CASE("tune: a Pareto front of predicted GPU ms against error, the best unbi
         CHECK(designs.contains(design) == eligible);
     }
     CHECK(designs.at(r["design"].get<std::string>())["lighting"] == r["lighting"]);
-    for (const auto& [design, best] : designs.items()) CHECK(best["rel_mse"].get<double>() >= r["rel_mse"].get<double>());
+    for (const auto& [design, best] : designs.items()) {
+        CHECK(best["rel_mse"].get<double>() >= r["rel_mse"].get<double>());
+        CHECK(best["error_vs_recommended"].get<double>() == Approx(best["rel_mse"].get<double>() / r["rel_mse"].get<double>()));
+    }
     // Reuse per configuration, at the steady state it was measured at: no
     // spatial pass without neighbours; every offer of the passes that ran counted.
     // Each configuration after its own steady state, the frame after the
