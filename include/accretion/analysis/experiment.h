@@ -43,8 +43,12 @@ struct ExperimentRender {
 /// The history frames that bring an estimator's reuse to steady state, as
 /// the engine runs it: for temporal reuse until the history's M cap
 /// saturates (a reservoir gains the current M a frame, up to m_cap times
-/// it: ceil(m_cap) frames) and at least 8; none without temporal reuse
-/// (nothing of a frame carries over to the next).
+/// it: ceil(m_cap) frames); the voxel cache's running mean to
+/// voxel.history; particle_split's texel average until its first frame
+/// weighs under 1% (h^n, or from a running mean 1/(n+1) until that falls
+/// to 1 - h, the first frame counting far_new rays where set); each at
+/// least 8; none without reuse (nothing of a frame carries over to the
+/// next).
 std::uint32_t steadyStateHistory(const Settings& settings);
 
 /// --history: "steady" (steadyStateHistory of each configuration) or a
