@@ -422,17 +422,40 @@ double leaveOneConfigOut(const std::vector<const CostRow*>& rows, const FeatureM
     return n ? std::sqrt(sum / double(n)) : 0.0;
 }
 
+/// A pass timed in fewer configurations than this is fitted as a scale of
+/// the fit of every pass (scaledFit): on one to three configurations a fit
+/// of its own over every counter is underdetermined, and NNLS then keeps
+/// whichever counters these few happen to follow (the world reuse fitted on
+/// 100K and 1M priced the cluster's 49-73% high).
+constexpr std::size_t kMinConfigsPerPass = 4;
+
+/// `shared` (every pass's fit) times the one factor that fits `rows` best
+/// in relative error: sum (s p_i / m_i - 1)^2 is least at s = sum(p_i / m_i)
+/// / sum((p_i / m_i)^2).
+CostFeatures scaledFit(const std::vector<const CostRow*>& rows, const CostFeatures& shared) {
+    double num = 0.0, den = 0.0;
+    for (const CostRow* r : rows) {
+        if (!(r->measuredMs > 0.0)) continue;
+        const double q = dotMs(shared, r->features) / r->measuredMs;
+        num += q;
+        den += q * q;
+    }
+    const double s = den > 0.0 ? num / den : 1.0;
+    CostFeatures ns = shared;
+    for (double& x : ns) x *= s;
+    return ns;
+}
+
 /// The selected form of one pass: the launch counters (a constant per
 /// dispatch, build and refit: always a cost where they occur, and a
 /// configuration of their own, such as the only refit, cannot vote for them
 /// when left out), then forward selection of the work counters, each step
 /// adding the one that lowers the leave-one-configuration-out error most,
 /// until none lowers it by more than its standard error; then the fit over
-/// the chosen counters. With fewer than 4 configurations, every counter
-/// (per_pass).
+/// the chosen counters. fit() calls it for passes timed in at least
+/// kMinConfigsPerPass configurations.
 CostFeatures fitSelected(const std::vector<const CostRow*>& rows, const FeatureMask& allowed) {
     const std::size_t nConfigs = distinctConfigs(rows).size();
-    if (nConfigs < 4) return fitRows(rows, allowed, true);
     FeatureMask chosen{};
     for (std::size_t k = 0; k < kCostFeatureCount; ++k)
         if (kCostFeatureTable[k].launch) chosen[k] = allowed[k];
@@ -510,7 +533,9 @@ CostCoefficients fit(const std::vector<CostRow>& input, CostModelForm form) {
     for (const CostRow& r : rows) all.push_back(&r);
     c.ns = fitRows(all, firstFeatures(kCostFeatures.size()), true);  // for a pass no row has
     for (const auto& [pass, rs] : rowsByPass(rows))
-        c.perPass[pass] = form == CostModelForm::selected ? fitSelected(rs, passFeatures(pass)) : fitRows(rs, passFeatures(pass), true);
+        c.perPass[pass] = distinctConfigs(rs).size() < kMinConfigsPerPass ? scaledFit(rs, c.ns)
+                          : form == CostModelForm::selected           ? fitSelected(rs, passFeatures(pass))
+                                                                      : fitRows(rs, passFeatures(pass), true);
     c.source = fmt::format("calibrated ({})", costModelFormName(form));
     return c;
 }

@@ -406,3 +406,58 @@ TEST_CASE("a pass timed once for all its runs joins its runs' counters summed, a
         if (r.pass.pass == Pass::spatialResampling) CHECK(r.measuredMs == double(r.pass.run));
     }
 }
+
+TEST_CASE("a pass timed in fewer than four configurations is priced as a scale of every pass's fit", "[gpu][cost]") {
+    // Every pass costs 1.5 ns a ray and 200 us a dispatch, nothing a thread.
+    // traceShadowRays is timed in 40 configurations of 1 to 10 M threads;
+    // resampleWorldNeighbours in 2 of 1 M threads. A fit of those two rows
+    // over every counter can put the dispatch's cost on the threads (they
+    // are the same in both); a third configuration of 10 M threads tells.
+    CostCoefficients truth;
+    truth.ns[CostFeature::rays] = 1.5;
+    truth.ns[CostFeature::dispatches] = 200000.0;
+    auto row = [&](const std::string& config, Pass pass, double threads, double rays, double scale) {
+        CostRow r{config, {pass}, {}, 0.0};
+        r.features[CostFeature::threads] = threads;
+        r.features[CostFeature::rays] = rays;
+        r.features[CostFeature::dispatches] = 1.0;
+        r.measuredMs = scale * truth.predictMs(r.features);
+        return r;
+    };
+    std::vector<CostRow> rows;
+    for (int c = 0; c < 40; ++c)
+        rows.push_back(row("c" + std::to_string(c), Pass::traceShadowRays, 1e6 * (1 + (c * 7) % 10), 1e5 * (1 + c), 1.0));
+    for (const double scale : {1.0, 1.25}) {
+        INFO("scale " << scale);
+        std::vector<CostRow> fitted = rows;
+        fitted.push_back(row("c0", Pass::resampleWorldNeighbours, 1e6, 2e5, scale));
+        fitted.push_back(row("c1", Pass::resampleWorldNeighbours, 1e6, 8e5, scale));
+        const Calibration c = calibrate(fitted, CostModelForm::per_pass);
+        const CostFeatures& world = c.coefficients.perPass.at(Pass::resampleWorldNeighbours);
+        // The least relative error of s x the shared fit: s = sum(q) / sum(q^2), q = shared / measured.
+        double num = 0.0, den = 0.0;
+        for (const CostRow& r : fitted)
+            if (r.pass.pass == Pass::resampleWorldNeighbours) {
+                const double q = c.coefficients.predictMs(r.features) / r.measuredMs;
+                num += q;
+                den += q * q;
+            }
+        for (std::size_t k = 0; k < world.size(); ++k) CHECK(world[k] == Approx(num / den * c.coefficients.ns[k]).margin(1e-12));
+        const CostRow unseen = row("c2", Pass::resampleWorldNeighbours, 1e7, 8e5, scale);
+        const double predicted = c.coefficients.predictMs(Pass::resampleWorldNeighbours, unseen.features);
+        if (scale == 1.0) {
+            // The shared fit is exact here (every row follows the truth): the scale is 1, the unseen configuration priced exactly.
+            CHECK(num / den == Approx(1.0).epsilon(1e-9));
+            CHECK(predicted == Approx(unseen.measuredMs).epsilon(1e-6));
+        } else {
+            CHECK(num / den > 1.1);  // the pass's own level, not the shared fit's
+            CHECK(predicted == Approx(unseen.measuredMs).epsilon(0.1));
+        }
+        // With four configurations the pass has a fit of its own over its counters.
+        fitted.push_back(row("c2", Pass::resampleWorldNeighbours, 3e6, 4e5, scale));
+        fitted.push_back(row("c3", Pass::resampleWorldNeighbours, 2e6, 1e5, scale));
+        const CostCoefficients own = calibrate(fitted, CostModelForm::per_pass).coefficients;
+        CHECK(own.predictMs(Pass::resampleWorldNeighbours, unseen.features) == Approx(unseen.measuredMs).epsilon(1e-6));
+        CHECK(own.perPass.at(Pass::resampleWorldNeighbours)[CostFeature::rays] == Approx(scale * 1.5).epsilon(1e-6));
+    }
+}
