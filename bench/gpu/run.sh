@@ -1,7 +1,7 @@
 #!/bin/bash
 # The OptiX twin's runs on a GPU machine, from the repository root:
 #   bash bench/gpu/run.sh STEP...      steps: env build images restir sampling seeds sweep builds frame ncu
-#                                      layout_images layouts streams front identity shared_core ab designs resample near_ncu voxel_ncu gather_ncu voxels splits iterations split_anatomy split_ncu split_stalls ray_launch split_order gbuffer_ncu near_cluster_ncu history texel_point history_start far_new far_prior far_share tune_h95
+#                                      layout_images layouts streams front identity shared_core ab designs resample near_ncu voxel_ncu gather_ncu voxels splits iterations split_anatomy split_ncu split_stalls ray_launch split_order gbuffer_ncu near_cluster_ncu history texel_point history_start far_new far_prior far_share tune_h95 far_handoff
 # Needs .twin-deps/ (made here by bench/gpu/stage_deps.sh on a Debian 12
 # machine: the header-only and small libraries the twin's host code uses,
 # the OptiX SDK headers, the commit). Results go to $OUT (or out/gpu).
@@ -415,6 +415,21 @@ step_tune_h95() {
     grep -E '^(ps_n8_f4_c8_h95_mean_far(_prior32_share(64|256))?|ps_n8_f4_c4_h95_anti_mean_far_prior32_share256|ps_n16_f8_c8_h95_mean_far_prior32_share256|ps_n16_f16_c8_h75|restir_m32_t_pairwise_05x)_100k ' \
         bench/gpu/designs.txt > "$W/tune_h95.txt"
     time_configs tune_h95 "$W/tune_h95.txt" 5
+}
+
+# particle_split.far_handoff (the far history follows the near set): its
+# frames on quickstart (frames 0-2, the disk rotating particles' near sets
+# apart) for compare_cpu.sh, and designs.txt's _handoff lines timed beside
+# the same configurations without it, in one run.
+step_far_handoff() {
+    quickstart_frames far_handoff particle_split ps_handoff_share24_prior8_mean_far_c4_h9 -D particle_split.far_handoff=true \
+        -D particle_split.far_share=24 -D particle_split.far_prior=8 -D particle_split.history_of=far -D particle_split.history_start=mean \
+        -D particle_split.candidates=4 -D particle_split.history=0.9
+    quickstart_frames far_handoff particle_split ps_handoff_2x2_far_anti_h5 -D particle_split.far_handoff=true -D particle_split.texels=2 \
+        -D particle_split.history_of=far -D particle_split.texel_point=antithetic -D particle_split.history=0.5
+    grep -E '^(ps_n8_f4_c8_h95_mean_far_prior32_share256(_handoff)?_100k|ps_n16_f8_c8_h95_mean_far(_prior32_share256)?(_handoff)?_100k|ps_n8_f4_c4_h95_anti_mean_far_prior32_share256(_handoff)?_1m) ' \
+        bench/gpu/designs.txt > "$W/far_handoff.txt"
+    time_configs far_handoff "$W/far_handoff.txt" 5
 }
 
 # The spatial passes run once and twice, each iteration timed apart

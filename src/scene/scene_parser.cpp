@@ -400,6 +400,10 @@ void validateLightingAndGeometry(const Settings& s, const RuleFailure& fail) {
         (s.particle_split.history <= 0.0 || s.particle_split.history_of != HistoryOf::far))
         fail("particle_split.far_share", "far_share blends a texel's far mean with its neighbours' far histories: set "
                                          "particle_split.history and history_of = \"far\"");
+    if (s.render.estimator == EstimatorKind::particle_split && s.particle_split.far_handoff &&
+        (s.particle_split.history <= 0.0 || s.particle_split.history_of != HistoryOf::far || s.particle_split.near == 0))
+        fail("particle_split.far_handoff", "far_handoff moves lights between a texel's far history and its near sum: set "
+                                           "particle_split.history, history_of = \"far\" and near");
     if (s.render.estimator == EstimatorKind::particle_split && s.particle_split.far_prior > 0) {
         if (s.particle_split.history <= 0.0 || s.particle_split.history_of != HistoryOf::far)
             fail("particle_split.far_prior", "far_prior starts a new texel's far mean from its neighbours' far histories: set "

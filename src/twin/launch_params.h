@@ -126,6 +126,10 @@ struct SplitLaunch {
     const Vec3* prevTexelFar = nullptr;         ///< and last frame's
     std::uint32_t* texelAge = nullptr;          ///< particle_split.history_start mean: the far rays (frames) each texel has averaged
     const std::uint32_t* prevTexelAge = nullptr;  ///< and last frame's
+    const std::uint32_t* prevNear = nullptr;      ///< particle_split.far_handoff: last frame's near lights by its slots (as near)
+    const std::uint32_t* prevNearFound = nullptr;
+    Vec3* texelNear = nullptr;                    ///< the texels' near terms, texel q's m at q x params.nearCount + m
+    const Vec3* prevTexelNear = nullptr;          ///< and last frame's
 };
 
 struct LaunchParams {

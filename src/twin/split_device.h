@@ -73,6 +73,14 @@ public:
     __device__ Vec3 historyFar(std::size_t q) const { return s_.prevTexelFar[q]; }
     __device__ void writeTexelFar(std::size_t q, const Vec3& far) const { s_.texelFar[q] = far; }
     __device__ std::uint32_t historyAge(std::size_t q) const { return s_.prevTexelAge[q]; }
+    __device__ std::uint32_t historyNearLights(std::uint32_t v, std::uint32_t* light) const {
+        const std::uint32_t n = s_.prevNearFound[v];
+        const std::uint32_t* in = s_.prevNear + std::size_t(v) * s_.params.nearCount;
+        for (std::uint32_t m = 0; m < n; ++m) light[m] = in[m];
+        return n;
+    }
+    __device__ Vec3 historyNearValue(std::size_t q, std::uint32_t m) const { return s_.prevTexelNear[q * s_.params.nearCount + m]; }
+    __device__ void writeTexelNear(std::size_t q, std::uint32_t m, const Vec3& v) const { s_.texelNear[q * s_.params.nearCount + m] = v; }
     __device__ void writeTexelAge(std::size_t q, std::uint32_t n) const { s_.texelAge[q] = n; }
 
     // shadeParticlePixels

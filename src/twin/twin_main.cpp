@@ -128,6 +128,7 @@ struct FrameBuffers {
     DeviceBuffer prevSlotOf, prevTexelLr;
     DeviceBuffer splitFar, prevSplitFar;  ///< particle_split.history_of far: the texels' far means' average, this frame's and last
     DeviceBuffer splitAge, prevSplitAge;  ///< particle_split.history_start mean: the far rays (frames) each texel has averaged
+    DeviceBuffer prevSplitNear, prevSplitNearFound, splitTexelNear, prevSplitTexelNear;  ///< particle_split.far_handoff: last frame's near sets; the texels' near terms
     DeviceBuffer prevPosition, prevEmission, prevAlbedo, prevDmin2, prevGbuffer, prevReservoirs;
     DeviceBuffer aliasProb, aliasAlias, aliasPmf;  // power: the alias table
     DeviceBuffer treeNodes, treePaths;            // tree: the light tree's nodes; particle_split: each light's path
@@ -215,6 +216,7 @@ private:
     Vec3 origin_{0.0f};
     VoxelPlacement voxelPlacement_;  ///< voxel_cache: where its grid lies (the CPU's VoxelCache's rule)
     unsigned voxelLast_ = 0;         ///< voxel_cache: buf_.voxelCells[voxelLast_] holds last frame's cells
+    std::size_t splitVisible_ = 0;   ///< particle_split: this frame's visible particles (slots), for keepSplitHistory
     bool splitHistory_ = false;      ///< particle_split: buf_.prevSlotOf and prevTexelLr hold last frame's
     Particles particles_;  ///< this frame's, rebased to origin_
     std::map<std::uint32_t, Particles> loaded_;  ///< --seeds: each frame's particles, loaded once
@@ -473,6 +475,7 @@ void TwinRun::runParticleSplit(LaunchParams& lp) {
         sl.params.visible = gatherTexels(lp, s_.particle_split.texels, 1, psplit::texelPoints(s_, sl.params.frame, sl.params.seed));
     }
     const std::size_t grid = std::size_t(gridW_) * gridH_, visible = sl.params.visible;
+    splitVisible_ = visible;
     buf_.splitNear.reserve(std::max<std::size_t>(1, visible * sl.params.nearCount) * sizeof(std::uint32_t));
     buf_.splitNearFound.reserve(std::max<std::size_t>(1, visible) * sizeof(std::uint32_t));
     buf_.splitNearRadius2.reserve(std::max<std::size_t>(1, visible) * sizeof(float));
@@ -519,6 +522,13 @@ void TwinRun::runParticleSplit(LaunchParams& lp) {
         sl.texelFar = buf_.splitFar.as<Vec3>();
         sl.prevTexelFar = buf_.prevSplitFar.as<Vec3>();
     }
+    if (sl.params.history > 0.0f && sl.params.historyOfFar && sl.params.farHandoff) {
+        buf_.splitTexelNear.reserve(std::max<std::size_t>(1, grid * sl.params.nearCount) * sizeof(Vec3));
+        sl.texelNear = buf_.splitTexelNear.as<Vec3>();
+        sl.prevTexelNear = buf_.prevSplitTexelNear.as<Vec3>();
+        sl.prevNear = buf_.prevSplitNear.as<std::uint32_t>();
+        sl.prevNearFound = buf_.prevSplitNearFound.as<std::uint32_t>();
+    }
     if (sl.params.history > 0.0f && sl.params.historyMean) {
         buf_.splitAge.reserve(grid * sizeof(std::uint32_t));
         sl.texelAge = buf_.splitAge.as<std::uint32_t>();
@@ -558,6 +568,12 @@ void TwinRun::keepSplitHistory(std::size_t n) {
         copyDevice(buf_.prevSplitFar, buf_.splitFar, std::size_t(gridW_) * gridH_ * sizeof(Vec3), stream_);
     if (s_.particle_split.history_start == HistoryStart::mean)
         copyDevice(buf_.prevSplitAge, buf_.splitAge, std::size_t(gridW_) * gridH_ * sizeof(std::uint32_t), stream_);
+    if (s_.particle_split.history_of == HistoryOf::far && s_.particle_split.far_handoff) {
+        const std::size_t k = s_.particle_split.near;
+        copyDevice(buf_.prevSplitNear, buf_.splitNear, std::max<std::size_t>(1, splitVisible_ * k) * sizeof(std::uint32_t), stream_);
+        copyDevice(buf_.prevSplitNearFound, buf_.splitNearFound, std::max<std::size_t>(1, splitVisible_) * sizeof(std::uint32_t), stream_);
+        copyDevice(buf_.prevSplitTexelNear, buf_.splitTexelNear, std::max<std::size_t>(1, std::size_t(gridW_) * gridH_ * k) * sizeof(Vec3), stream_);
+    }
     CUDA_CHECK(cudaStreamSynchronize(stream_));
     prevCount_ = static_cast<std::uint32_t>(n);
     splitHistory_ = true;

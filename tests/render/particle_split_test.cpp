@@ -784,6 +784,9 @@ struct PriorBridge {
     std::vector<std::uint32_t> lastSlot;
     std::vector<Vec3> lastFar;
     std::vector<std::uint32_t> lastAge;
+    std::vector<std::vector<std::uint32_t>> lastNear;  ///< far_handoff: last frame's near lights by its slots
+    std::vector<std::vector<Vec3>> lastNearValue;      ///< and its texels' near terms (a texel a slot here)
+    std::vector<Vec3> nearWritten;                     ///< this frame's near terms of the texel summed
     std::vector<Vec3> ray;  ///< ray r's value, every texel
     Vec3 Lr{0.0f}, far{0.0f};
     std::uint32_t age = 0;
@@ -810,6 +813,15 @@ struct PriorBridge {
     void writeTexelAge(std::size_t, std::uint32_t n) { age = n; }
     void writeTexelFar(std::size_t, const Vec3& f) { far = f; }
     void writeTexelLr(std::size_t, const Vec3& L) { Lr = L; }
+    std::uint32_t historyNearLights(std::uint32_t v, std::uint32_t* light) const {
+        std::copy(lastNear[v].begin(), lastNear[v].end(), light);
+        return std::uint32_t(lastNear[v].size());
+    }
+    Vec3 historyNearValue(std::size_t q, std::uint32_t m) const { return lastNearValue[q][m]; }
+    void writeTexelNear(std::size_t, std::uint32_t m, const Vec3& v) {
+        if (nearWritten.size() <= m) nearWritten.resize(m + 1);
+        nearWritten[m] = v;
+    }
 };
 
 }  // namespace
@@ -904,6 +916,84 @@ TEST_CASE("particle_split: far_prior changes nothing where no particle comes int
     Settings prior = s;
     prior.particle_split.far_prior = 8;
     FrameRenderer a(s, source, RenderOptions{true}), b(prior, source, RenderOptions{true});
+    for (std::uint32_t f = 0; f < 4; ++f) {
+        FrameStats sa, sb;
+        const FrameImage x = a.render(f, sa), y = b.render(f, sb);
+        REQUIRE(x.lighting.Lr == y.lighting.Lr);
+    }
+}
+
+TEST_CASE("particle_split: far_handoff moves the lights that joined or left the near set between the far history and the near sum, in closed form",
+          "[particle_split]") {
+    // Near 3, far 2, h 0.9 (history_start first): texel 1 (particle 1) has
+    // near lights 7, 4 and 9 now; last frame (its slot 2) it had 4, 3 and 8,
+    // with near terms (4) a, (3) b and (8) c. 7 and 9 joined the near set:
+    // the history's far light held them (at their far terms then); 3 and 8
+    // left it: the history lacks them. Its history, as if its frames had
+    // taken this frame's near set out: last far - (v7 + v9) + (b + c).
+    PriorBridge b;
+    b.p.nearCount = 3;
+    b.p.farSamples = 2;
+    b.p.history = 0.9f;
+    b.p.historyOfFar = true;
+    b.p.farHandoff = true;
+    b.near = {{5}, {7, 4, 9}};
+    b.lastSlot.assign(8, kNoSlot);
+    b.lastSlot[1] = 2;
+    b.lastFar = {Vec3(0.0f), Vec3(0.0f), Vec3(6.0f, 5.0f, 4.0f)};
+    b.lastNear = {{}, {}, {4, 3, 8}};
+    const Vec3 a(0.5f, 0.25f, 1.0f), bb(1.0f, 2.0f, 0.5f), c(0.25f, 0.5f, 0.75f);
+    b.lastNearValue = {{}, {}, {a, bb, c}};
+    const Vec3 v7(1.0f, 0.5f, 0.25f), v4(0.75f), v9(0.5f, 1.5f, 1.0f);
+    b.ray = {v7, v4, v9, Vec3(4.0f, 0.0f, 2.0f), Vec3(2.0f, 8.0f, 0.0f)};
+    const Vec3 own(3.0f, 4.0f, 1.0f);
+    SECTION("a texel with history") {
+        psplit::sumSplitTexel(b, 1);
+        const Vec3 last = b.lastFar[2] - (v7 + v9) + (bb + c);
+        for (int k = 0; k < 3; ++k) {
+            CHECK(b.far[k] == Approx(0.1f * own[k] + 0.9f * last[k]).epsilon(1e-6));
+            CHECK(b.Lr[k] == Approx(v7[k] + v4[k] + v9[k] + 0.1f * own[k] + 0.9f * last[k]).epsilon(1e-6));
+        }
+        // This frame's near terms, in the order of its near lights, for the next frame.
+        REQUIRE(b.nearWritten.size() == 3);
+        CHECK(b.nearWritten[0] == v7);
+        CHECK(b.nearWritten[1] == v4);
+        CHECK(b.nearWritten[2] == v9);
+    }
+    SECTION("the same near set: the history as it is") {
+        b.lastNear[2] = {9, 7, 4};
+        psplit::sumSplitTexel(b, 1);
+        for (int k = 0; k < 3; ++k) CHECK(b.far[k] == Approx(0.1f * own[k] + 0.9f * b.lastFar[2][k]).epsilon(1e-6));
+    }
+    SECTION("without far_handoff the history is read as it is, no near term kept") {
+        b.p.farHandoff = false;
+        psplit::sumSplitTexel(b, 1);
+        for (int k = 0; k < 3; ++k) CHECK(b.far[k] == Approx(0.1f * own[k] + 0.9f * b.lastFar[2][k]).epsilon(1e-6));
+        CHECK(b.nearWritten.empty());
+    }
+    SECTION("a texel new to the view keeps its near terms and reads no history") {
+        b.near[0] = {5, 6, 7};
+        psplit::sumSplitTexel(b, 0);
+        CHECK(b.far == own);
+        REQUIRE(b.nearWritten.size() == 3);
+        CHECK(b.nearWritten[2] == v9);
+    }
+}
+
+TEST_CASE("particle_split: far_handoff changes nothing where no near set changes", "[particle_split]") {
+    // A static disk and camera: every particle keeps its near set, so the
+    // frames are those without far_handoff, bit for bit.
+    Settings s = splitSettings(ShadingModel::lambert, 400, 4, 2);
+    s.shading.visibility = true;
+    s.particles.gm = 0.0;
+    s.render.frames = 4;
+    s.particle_split.history = 0.9;
+    s.particle_split.history_of = HistoryOf::far;
+    s.particle_split.history_start = HistoryStart::mean;
+    const ParticleSource source(s);
+    Settings handoff = s;
+    handoff.particle_split.far_handoff = true;
+    FrameRenderer a(s, source, RenderOptions{true}), b(handoff, source, RenderOptions{true});
     for (std::uint32_t f = 0; f < 4; ++f) {
         FrameStats sa, sb;
         const FrameImage x = a.render(f, sa), y = b.render(f, sb);

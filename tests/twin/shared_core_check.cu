@@ -406,11 +406,13 @@ ACC_HD void voxelCase(int k, const PassInputs* variants, const voxel::VoxelParam
 // RIS among 4 with a history (even particles: a fixed last Lr), its far
 // mean's alone, a running-mean start, 12 far draws without history
 // (far_new: the odd particles), and a new texel started from its near
-// lights' far means (far_prior), and every texel's far mean shown blended
-// with theirs (far_share).
+// lights' far means (far_prior), every texel's far mean shown blended
+// with theirs (far_share), and its far history following a near set that
+// changed since last frame (far_handoff: last frame's set a fixed function
+// of this one's, the near terms kept hashed).
 // Visibility is a fixed function of (point, light).
 
-constexpr int kSplitVariants = 9;
+constexpr int kSplitVariants = 10;
 constexpr int kSplitCases = (1 + kSplitVariants) * int(kGridW * kGridH);
 
 struct SplitCheckBridge {
@@ -478,6 +480,18 @@ struct SplitCheckBridge {
         o.w[6] = bits(far.y);
         o.w[7] = bits(far.z);
     }
+    /// Last frame's near set: this one's with every third light replaced by
+    /// a light index shifted by 5, and one light fewer where it is long.
+    ACC_HD std::uint32_t historyNearLights(std::uint32_t v, std::uint32_t* light) const {
+        std::uint32_t n = nearLights(v, light);
+        for (std::uint32_t m = 0; m < n; m += 3) light[m] = (light[m] + 5u) % in.particles;
+        return n > 4 ? n - 1 : n;
+    }
+    ACC_HD Vec3 historyNearValue(std::size_t q, std::uint32_t m) const { return Vec3(0.01f * float((q + m) % 9u), 0.02f * float(m), 0.05f); }
+    /// The near terms, hashed where history_start mean would write the age.
+    ACC_HD void writeTexelNear(std::size_t, std::uint32_t m, const Vec3& v) const {
+        o.w[4] = o.w[4] * 0x9e3779b1u + (bits(v.x) ^ bits(v.y) * 3u ^ bits(v.z) * 7u ^ m);
+    }
 };
 
 ACC_HD void splitCase(int k, const PassInputs* variants, const LightTreeView* tree, const std::uint64_t* paths,
@@ -503,7 +517,7 @@ struct Inputs {
     voxel::VoxelParams* voxel;  ///< l1, camera
     LightTreeView* tree;        ///< the light tree over the passes' lights
     std::uint64_t* paths;       ///< its lights' paths
-    psplit::SplitParams* split; ///< the near search; the nine texel variants
+    psplit::SplitParams* split; ///< the near search; the ten texel variants
 };
 
 enum class Step { neighbours, reprojections, caps, candidates, combines, shades, passes, loops, voxels, splits, texelPoints };
@@ -705,7 +719,7 @@ int main() {
         v.facesPlane = false;
     }
     // particle_split: the light tree over the passes' lights (lambert), one
-    // texel a particle; the near search's and the nine texel variants' settings.
+    // texel a particle; the near search's and the ten texel variants' settings.
     Particles lights;
     lights.position = centres;
     lights.emission = emission;
@@ -728,6 +742,8 @@ int main() {
         s.farNew = v == 7 ? 12 : 0;         // far_new: a texel without history draws 12
         s.farPrior = v == 8 ? 8 : 0;        // far_prior: and starts from its near lights' far means
         s.farShare = v == 9 ? 24 : 0;       // far_share: every texel shown blended with them
+        s.farHandoff = v == 10;             // far_handoff: the far history follows the near set (no running mean: the near terms' hash in the age's word)
+        if (v == 10) s.historyMean = false;
         s.visible = texels;
         s.frame = 3;
         s.seed = 21;

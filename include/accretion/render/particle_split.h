@@ -45,6 +45,8 @@ private:
     std::vector<Vec3> prevTexelLr_;          ///< last frame's texels' Lr
     std::vector<Vec3> prevTexelFar_;         ///< and their far means' average (history_of far)
     std::vector<std::uint32_t> prevTexelAge_;  ///< and the frames each has been seen (history_start mean)
+    std::vector<std::uint32_t> prevNear_, prevNearFound_;  ///< far_handoff: last frame's near lights by its slots
+    std::vector<Vec3> prevTexelNear_;                      ///< and its texels' near terms
 };
 
 }  // namespace accretion

@@ -35,7 +35,14 @@
 // means of last frame (those in view then), worth P far rays: a particle
 // new to the view starts from its world-space neighbours' far light. With
 // particle_split.far_share every texel's Lr so blends its far mean with
-// its neighbours' (its history keeping its own). The pixels interpolate their particle's texels:
+// its neighbours' (its history keeping its own). With particle_split.far_handoff
+// a texel's far history follows its particle's near set: a light near
+// now but not last frame (its far light in the history) is taken out of
+// the history at this frame's near term, and one near last frame but not
+// now (missing from the history) put in at last frame's near term, kept
+// per texel. Without it the history and the near sum both hold a light
+// that joined the near set, at its term then (far, small) and now, and
+// neither holds one that left at its term now: darker. The pixels interpolate their particle's texels:
 // biased by the light at the texels, not at the pixel.
 //
 // The bodies are the CPU's (src/render/particle_split/) and the twin's
@@ -58,6 +65,8 @@
 //                     void reject(q)          a far ray's non-finite value rejected (render.nonfinite)
 //                     bool historyTexelOf(j, sub, q); Vec3 historyLr(q); void writeTexelLr(q, Lr)
 //                     Vec3 historyFar(q); void writeTexelFar(q, far)  (history_of far)
+//                     std::uint32_t historyNearLights(v, light)  last frame's slot v's near lights (far_handoff)
+//                     Vec3 historyNearValue(q, m); void writeTexelNear(q, m, value)  a texel's near term m, last frame's and this one's
 //                     std::uint32_t historyAge(q); void writeTexelAge(q, n)  (history_start mean)
 //   shadePixels:      GBufferTexel pixel(px); std::uint32_t slotOf(j); Vec2 pixelUv(g);
 //                     Vec3 texelLr(q); void writePixelLr(px, Lr)
@@ -91,6 +100,7 @@ struct SplitParams {
     float history = 0.0f;           ///< particle_split.history
     bool historyOfFar = false;      ///< particle_split.history_of far: the history averages the far mean alone
     bool historyMean = false;       ///< particle_split.history_start mean: a running mean over the texel's age first
+    bool farHandoff = false;        ///< particle_split.far_handoff: the far history follows the near set's changes
     bool discardNonFinite = false;  ///< render.nonfinite discard: a non-finite far draw is not counted (else it counts as 0)
     std::uint32_t visible = 0;      ///< the frame's visible particles (slots)
     std::uint32_t frame = 0;
@@ -111,6 +121,7 @@ inline SplitParams splitParams(const Settings& s, std::uint32_t visible, std::ui
     p.history = float(s.particle_split.history);
     p.historyOfFar = s.particle_split.history_of == HistoryOf::far;
     p.historyMean = s.particle_split.history_start == HistoryStart::mean;
+    p.farHandoff = s.particle_split.far_handoff;
     p.discardNonFinite = s.render.nonfinite == NonFinitePolicy::discard;
     p.visible = visible;
     p.frame = frame;
@@ -436,8 +447,21 @@ ACC_HD_BODY void sumSplitTexel(B& b, std::size_t q) {
     std::size_t h = 0;
     const bool seen = history && b.historyTexelOf(g.particle, std::uint32_t(q % p.texelsPerParticle()), h);
     const std::uint32_t farRays = p.farSamples + (history && !seen ? extraNewRays(p) : 0u);
-    Vec3 Lr(0.0f), far(0.0f);
-    for (std::uint32_t r = 0; r < p.nearCount; ++r) Lr += b.splitRay(q, r).value;
+    // far_handoff: this frame's near terms are kept for the next frame,
+    // and a texel with history reads last frame's near set (by its slot then).
+    const bool keepNear = history && p.historyOfFar && p.farHandoff, handoff = keepNear && seen;
+    std::uint32_t now[kMaxNear], before[kMaxNear], kNow = 0, kBefore = 0;
+    if (handoff) {
+        kNow = b.nearLights(std::uint32_t(q / p.texelsPerParticle()), now);
+        kBefore = b.historyNearLights(std::uint32_t(h / p.texelsPerParticle()), before);
+    }
+    Vec3 Lr(0.0f), far(0.0f), joined(0.0f);
+    for (std::uint32_t r = 0; r < p.nearCount; ++r) {
+        const Vec3 v = b.splitRay(q, r).value;
+        Lr += v;
+        if (keepNear) b.writeTexelNear(q, r, v);
+        if (handoff && r < kNow && !isNear(before, kBefore, now[r])) joined += v;  // far in the history, near now
+    }
     std::uint32_t counted = farRays;
     for (std::uint32_t s = 0; s < farRays; ++s) {
         const SplitRay ray = b.splitRay(q, p.nearCount + s);
@@ -462,7 +486,15 @@ ACC_HD_BODY void sumSplitTexel(B& b, std::size_t q) {
     }
     if (history && p.historyOfFar) {
         Vec3 farMean = counted > 0 ? far / float(counted) : Vec3(0.0f);
-        if (seen) farMean = (1.0f - keep) * farMean + keep * b.historyFar(h);
+        if (seen) {
+            Vec3 last = b.historyFar(h);
+            if (handoff) {  // the history as if its frames had taken this frame's near set out
+                last -= joined;
+                for (std::uint32_t m = 0; m < kBefore; ++m)
+                    if (!isNear(now, kNow, before[m])) last += b.historyNearValue(h, m);  // near in the history, far now: its last term
+            }
+            farMean = (1.0f - keep) * farMean + keep * last;
+        }
         else if (priorUnits > 0) {
             const float own = float(units) / float(units + priorUnits);
             farMean = own * farMean + (1.0f - own) * prior;

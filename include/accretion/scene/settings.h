@@ -386,6 +386,7 @@ struct ParticleSplitSettings {
     std::uint32_t far_new = 0;     ///< far draws of a texel without history (0: far)
     std::uint32_t far_prior = 0;   ///< far rays' worth of a new texel's near lights' far means (0: none)
     std::uint32_t far_share = 0;   ///< far rays' worth of every texel's near lights' far means in its Lr (0: none)
+    bool far_handoff = false;      ///< the far history follows the near set's changes
     template <class V> void visit(V& v) {
         v.field("near", near, "particle_split: the lights nearest each visible particle's centre (on the light tree, no rays), summed exactly at each of its texels with a shadow ray each", Range{0, 64});
         v.field("far", far, "particle_split: lights drawn per texel and frame from the light tree at the texel, the near lights' ball taken out, one shadow ray each", Range{0, 1024});
@@ -398,6 +399,7 @@ struct ParticleSplitSettings {
         v.field("far_new", far_new, "particle_split: far rays for a texel without history (its particle not in last frame's view: a history has nothing to average it with), at least far; 0: far. With history_start mean its age counts far rays, so that first frame weighs far_new / far frames", Range{0, 1024});
         v.field("far_prior", far_prior, "particle_split: with history_of far, a texel without history starts its far mean from the mean of its particle's near lights' far means of last frame (those then in view: its world-space neighbours' far light, biased by how theirs differs), weighted as this many far rays against its own; 0: its own rays alone", Range{0, 1024});
         v.field("far_share", far_share, "particle_split: with history_of far, every texel's Lr blends its far mean with the mean of its particle's near lights' far means of last frame (those then in view), theirs weighted as this many far rays and its own as its age in far rays (at most far (1 + h) / (1 - h)); its history keeps its own: a world-space filter of the far light, biased by how the neighbours' differs; 0: off", Range{0, 65536});
+        v.field("far_handoff", far_handoff, "particle_split: with history_of far, a texel's far history follows its particle's near set: a light that joined it since last frame (in the history's far light, summed exactly now) is taken out of the history at its term now, one that left it (missing from the history, a far light now) put in at its term last frame (kept per texel); without it the history keeps the far light of the near sets it averaged, and a disk whose neighbours drift apart comes out dark");
     }
 };
 

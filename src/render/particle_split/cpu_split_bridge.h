@@ -32,12 +32,16 @@ struct CpuFrame {
     std::vector<std::uint32_t>& nearFound;         ///< how many each slot has
     std::vector<float>& nearRadius2;               ///< the farthest one's squared distance
     const std::vector<std::uint32_t>& prevSlotOf;  ///< history: last frame's slots (empty: none)
+    const std::vector<std::uint32_t>& prevNear;    ///< far_handoff: last frame's near lights by its slots (as near)
+    const std::vector<std::uint32_t>& prevNearFound;
     const std::vector<Vec3>& prevTexelLr;
     std::vector<Vec3>& texelLr;
     const std::vector<Vec3>& prevTexelFar;         ///< history_of far: last frame's far means' average (else empty)
     std::vector<Vec3>& texelFar;
     const std::vector<std::uint32_t>& prevTexelAge;  ///< history_start mean: last frame's texels' ages (else empty)
     std::vector<std::uint32_t>& texelAge;
+    const std::vector<Vec3>& prevTexelNear;        ///< far_handoff: last frame's texels' near terms, texel q's m at q x nearCount + m
+    std::vector<Vec3>& texelNear;
     std::vector<std::uint32_t>& texelRejected;     ///< non-finite far draws per texel
     std::vector<std::uint32_t>& newIndex;          ///< far_new: each texel's place among those without history (kNoSlot: it has one)
     std::vector<Vec3>& Lr;                         ///< the pixels'
@@ -133,6 +137,20 @@ public:
         if (j >= f_.prevSlotOf.size() || f_.prevSlotOf[j] == kNoSlot) return false;
         q = std::size_t(f_.prevSlotOf[j]) * f_.params.texelsPerParticle() + sub;
         return true;
+    }
+    std::uint32_t historyNearLights(std::uint32_t v, std::uint32_t* light) {
+        const std::uint32_t n = f_.prevNearFound[v];
+        rec_.read(4 * (n + 1));
+        std::copy_n(f_.prevNear.begin() + std::size_t(v) * f_.params.nearCount, n, light);
+        return n;
+    }
+    Vec3 historyNearValue(std::size_t q, std::uint32_t m) {
+        rec_.read(gpu_layout::kRadiance);
+        return f_.prevTexelNear[q * f_.params.nearCount + m];
+    }
+    void writeTexelNear(std::size_t q, std::uint32_t m, const Vec3& v) {
+        rec_.write(gpu_layout::kRadiance);
+        f_.texelNear[q * f_.params.nearCount + m] = v;
     }
     Vec3 historyLr(std::size_t q) {
         rec_.read(gpu_layout::kRadiance);

@@ -32,12 +32,14 @@ LightingCounters ParticleSplit::render(const ParticleSplitInputs& in, LightingIm
     std::vector<Vec3> texelLr(texels.grid.texels.size());
     std::vector<Vec3> texelFar(params.history > 0.0f && params.historyOfFar ? texels.grid.texels.size() : 0);
     std::vector<std::uint32_t> texelAge(params.history > 0.0f && params.historyMean ? texels.grid.texels.size() : 0);
+    const bool handoff = params.history > 0.0f && params.historyOfFar && params.farHandoff;
+    std::vector<Vec3> texelNear(handoff ? texels.grid.texels.size() * params.nearCount : 0);
     std::vector<std::uint32_t> texelRejected(texels.grid.texels.size(), 0);
     std::vector<std::uint32_t> newIndex;  // far_new's texels without history (shadeSplitTexels)
     const std::vector<std::uint64_t> paths = in.lightTree.paths();
     // Last frame's texels: kept only with a history, so empty without one.
     const psplit::CpuFrame f{in, params, L, in.lightTree.view(), paths, VisibilityOptions::from(in.settings.render), plan.shadowRays,
-                             texels, near, nearFound, nearRadius2, prevSlotOf_, prevTexelLr_, texelLr, prevTexelFar_, texelFar, prevTexelAge_, texelAge, texelRejected, newIndex, out.Lr};
+                             texels, near, nearFound, nearRadius2, prevSlotOf_, prevNear_, prevNearFound_, prevTexelLr_, texelLr, prevTexelFar_, texelFar, prevTexelAge_, texelAge, prevTexelNear_, texelNear, texelRejected, newIndex, out.Lr};
     LightingCounters counters;
     {
         auto t = timer.scope(Pass::findNearLights);
@@ -67,6 +69,11 @@ LightingCounters ParticleSplit::render(const ParticleSplitInputs& in, LightingIm
         prevTexelLr_ = std::move(texelLr);
         prevTexelFar_ = std::move(texelFar);
         prevTexelAge_ = std::move(texelAge);
+        if (handoff) {
+            prevNear_ = std::move(near);
+            prevNearFound_ = std::move(nearFound);
+            prevTexelNear_ = std::move(texelNear);
+        }
     }
     return counters;
 }
