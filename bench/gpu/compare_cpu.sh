@@ -123,6 +123,9 @@ design_case particle_split ps_new9_far_anti_h5 -D particle_split.far_new=9 -D pa
 design_case particle_split ps_prior8_mean_far_c4_h9 -D particle_split.far_prior=8 -D particle_split.history_of=far -D particle_split.history_start=mean -D particle_split.candidates=4 -D particle_split.history=0.9
 # particle_split.far_share (run.sh far_share): every texel's far mean shown blended with its near lights'.
 design_case particle_split ps_share24_prior8_mean_far_c4_h9 -D particle_split.far_share=24 -D particle_split.far_prior=8 -D particle_split.history_of=far -D particle_split.history_start=mean -D particle_split.candidates=4 -D particle_split.history=0.9
+# particle_split.far_handoff (run.sh far_handoff).
+design_case particle_split ps_handoff_share24_prior8_mean_far_c4_h9 -D particle_split.far_handoff=true -D particle_split.far_share=24 -D particle_split.far_prior=8 -D particle_split.history_of=far -D particle_split.history_start=mean -D particle_split.candidates=4 -D particle_split.history=0.9
+design_case particle_split ps_handoff_2x2_far_anti_h5 -D particle_split.far_handoff=true -D particle_split.texels=2 -D particle_split.history_of=far -D particle_split.texel_point=antithetic -D particle_split.history=0.5
 
 # uniform and power (one frame): Lr, its standard error and the samples taken.
 declare -A sampled=(
