@@ -901,10 +901,11 @@ TEST_CASE("particle_split: far_prior starts a new texel's far mean from its near
     }
 }
 
-TEST_CASE("particle_split: far_prior changes nothing where no particle comes into view", "[particle_split]") {
-    // A static disk and camera: frame 0 has no history (no neighbour's far
-    // mean to start from), and later frames no new texel. The frames are
-    // those without far_prior, bit for bit.
+namespace {
+
+/// A static disk and camera with the far history's running mean, 4 frames
+/// rendered with and without `option`: the same frames, bit for bit.
+void requireStaticDiskUnchanged(void (*option)(Settings&)) {
     Settings s = splitSettings(ShadingModel::lambert, 400, 4, 2);
     s.shading.visibility = true;
     s.particles.gm = 0.0;
@@ -913,14 +914,22 @@ TEST_CASE("particle_split: far_prior changes nothing where no particle comes int
     s.particle_split.history_of = HistoryOf::far;
     s.particle_split.history_start = HistoryStart::mean;
     const ParticleSource source(s);
-    Settings prior = s;
-    prior.particle_split.far_prior = 8;
-    FrameRenderer a(s, source, RenderOptions{true}), b(prior, source, RenderOptions{true});
+    Settings with = s;
+    option(with);
+    FrameRenderer a(s, source, RenderOptions{true}), b(with, source, RenderOptions{true});
     for (std::uint32_t f = 0; f < 4; ++f) {
         FrameStats sa, sb;
         const FrameImage x = a.render(f, sa), y = b.render(f, sb);
         REQUIRE(x.lighting.Lr == y.lighting.Lr);
     }
+}
+
+}  // namespace
+
+TEST_CASE("particle_split: far_prior changes nothing where no particle comes into view", "[particle_split]") {
+    // Frame 0 has no history (no neighbour's far mean to start from), and
+    // later frames no new texel.
+    requireStaticDiskUnchanged([](Settings& s) { s.particle_split.far_prior = 8; });
 }
 
 TEST_CASE("particle_split: far_handoff moves the lights that joined or left the near set between the far history and the near sum, in closed form",
@@ -981,24 +990,8 @@ TEST_CASE("particle_split: far_handoff moves the lights that joined or left the 
 }
 
 TEST_CASE("particle_split: far_handoff changes nothing where no near set changes", "[particle_split]") {
-    // A static disk and camera: every particle keeps its near set, so the
-    // frames are those without far_handoff, bit for bit.
-    Settings s = splitSettings(ShadingModel::lambert, 400, 4, 2);
-    s.shading.visibility = true;
-    s.particles.gm = 0.0;
-    s.render.frames = 4;
-    s.particle_split.history = 0.9;
-    s.particle_split.history_of = HistoryOf::far;
-    s.particle_split.history_start = HistoryStart::mean;
-    const ParticleSource source(s);
-    Settings handoff = s;
-    handoff.particle_split.far_handoff = true;
-    FrameRenderer a(s, source, RenderOptions{true}), b(handoff, source, RenderOptions{true});
-    for (std::uint32_t f = 0; f < 4; ++f) {
-        FrameStats sa, sb;
-        const FrameImage x = a.render(f, sa), y = b.render(f, sb);
-        REQUIRE(x.lighting.Lr == y.lighting.Lr);
-    }
+    // Every particle keeps its near set.
+    requireStaticDiskUnchanged([](Settings& s) { s.particle_split.far_handoff = true; });
 }
 
 TEST_CASE("particle_split: the steady state is the frames after which the first weighs under 1%, in closed form", "[particle_split]") {
