@@ -41,8 +41,9 @@
 // the history at this frame's near term, and one near last frame but not
 // now (missing from the history) put in at last frame's near term, kept
 // per texel. Without it the history and the near sum both hold a light
-// that joined the near set, at its term then (far, small) and now, and
-// neither holds one that left at its term now: darker. The pixels interpolate their particle's texels:
+// that joined the near set (at its far terms then and its near term now)
+// and neither holds one that left; on the rotating disk these do not
+// cancel: the frames come out darker (docs/designs.md). The pixels interpolate their particle's texels:
 // biased by the light at the texels, not at the pixel.
 //
 // The bodies are the CPU's (src/render/particle_split/) and the twin's
