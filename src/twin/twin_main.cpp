@@ -217,6 +217,7 @@ private:
     VoxelPlacement voxelPlacement_;  ///< voxel_cache: where its grid lies (the CPU's VoxelCache's rule)
     unsigned voxelLast_ = 0;         ///< voxel_cache: buf_.voxelCells[voxelLast_] holds last frame's cells
     std::size_t splitVisible_ = 0;   ///< particle_split: this frame's visible particles (slots), for keepSplitHistory
+    bool splitKeepsNear_ = false;    ///< particle_split: this frame kept its near sets and texels' near terms (far_handoff)
     bool splitHistory_ = false;      ///< particle_split: buf_.prevSlotOf and prevTexelLr hold last frame's
     Particles particles_;  ///< this frame's, rebased to origin_
     std::map<std::uint32_t, Particles> loaded_;  ///< --seeds: each frame's particles, loaded once
@@ -476,6 +477,7 @@ void TwinRun::runParticleSplit(LaunchParams& lp) {
     }
     const std::size_t grid = std::size_t(gridW_) * gridH_, visible = sl.params.visible;
     splitVisible_ = visible;
+    splitKeepsNear_ = sl.params.keepsNearTerms();
     buf_.splitNear.reserve(std::max<std::size_t>(1, visible * sl.params.nearCount) * sizeof(std::uint32_t));
     buf_.splitNearFound.reserve(std::max<std::size_t>(1, visible) * sizeof(std::uint32_t));
     buf_.splitNearRadius2.reserve(std::max<std::size_t>(1, visible) * sizeof(float));
@@ -522,7 +524,7 @@ void TwinRun::runParticleSplit(LaunchParams& lp) {
         sl.texelFar = buf_.splitFar.as<Vec3>();
         sl.prevTexelFar = buf_.prevSplitFar.as<Vec3>();
     }
-    if (sl.params.history > 0.0f && sl.params.historyOfFar && sl.params.farHandoff) {
+    if (splitKeepsNear_) {
         buf_.splitTexelNear.reserve(std::max<std::size_t>(1, grid * sl.params.nearCount) * sizeof(Vec3));
         sl.texelNear = buf_.splitTexelNear.as<Vec3>();
         sl.prevTexelNear = buf_.prevSplitTexelNear.as<Vec3>();
@@ -568,7 +570,7 @@ void TwinRun::keepSplitHistory(std::size_t n) {
         copyDevice(buf_.prevSplitFar, buf_.splitFar, std::size_t(gridW_) * gridH_ * sizeof(Vec3), stream_);
     if (s_.particle_split.history_start == HistoryStart::mean)
         copyDevice(buf_.prevSplitAge, buf_.splitAge, std::size_t(gridW_) * gridH_ * sizeof(std::uint32_t), stream_);
-    if (s_.particle_split.history_of == HistoryOf::far && s_.particle_split.far_handoff) {
+    if (splitKeepsNear_) {
         const std::size_t k = s_.particle_split.near;
         copyDevice(buf_.prevSplitNear, buf_.splitNear, std::max<std::size_t>(1, splitVisible_ * k) * sizeof(std::uint32_t), stream_);
         copyDevice(buf_.prevSplitNearFound, buf_.splitNearFound, std::max<std::size_t>(1, splitVisible_) * sizeof(std::uint32_t), stream_);

@@ -107,6 +107,8 @@ struct SplitParams {
     std::uint32_t frame = 0;
     std::uint64_t seed = 0;
     ACC_HD std::uint32_t texelsPerParticle() const { return side * side; }
+    /// far_handoff in effect: the texels' near terms and the near sets are kept for the next frame.
+    ACC_HD bool keepsNearTerms() const { return history > 0.0f && historyOfFar && farHandoff; }
 };
 
 /// The frame's parameters from the settings (the CPU's and the twin's).
@@ -450,7 +452,7 @@ ACC_HD_BODY void sumSplitTexel(B& b, std::size_t q) {
     const std::uint32_t farRays = p.farSamples + (history && !seen ? extraNewRays(p) : 0u);
     // far_handoff: this frame's near terms are kept for the next frame,
     // and a texel with history reads last frame's near set (by its slot then).
-    const bool keepNear = history && p.historyOfFar && p.farHandoff, handoff = keepNear && seen;
+    const bool keepNear = p.keepsNearTerms(), handoff = keepNear && seen;
     std::uint32_t now[kMaxNear], before[kMaxNear], kNow = 0, kBefore = 0;
     if (handoff) {
         kNow = b.nearLights(std::uint32_t(q / p.texelsPerParticle()), now);

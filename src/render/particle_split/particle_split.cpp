@@ -32,7 +32,7 @@ LightingCounters ParticleSplit::render(const ParticleSplitInputs& in, LightingIm
     std::vector<Vec3> texelLr(texels.grid.texels.size());
     std::vector<Vec3> texelFar(params.history > 0.0f && params.historyOfFar ? texels.grid.texels.size() : 0);
     std::vector<std::uint32_t> texelAge(params.history > 0.0f && params.historyMean ? texels.grid.texels.size() : 0);
-    const bool handoff = params.history > 0.0f && params.historyOfFar && params.farHandoff;
+    const bool handoff = params.keepsNearTerms();
     std::vector<Vec3> texelNear(handoff ? texels.grid.texels.size() * params.nearCount : 0);
     std::vector<std::uint32_t> texelRejected(texels.grid.texels.size(), 0);
     std::vector<std::uint32_t> newIndex;  // far_new's texels without history (shadeSplitTexels)
