@@ -95,5 +95,6 @@ void addBatchCommand(CLI::App& app);
 void addCamerasCommand(CLI::App& app);
 void addImportGpuCommand(CLI::App& app);
 void addTuneCommand(CLI::App& app);
+void addLagCommand(CLI::App& app);
 
 }  // namespace accretion::cmd

@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
     accretion::cmd::addCamerasCommand(app);
     accretion::cmd::addImportGpuCommand(app);
     accretion::cmd::addTuneCommand(app);
+    accretion::cmd::addLagCommand(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

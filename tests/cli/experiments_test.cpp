@@ -582,3 +582,90 @@ TEST_CASE("bias --age-frames: the error by the frames each pixel's particle has 
     CHECK_THAT(out, Contains("--age-frames"));
     CHECK_FALSE(std::filesystem::exists(dir / "bad.json"));
 }
+
+namespace {
+
+/// A 4x1 frame as render writes one: Lr.R/G/B (float) and particle.id
+/// (uint32), written with OpenImageIO: pixels 0-1 see particle 5 lit `lit`,
+/// pixel 2 particle 9 lit 1, pixel 3 none.
+void writeLagFrame(const std::filesystem::path& file, float lit, bool withIds = true) {
+    OIIO::ImageSpec spec(4, 1, withIds ? 4 : 3, OIIO::TypeDesc::FLOAT);
+    spec.channelnames = {"Lr.R", "Lr.G", "Lr.B"};
+    if (withIds) {
+        spec.channelnames.push_back("particle.id");
+        spec.channelformats = {OIIO::TypeDesc::FLOAT, OIIO::TypeDesc::FLOAT, OIIO::TypeDesc::FLOAT, OIIO::TypeDesc::UINT32};
+    }
+    std::vector<unsigned char> bytes;
+    const auto put = [&](const void* v) { bytes.insert(bytes.end(), (const unsigned char*)v, (const unsigned char*)v + 4); };
+    const float light[4] = {lit, lit, 1.0f, 0.0f};
+    const std::uint32_t ids[4] = {5, 5, 9, 0xffffffffu};
+    for (int p = 0; p < 4; ++p) {
+        for (int c = 0; c < 3; ++c) put(&light[p]);
+        if (withIds) put(&ids[p]);
+    }
+    auto out = OIIO::ImageOutput::create(file.string());
+    REQUIRE(out);
+    REQUIRE(out->open(file.string(), spec));
+    REQUIRE(out->write_image(OIIO::TypeDesc::UNKNOWN, bytes.data()));
+    REQUIRE(out->close());
+}
+
+}  // namespace
+
+TEST_CASE("lag: a history's lag on exact frames, in closed form; none where nothing moves", "[cli][experiments][lag]") {
+    const auto dir = accretion::test::scratchDir("lag");
+    std::string out;
+    SECTION("frames in closed form: particle 5 lit 1, 2, 4; h = 0.5 from its first frame: 1, 1.5, 2.75") {
+        const float lit[3] = {1.0f, 2.0f, 4.0f};
+        for (int f = 0; f < 3; ++f) writeLagFrame(dir / fmt::format("f.{:04d}.exr", f), lit[f]);
+        const std::string cmd = kBin + " lag " + (dir / "f.{frame}.exr").string() +
+                                " --frames 0:3 --history 0.5,0 --start first --json -q --csv " + (dir / "trend.csv").string();
+        INFO(cmd << "\n" << out);
+        REQUIRE(runCommand(cmd, out) == 0);
+        const auto rows = nlohmann::json::parse(out.substr(out.find('[')));
+        REQUIRE(rows.size() == 2);
+        // Pixels 0-1: 2.75 against 4; pixel 2: 1 against 1: (2 x 2.75 + 1) / (2 x 4 + 1) - 1.
+        CHECK(rows[0]["energy_pct"].get<double>() == Approx(100.0 * (6.5 / 9.0 - 1.0)));
+        CHECK(rows[0]["rel_mse"].get<double>() == Approx(2.0 * 1.25 * 1.25 / (16.0 + kRelMseEpsilon) / 4.0));
+        CHECK(rows[0]["particles"].get<int>() == 2);
+        CHECK(rows[1]["energy_pct"].get<double>() == 0.0);
+        const auto trend = readCsv(dir / "trend.csv");
+        REQUIRE(trend.size() == 4);
+        CHECK(std::stod(trend[1][1]) == Approx(3.0 / 9.0));  // frame 0: (2 x 1 + 1) / (2 x 4 + 1)
+        CHECK(std::stod(trend[3][1]) == 1.0);
+        // --subtract frames of particle 5 lit 0.5 (particle 9 lit 1, as here):
+        // 0.5, 1.5, 3.5 averaged to 2.25 against 3.5; particle 9 lit 0.
+        for (int f = 0; f < 3; ++f) writeLagFrame(dir / fmt::format("s.{:04d}.exr", f), 0.5f);
+        REQUIRE(runCommand(kBin + " lag " + (dir / "f.{frame}.exr").string() + " --frames 0:3 --history 0.5 --start first --json -q "
+                               "--subtract " + (dir / "s.{frame}.exr").string(), out) == 0);
+        CHECK(nlohmann::json::parse(out.substr(out.find('[')))[0]["energy_pct"].get<double>() == Approx(100.0 * (4.5 / 7.0 - 1.0)));
+    }
+    SECTION("bad frames: one error naming the file, exit 1") {
+        writeLagFrame(dir / "g.0000.exr", 1.0f);
+        writeLagFrame(dir / "g.0001.exr", 1.0f, false);
+        CHECK(runCommand(kBin + " lag " + (dir / "g.{frame}.exr").string() + " --frames 0:2 -q", out) == 1);
+        CHECK_THAT(out, Contains("g.0001.exr: no particle.id channel"));
+        CHECK(runCommand(kBin + " lag " + (dir / "g.{frame}.exr").string() + " --frames 0:3 -q", out) == 1);
+        CHECK_THAT(out, Contains("g.0002.exr: not found (frame 2 of --frames 0:3)"));
+        CHECK(runCommand(kBin + " lag " + (dir / "g.{frame}.exr").string() + " --frames 0:1 -q --csv " + (dir / "g.0000.exr").string(),
+                         out) == 1);
+        CHECK(runCommand(kBin + " lag " + (dir / "g.{frame}.exr").string() + " --frames 0:1 --history 1 -q", out) == 1);
+    }
+    SECTION("render's exact frames: a disk held still has none, a moving one some") {
+        for (const std::string gm : {"0", "40"}) {
+            const std::string pattern = (dir / ("gm" + gm + ".{frame}.exr")).string();
+            REQUIRE(runCommand(kBin + " render " + tinyScene() + " -D particles.gm=" + gm + " --frames 20:24 --quiet --estimator exact -o " +
+                                   pattern, out) == 0);
+            const std::string cmd = kBin + " lag " + pattern + " --frames 20:24 --history 0.9 --json -q";
+            INFO(cmd << "\n" << out);
+            REQUIRE(runCommand(cmd, out) == 0);
+            const auto rows = nlohmann::json::parse(out.substr(out.find('[')));
+            if (gm == "0") {
+                CHECK(rows[0]["energy_pct"].get<double>() == 0.0);
+                CHECK(rows[0]["rel_mse"].get<double>() == 0.0);
+            } else {
+                CHECK(rows[0]["rel_mse"].get<double>() > 1e-6);
+            }
+        }
+    }
+}
