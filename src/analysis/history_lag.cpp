@@ -1,6 +1,7 @@
 #include "accretion/analysis/history_lag.h"
 
 #include <algorithm>
+#include <unordered_set>
 
 #include "accretion/analysis/image_metrics.h"
 #include "accretion/core/error.h"
@@ -16,11 +17,10 @@ double rgbMean(const DVec3& v) { return (v.x + v.y + v.z) / 3.0; }
 
 HistoryLag::HistoryLag(std::vector<LagRule> rules) : rules_(std::move(rules)), kept_(rules_.size()) {}
 
-void HistoryLag::addFrame(std::uint32_t frame, const std::vector<Vec3>& light, const std::vector<std::uint32_t>& particle) {
-    if (light.size() != particle.size()) throw InternalError("HistoryLag::addFrame: light and particle differ in size");
-    if (!lastParticle_.empty() && particle.size() != lastParticle_.size())
-        throw InternalError("HistoryLag::addFrame: the frames differ in size");
-    // Each visible particle's mean light over its pixels.
+namespace {
+
+/// Each visible particle's mean of `light` over its pixels.
+std::unordered_map<std::uint32_t, DVec3> particleMeans(const std::vector<Vec3>& light, const std::vector<std::uint32_t>& particle) {
     std::unordered_map<std::uint32_t, std::pair<DVec3, std::uint32_t>> sums;
     for (std::size_t p = 0; p < light.size(); ++p) {
         if (particle[p] == kNoParticle) continue;
@@ -29,13 +29,23 @@ void HistoryLag::addFrame(std::uint32_t frame, const std::vector<Vec3>& light, c
         ++s.second;
     }
     std::unordered_map<std::uint32_t, DVec3> mean;
-    std::unordered_map<std::uint32_t, float> scalar;
     mean.reserve(sums.size());
-    scalar.reserve(sums.size());
-    for (const auto& [id, s] : sums) {
-        mean[id] = s.first / double(s.second);
-        scalar[id] = float(rgbMean(mean[id]));
-    }
+    for (const auto& [id, s] : sums) mean[id] = s.first / double(s.second);
+    return mean;
+}
+
+}  // namespace
+
+void HistoryLag::addFrame(std::uint32_t frame, const std::vector<Vec3>& light, const std::vector<std::uint32_t>& particle,
+                          const std::vector<Vec3>& whole) {
+    if (light.size() != particle.size() || (!whole.empty() && whole.size() != light.size()))
+        throw InternalError("HistoryLag::addFrame: light, particle and whole differ in size");
+    if (!lastParticle_.empty() && particle.size() != lastParticle_.size())
+        throw InternalError("HistoryLag::addFrame: the frames differ in size");
+    std::unordered_map<std::uint32_t, DVec3> mean = particleMeans(light, particle);
+    std::unordered_map<std::uint32_t, float> scalar;
+    scalar.reserve(mean.size());
+    for (const auto& [id, m] : mean) scalar[id] = float(rgbMean(m));
     // Each rule's histories: the particles in this frame's view, from theirs in the last.
     for (std::size_t r = 0; r < rules_.size(); ++r) {
         const LagRule& rule = rules_[r];
@@ -53,51 +63,59 @@ void HistoryLag::addFrame(std::uint32_t frame, const std::vector<Vec3>& light, c
         }
         kept_[r] = std::move(next);
     }
+    lastWhole_ = whole.empty() ? mean : particleMeans(whole, particle);
     lastMean_ = std::move(mean);
-    lastLight_ = light;
     lastParticle_ = particle;
     frames_.emplace_back(frame, std::move(scalar));
 }
 
-std::vector<LagOutcome> HistoryLag::outcomes() const {
+std::vector<LagOutcome> HistoryLag::outcomes(const std::vector<bool>& measured) const {
+    if (!measured.empty() && measured.size() != lastParticle_.size()) throw InternalError("HistoryLag::outcomes: a mask of another size");
     std::vector<LagOutcome> out;
     for (std::size_t r = 0; r < rules_.size(); ++r) {
         LagOutcome o;
         o.rule = rules_[r];
-        o.particles = lastMean_.size();
-        for (const auto& [id, k] : kept_[r]) o.fresh += k.age == 1;
+        std::unordered_set<std::uint32_t> seen;  // the particles the measured pixels see
         double rel = 0.0;
-        for (const std::uint32_t id : lastParticle_) {
+        std::size_t pixels = 0;
+        for (std::size_t p = 0; p < lastParticle_.size(); ++p) {
+            if (!measured.empty() && !measured[p]) continue;
+            ++pixels;
+            const std::uint32_t id = lastParticle_[p];
             if (id == kNoParticle) continue;
-            const DVec3 now = lastMean_.at(id), history = kept_[r].at(id).value;
+            if (seen.insert(id).second) o.fresh += kept_[r].at(id).age == 1;
+            const DVec3 now = lastMean_.at(id), history = kept_[r].at(id).value, whole = lastWhole_.at(id);
             o.now += rgbMean(now);
             o.history += rgbMean(history);
-            for (int c = 0; c < 3; ++c) rel += (history[c] - now[c]) * (history[c] - now[c]) / (now[c] * now[c] + kRelMseEpsilon);
+            o.whole += rgbMean(whole);
+            for (int c = 0; c < 3; ++c) rel += (history[c] - now[c]) * (history[c] - now[c]) / (whole[c] * whole[c] + kRelMseEpsilon);
         }
-        o.relMSE = lastParticle_.empty() ? 0.0 : rel / (3.0 * double(lastParticle_.size()));
+        o.particles = seen.size();
+        o.relMSE = pixels ? rel / (3.0 * double(pixels)) : 0.0;
         out.push_back(o);
     }
     return out;
 }
 
-std::vector<LagTrendPoint> HistoryLag::trend() const {
+std::vector<LagTrendPoint> HistoryLag::trend(const std::vector<bool>& measured) const {
     std::vector<LagTrendPoint> out;
     if (frames_.empty()) return out;
+    if (!measured.empty() && measured.size() != lastParticle_.size()) throw InternalError("HistoryLag::trend: a mask of another size");
     const auto& last = frames_.back().second;
-    std::size_t lit = 0;
-    for (const std::uint32_t id : lastParticle_) lit += id != kNoParticle;
+    std::vector<std::uint32_t> lit;  // the measured pixels' particles
+    for (std::size_t p = 0; p < lastParticle_.size(); ++p)
+        if ((measured.empty() || measured[p]) && lastParticle_[p] != kNoParticle) lit.push_back(lastParticle_[p]);
     for (const auto& [frame, means] : frames_) {
         double then = 0.0, now = 0.0;
         std::size_t tracked = 0;
-        for (const std::uint32_t id : lastParticle_) {
-            if (id == kNoParticle) continue;
+        for (const std::uint32_t id : lit) {
             const auto t = means.find(id);
             if (t == means.end()) continue;
             then += t->second;
             now += last.at(id);
             ++tracked;
         }
-        out.push_back({frame, now > 0.0 ? then / now : 0.0, lit ? double(tracked) / double(lit) : 0.0});
+        out.push_back({frame, now > 0.0 ? then / now : 0.0, lit.empty() ? 0.0 : double(tracked) / double(lit.size())});
     }
     return out;
 }

@@ -26,6 +26,7 @@ struct LagArgs {
     std::string start = "mean";     ///< --start first | mean
     std::string layer = "Lr";
     std::string subtract;           ///< --subtract: a {frame} pattern whose light is taken out of each frame's
+    std::vector<std::string> windowsOf;  ///< --windows-of: measure the pixels of these EXRs' data windows (crops)
     std::string csv;                ///< --csv FILE: the last frame's particles' light in every frame
     bool json = false;
     bool quiet = false;
@@ -59,7 +60,7 @@ void runLag(const LagArgs& a) {
     HistoryLag lag(rules);
     std::uint32_t width = 0, height = 0;
     for (std::size_t k = 0; k < files.size(); ++k) {
-        RgbLayer light = readExrLayer(files[k], a.layer);
+        const RgbLayer light = readExrLayer(files[k], a.layer);
         if (!light.whole())
             throw InputError(fmt::format("{}: a window of {}x{} pixels; lag reads whole frames", files[k], light.width, light.height));
         if (k > 0 && (light.width != width || light.height != height))
@@ -78,21 +79,39 @@ void runLag(const LagArgs& a) {
             if (readExrUintChannel(subtracted[k], "particle.id") != particle)
                 throw InputError(fmt::format("{}: its pixels see other particles than {}'s (another frame or view?)", subtracted[k],
                                              files[k]));
-            for (std::size_t p = 0; p < light.rgb.size(); ++p) light.rgb[p] -= less.rgb[p];
+            std::vector<Vec3> part = light.rgb;
+            for (std::size_t p = 0; p < part.size(); ++p) part[p] -= less.rgb[p];
+            lag.addFrame(std::uint32_t(first + k), part, particle, light.rgb);
+        } else {
+            lag.addFrame(std::uint32_t(first + k), light.rgb, particle);
         }
-        lag.addFrame(std::uint32_t(first + k), light.rgb, particle);
         if (!a.quiet) fmt::print(stderr, "\raccretion: lag: frame {} ({} of {})", first + k, k + 1, files.size());
     }
     if (!a.quiet) fmt::print(stderr, "\n");
+    // --windows-of: the crops' pixels alone (a crop's EXR holds its data window in the whole frame).
+    std::vector<bool> measured;
+    if (!a.windowsOf.empty()) {
+        measured.assign(std::size_t(width) * height, false);
+        for (const std::string& file : a.windowsOf) {
+            const RgbLayer crop = readExrLayer(file, "");
+            if (crop.width != width || crop.height != height || crop.x0 < 0 || crop.y0 < 0 ||
+                crop.x0 + int(crop.dataWidth) > int(width) || crop.y0 + int(crop.dataHeight) > int(height))
+                throw InputError(fmt::format("{}: its window ({}x{} at ({}, {}) of {}x{}) is not one of the {}x{} frames'", file,
+                                             crop.dataWidth, crop.dataHeight, crop.x0, crop.y0, crop.width, crop.height, width, height));
+            for (std::uint32_t y = 0; y < crop.dataHeight; ++y)
+                for (std::uint32_t x = 0; x < crop.dataWidth; ++x)
+                    measured[std::size_t(crop.y0 + int(y)) * width + std::size_t(crop.x0 + int(x))] = true;
+        }
+    }
     Table t({{"history", "h", 6, "{:.3f}", "{:.9g}"}, {"start", "start", -6}, {"frames", "frames", 7},
              {"particles", "particles", 10}, {"fresh", "fresh", 8}, {"energy_pct", "energy %", 10, "{:+.3f}", "{:.9g}"},
              {"rel_mse", "relMSE", 12, "{:.4g}", "{:.9g}"}});
-    for (const LagOutcome& o : lag.outcomes())
+    for (const LagOutcome& o : lag.outcomes(measured))
         t.add({o.rule.history, std::string(enumName(o.rule.start)), std::uint64_t(files.size()), std::uint64_t(o.particles),
                std::uint64_t(o.fresh), o.energyPct(), o.relMSE});
     if (!a.csv.empty()) {
         Table trend({{"frame", "frame", 6}, {"ratio", "ratio", 10, "{:.5f}", "{:.9g}"}, {"tracked", "tracked", 8, "{:.3f}", "{:.6f}"}});
-        for (const LagTrendPoint& p : lag.trend()) trend.add({std::uint64_t(p.frame), p.ratio, p.tracked});
+        for (const LagTrendPoint& p : lag.trend(measured)) trend.add({std::uint64_t(p.frame), p.ratio, p.tracked});
         writeFileAtomic(a.csv, trend.csv());
     }
     fmt::print("{}", a.json ? t.json().dump(2) + "\n" : t.console());
@@ -116,12 +135,17 @@ void addLagCommand(CLI::App& app) {
     cmd->add_option("--layer", args->layer, "The light averaged (default Lr: the lighting alone; \"\" for R,G,B)");
     cmd->add_option("--subtract", args->subtract,
                     "A {frame} pattern whose light each frame's loses before the average (e.g. a render of the near lights "
-                    "alone, particle_split.far=0: the far light, which history_of far averages)");
+                    "alone, particle_split.far=0: the far light, which history_of far averages); the errors stay relative "
+                    "to the whole light");
+    cmd->add_option("--windows-of", args->windowsOf,
+                    "Measure the pixels of these EXRs' data windows alone (crops of the frame, e.g. bias's references); "
+                    "the histories follow the whole frames");
     cmd->add_option("--csv", args->csv, "Write the last frame's particles' light in every frame, over their light now (CSV)");
     cmd->add_flag("--json", args->json, "Machine-readable output");
     cmd->add_flag("-q,--quiet", args->quiet, "No progress on stderr");
     cmd->footer("Each pixel is its particle's mean over its pixels, now and in its history: what one texel a particle "
-                "shows.\nenergy %: the history's light over the light now, less 1; relMSE: per pixel, as compare measures it.");
+                "shows.\nenergy %: the history's light less the light now, over the whole light now (--subtract: before it); relMSE: per pixel, "
+                "as compare measures it, against the whole light.");
     cmd->callback([args] { runLag(*args); });
 }
 

@@ -90,6 +90,13 @@ TEST_CASE("HistoryLag: a particle out of view loses its history; pixels weigh th
     CHECK(o[0].now == Approx(4.0 + 3.0 * 4.0));
     CHECK(o[0].history == Approx(3.125 + 3.0 * 4.0));
     CHECK(o[0].energyPct() == Approx(100.0 * (15.125 / 16.0 - 1.0)));
+    // Measured at pixel 0 alone (a crop): particle 1's 3.125 against 4.
+    const auto crop = lag.outcomes({true, false, false, false});
+    CHECK(crop[0].particles == 1);
+    CHECK(crop[0].fresh == 0);
+    CHECK(crop[0].energyPct() == Approx(100.0 * (3.125 / 4.0 - 1.0)));
+    CHECK(crop[0].relMSE == Approx(0.875 * 0.875 / (16.0 + kRelMseEpsilon)));
+    CHECK(lag.trend({true, false, false, false})[0].ratio == Approx(1.0 / 4.0));
     // h = 0: no history, no lag.
     CHECK(o[1].energyPct() == 0.0);
     CHECK(o[1].relMSE == 0.0);

@@ -634,11 +634,31 @@ TEST_CASE("lag: a history's lag on exact frames, in closed form; none where noth
         CHECK(std::stod(trend[1][1]) == Approx(3.0 / 9.0));  // frame 0: (2 x 1 + 1) / (2 x 4 + 1)
         CHECK(std::stod(trend[3][1]) == 1.0);
         // --subtract frames of particle 5 lit 0.5 (particle 9 lit 1, as here):
-        // 0.5, 1.5, 3.5 averaged to 2.25 against 3.5; particle 9 lit 0.
+        // 0.5, 1.5, 3.5 averaged to 2.25 against 3.5; particle 9 lit 0. The
+        // errors stay relative to the whole light (4 and 1 in the last frame).
         for (int f = 0; f < 3; ++f) writeLagFrame(dir / fmt::format("s.{:04d}.exr", f), 0.5f);
         REQUIRE(runCommand(kBin + " lag " + (dir / "f.{frame}.exr").string() + " --frames 0:3 --history 0.5 --start first --json -q "
                                "--subtract " + (dir / "s.{frame}.exr").string(), out) == 0);
-        CHECK(nlohmann::json::parse(out.substr(out.find('[')))[0]["energy_pct"].get<double>() == Approx(100.0 * (4.5 / 7.0 - 1.0)));
+        const auto less = nlohmann::json::parse(out.substr(out.find('[')))[0];
+        // --windows-of a crop holding pixel 1 alone (its data window in the 4x1 frame): 2.75 against 4.
+        {
+            OIIO::ImageSpec spec(1, 1, 3, OIIO::TypeDesc::FLOAT);
+            spec.x = 1;
+            spec.full_width = 4;
+            spec.full_height = 1;
+            const float rgb[3] = {0.0f, 0.0f, 0.0f};
+            auto crop = OIIO::ImageOutput::create((dir / "crop.exr").string());
+            REQUIRE(crop);
+            REQUIRE(crop->open((dir / "crop.exr").string(), spec));
+            REQUIRE(crop->write_image(OIIO::TypeDesc::FLOAT, rgb));
+            REQUIRE(crop->close());
+        }
+        std::string cropped;
+        REQUIRE(runCommand(kBin + " lag " + (dir / "f.{frame}.exr").string() + " --frames 0:3 --history 0.5 --start first --json -q "
+                               "--windows-of " + (dir / "crop.exr").string(), cropped) == 0);
+        CHECK(nlohmann::json::parse(cropped.substr(cropped.find('[')))[0]["energy_pct"].get<double>() == Approx(100.0 * (2.75 / 4.0 - 1.0)));
+        CHECK(less["energy_pct"].get<double>() == Approx(100.0 * (2.0 * 2.25 - 2.0 * 3.5) / 9.0));
+        CHECK(less["rel_mse"].get<double>() == Approx(2.0 * 1.25 * 1.25 / (16.0 + kRelMseEpsilon) / 4.0));
     }
     SECTION("bad frames: one error naming the file, exit 1") {
         writeLagFrame(dir / "g.0000.exr", 1.0f);

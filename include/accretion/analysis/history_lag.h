@@ -29,13 +29,14 @@ struct LagRule {
 /// The last frame's pixels with their particle's history against its light now.
 struct LagOutcome {
     LagRule rule;
-    std::size_t particles = 0;  ///< visible in the last frame
-    std::size_t fresh = 0;      ///< of them, new to the view there (no history)
+    std::size_t particles = 0;  ///< those the last frame's measured pixels see
+    std::size_t fresh = 0;      ///< of them, new to the view in that frame (no history)
     double now = 0.0;           ///< the last frame's light, summed over its pixels (mean of RGB): each pixel its particle's mean
     double history = 0.0;       ///< the same with each pixel its particle's history
-    double relMSE = 0.0;        ///< the histories against the means, over the frame's pixels (kRelMseEpsilon)
-    /// The energy the lag adds (negative: the history is darker), in percent.
-    double energyPct() const { return now > 0.0 ? 100.0 * (history / now - 1.0) : 0.0; }
+    double whole = 0.0;         ///< the same of the whole light (addFrame's `whole`; `now` without it)
+    double relMSE = 0.0;        ///< the histories against the means, over the frame's pixels, relative to the whole light (kRelMseEpsilon)
+    /// The energy the lag adds to the whole light (negative: the history is darker), in percent.
+    double energyPct() const { return whole > 0.0 ? 100.0 * (history - now) / whole : 0.0; }
 };
 
 /// The last frame's particles' light in an earlier frame: sum over the last
@@ -52,13 +53,17 @@ public:
     explicit HistoryLag(std::vector<LagRule> rules);
 
     /// The next frame: per pixel its light and its particle (kNoParticle: none);
-    /// every frame the same size.
-    void addFrame(std::uint32_t frame, const std::vector<Vec3>& light, const std::vector<std::uint32_t>& particle);
+    /// every frame the same size. `whole` (or empty: `light`) is the light
+    /// the error is measured against, where `light` is part of it (the far
+    /// light, which particle_split.history_of far averages).
+    void addFrame(std::uint32_t frame, const std::vector<Vec3>& light, const std::vector<std::uint32_t>& particle,
+                  const std::vector<Vec3>& whole = {});
 
-    /// Each rule's outcome at the last frame added.
-    std::vector<LagOutcome> outcomes() const;
-    /// The last frame's particles in each frame added, oldest first.
-    std::vector<LagTrendPoint> trend() const;
+    /// Each rule's outcome at the last frame added, over its pixels p with
+    /// measured[p] (empty: all of them; e.g. crops of the frame).
+    std::vector<LagOutcome> outcomes(const std::vector<bool>& measured = {}) const;
+    /// The last frame's particles in each frame added, oldest first (over the same pixels).
+    std::vector<LagTrendPoint> trend(const std::vector<bool>& measured = {}) const;
 
 private:
     struct Kept {
@@ -68,7 +73,7 @@ private:
     std::vector<LagRule> rules_;
     std::vector<std::unordered_map<std::uint32_t, Kept>> kept_;  ///< per rule, the particles in the last frame's view
     std::unordered_map<std::uint32_t, DVec3> lastMean_;          ///< the last frame's particles' means
-    std::vector<Vec3> lastLight_;
+    std::unordered_map<std::uint32_t, DVec3> lastWhole_;         ///< and of their whole light
     std::vector<std::uint32_t> lastParticle_;
     /// Every frame's particles' mean light (mean of RGB), by id, for trend().
     std::vector<std::pair<std::uint32_t, std::unordered_map<std::uint32_t, float>>> frames_;
