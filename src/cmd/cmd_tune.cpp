@@ -133,8 +133,9 @@ struct SplitHistory {
     HistoryStart start = HistoryStart::first;
     HistoryOf of = HistoryOf::all;
     std::uint32_t farNew = 0, farPrior = 0, farShare = 0;
+    bool farHandoff = false;
 
-    /// " anti mean far-only prior32 share256": the settings not at their defaults.
+    /// " anti mean far-only prior32 share256 handoff": the settings not at their defaults.
     std::string label() const {
         std::string l;
         if (point != TexelPoint::centre) l += point == TexelPoint::antithetic ? " anti" : " jitter";
@@ -143,6 +144,7 @@ struct SplitHistory {
         if (farNew) l += fmt::format(" new{}", farNew);
         if (farPrior) l += fmt::format(" prior{}", farPrior);
         if (farShare) l += fmt::format(" share{}", farShare);
+        if (farHandoff) l += " handoff";
         return l;
     }
     /// The -D overrides of the settings not at their defaults.
@@ -154,6 +156,7 @@ struct SplitHistory {
         if (farNew) d.push_back(fmt::format("particle_split.far_new={}", farNew));
         if (farPrior) d.push_back(fmt::format("particle_split.far_prior={}", farPrior));
         if (farShare) d.push_back(fmt::format("particle_split.far_share={}", farShare));
+        if (farHandoff) d.push_back("particle_split.far_handoff=true");
         return d;
     }
 };
@@ -243,7 +246,7 @@ private:
 };
 
 /// The lighting choices of `space`: quick, 34 restir points around the GPU
-/// team's settings, 8 of particle_restir, 2 of voxel_cache and 10 of
+/// team's settings, 8 of particle_restir, 2 of voxel_cache and 12 of
 /// particle_split; full, the whole grids (hours).
 std::vector<LightingChoice> lightingChoices(const std::string& space) {
     struct Axes {
@@ -334,13 +337,15 @@ std::vector<LightingChoice> lightingChoices(const std::string& space) {
     // light alone, from a running mean (steady after 51 frames, which moves
     // tune's frame there); a particle new to the view started from its near
     // lights' far means (far_prior) and every texel's shown blended with
-    // them (far_share). The quick space holds designs.md's 100K answer and
-    // its less biased form (far_share 64), the answer without them, the 1M
-    // answer (4 candidates, antithetic texel points) and near 16, far 8.
+    // them (far_share); the far history following the near set's changes
+    // (far_handoff). The quick space holds designs.md's 100K answer and its
+    // less biased form (far_share 64), the answer without them, the 1M
+    // answer (4 candidates, antithetic texel points) and near 16, far 8;
+    // the 100K answer and near 16, far 8 with far_handoff too.
     const auto longSplit = [&](std::uint32_t near, std::uint32_t far, std::uint32_t candidates, TexelPoint point,
-                               std::uint32_t prior, std::uint32_t share, std::uint32_t farNew = 0) {
+                               std::uint32_t prior, std::uint32_t share, std::uint32_t farNew = 0, bool handoff = false) {
         LightingChoice c = split(near, far, candidates, 0.95);
-        c.design.splitHistory = {point, HistoryStart::mean, HistoryOf::far, farNew, prior, share};
+        c.design.splitHistory = {point, HistoryStart::mean, HistoryOf::far, farNew, prior, share, handoff};
         return c;
     };
     using enum TexelPoint;
@@ -349,7 +354,9 @@ std::vector<LightingChoice> lightingChoices(const std::string& space) {
     designs.push_back(longSplit(8, 4, 8, centre, 32, 256));
     designs.push_back(longSplit(8, 4, 4, antithetic, 32, 256));
     designs.push_back(longSplit(16, 8, 8, centre, 32, 256));
-    if (space == "full")  // the options across the answer's neighbourhood, and 16 far rays for a new particle's texels
+    designs.push_back(longSplit(8, 4, 8, centre, 32, 256, 0, true));
+    designs.push_back(longSplit(16, 8, 8, centre, 32, 256, 0, true));
+    if (space == "full")  // the options across the answer's neighbourhood, 16 far rays for a new particle's texels, the hand-off
         for (std::uint32_t near : {8u, 16u})
             for (std::uint32_t far : {4u, 8u})
                 for (std::uint32_t c : {4u, 8u})
@@ -357,7 +364,8 @@ std::vector<LightingChoice> lightingChoices(const std::string& space) {
                         for (const auto& [prior, share] : std::vector<std::pair<std::uint32_t, std::uint32_t>>{
                                  {0, 0}, {32, 0}, {32, 64}, {32, 256}, {32, 1024}})
                             for (const std::uint32_t farNew : {0u, 16u})
-                                designs.push_back(longSplit(near, far, c, point, prior, share, farNew));
+                                for (const bool handoff : {false, true})
+                                    designs.push_back(longSplit(near, far, c, point, prior, share, farNew, handoff));
     out.insert(out.end(), designs.begin(), designs.end());
     // A grid point the quick space also lists is measured once: the first kept.
     std::set<std::string> labels;
