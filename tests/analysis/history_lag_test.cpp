@@ -65,7 +65,7 @@ TEST_CASE("HistoryLag: with history_start mean the first 1 / (1 - h) frames are 
     }
 }
 
-TEST_CASE("HistoryLag: a particle out of view loses its history; pixels weigh their particles", "[analysis][lag]") {
+TEST_CASE("HistoryLag: a particle out of view loses its history, and pixels weigh their particles", "[analysis][lag]") {
     // Particle 1 (1 pixel) is lit 1 + t and in view every frame; particle 2 (3
     // pixels) is lit 10 (constant) in frames 0-1, out of view in frame 2 and
     // back in frame 3 lit 4: fresh there, its history its light now.

@@ -612,7 +612,7 @@ void writeLagFrame(const std::filesystem::path& file, float lit, bool withIds = 
 
 }  // namespace
 
-TEST_CASE("lag: a history's lag on exact frames, in closed form; none where nothing moves", "[cli][experiments][lag]") {
+TEST_CASE("lag: a history's lag on exact frames, in closed form, and none where nothing moves", "[cli][experiments][lag]") {
     const auto dir = accretion::test::scratchDir("lag");
     std::string out;
     SECTION("frames in closed form: particle 5 lit 1, 2, 4; h = 0.5 from its first frame: 1, 1.5, 2.75") {
