@@ -12,7 +12,7 @@
 #include "accretion/core/atomic_file.h"
 #include "accretion/core/error.h"
 #include "accretion/core/output_guard.h"
-#include "accretion/core/parse.h"
+#include "accretion/io/exr_file.h"
 #include "accretion/io/report_table.h"
 #include "commands.h"
 
@@ -57,17 +57,33 @@ void runLag(const LagArgs& a) {
             throw InputError(fmt::format("command line --csv {}: must end in .csv", a.csv));
         guard.check(a.csv, "--csv");
     }
+    // The frames' size, and --windows-of's crops in it, before any pixel is read.
+    const ExrHeader head = readExrHeader(files.front());
+    const std::uint32_t width = head.fullWidth, height = head.fullHeight;
+    std::vector<bool> measured;  // --windows-of: the crops' pixels alone (a crop's EXR holds its data window in the whole frame)
+    if (!a.windowsOf.empty()) {
+        measured.assign(std::size_t(width) * height, false);
+        for (const std::string& file : a.windowsOf) {
+            const ExrHeader crop = readExrHeader(file);
+            if (crop.fullWidth != width || crop.fullHeight != height || crop.x0 < 0 || crop.y0 < 0 ||
+                crop.x0 + int(crop.width) > int(width) || crop.y0 + int(crop.height) > int(height))
+                throw InputError(fmt::format("{}: its window ({}x{} at ({}, {}) of {}x{}) is not one of the {}x{} frames' ({})", file,
+                                             crop.width, crop.height, crop.x0, crop.y0, crop.fullWidth, crop.fullHeight, width,
+                                             height, files.front()));
+            for (std::uint32_t y = 0; y < crop.height; ++y)
+                for (std::uint32_t x = 0; x < crop.width; ++x)
+                    measured[std::size_t(crop.y0 + int(y)) * width + std::size_t(crop.x0 + int(x))] = true;
+        }
+    }
     HistoryLag lag(rules);
-    std::uint32_t width = 0, height = 0;
     for (std::size_t k = 0; k < files.size(); ++k) {
         const RgbLayer light = readExrLayer(files[k], a.layer);
         if (!light.whole())
-            throw InputError(fmt::format("{}: a window of {}x{} pixels; lag reads whole frames", files[k], light.width, light.height));
-        if (k > 0 && (light.width != width || light.height != height))
+            throw InputError(fmt::format("{}: a window of {}x{} pixels at ({}, {}); lag reads whole frames", files[k], light.dataWidth,
+                                         light.dataHeight, light.x0, light.y0));
+        if (light.width != width || light.height != height)
             throw InputError(fmt::format("{}: {}x{} pixels, but {} is {}x{}", files[k], light.width, light.height, files[0], width,
                                          height));
-        width = light.width;
-        height = light.height;
         const std::vector<std::uint32_t> particle = readExrUintChannel(files[k], "particle.id");
         if (particle.size() != light.rgb.size())
             throw InputError(fmt::format("{}: no particle.id channel (a frame of `accretion render` has one)", files[k]));
@@ -88,21 +104,6 @@ void runLag(const LagArgs& a) {
         if (!a.quiet) fmt::print(stderr, "\raccretion: lag: frame {} ({} of {})", first + k, k + 1, files.size());
     }
     if (!a.quiet) fmt::print(stderr, "\n");
-    // --windows-of: the crops' pixels alone (a crop's EXR holds its data window in the whole frame).
-    std::vector<bool> measured;
-    if (!a.windowsOf.empty()) {
-        measured.assign(std::size_t(width) * height, false);
-        for (const std::string& file : a.windowsOf) {
-            const RgbLayer crop = readExrLayer(file, "");
-            if (crop.width != width || crop.height != height || crop.x0 < 0 || crop.y0 < 0 ||
-                crop.x0 + int(crop.dataWidth) > int(width) || crop.y0 + int(crop.dataHeight) > int(height))
-                throw InputError(fmt::format("{}: its window ({}x{} at ({}, {}) of {}x{}) is not one of the {}x{} frames'", file,
-                                             crop.dataWidth, crop.dataHeight, crop.x0, crop.y0, crop.width, crop.height, width, height));
-            for (std::uint32_t y = 0; y < crop.dataHeight; ++y)
-                for (std::uint32_t x = 0; x < crop.dataWidth; ++x)
-                    measured[std::size_t(crop.y0 + int(y)) * width + std::size_t(crop.x0 + int(x))] = true;
-        }
-    }
     Table t({{"history", "h", 6, "{:.3f}", "{:.9g}"}, {"start", "start", -6}, {"frames", "frames", 7},
              {"particles", "particles", 10}, {"fresh", "fresh", 8}, {"energy_pct", "energy %", 10, "{:+.3f}", "{:.9g}"},
              {"rel_mse", "relMSE", 12, "{:.4g}", "{:.9g}"}});

@@ -610,6 +610,20 @@ void writeLagFrame(const std::filesystem::path& file, float lit, bool withIds = 
     REQUIRE(out->close());
 }
 
+/// A crop as bias's references are: one black pixel at (x, 0) of a frame `fullWidth` x 1.
+void writeLagCrop(const std::filesystem::path& file, int x, int fullWidth) {
+    OIIO::ImageSpec spec(1, 1, 3, OIIO::TypeDesc::FLOAT);
+    spec.x = x;
+    spec.full_width = fullWidth;
+    spec.full_height = 1;
+    const float rgb[3] = {0.0f, 0.0f, 0.0f};
+    auto out = OIIO::ImageOutput::create(file.string());
+    REQUIRE(out);
+    REQUIRE(out->open(file.string(), spec));
+    REQUIRE(out->write_image(OIIO::TypeDesc::FLOAT, rgb));
+    REQUIRE(out->close());
+}
+
 }  // namespace
 
 TEST_CASE("lag: a history's lag on exact frames, in closed form, and none where nothing moves", "[cli][experiments][lag]") {
@@ -641,18 +655,7 @@ TEST_CASE("lag: a history's lag on exact frames, in closed form, and none where 
                                "--subtract " + (dir / "s.{frame}.exr").string(), out) == 0);
         const auto less = nlohmann::json::parse(out.substr(out.find('[')))[0];
         // --windows-of a crop holding pixel 1 alone (its data window in the 4x1 frame): 2.75 against 4.
-        {
-            OIIO::ImageSpec spec(1, 1, 3, OIIO::TypeDesc::FLOAT);
-            spec.x = 1;
-            spec.full_width = 4;
-            spec.full_height = 1;
-            const float rgb[3] = {0.0f, 0.0f, 0.0f};
-            auto crop = OIIO::ImageOutput::create((dir / "crop.exr").string());
-            REQUIRE(crop);
-            REQUIRE(crop->open((dir / "crop.exr").string(), spec));
-            REQUIRE(crop->write_image(OIIO::TypeDesc::FLOAT, rgb));
-            REQUIRE(crop->close());
-        }
+        writeLagCrop(dir / "crop.exr", 1, 4);
         std::string cropped;
         REQUIRE(runCommand(kBin + " lag " + (dir / "f.{frame}.exr").string() + " --frames 0:3 --history 0.5 --start first --json -q "
                                "--windows-of " + (dir / "crop.exr").string(), cropped) == 0);
@@ -670,6 +673,10 @@ TEST_CASE("lag: a history's lag on exact frames, in closed form, and none where 
         CHECK(runCommand(kBin + " lag " + (dir / "g.{frame}.exr").string() + " --frames 0:1 -q --csv " + (dir / "g.0000.exr").string(),
                          out) == 1);
         CHECK(runCommand(kBin + " lag " + (dir / "g.{frame}.exr").string() + " --frames 0:1 --history 1 -q", out) == 1);
+        writeLagCrop(dir / "wide.exr", 6, 8);  // a crop of an 8x1 frame
+        CHECK(runCommand(kBin + " lag " + (dir / "g.{frame}.exr").string() + " --frames 0:1 -q --windows-of " + (dir / "wide.exr").string(),
+                         out) == 1);
+        CHECK_THAT(out, Contains("wide.exr: its window (1x1 at (6, 0) of 8x1) is not one of the 4x1 frames'"));
     }
     SECTION("render's exact frames: a disk held still has none, a moving one some") {
         for (const std::string gm : {"0", "40"}) {
