@@ -41,27 +41,29 @@ ErrorAnatomy splitRelMse(const std::vector<DVec3>& sum, const std::vector<DVec3>
     return splitRelMseByGroup(sum, sumSq, seeds, ref, refStderr, eps, std::vector<std::uint32_t>(ref.size(), 0u), 1)[0];
 }
 
+std::unordered_map<std::uint32_t, ParticlePixels> particlePixels(const std::vector<Vec3>& light, const std::vector<std::uint32_t>& ids) {
+    ACC_CHECK(ids.size() == light.size());
+    std::unordered_map<std::uint32_t, ParticlePixels> out;
+    for (std::size_t p = 0; p < light.size(); ++p)
+        if (ids[p] != kNoParticle) {
+            ParticlePixels& m = out[ids[p]];
+            m.sum += DVec3(light[p]);
+            ++m.pixels;
+        }
+    return out;
+}
+
 ParticleMeanFloor particleMeanFloor(const std::vector<Vec3>& ref, const std::vector<std::uint32_t>& ids,
                                     const std::vector<Vec3>& refStderr, double eps) {
     ACC_CHECK(ids.size() == ref.size() && (refStderr.empty() || refStderr.size() == ref.size()));
-    struct Mean {
-        DVec3 sum{0.0};
-        std::size_t pixels = 0;
-    };
-    std::unordered_map<std::uint32_t, Mean> means;
-    for (std::size_t p = 0; p < ref.size(); ++p)
-        if (ids[p] != kNoParticle) {
-            Mean& m = means[ids[p]];
-            m.sum += DVec3(ref[p]);
-            ++m.pixels;
-        }
+    const std::unordered_map<std::uint32_t, ParticlePixels> means = particlePixels(ref, ids);
     ParticleMeanFloor f;
     f.particles = means.size();
     if (ref.empty()) return f;
     double rel = 0.0;
     for (std::size_t p = 0; p < ref.size(); ++p) {
         if (ids[p] == kNoParticle) continue;
-        const Mean& m = means.at(ids[p]);
+        const ParticlePixels& m = means.at(ids[p]);
         const double k = double(m.pixels);
         for (int c = 0; c < 3; ++c) {
             const double r = ref[p][c], d = m.sum[c] / k - r;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <unordered_set>
 
+#include "accretion/analysis/error_anatomy.h"
 #include "accretion/analysis/image_metrics.h"
 #include "accretion/core/error.h"
 #include "accretion/core/gbuffer_texel_layout.h"
@@ -13,28 +14,16 @@ namespace {
 
 double rgbMean(const DVec3& v) { return (v.x + v.y + v.z) / 3.0; }
 
-}  // namespace
-
-HistoryLag::HistoryLag(std::vector<LagRule> rules) : rules_(std::move(rules)), kept_(rules_.size()) {}
-
-namespace {
-
 /// Each visible particle's mean of `light` over its pixels.
 std::unordered_map<std::uint32_t, DVec3> particleMeans(const std::vector<Vec3>& light, const std::vector<std::uint32_t>& particle) {
-    std::unordered_map<std::uint32_t, std::pair<DVec3, std::uint32_t>> sums;
-    for (std::size_t p = 0; p < light.size(); ++p) {
-        if (particle[p] == kNoParticle) continue;
-        auto& s = sums[particle[p]];
-        s.first += DVec3(light[p]);
-        ++s.second;
-    }
     std::unordered_map<std::uint32_t, DVec3> mean;
-    mean.reserve(sums.size());
-    for (const auto& [id, s] : sums) mean[id] = s.first / double(s.second);
+    for (const auto& [id, m] : particlePixels(light, particle)) mean[id] = m.mean();
     return mean;
 }
 
 }  // namespace
+
+HistoryLag::HistoryLag(std::vector<LagRule> rules) : rules_(std::move(rules)), kept_(rules_.size()) {}
 
 void HistoryLag::addFrame(std::uint32_t frame, const std::vector<Vec3>& light, const std::vector<std::uint32_t>& particle,
                           const std::vector<Vec3>& whole) {

@@ -1,6 +1,7 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <unordered_map>
 #include <vector>
 
 #include "accretion/core/math.h"
@@ -36,6 +37,16 @@ ErrorAnatomy splitRelMse(const std::vector<DVec3>& sum, const std::vector<DVec3>
 std::vector<ErrorAnatomy> splitRelMseByGroup(const std::vector<DVec3>& sum, const std::vector<DVec3>& sumSq, double seeds,
                                              const std::vector<Vec3>& ref, const std::vector<Vec3>& refStderr, double eps,
                                              const std::vector<std::uint32_t>& group, std::uint32_t groups);
+
+/// A visible particle's light summed over the pixels that see it, and how many.
+struct ParticlePixels {
+    DVec3 sum{0.0};
+    std::size_t pixels = 0;
+    DVec3 mean() const { return sum / double(pixels); }
+};
+/// Each particle's ParticlePixels in an image (ids: its particle.id;
+/// kNoParticle pixels left out).
+std::unordered_map<std::uint32_t, ParticlePixels> particlePixels(const std::vector<Vec3>& light, const std::vector<std::uint32_t>& ids);
 
 /// The floor of shading one value per visible particle: the relMSE of the
 /// image whose every pixel holds its particle's mean reference light over
